@@ -1,0 +1,48 @@
+"""Exceptions that mean "the user asked for something invalid".
+
+Command-line entry points catch :class:`InputError`, print its one-line
+message and exit with status 2 (no traceback). Library code raises it for
+every user mistake: a value outside its allowed range, an unknown name, a
+malformed parameter file. Numerical trouble is *not* an InputError.
+"""
+
+
+class InputError(ValueError):
+    """A user-supplied value, name or file is invalid.
+
+    The message is one line and names the value, the allowed range or
+    choices, and the unit.
+    """
+
+
+def check_range(name, value, low, high, unit, *, low_open=False, high_open=False):
+    """Return ``float(value)`` or raise :class:`InputError` naming the range.
+
+    Parameters
+    ----------
+    name : str
+        What the value is, as the user knows it (e.g. ``"pressure"``).
+    value : float
+        The value to check; must be finite.
+    low, high : float or None
+        Allowed bounds (``None`` for unbounded).
+    unit : str
+        Unit shown in the message (e.g. ``"kPa"``).
+    low_open, high_open : bool
+        Exclude the bound itself.
+    """
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be a number in {unit}, got {value!r}") from None
+    lo_txt = "-inf" if low is None else f"{low:g}"
+    hi_txt = "inf" if high is None else f"{high:g}"
+    bracket = ("(" if low_open else "[") + f"{lo_txt}, {hi_txt}" + (")" if high_open else "]")
+    bad = x != x or x in (float("inf"), float("-inf"))
+    if low is not None:
+        bad = bad or (x <= low if low_open else x < low)
+    if high is not None:
+        bad = bad or (x >= high if high_open else x > high)
+    if bad:
+        raise InputError(f"{name} = {value!r} {unit} is outside the allowed range {bracket} {unit}")
+    return x
