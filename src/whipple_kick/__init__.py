@@ -10,7 +10,7 @@ import importlib
 __version__ = "0.1.0"
 
 _SUBMODULES = (
-    "analysis", "benchmark", "bicycles", "cache", "classic", "cli", "codegen",
+    "analysis", "benchmark", "bicycles", "cache", "classic", "cli", "codegen", "errors",
     "control", "derivation", "inputs", "magic_formula", "parameters",
     "plotting", "riders", "simulation", "slip", "sweep", "symbols", "tyres",
 )
