@@ -201,6 +201,16 @@ def test_too_few_peaks_for_later_pairs():
     assert m["log_decrement_2_4"] is None and "peak #4 not found" in m["unavailable"]["log_decrement_2_4"]
 
 
+def test_quiet_tail_shorter_than_a_period_is_not_trusted():
+    # Last peak at 0.35 s, peak spacing 0.1 s: a tail of 0.35 s counts as
+    # decayed, one of 0.15 s (< one period, 0.2 s) might hide another peak.
+    t, x, centres = lobes([1.0, -0.5, 0.2])
+    assert an.yaw_rate_peaks(t, x).stop_reason == "decayed"
+    short = t <= centres[-1] + 0.15
+    p = an.yaw_rate_peaks(t[short], x[short])
+    assert len(p) == 3 and p.stop_reason == "end_of_record"
+
+
 def test_record_ending_mid_oscillation_has_no_recovery_time():
     t = np.arange(0.0, 1.0, 1e-3)
     p = an.yaw_rate_peaks(t, np.sin(2 * math.pi * 5.3 * t))
@@ -324,6 +334,23 @@ def test_bad_arguments(kwargs, message):
     t = np.arange(0.0, 1.0, 1e-3)
     with pytest.raises(InputError, match=message):
         an.yaw_rate_peaks(t, damped(t), **kwargs)
+
+
+def test_lowpass_needs_uniform_sampling_and_resample_provides_it():
+    rng = np.random.default_rng(4)
+    t = np.cumsum(rng.uniform(0.5e-3, 1.5e-3, 2000))
+    with pytest.raises(InputError, match="uniform"):
+        an.lowpass(t, damped(t))
+    tu, xu = an.resample_uniform(t, damped(t))
+    assert np.ptp(np.diff(tu)) < 1e-9 and tu[0] == t[0] and tu[-1] <= t[-1]
+    # 5.5 Hz passes a 20 Hz 4th-order Butterworth applied twice with gain
+    # |H|^2 = 1 / (1 + (5.5/20)^8) = 1 - 3.3e-5 (the damped sine's spectrum is
+    # broader, hence 1e-3), away from the ends where filtfilt's padding
+    # transients live.
+    inner = (tu > tu[0] + 0.3) & (tu < tu[-1] - 0.3)
+    assert np.max(np.abs(an.lowpass(tu, xu) - xu)[inner]) < 1e-3
+    with pytest.raises(InputError, match="cutoff_hz"):
+        an.lowpass(tu, xu, cutoff_hz=600.0)
 
 
 def test_bad_series():

@@ -450,6 +450,8 @@ def lowpass(t, signal, cutoff_hz=20.0, order=4):
                          "resample with resample_uniform() first")
     fs = (t.size - 1) / (t[-1] - t[0])
     cutoff_hz = check_range("cutoff_hz", cutoff_hz, 0.0, fs / 2, "Hz", low_open=True, high_open=True)
+    if isinstance(order, bool) or int(order) != order or not 1 <= order <= 10:
+        raise InputError(f"filter order = {order!r} must be an integer in [1, 10]")
     sos = butter(int(order), cutoff_hz, fs=fs, output="sos")
     try:
         return sosfiltfilt(sos, x)
