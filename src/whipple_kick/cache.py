@@ -1,0 +1,95 @@
+"""Per-user cache of generated code, keyed by a hash of what it was generated from.
+
+Generated code is a build artefact. It lives in ``$WHIPPLE_KICK_CACHE`` or
+``$XDG_CACHE_HOME/whipple_kick`` (default ``~/.cache/whipple_kick``), in a
+folder created with private permissions (0700) and refused if another user
+can write to it. Several processes may build the same entry at once: a file
+lock serialises the builders and each entry is written to a temporary name
+and renamed into place, so a reader never sees a half-written file.
+"""
+import contextlib
+import fcntl
+import hashlib
+import os
+import pathlib
+import platform
+import stat
+import sys
+
+import sympy
+
+_PACKAGE_DIR = pathlib.Path(__file__).resolve().parent
+
+
+def cache_dir():
+    """Return the private cache folder, creating it if needed.
+
+    Raises
+    ------
+    PermissionError
+        If the folder is not owned by this user or is writable by others.
+    """
+    root = os.environ.get("WHIPPLE_KICK_CACHE")
+    if root:
+        path = pathlib.Path(root)
+    else:
+        base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+        path = pathlib.Path(base) / "whipple_kick"
+    path.mkdir(mode=0o700, parents=True, exist_ok=True)
+    info = path.stat()
+    if info.st_uid != os.getuid() or info.st_mode & (stat.S_IWGRP | stat.S_IWOTH):
+        raise PermissionError(
+            f"cache folder {path} is not private to this user (owner uid {info.st_uid}, "
+            f"mode {oct(info.st_mode & 0o777)}); remove it or set WHIPPLE_KICK_CACHE"
+        )
+    return path
+
+
+def source_hash(module_names, extra=""):
+    """Hash of the package's source files that a build depends on.
+
+    Parameters
+    ----------
+    module_names : iterable of str
+        Module file stems in the package (e.g. ``"derivation"``).
+    extra : str
+        Anything else the build depends on (options, compiler flags).
+    """
+    digest = hashlib.sha256()
+    for name in sorted(module_names):
+        digest.update(name.encode())
+        digest.update((_PACKAGE_DIR / f"{name}.py").read_bytes())
+    digest.update(f"sympy {sympy.__version__}; python {sys.version_info[:2]}; "
+                  f"{platform.machine()}; {extra}".encode())
+    return digest.hexdigest()[:20]
+
+
+@contextlib.contextmanager
+def locked(path):
+    """Hold an exclusive lock on ``path.lock`` while building ``path``."""
+    lock_path = pathlib.Path(str(path) + ".lock")
+    fd = os.open(lock_path, os.O_CREAT | os.O_RDWR, 0o600)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        fcntl.flock(fd, fcntl.LOCK_UN)
+        os.close(fd)
+
+
+def write_atomic(path, data):
+    """Write bytes or text to ``path`` via a temporary file and an atomic rename."""
+    path = pathlib.Path(path)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    mode = "wb" if isinstance(data, bytes) else "w"
+    with open(tmp, mode) as fh:
+        fh.write(data)
+    os.chmod(tmp, 0o600)
+    os.replace(tmp, path)
+
+
+def check_private_file(path):
+    """Refuse to load a cached file another user could have written."""
+    info = pathlib.Path(path).stat()
+    if info.st_uid != os.getuid() or info.st_mode & (stat.S_IWGRP | stat.S_IWOTH):
+        raise PermissionError(f"cached file {path} is writable by others; refusing to load it")

@@ -1,0 +1,148 @@
+"""Registry of every symbol in the model: name, one-line description, unit.
+
+Everything symbolic in whipple_kick (constants, generalised coordinates and
+speeds, inputs, tyre states) is declared here exactly once, and created
+through :func:`sym` / :func:`dyn`, which refuse names that are not
+registered. Numeric values are always passed and looked up by these names.
+
+Frames and points follow Moore (2012): N ground (x, y horizontal, z down),
+A yaw frame, B roll frame, C rear frame (pitched so C.z is the steer axis),
+D rear wheel, E front frame, F front wheel.
+"""
+from dataclasses import dataclass
+
+import sympy as sm
+import sympy.physics.mechanics as me
+
+
+@dataclass(frozen=True)
+class SymbolInfo:
+    """Description of one model symbol."""
+
+    name: str
+    description: str
+    unit: str
+    kind: str  # constant | coordinate | speed | input | state
+
+
+def _entries():
+    c, q, u, i, s = "constant", "coordinate", "speed", "input", "state"
+    rows = [
+        # --- Moore (2012) bicycle geometry and mass distribution -----------
+        ("d1", "perpendicular distance from the rear wheel centre to the steer axis", "m", c),
+        ("d2", "distance along the steer axis between the feet of the perpendiculars from the wheel centres", "m", c),
+        ("d3", "perpendicular distance from the steer axis to the front wheel centre (fork offset)", "m", c),
+        ("l1", "rear-frame mass centre from the rear wheel centre along C.x", "m", c),
+        ("l2", "rear-frame mass centre from the rear wheel centre along C.z", "m", c),
+        ("l3", "front-frame mass centre from the front wheel centre along E.x", "m", c),
+        ("l4", "front-frame mass centre from the front wheel centre along E.z", "m", c),
+        ("rr", "rear wheel radius (to the tyre's outer crown)", "m", c),
+        ("rf", "front wheel radius (to the tyre's outer crown)", "m", c),
+        ("mc", "mass of the rear frame C (with the rigid rider)", "kg", c),
+        ("md", "mass of the rear wheel D", "kg", c),
+        ("me", "mass of the front frame E (fork and handlebar)", "kg", c),
+        ("mf", "mass of the front wheel F", "kg", c),
+        ("ic11", "rear-frame moment of inertia about its mass centre, C.x axis", "kg m^2", c),
+        ("ic22", "rear-frame moment of inertia about its mass centre, C.y axis", "kg m^2", c),
+        ("ic33", "rear-frame moment of inertia about its mass centre, C.z axis", "kg m^2", c),
+        ("ic31", "rear-frame product of inertia about its mass centre, C.z-C.x entry", "kg m^2", c),
+        ("id11", "rear-wheel moment of inertia about a diameter", "kg m^2", c),
+        ("id22", "rear-wheel moment of inertia about its spin axis", "kg m^2", c),
+        ("ie11", "front-frame moment of inertia about its mass centre, E.x axis", "kg m^2", c),
+        ("ie22", "front-frame moment of inertia about its mass centre, E.y axis", "kg m^2", c),
+        ("ie33", "front-frame moment of inertia about its mass centre, E.z axis", "kg m^2", c),
+        ("ie31", "front-frame product of inertia about its mass centre, E.z-E.x entry", "kg m^2", c),
+        ("if11", "front-wheel moment of inertia about a diameter", "kg m^2", c),
+        ("if22", "front-wheel moment of inertia about its spin axis", "kg m^2", c),
+        ("g", "acceleration due to gravity", "m/s^2", c),
+        # --- tyre geometry and vertical compliance (slip model) ------------
+        ("rtr", "rear tyre crown (cross-section) radius of the toroidal tyre", "m", c),
+        ("rtf", "front tyre crown (cross-section) radius of the toroidal tyre", "m", c),
+        ("kzr", "rear tyre vertical stiffness", "N/m", c),
+        ("kzf", "front tyre vertical stiffness", "N/m", c),
+        ("czr", "rear tyre vertical damping", "N s/m", c),
+        ("czf", "front tyre vertical damping", "N s/m", c),
+        ("sigr", "rear tyre relaxation length", "m", c),
+        ("sigf", "front tyre relaxation length", "m", c),
+        # --- generalised coordinates (Moore 2012) --------------------------
+        ("q1", "rear contact point position along N.x", "m", q),
+        ("q2", "rear contact point position along N.y", "m", q),
+        ("q3", "yaw angle of the rear frame (about N.z)", "rad", q),
+        ("q4", "roll angle of the rear frame (about A.x), positive = lean right", "rad", q),
+        ("q5", "pitch angle of the rear frame (about B.y)", "rad", q),
+        ("q6", "rear wheel rotation angle relative to the rear frame (about C.y)", "rad", q),
+        ("q7", "steer angle of the front frame relative to the rear frame (about C.z)", "rad", q),
+        ("q8", "front wheel rotation angle relative to the front frame (about E.y)", "rad", q),
+        ("q9", "rear tyre vertical compression", "m", q),
+        ("q10", "front tyre vertical compression", "m", q),
+        # --- generalised speeds: u_i = d q_i / dt --------------------------
+        ("u1", "rate of q1: rear contact velocity along N.x", "m/s", u),
+        ("u2", "rate of q2: rear contact velocity along N.y", "m/s", u),
+        ("u3", "rate of q3: yaw rate", "rad/s", u),
+        ("u4", "rate of q4: roll rate", "rad/s", u),
+        ("u5", "rate of q5: pitch rate", "rad/s", u),
+        ("u6", "rate of q6: rear wheel spin rate relative to the rear frame", "rad/s", u),
+        ("u7", "rate of q7: steer rate", "rad/s", u),
+        ("u8", "rate of q8: front wheel spin rate relative to the front frame", "rad/s", u),
+        ("u9", "rate of q9: rear tyre compression rate", "m/s", u),
+        ("u10", "rate of q10: front tyre compression rate", "m/s", u),
+        # --- inputs --------------------------------------------------------
+        ("T4", "roll torque on the rear frame about A.x (from the ground)", "N m", i),
+        ("T6", "rear wheel drive torque, between rear frame and rear wheel (about C.y)", "N m", i),
+        ("T7", "steer torque, on the front frame about C.z, reaction on the rear frame", "N m", i),
+        ("yp", "kick-plate lateral displacement along N.y", "m", i),
+        ("vp", "kick-plate lateral velocity along N.y", "m/s", i),
+        ("ap", "kick-plate lateral acceleration along N.y", "m/s^2", i),
+        # --- tyre force states (slip model, relaxed) ------------------------
+        ("fyr", "rear tyre lateral force on the wheel, along the rear lateral axis A.y", "N", s),
+        ("fyf", "front tyre lateral force on the wheel, along the front lateral axis", "N", s),
+        ("mzr", "rear tyre self-aligning moment on the wheel about the downward normal", "N m", s),
+        ("mzf", "front tyre self-aligning moment on the wheel about the downward normal", "N m", s),
+    ]
+    return {name: SymbolInfo(name, desc, unit, kind) for name, desc, unit, kind in rows}
+
+
+#: Every registered symbol by name.
+REGISTRY = _entries()
+
+#: Moore's parameters of the classic Carvallo-Whipple model, by name.
+CLASSIC_CONSTANTS = (
+    "d1", "d2", "d3", "l1", "l2", "l3", "l4", "rf", "rr",
+    "mc", "md", "me", "mf",
+    "ic11", "ic22", "ic33", "ic31", "id11", "id22",
+    "ie11", "ie22", "ie33", "ie31", "if11", "if22", "g",
+)
+
+
+def info(name):
+    """Return the :class:`SymbolInfo` registered under ``name``."""
+    try:
+        return REGISTRY[name]
+    except KeyError:
+        raise KeyError(f"symbol {name!r} is not registered in whipple_kick.symbols") from None
+
+
+def sym(name):
+    """Return the (real) SymPy symbol for a registered constant or input."""
+    entry = info(name)
+    if entry.kind in ("coordinate", "speed", "state"):
+        raise KeyError(f"{name!r} is a {entry.kind}; use dyn()")
+    return sm.Symbol(name, real=True)
+
+
+def dyn(name):
+    """Return the dynamicsymbol (function of time) for a registered coordinate, speed or state."""
+    entry = info(name)
+    if entry.kind not in ("coordinate", "speed", "state"):
+        raise KeyError(f"{name!r} is a {entry.kind}; use sym()")
+    return me.dynamicsymbols(name, real=True)
+
+
+def syms(names):
+    """Tuple of :func:`sym` for several names."""
+    return tuple(sym(n) for n in names)
+
+
+def dyns(names):
+    """Tuple of :func:`dyn` for several names."""
+    return tuple(dyn(n) for n in names)
