@@ -1,0 +1,299 @@
+"""Bicycle parameter sets: loading the shipped files and the :class:`Bicycle` mapping.
+
+A bicycle file (``parameters/bicycles/<name>.toml``) holds one parameter set
+in either of two parameterisations of the Carvallo-Whipple bicycle, stated in
+the file's ``parameterisation`` entry:
+
+* ``"benchmark"``: Meijaard et al. (2007) names (``w, c, lam, ..., IFyy``);
+* ``"moore"``: Moore (2012) names (``d1, d2, d3, l1..l4, ..., g``).
+
+Every parameter is an inline table ``{value, unit, source[, uncertainty]}``
+whose ``source`` names an entry of the file's ``[sources]`` table. Optional
+tables: ``[seating]`` (the geometry needed to seat a rider, see
+:mod:`whipple_kick.riders`) and ``[tyre_placeholders]`` (the linear-tyre
+entries of the authors' sets, kept as metadata only).
+
+Whatever the file's form, :func:`load` returns a :class:`Bicycle`: a mapping
+of Moore's parameters (what the equations of motion use) that also carries
+the benchmark form and the file's metadata.
+"""
+from collections.abc import Mapping
+import math
+import types
+
+from . import benchmark as _benchmark
+from .errors import InputError
+from .parameters import PARAMETER_DIR, load_toml, require_finite
+
+#: Folder of the shipped bicycle files.
+BICYCLE_DIR = PARAMETER_DIR / "bicycles"
+
+FORMAT = "whipple_kick bicycle, version 1"
+
+_LENGTH, _ANGLE, _MASS, _INERTIA, _ACCEL = "m", "rad", "kg", "kg m^2", "m/s^2"
+
+#: Unit required for each parameter, per parameterisation.
+BENCHMARK_UNITS = {
+    name: (_ACCEL if name == "g" else _ANGLE if name == "lam"
+           else _MASS if name.startswith("m") else _INERTIA if name.startswith("I")
+           else _LENGTH)
+    for name in _benchmark.BENCHMARK_NAMES
+}
+MOORE_UNITS = {
+    name: (_ACCEL if name == "g" else _MASS if name.startswith("m")
+           else _INERTIA if name.startswith("i") else _LENGTH)
+    for name in _benchmark.MOORE_NAMES
+}
+
+#: Seating geometry (names of Moore's BicycleParameters measurements) and units.
+SEATING_UNITS = {
+    "lcs": _LENGTH,    # chain stay: rear wheel centre to bottom bracket
+    "hbb": _LENGTH,    # bottom-bracket height above the ground
+    "lst": _LENGTH,    # seat-tube length
+    "lsp": _LENGTH,    # seat-post length
+    "lamst": _ANGLE,   # seat-tube angle above the horizontal
+    "whb": _LENGTH,    # handlebar width between the grips
+    "LhbR": _LENGTH,   # rear wheel centre to a grip
+    "LhbF": _LENGTH,   # front wheel centre to a grip
+}
+
+_TOP_KEYS = {"format", "name", "parameterisation", "includes_rider", "description",
+             "sources", "parameters", "seating", "tyre_placeholders"}
+
+
+class Bicycle(Mapping):
+    """One bicycle parameter set: a read-only mapping of Moore's parameters.
+
+    ``bike["d1"]`` etc. are Moore (2012) parameters in SI units. Metadata:
+
+    Attributes
+    ----------
+    name : str
+        Name of the set (the file name without ``.toml`` for shipped files).
+    benchmark : Mapping
+        The same set in Meijaard et al. (2007) benchmark form.
+    moore : Mapping
+        Moore's parameters (the mapping itself, as a separate view).
+    uncertainties : Mapping
+        Measurement uncertainty per parameter name of the file's
+        parameterisation, same units (empty when the source gives none).
+    geometry : Mapping or None
+        Seating geometry (:data:`SEATING_UNITS`) when present, else None.
+    source : str
+        The file's sources, one per line (``key: citation``).
+    includes_rider : bool
+        True when a rider is already lumped into the rear frame.
+    parameterisation : str
+        ``"benchmark"`` or ``"moore"``: the form the values were given in.
+    tyre_placeholders : Mapping
+        The authors' linear-tyre placeholder entries, if the file has them
+        (metadata only; not used by whipple_kick's tyre models).
+    description : str
+        One-line description.
+    rider : Mapping or None
+        For a bicycle built by :func:`whipple_kick.riders.seat`: the rider's
+        name, mass [kg], height [m] and its own benchmark-form inertia.
+    """
+
+    def __init__(self, *, name, benchmark=None, moore=None, parameterisation,
+                 includes_rider, source, description="", uncertainties=None,
+                 geometry=None, tyre_placeholders=None, rider=None):
+        if (benchmark is None) == (moore is None):
+            raise InputError(f"bicycle {name!r}: give exactly one of benchmark or moore parameters")
+        if benchmark is not None:
+            bench = {k: float(benchmark[k]) for k in _benchmark.BENCHMARK_NAMES
+                     if k in benchmark}
+            moore_dict = _benchmark.to_moore(bench)
+        else:
+            moore_dict = {k: float(moore[k]) for k in _benchmark.MOORE_NAMES if k in moore}
+            bench = _benchmark.from_moore(moore_dict)
+        self.name = str(name)
+        self.parameterisation = str(parameterisation)
+        self.includes_rider = bool(includes_rider)
+        self.source = str(source)
+        self.description = str(description)
+        self._moore = moore_dict
+        self.moore = types.MappingProxyType(moore_dict)
+        self.benchmark = types.MappingProxyType(bench)
+        self.uncertainties = types.MappingProxyType(dict(uncertainties or {}))
+        self.geometry = None if geometry is None else types.MappingProxyType(dict(geometry))
+        self.tyre_placeholders = types.MappingProxyType(dict(tyre_placeholders or {}))
+        self.rider = None if rider is None else types.MappingProxyType(dict(rider))
+
+    def __getitem__(self, key):
+        return self._moore[key]
+
+    def __iter__(self):
+        return iter(self._moore)
+
+    def __len__(self):
+        return len(self._moore)
+
+    def __repr__(self):
+        rider = ", with rider" if self.includes_rider else ""
+        return f"<Bicycle {self.name!r} ({self.parameterisation} file{rider})>"
+
+
+def available():
+    """Names of the shipped bicycle parameter sets, sorted.
+
+    Returns
+    -------
+    list of str
+        Names accepted by :func:`load`.
+    """
+    return sorted(p.stem for p in BICYCLE_DIR.glob("*.toml"))
+
+
+def load(name):
+    """Load a bicycle parameter set by name or from a path.
+
+    Parameters
+    ----------
+    name : str or os.PathLike
+        A shipped set (see :func:`available`), or the path of a ``.toml``
+        file in the same format.
+
+    Returns
+    -------
+    Bicycle
+        Moore-parameter mapping with the benchmark form and metadata.
+
+    Raises
+    ------
+    InputError
+        Unknown name, or a malformed file (naming file, key and problem).
+    """
+    text = str(name)
+    if text.endswith(".toml") or "/" in text or "\\" in text:
+        path = text
+    else:
+        names = available()
+        if text not in names:
+            raise InputError(f"unknown bicycle {text!r}; available: {', '.join(names)}")
+        path = BICYCLE_DIR / f"{text}.toml"
+    return _parse(path, load_toml(path))
+
+
+def _entries(path, table_name, table, units, sources, *, complete):
+    """Validate a table of ``{value, unit, source[, uncertainty]}`` entries.
+
+    Returns ``(values, uncertainties)`` dicts. ``units`` maps each allowed key
+    to its required unit (None: any non-empty unit string).
+    """
+    if not isinstance(table, dict):
+        raise InputError(f"{path}: [{table_name}] must be a table")
+    if units is not None:
+        unknown = sorted(set(table) - set(units))
+        if unknown:
+            raise InputError(f"{path}: [{table_name}] has unknown keys {', '.join(unknown)}; "
+                             f"allowed: {', '.join(units)}")
+        if complete:
+            missing = [k for k in units if k not in table]
+            if missing:
+                raise InputError(f"{path}: [{table_name}] is missing {', '.join(missing)}")
+    values, uncertainties = {}, {}
+    for key, entry in table.items():
+        where = f"{table_name}.{key}"
+        if not isinstance(entry, dict) or "value" not in entry:
+            raise InputError(f"{path}: {where} must be a table {{value, unit, source}}")
+        extra = sorted(set(entry) - {"value", "unit", "source", "uncertainty"})
+        if extra:
+            raise InputError(f"{path}: {where} has unknown fields {', '.join(extra)}")
+        unit = entry.get("unit")
+        want = None if units is None else units[key]
+        if not isinstance(unit, str) or not unit or (want is not None and unit != want):
+            raise InputError(f"{path}: {where} unit must be {want or 'a unit string'!r}, got {unit!r}")
+        if entry.get("source") not in sources:
+            raise InputError(f"{path}: {where} source {entry.get('source')!r} is not a key of "
+                             f"[sources] ({', '.join(sources)})")
+        values[key] = require_finite(path, f"{where}.value", entry["value"])
+        if "uncertainty" in entry:
+            unc = require_finite(path, f"{where}.uncertainty", entry["uncertainty"])
+            if unc < 0:
+                raise InputError(f"{path}: {where}.uncertainty must be >= 0 {unit}, got {unc!r}")
+            uncertainties[key] = unc
+    return values, uncertainties
+
+
+def _positive(path, values, names, unit_of):
+    for key in names:
+        if not values[key] > 0:
+            raise InputError(f"{path}: {key} = {values[key]!r} {unit_of[key]} must be > 0")
+
+
+def check_benchmark(path, bench):
+    """Physical sanity of a benchmark-form set; raise InputError naming the key.
+
+    Masses, radii, wheelbase, g and the principal inertias must be positive;
+    the steer-axis tilt must lie in (-pi/2, pi/2) rad; each planar inertia
+    tensor [[Ixx, Ixz], [Ixz, Izz]] must be positive definite.
+    """
+    _positive(path, bench, ("w", "g", "rR", "rF", "mR", "mB", "mH", "mF",
+                            "IRxx", "IRyy", "IFxx", "IFyy", "IBxx", "IByy", "IBzz",
+                            "IHxx", "IHyy", "IHzz"), BENCHMARK_UNITS)
+    if not abs(bench["lam"]) < math.pi / 2:
+        raise InputError(f"{path}: lam = {bench['lam']!r} rad is outside (-pi/2, pi/2) rad")
+    for body in ("B", "H"):
+        ixx, izz, ixz = bench[f"I{body}xx"], bench[f"I{body}zz"], bench[f"I{body}xz"]
+        if not ixx * izz > ixz * ixz:
+            raise InputError(f"{path}: I{body}xz = {ixz!r} kg m^2 makes the {body} inertia tensor "
+                             f"indefinite (need I{body}xz^2 < I{body}xx*I{body}zz = {ixx * izz:g} kg^2 m^4)")
+
+
+def _parse(path, data):
+    """Build a :class:`Bicycle` from a parsed TOML file, validating everything."""
+    unknown = sorted(set(data) - _TOP_KEYS)
+    if unknown:
+        raise InputError(f"{path}: unknown top-level keys {', '.join(unknown)}")
+    for key in ("format", "name", "parameterisation", "includes_rider", "sources", "parameters"):
+        if key not in data:
+            raise InputError(f"{path}: missing top-level key {key!r}")
+    if data["format"] != FORMAT:
+        raise InputError(f"{path}: format must be {FORMAT!r}, got {data['format']!r}")
+    form = data["parameterisation"]
+    if form not in ("benchmark", "moore"):
+        raise InputError(f"{path}: parameterisation must be 'benchmark' or 'moore', got {form!r}")
+    if not isinstance(data["includes_rider"], bool):
+        raise InputError(f"{path}: includes_rider must be true or false, got {data['includes_rider']!r}")
+    sources = data["sources"]
+    if not isinstance(sources, dict) or not sources or not all(
+            isinstance(v, str) and v for v in sources.values()):
+        raise InputError(f"{path}: [sources] must map keys to non-empty citation strings")
+
+    units = BENCHMARK_UNITS if form == "benchmark" else MOORE_UNITS
+    values, unc = _entries(path, "parameters", data["parameters"], units, sources, complete=True)
+    geometry = None
+    if "seating" in data:
+        geometry, geo_unc = _entries(path, "seating", data["seating"], SEATING_UNITS, sources,
+                                     complete=True)
+        _positive(path, geometry, SEATING_UNITS, SEATING_UNITS)
+        unc.update({f"seating.{k}": v for k, v in geo_unc.items()})
+    tyres = None
+    if "tyre_placeholders" in data:
+        tyres, _ = _entries(path, "tyre_placeholders", data["tyre_placeholders"], None, sources,
+                            complete=False)
+
+    if form == "benchmark":
+        bench = values
+    else:
+        _positive(path, values, ("g", "rf", "rr", "mc", "md", "me", "mf", "id11", "id22",
+                                 "if11", "if22", "ic22", "ie22"), MOORE_UNITS)
+        try:
+            bench = _benchmark.from_moore(values)
+        except ValueError:  # acos outside [-1, 1]: no upright pose with both wheels down
+            raise InputError(f"{path}: d1, d2, d3, rr, rf admit no upright configuration with "
+                             f"both wheels on the ground") from None
+    check_benchmark(path, bench)
+    return Bicycle(
+        name=data["name"],
+        benchmark=values if form == "benchmark" else None,
+        moore=values if form == "moore" else None,
+        parameterisation=form,
+        includes_rider=data["includes_rider"],
+        source="\n".join(f"{k}: {v}" for k, v in sources.items()),
+        description=data.get("description", ""),
+        uncertainties=unc,
+        geometry=geometry,
+        tyre_placeholders=tyres,
+    )
