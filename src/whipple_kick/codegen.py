@@ -55,10 +55,12 @@ def numpy_function(name, arguments, outputs, doc=""):
             flat.append(sm.sympify(out))
     replacements, reduced = sm.cse(flat, symbols=sm.numbered_symbols("_x"), order="none")
     lines = [f"def {name}({', '.join(a for a, _ in arguments)}):", f'    """{doc}"""']
+    # A zero of the first argument's dtype (complex under complex-step), so
+    # constant entries of the outputs take the same dtype.
+    lines.append("    _z = numpy.zeros_like(numpy.asarray(" + arguments[0][0] + ")[0])")
     for arg, syms in arguments:
         if syms:
             lines.append(f"    {', '.join(str(s) for s in syms)}, = {arg}")
-    lines.append("    _z = numpy.zeros_like(numpy.asarray(" + arguments[0][0] + ")[0])")
     for lhs, rhs in replacements:
         lines.append(f"    {lhs} = {printer.doprint(rhs)}")
     results, k = [], 0

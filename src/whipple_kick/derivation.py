@@ -288,3 +288,136 @@ def classic_equations():
         holonomic=kin.holonomic,
         kinetic_energy=kinetic_energy(kin), potential_energy=potential_energy(kin),
     )
+
+
+def kick_plate_motion(t):
+    """Prescribed lateral motion of the kick plate: (y, dy/dt, d2y/dt2) as SymPy expressions.
+
+    Profile 0 (thesis Section 8.4): constant acceleration ``2 D / T^2`` from
+    ``kick_t0`` for ``kick_T`` seconds, then held at ``D`` (the plate stops
+    instantly, as in the thesis' Figure 8.5). Profile 1: minimum-jerk quintic
+    ``D (10 s^3 - 15 s^4 + 6 s^5)``, ``s = (t - t0)/T``, with finite jerk.
+    """
+    t0, T, D, profile = S.syms(["kick_t0", "kick_T", "kick_D", "kick_profile"])
+    tau = t - t0
+    s = tau / T
+    acc = 2 * D / T**2
+    const = (acc * tau**2 / 2, acc * tau, acc)
+    smooth = (D * (10 * s**3 - 15 * s**4 + 6 * s**5),
+              D * (30 * s**2 - 60 * s**3 + 30 * s**4) / T,
+              D * (60 * s - 180 * s**2 + 120 * s**3) / T**2)
+    out = []
+    for k, (c_expr, s_expr) in enumerate(zip(const, smooth)):
+        after = D if k == 0 else sm.S(0)
+        moving = sm.Piecewise((c_expr, profile < sm.Rational(1, 2)), (s_expr, True))
+        out.append(sm.Piecewise((sm.S(0), tau < 0), (moving, tau < T), (after, True)))
+    return tuple(out)
+
+
+def slip_equations():
+    """Derive the slip model: toroidal tyres, vertical compliance, Magic-Formula lateral forces.
+
+    Constraints: rolling without longitudinal slip at both wheels (the rear
+    relative to the kick plate) and the front contact on the ground.
+    Dependent speeds u5 (pitch rate), u6, u8 (wheel spin rates);
+    independent u1, u2, u3, u4, u7, u9, u10. Tyre force states fyr, fyf, mzr,
+    mzf follow ``(sigma/|v_x|) dF/dt + F = F_steady``.
+
+    Returns
+    -------
+    EquationsOfMotion
+        With ``extra`` holding the named outputs (slip and camber angles,
+        normal forces, steady tyre forces, steer torque, plate motion,
+        tyre-state rates, spring energy).
+    """
+    from . import magic_formula as mf
+
+    t = me.dynamicsymbols._t
+    kin = kinematics(tyre_model=True)
+    N, A, C, D, E, F = (kin.frames[k] for k in "NACDEF")
+    q, u = kin.q, kin.u
+    Q = {f"q{i + 1}": qi for i, qi in enumerate(q)}
+    U = {f"u{i + 1}": ui for i, ui in enumerate(u)}
+    par = {n: S.sym(n) for n in S.SLIP_CONSTANTS}
+    fyr, fyf, mzr, mzf = S.dyns(["fyr", "fyf", "mzr", "mzf"])
+    yp, vp, ap = kick_plate_motion(sm.Symbol("t", real=True))
+    vp_s, ap_s = S.syms(["vp", "ap"])   # placeholders, replaced by the profile at code generation
+
+    # Normal forces: linear spring-damper on the compression, never pulling.
+    fz_r_raw = par["kzr"] * Q["q9"] + par["czr"] * U["u9"]
+    fz_f_raw = par["kzf"] * Q["q10"] + par["czf"] * U["u10"]
+    fz_r = sm.Max(0, fz_r_raw)
+    fz_f = sm.Max(0, fz_f_raw)
+
+    # Steer torque: full-state feedback, T7 = -K x (LQR convention).
+    T7 = -(par["kq4"] * Q["q4"] + par["kq7"] * Q["q7"] + par["ku4"] * U["u4"]
+           + par["ku7"] * U["u7"] + par["kq3"] * Q["q3"] + par["ku3"] * U["u3"])
+    T6 = par["T6c"]
+
+    dn_mat, fn_mat = kin.points["dn_mat"], kin.points["fn_mat"]
+    loads = list(kin.gravity_loads)
+    loads += [
+        (dn_mat, -fz_r * A.z + fyr * kin.rear_lateral),
+        (fn_mat, -fz_f * A.z + fyf * kin.front_lateral),
+        (D, mzr * A.z + T6 * C.y),
+        (F, mzf * A.z),
+        (C, -T6 * C.y - T7 * C.z),
+        (E, T7 * C.z),
+    ]
+    mass_matrix, forcing = kane_full(kin, loads)
+
+    # Velocities relative to the ground under each wheel (the rear one moves).
+    plate_vel = vp_s * N.y
+    v_r_slide = dn_mat.vel(N) - plate_vel
+    v_f_slide = fn_mat.vel(N)
+    rows = [
+        v_r_slide.dot(kin.rear_heading),
+        fn_mat.vel(N).dot(kin.front_heading_scaled),
+        kin.holonomic_rate,
+    ]
+    A_c, a0, b = constraint_terms(rows, kin, time_terms={vp_s: ap_s})
+
+    # Slip and camber angles (model convention: slip > 0 slides to the right,
+    # camber > 0 leans right) and rolling speeds along each heading.
+    vx_r = (kin.points["do"].vel(N) - plate_vel).dot(kin.rear_heading)
+    vx_f = kin.points["fo"].vel(N).dot(kin.front_heading)
+    slip_r = sm.atan2(v_r_slide.dot(kin.rear_lateral), sm.Abs(vx_r))
+    slip_f = sm.atan2(v_f_slide.dot(kin.front_lateral), sm.Abs(vx_f))
+    camber_r = sm.asin(kin.frames["B"].y.dot(A.z))
+    camber_f = sm.asin(E.y.dot(A.z))
+
+    def steady(builder, slip, camber, fz, wheel, letter):
+        sets = [[par[f"{letter}{wheel}{k}_{i}"] for i in range(14 if letter == "a" else 18)] for k in (1, 2)]
+        w = par[f"w{wheel}"]
+        mu = par[f"mu{wheel}"]
+        lam = par[f"lam{wheel}"]
+        return lam * ((1 - w) * builder(slip, camber, fz, sets[0], friction_scale=mu)
+                      + w * builder(slip, camber, fz, sets[1], friction_scale=mu))
+
+    fy_ss_r = steady(mf.lateral_force_model, slip_r, camber_r, fz_r, "r", "a")
+    fy_ss_f = steady(mf.lateral_force_model, slip_f, camber_f, fz_f, "f", "a")
+    mz_ss_r = steady(mf.aligning_moment_model, slip_r, camber_r, fz_r, "r", "c")
+    mz_ss_f = steady(mf.aligning_moment_model, slip_f, camber_f, fz_f, "f", "c")
+    rate_r = sm.Abs(vx_r) / par["sigr"]
+    rate_f = sm.Abs(vx_f) / par["sigf"]
+
+    # Spring energy counts only while the tyre is compressed.
+    spring = (par["kzr"] * sm.Max(0, Q["q9"])**2 + par["kzf"] * sm.Max(0, Q["q10"])**2) / 2
+    extra = {
+        "yp": yp, "vp": vp, "ap": ap,
+        "slip_r": slip_r, "slip_f": slip_f, "camber_r": camber_r, "camber_f": camber_f,
+        "vx_r": vx_r, "vx_f": vx_f, "fz_r": fz_r, "fz_f": fz_f,
+        "fy_ss_r": fy_ss_r, "fy_ss_f": fy_ss_f, "mz_ss_r": mz_ss_r, "mz_ss_f": mz_ss_f,
+        "dfyr": rate_r * (fy_ss_r - fyr), "dfyf": rate_f * (fy_ss_f - fyf),
+        "dmzr": rate_r * (mz_ss_r - mzr), "dmzf": rate_f * (mz_ss_f - mzf),
+        "T7": T7, "spring_energy": spring,
+        "sliding_power": fyr * v_r_slide.dot(kin.rear_lateral) + fyf * v_f_slide.dot(kin.front_lateral),
+    }
+    return EquationsOfMotion(
+        q=q, u=u, dependent=("u5", "u6", "u8"), inputs=(vp_s, ap_s),
+        mass_matrix=mass_matrix, forcing=forcing,
+        constraint_matrix=A_c, constraint_offset=a0, constraint_accel=b,
+        holonomic=kin.holonomic,
+        kinetic_energy=kinetic_energy(kin), potential_energy=potential_energy(kin),
+        extra=extra,
+    )

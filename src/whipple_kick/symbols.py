@@ -99,6 +99,39 @@ def _entries():
         ("mzr", "rear tyre self-aligning moment on the wheel about the downward normal", "N m", s),
         ("mzf", "front tyre self-aligning moment on the wheel about the downward normal", "N m", s),
     ]
+    rows += [
+        # --- slip model: tyre blending, friction, kick plate, controller -------
+        ("wr", "weight of the rear tyre's second Magic-Formula coefficient set (pressure interpolation)", "-", c),
+        ("wf", "weight of the front tyre's second Magic-Formula coefficient set (pressure interpolation)", "-", c),
+        ("mur", "rear tyre friction scale: peak factor D times mur, B divided by mur", "-", c),
+        ("muf", "front tyre friction scale: peak factor D times muf, B divided by muf", "-", c),
+        ("lamr", "rear tyre lateral-force and moment multiplier (thesis friction mode; 0 switches the tyre's lateral forces off)", "-", c),
+        ("lamf", "front tyre lateral-force and moment multiplier (0 switches the tyre's lateral forces off)", "-", c),
+        ("kick_t0", "time at which the kick plate starts to move", "s", c),
+        ("kick_T", "duration of the kick plate's motion", "s", c),
+        ("kick_D", "kick plate displacement (signed: positive along N.y, to the right)", "m", c),
+        ("kick_profile", "kick profile: 0 constant acceleration (thesis), 1 minimum-jerk quintic", "-", c),
+        ("kq3", "steer-torque feedback gain on yaw angle q3", "N m/rad", c),
+        ("kq4", "steer-torque feedback gain on roll angle q4", "N m/rad", c),
+        ("kq7", "steer-torque feedback gain on steer angle q7", "N m/rad", c),
+        ("ku3", "steer-torque feedback gain on yaw rate u3", "N m s/rad", c),
+        ("ku4", "steer-torque feedback gain on roll rate u4", "N m s/rad", c),
+        ("ku7", "steer-torque feedback gain on steer rate u7", "N m s/rad", c),
+        ("T6c", "constant rear-wheel drive torque holding the steady speed", "N m", c),
+    ]
+    fy_units = ["-", "N/kN^2", "N/kN", "N/deg", "kN", "1/deg", "1/kN", "-", "deg/deg", "deg/kN",
+                "deg", "N/(kN deg)", "N/kN", "N"]
+    mz_units = ["-", "N m/kN^2", "N m/kN", "N m/(deg kN^2)", "N m/(deg kN)", "1/kN", "1/deg",
+                "1/kN^2", "1/kN", "-", "1/deg", "deg/deg", "deg/kN", "deg", "N m/(kN^2 deg)",
+                "N m/(kN deg)", "N m/kN", "N m"]
+    for wheel, wname in (("r", "rear"), ("f", "front")):
+        for k in (1, 2):
+            for i, unit in enumerate(fy_units):
+                rows.append((f"a{wheel}{k}_{i}", f"{wname} tyre lateral-force Magic-Formula coefficient a{i}, "
+                             f"coefficient set {k} (Pacejka 1989, formula units)", unit, c))
+            for i, unit in enumerate(mz_units):
+                rows.append((f"c{wheel}{k}_{i}", f"{wname} tyre aligning-moment Magic-Formula coefficient c{i}, "
+                             f"coefficient set {k} (Pacejka 1989, formula units)", unit, c))
     return {name: SymbolInfo(name, desc, unit, kind) for name, desc, unit, kind in rows}
 
 
@@ -112,6 +145,16 @@ CLASSIC_CONSTANTS = (
     "ic11", "ic22", "ic33", "ic31", "id11", "id22",
     "ie11", "ie22", "ie33", "ie31", "if11", "if22", "g",
 )
+
+
+#: Constants of the slip model (classic constants plus tyre, plate and controller).
+SLIP_CONSTANTS = CLASSIC_CONSTANTS + (
+    "rtr", "rtf", "kzr", "kzf", "czr", "czf", "sigr", "sigf",
+    "wr", "wf", "mur", "muf", "lamr", "lamf",
+    "kick_t0", "kick_T", "kick_D", "kick_profile",
+    "kq3", "kq4", "kq7", "ku3", "ku4", "ku7", "T6c",
+) + tuple(f"{kind}{wheel}{k}_{i}" for wheel in "rf" for k in (1, 2)
+          for kind, n in (("a", 14), ("c", 18)) for i in range(n))
 
 
 def info(name):

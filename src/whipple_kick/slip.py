@@ -1,0 +1,558 @@
+"""The slip model as compiled C: one call per right-hand-side evaluation.
+
+The symbolic equations of :func:`whipple_kick.derivation.slip_equations` are
+printed twice from the same expression lists: to C (with common
+subexpressions eliminated, compiled with the system C compiler and loaded
+with ctypes) and to NumPy (the test oracle and speed baseline). The C
+function does everything for one evaluation: the kick-plate profile, the
+constraint matrix and the dependent speeds, slip and camber angles, normal
+forces, Magic-Formula steady forces, tyre relaxation, the steer controller,
+Kane's equations and their reduction by pivoted LU.
+
+State vector layout (by name, see :data:`STATE_NAMES`): q1..q10, the
+independent speeds u1 u2 u3 u4 u7 u9 u10, the tyre force states fyr fyf
+mzr mzf.
+"""
+import ctypes
+import functools
+import os
+import shutil
+import subprocess
+
+import numpy as np
+import sympy as sm
+from sympy.printing.c import C99CodePrinter
+
+from . import cache, codegen, kane
+from . import symbols as S
+from .errors import InputError
+
+COORDINATES = tuple(f"q{i}" for i in range(1, 11))
+SPEEDS = tuple(f"u{i}" for i in range(1, 11))
+DEPENDENT = ("u5", "u6", "u8")
+INDEPENDENT = tuple(n for n in SPEEDS if n not in DEPENDENT)
+TYRE_STATES = ("fyr", "fyf", "mzr", "mzf")
+STATE_NAMES = COORDINATES + INDEPENDENT + TYRE_STATES
+#: Per-evaluation outputs written by the C function when asked (by name).
+OUTPUT_NAMES = SPEEDS + (
+    "yp", "vp", "ap", "slip_r", "slip_f", "camber_r", "camber_f", "vx_r", "vx_f",
+    "fz_r", "fz_f", "fy_ss_r", "fy_ss_f", "mz_ss_r", "mz_ss_f", "T7",
+    "kinetic_energy", "potential_energy", "spring_energy", "holonomic", "sliding_power",
+)
+PARAMETER_NAMES = S.SLIP_CONSTANTS
+X = {n: i for i, n in enumerate(STATE_NAMES)}
+OUT = {n: i for i, n in enumerate(OUTPUT_NAMES)}
+P = {n: i for i, n in enumerate(PARAMETER_NAMES)}
+
+_SOURCES = ("symbols", "derivation", "codegen", "magic_formula", "slip")
+_PARTITION = kane.ConstraintPartition(SPEEDS, DEPENDENT)
+
+
+@functools.lru_cache(maxsize=None)
+def _expressions():
+    """The expression lists both printers use (plain symbols, plate profile substituted)."""
+    from . import derivation
+    eom = derivation.slip_equations()
+    tyre = S.dyns(TYRE_STATES)
+    dyn = list(eom.q) + list(eom.u) + list(tyre)
+    t = sm.Symbol("t", real=True)
+    vp_s, ap_s = eom.inputs
+    ex = eom.extra
+    profile = {vp_s: ex["vp"], ap_s: ex["ap"]}
+
+    def plain(e):
+        return codegen.plain(sm.sympify(e) if not isinstance(e, sm.MatrixBase) else e, dyn).xreplace(profile)
+
+    stage1 = {"A": plain(eom.constraint_matrix), "a0": plain(eom.constraint_offset)}
+    outputs = [
+        ex["yp"], ex["vp"], ex["ap"], ex["slip_r"], ex["slip_f"], ex["camber_r"], ex["camber_f"],
+        ex["vx_r"], ex["vx_f"], ex["fz_r"], ex["fz_f"], ex["fy_ss_r"], ex["fy_ss_f"],
+        ex["mz_ss_r"], ex["mz_ss_f"], ex["T7"], eom.kinetic_energy, eom.potential_energy,
+        ex["spring_energy"], eom.holonomic, ex["sliding_power"],
+    ]
+    stage2 = {
+        "M": plain(eom.mass_matrix), "f": plain(eom.forcing), "b": plain(eom.constraint_accel),
+        "tyre_rates": sm.Matrix([plain(ex[k]) for k in ("dfyr", "dfyf", "dmzr", "dmzf")]),
+        "outputs": sm.Matrix([plain(e) for e in outputs]),
+    }
+    symbols = {
+        "t": t,
+        "q": [codegen.plain_symbol(s) for s in eom.q],
+        "u": [codegen.plain_symbol(s) for s in eom.u],
+        "s": [codegen.plain_symbol(s) for s in tyre],
+        "p": list(S.syms(PARAMETER_NAMES)),
+    }
+    return stage1, stage2, symbols
+
+
+# --------------------------------------------------------------------------- C
+
+_C_HELPERS = r"""
+#include <math.h>
+#include <string.h>
+/* Not defined by strict C99 <math.h>; SymPy's printer uses them. */
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+#ifndef M_1_PI
+#define M_1_PI 0.31830988618379067154
+#endif
+#ifndef M_PI_2
+#define M_PI_2 1.57079632679489661923
+#endif
+
+/* Solve A X = B in place by LU with partial pivoting. A is n x n, B is
+   n x m, both row-major. Returns 0 on success, 1 if A is singular. */
+static int lu_solve(int n, double *A, int m, double *B)
+{
+    for (int k = 0; k < n; k++) {
+        int piv = k;
+        double big = fabs(A[k * n + k]);
+        for (int i = k + 1; i < n; i++) {
+            double v = fabs(A[i * n + k]);
+            if (v > big) { big = v; piv = i; }
+        }
+        if (!(big > 0.0)) return 1;
+        if (piv != k) {
+            for (int j = 0; j < n; j++) { double tmp = A[k * n + j]; A[k * n + j] = A[piv * n + j]; A[piv * n + j] = tmp; }
+            for (int j = 0; j < m; j++) { double tmp = B[k * m + j]; B[k * m + j] = B[piv * m + j]; B[piv * m + j] = tmp; }
+        }
+        for (int i = k + 1; i < n; i++) {
+            double l = A[i * n + k] / A[k * n + k];
+            A[i * n + k] = l;
+            for (int j = k + 1; j < n; j++) A[i * n + j] -= l * A[k * n + j];
+            for (int j = 0; j < m; j++) B[i * m + j] -= l * B[k * m + j];
+        }
+    }
+    for (int i = n - 1; i >= 0; i--) {
+        for (int j = 0; j < m; j++) {
+            double s = B[i * m + j];
+            for (int k = i + 1; k < n; k++) s -= A[i * n + k] * B[k * m + j];
+            B[i * m + j] = s / A[i * n + i];
+        }
+    }
+    return 0;
+}
+"""
+
+
+class _Printer(C99CodePrinter):
+    """C printer: plain symbols print as their names (declared as locals)."""
+
+    def _print_Symbol(self, expr):
+        return expr.name
+
+
+def _c_block(exprs, targets, indent="    "):
+    """C statements computing ``exprs`` (CSE'd) into the C lvalues ``targets``."""
+    printer = _Printer()
+    replacements, reduced = sm.cse(list(exprs), symbols=sm.numbered_symbols("x_"), order="none")
+    lines = [f"{indent}const double {lhs} = {printer.doprint(rhs)};" for lhs, rhs in replacements]
+    lines += [f"{indent}{target} = {printer.doprint(e)};" for target, e in zip(targets, reduced)]
+    return "\n".join(lines)
+
+
+def c_source():
+    """Full C source of the slip model's right-hand side."""
+    stage1, stage2, sy = _expressions()
+    n, m, k = len(SPEEDS), len(DEPENDENT), len(INDEPENDENT)
+    dep = [SPEEDS.index(x) for x in DEPENDENT]
+    ind = [SPEEDS.index(x) for x in INDEPENDENT]
+    lines = [_C_HELPERS, "/* Generated by whipple_kick.slip; do not edit. */",
+             "int wk_slip_rhs(double t, const double *x, const double *p, double *dx, double *out)", "{"]
+    for i, s in enumerate(sy["p"]):
+        lines.append(f"    const double {s.name} = p[{i}];")
+    for i, s in enumerate(sy["q"]):
+        lines.append(f"    const double {s.name} = x[{i}];")
+    for i, name in enumerate(TYRE_STATES):
+        lines.append(f"    const double {name} = x[{X[name]}];")
+    lines.append(f"    double A[{m * n}], a0[{m}];")
+    stage1_exprs = list(stage1["A"]) + list(stage1["a0"])
+    stage1_targets = [f"A[{i}]" for i in range(m * n)] + [f"a0[{i}]" for i in range(m)]
+    lines.append("    {")
+    lines.append(_c_block(stage1_exprs, stage1_targets, indent="        "))
+    lines.append("    }")
+    # Dependent speeds: A_dep u_dep = -(A_ind u_ind + a0).
+    lines.append(f"    double u[{n}];")
+    for j, idx in enumerate(ind):
+        lines.append(f"    u[{idx}] = x[{len(COORDINATES) + j}];")
+    lines.append(f"    double Adep[{m * m}], rhs1[{m * (k + 1)}];")
+    lines.append(f"    for (int i = 0; i < {m}; i++) {{")
+    lines.append(f"        double s = a0[i];")
+    for jj, idx in enumerate(dep):
+        lines.append(f"        Adep[i * {m} + {jj}] = A[i * {n} + {idx}];")
+    for jj, idx in enumerate(ind):
+        lines.append(f"        s += A[i * {n} + {idx}] * u[{idx}];")
+        lines.append(f"        rhs1[i * {k + 1} + {jj}] = A[i * {n} + {idx}];")
+    lines.append(f"        rhs1[i * {k + 1} + {k}] = -s;")
+    lines.append("    }")
+    # One LU of A_dep serves both the speeds (last column) and T (the rest).
+    lines.append(f"    if (lu_solve({m}, Adep, {k + 1}, rhs1)) return 1;")
+    for jj, idx in enumerate(dep):
+        lines.append(f"    u[{idx}] = rhs1[{jj} * {k + 1} + {k}];")
+    for i, s in enumerate(sy["u"]):
+        lines.append(f"    const double {s.name} = u[{i}];")
+    lines.append(f"    double M[{n * n}], f[{n}], b[{m}], rates[4], o[{len(OUTPUT_NAMES) - n}];")
+    stage2_exprs = list(stage2["M"]) + list(stage2["f"]) + list(stage2["b"]) + list(stage2["tyre_rates"]) + list(stage2["outputs"])
+    stage2_targets = ([f"M[{i}]" for i in range(n * n)] + [f"f[{i}]" for i in range(n)]
+                      + [f"b[{i}]" for i in range(m)] + [f"rates[{i}]" for i in range(4)]
+                      + [f"o[{i}]" for i in range(len(OUTPUT_NAMES) - n)])
+    lines.append("    {")
+    lines.append(_c_block(stage2_exprs, stage2_targets, indent="        "))
+    lines.append("    }")
+    # Kane's reduced equations: T = [I; C], C = -A_dep^-1 A_ind, t0 = [0; d], d = -A_dep^-1 b.
+    lines.append(f"    double T[{n * k}], t0[{n}], d[{m}];")
+    lines.append(f"    memset(T, 0, sizeof T); memset(t0, 0, sizeof t0);")
+    for jj, idx in enumerate(ind):
+        lines.append(f"    T[{idx} * {k} + {jj}] = 1.0;")
+    lines.append(f"    double Adep2[{m * m}], rhs2[{m}];")
+    lines.append(f"    for (int i = 0; i < {m}; i++) {{")
+    for jj, idx in enumerate(dep):
+        lines.append(f"        Adep2[i * {m} + {jj}] = A[i * {n} + {idx}];")
+    lines.append("        rhs2[i] = b[i];")
+    lines.append("    }")
+    lines.append(f"    if (lu_solve({m}, Adep2, 1, rhs2)) return 1;")
+    lines.append(f"    for (int i = 0; i < {m}; i++) d[i] = -rhs2[i];")
+    # rhs1 now holds A_dep^-1 A_ind in its first k columns.
+    for ii, idx in enumerate(dep):
+        lines.append(f"    for (int j = 0; j < {k}; j++) T[{idx} * {k} + j] = -rhs1[{ii} * {k + 1} + j];")
+        lines.append(f"    t0[{idx}] = d[{ii}];")
+    lines.append(f"    double MT[{n * k}], Mr[{k * k}], r[{k}];")
+    lines.append(f"    for (int i = 0; i < {n}; i++) for (int j = 0; j < {k}; j++) {{")
+    lines.append(f"        double s = 0.0; for (int l = 0; l < {n}; l++) s += M[i * {n} + l] * T[l * {k} + j]; MT[i * {k} + j] = s; }}")
+    lines.append(f"    for (int i = 0; i < {k}; i++) {{")
+    lines.append(f"        for (int j = 0; j < {k}; j++) {{ double s = 0.0; for (int l = 0; l < {n}; l++) s += T[l * {k} + i] * MT[l * {k} + j]; Mr[i * {k} + j] = s; }}")
+    lines.append(f"        double s = 0.0;")
+    lines.append(f"        for (int l = 0; l < {n}; l++) {{ double g = f[l]; for (int c = 0; c < {n}; c++) g -= M[l * {n} + c] * t0[c]; s += T[l * {k} + i] * g; }}")
+    lines.append(f"        r[i] = s;")
+    lines.append("    }")
+    lines.append(f"    if (lu_solve({k}, Mr, 1, r)) return 1;")
+    # Outputs.
+    lines.append(f"    for (int i = 0; i < {n}; i++) dx[i] = u[i];")
+    lines.append(f"    for (int i = 0; i < {k}; i++) dx[{n} + i] = r[i];")
+    lines.append(f"    for (int i = 0; i < 4; i++) dx[{n + k} + i] = rates[i];")
+    lines.append("    if (out) {")
+    lines.append(f"        for (int i = 0; i < {n}; i++) out[i] = u[i];")
+    lines.append(f"        for (int i = 0; i < {len(OUTPUT_NAMES) - n}; i++) out[{n} + i] = o[i];")
+    lines.append("    }")
+    lines.append("    for (int i = 0; i < %d; i++) if (!isfinite(dx[i])) return 2;" % len(STATE_NAMES))
+    lines.append("    return 0;")
+    lines.append("}")
+    lines.append(f"int wk_slip_sizes(int *sizes) {{ sizes[0] = {len(STATE_NAMES)}; sizes[1] = {len(PARAMETER_NAMES)}; sizes[2] = {len(OUTPUT_NAMES)}; return 0; }}")
+    return "\n".join(lines) + "\n"
+
+
+def _compiler():
+    cc = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc") or shutil.which("clang")
+    if not cc:
+        raise InputError("no C compiler found: install gcc (or clang) or set CC to a C compiler's path")
+    return cc
+
+
+_CFLAGS = ("-O2", "-fPIC", "-shared", "-std=c99")
+
+
+@functools.lru_cache(maxsize=None)
+def library():
+    """Load (building and caching if needed) the compiled slip model."""
+    cc = _compiler()
+    key = cache.source_hash(_SOURCES, extra=f"{os.path.basename(cc)} {' '.join(_CFLAGS)}")
+    folder = cache.cache_dir()
+    lib_path = folder / f"slip_{key}.so"
+    if not lib_path.exists():
+        with cache.locked(lib_path):
+            if not lib_path.exists():
+                src_path = folder / f"slip_{key}.c"
+                cache.write_atomic(src_path, c_source())
+                tmp = folder / f".slip_{key}.{os.getpid()}.so"
+                proc = subprocess.run([cc, *_CFLAGS, "-o", str(tmp), str(src_path), "-lm"],
+                                      capture_output=True, text=True)
+                if proc.returncode != 0:
+                    raise RuntimeError(f"compiling the slip model failed ({cc}):\n{proc.stderr[-4000:]}")
+                os.chmod(tmp, 0o600)
+                os.replace(tmp, lib_path)
+    cache.check_private_file(lib_path)
+    lib = ctypes.CDLL(str(lib_path))
+    lib.wk_slip_rhs.restype = ctypes.c_int
+    lib.wk_slip_rhs.argtypes = [ctypes.c_double, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p]
+    sizes = (ctypes.c_int * 3)()
+    lib.wk_slip_sizes(sizes)
+    if tuple(sizes) != (len(STATE_NAMES), len(PARAMETER_NAMES), len(OUTPUT_NAMES)):
+        raise RuntimeError(f"compiled slip model has sizes {tuple(sizes)}; rebuild the cache")
+    return lib
+
+
+# ----------------------------------------------------------------------- NumPy
+
+def numpy_source():
+    """NumPy module source of the same expressions (oracle and baseline)."""
+    stage1, stage2, sy = _expressions()
+    t = [sy["t"]]
+    parts = [
+        '"""Generated by whipple_kick.slip (NumPy oracle); do not edit."""',
+        "import functools\nimport numpy",
+        codegen.numpy_function("stage1", [("t", t), ("q", sy["q"]), ("p", sy["p"])],
+                               [stage1["A"], stage1["a0"]], doc="Constraint matrix and offset."),
+        codegen.numpy_function("stage2", [("t", t), ("q", sy["q"]), ("u", sy["u"]), ("s", sy["s"]), ("p", sy["p"])],
+                               [stage2["M"], stage2["f"], stage2["b"], stage2["tyre_rates"], stage2["outputs"]],
+                               doc="Mass matrix, forcing, constraint remainder, tyre rates, outputs."),
+    ]
+    return "\n\n".join(parts)
+
+
+@functools.lru_cache(maxsize=None)
+def numpy_module():
+    """The generated NumPy oracle module (cached like the C library)."""
+    key = cache.source_hash(_SOURCES, extra="numpy")
+    path = cache.cache_dir() / f"slip_numpy_{key}.py"
+    if not path.exists():
+        with cache.locked(path):
+            if not path.exists():
+                cache.write_atomic(path, numpy_source())
+    cache.check_private_file(path)
+    return codegen.load_module(path, f"whipple_kick_generated_slip_{key}")
+
+
+def numpy_rhs(t, x, p, with_outputs=False):
+    """Right-hand side evaluated with NumPy (slow; the oracle for the C code)."""
+    mod = numpy_module()
+    q = x[:len(COORDINATES)]
+    u_ind = x[len(COORDINATES):len(COORDINATES) + len(INDEPENDENT)]
+    s = x[len(COORDINATES) + len(INDEPENDENT):]
+    A, a0 = mod.stage1([t], q, p)
+    u = _PARTITION.dependent_speeds(A, a0, u_ind)
+    M, f, b, rates, outputs = mod.stage2([t], q, u, s, p)
+    udot = _PARTITION.accelerations(M, f, A, b)
+    dx = np.concatenate([u, udot[_PARTITION.ind], rates])
+    if with_outputs:
+        return dx, np.concatenate([u, outputs])
+    return dx
+
+
+# ------------------------------------------------------------------- interface
+
+def parameter_vector(params):
+    """Parameter array for the compiled model, looked up by name.
+
+    Raises
+    ------
+    InputError
+        If a name is missing or unknown.
+    """
+    missing = [n for n in PARAMETER_NAMES if n not in params]
+    if missing:
+        raise InputError(f"slip-model parameters are missing: {', '.join(missing[:8])}"
+                         + (" ..." if len(missing) > 8 else ""))
+    unknown = [n for n in params if n not in P]
+    if unknown:
+        raise InputError(f"unknown slip-model parameters: {', '.join(sorted(unknown)[:8])}")
+    return np.array([float(params[n]) for n in PARAMETER_NAMES])
+
+
+class CompiledRHS:
+    """Callable ``f(t, x) -> dx/dt`` backed by the C library, for one parameter set.
+
+    Parameters
+    ----------
+    params : mapping
+        Every name in :data:`PARAMETER_NAMES`.
+    """
+
+    def __init__(self, params):
+        self.lib = library()
+        self.p = np.ascontiguousarray(parameter_vector(params))
+        self._p_ptr = self.p.ctypes.data
+        self._dx = np.empty(len(STATE_NAMES))
+        self._dx_ptr = self._dx.ctypes.data
+        self._out = np.empty(len(OUTPUT_NAMES))
+        self._out_ptr = self._out.ctypes.data
+        self.calls = 0
+
+    def __call__(self, t, x):
+        x = np.ascontiguousarray(x, dtype=float)
+        status = self.lib.wk_slip_rhs(t, x.ctypes.data, self._p_ptr, self._dx_ptr, None)
+        self.calls += 1
+        if status:
+            raise FloatingPointError(_STATUS.get(status, f"status {status}") + f" at t = {t:.6g} s")
+        return self._dx.copy()
+
+    def outputs(self, t, x):
+        """Derivatives and named outputs (:data:`OUTPUT_NAMES`) at one state."""
+        x = np.ascontiguousarray(x, dtype=float)
+        status = self.lib.wk_slip_rhs(t, x.ctypes.data, self._p_ptr, self._dx_ptr, self._out_ptr)
+        if status:
+            raise FloatingPointError(_STATUS.get(status, f"status {status}") + f" at t = {t:.6g} s")
+        return self._dx.copy(), self._out.copy()
+
+
+_STATUS = {
+    1: "singular constraint or mass matrix in the slip model",
+    2: "non-finite derivative in the slip model",
+}
+
+
+# ------------------------------------------------------- parameters and steady state
+
+#: Magic-Formula coefficients that shift the curves at zero slip and camber
+#: (Sh and Sv terms not multiplied by camber). "Symmetric tyres" zero them.
+FY_OFFSET_INDICES = (9, 10, 12, 13)
+MZ_OFFSET_INDICES = (12, 13, 16, 17)
+GAIN_NAMES = ("kq3", "kq4", "kq7", "ku3", "ku4", "ku7")
+
+
+def tyre_parameters(tyre, wheel, symmetric=False, lateral=True):
+    """Slip-model parameters of one tyre, by name.
+
+    Parameters
+    ----------
+    tyre : whipple_kick.tyres.Tyre
+        A loaded tyre (its ``blend`` gives one or two coefficient sets).
+    wheel : {"r", "f"}
+        Rear or front.
+    symmetric : bool
+        Zero the zero-slip offsets (:data:`FY_OFFSET_INDICES`, :data:`MZ_OFFSET_INDICES`).
+    lateral : bool
+        False switches the tyre's lateral force and moment off.
+    """
+    if wheel not in ("r", "f"):
+        raise ValueError(f"wheel must be 'r' or 'f', got {wheel!r}")
+    sets = list(tyre.blend)
+    if len(sets) == 1:
+        # The second slot gets weight 0; filling it with the same (finite)
+        # coefficients keeps 0 * value finite.
+        sets = [sets[0], (0.0, sets[0][1], sets[0][2])]
+    out = {
+        f"rt{wheel}": tyre.crown_radius, f"kz{wheel}": tyre.vertical_stiffness,
+        f"cz{wheel}": tyre.vertical_damping, f"sig{wheel}": tyre.relaxation_length,
+        f"w{wheel}": sets[1][0], f"mu{wheel}": tyre.friction_scale,
+        f"lam{wheel}": tyre.curve_scale if lateral else 0.0,
+    }
+    for k, (_, fy, mz) in enumerate(sets, start=1):
+        fy, mz = np.array(fy, dtype=float), np.array(mz, dtype=float)
+        if symmetric:
+            fy[list(FY_OFFSET_INDICES)] = 0.0
+            mz[list(MZ_OFFSET_INDICES)] = 0.0
+        out.update({f"a{wheel}{k}_{i}": v for i, v in enumerate(fy)})
+        out.update({f"c{wheel}{k}_{i}": v for i, v in enumerate(mz)})
+    return out
+
+
+def model_parameters(moore, rear_tyre, front_tyre, gains=None, kick=None,
+                     symmetric=False, lateral=True, drive_torque=0.0):
+    """Assemble the slip model's parameters by name.
+
+    Parameters
+    ----------
+    moore : mapping
+        Moore parameters of the bicycle (with rider).
+    rear_tyre, front_tyre : whipple_kick.tyres.Tyre
+        Loaded tyres.
+    gains : mapping, optional
+        Steer-torque gains by name (:data:`GAIN_NAMES`); missing ones are 0.
+        ``T7 = -(kq4 q4 + kq7 q7 + ku4 u4 + ku7 u7 + kq3 q3 + ku3 u3)``.
+    kick : mapping, optional
+        ``t0`` [s], ``duration`` [s], ``displacement`` [m, + to the right],
+        ``profile`` (0 constant acceleration, 1 minimum jerk). Default: no kick.
+    symmetric, lateral : bool
+        See :func:`tyre_parameters`.
+    drive_torque : float
+        Constant rear-wheel torque [N m] (the steady-state solver sets it).
+    """
+    params = {n: float(moore[n]) for n in S.CLASSIC_CONSTANTS}
+    params.update(tyre_parameters(rear_tyre, "r", symmetric, lateral))
+    params.update(tyre_parameters(front_tyre, "f", symmetric, lateral))
+    gains = dict(gains or {})
+    unknown = set(gains) - set(GAIN_NAMES)
+    if unknown:
+        raise InputError(f"unknown controller gains {sorted(unknown)}; known: {', '.join(GAIN_NAMES)}")
+    params.update({n: float(gains.get(n, 0.0)) for n in GAIN_NAMES})
+    kick = dict(kick or {})
+    params.update({
+        "kick_t0": float(kick.get("t0", 0.0)),
+        "kick_T": float(kick.get("duration", 0.15)),
+        "kick_D": float(kick.get("displacement", 0.0)),
+        "kick_profile": float(kick.get("profile", 0)),
+        "T6c": float(drive_torque),
+    })
+    return params
+
+
+class SteadyState:
+    """Result of :func:`steady_state`."""
+
+    def __init__(self, x, params, residual, unknowns):
+        self.x = x                  # full state vector (STATE_NAMES)
+        self.params = params        # parameters with the holding drive torque T6c
+        self.residual = residual    # max |residual| of the steady equations
+        self.unknowns = unknowns    # dict of the solved quantities
+
+    def __repr__(self):
+        u = ", ".join(f"{k}={v:.3g}" for k, v in self.unknowns.items())
+        return f"SteadyState({u}; residual {self.residual:.2g})"
+
+
+def steady_state(params, speed, tol=1e-13):
+    """Steady motion at ``speed`` [m/s] with the tyres' offsets balanced.
+
+    Unknowns: roll q4, steer q7, pitch q5, tyre compressions q9, q10, lateral
+    drift velocity u2, yaw rate u3 and the drive torque T6c that holds the
+    speed against the sliding losses of the offset-balancing slip. The tyre
+    force states are at their steady values. Equations: front contact on
+    the ground and every acceleration zero in the heading frame
+    (du1/dt + u3 u2 = du2/dt - u3 u1 = du3/dt = du4/dt = du7/dt = du9/dt =
+    du10/dt = 0), with q3 = 0 so the heading is N.x.
+
+    Parameters
+    ----------
+    params : mapping
+        From :func:`model_parameters`; ``T6c`` is replaced by the solution.
+    speed : float
+        Forward speed of the rear contact [m/s], > 0.
+
+    Returns
+    -------
+    SteadyState
+    """
+    from scipy.optimize import root
+    from .benchmark import steer_axis_tilt
+
+    rhs = CompiledRHS(params)
+    rr = params["rr"]
+    weight = params["g"] * (params["mc"] + params["md"] + params["me"] + params["mf"])
+    x = np.zeros(len(STATE_NAMES))
+    x[X["u1"]] = speed
+    names = ("q4", "q7", "q5", "q9", "q10", "u2", "u3", "T6c")
+    z0 = np.array([0.0, 0.0, steer_axis_tilt(params),
+                   0.5 * weight / params["kzr"], 0.5 * weight / params["kzf"], 0.0, 0.0, 0.0])
+    scale = np.array([1.0, 1.0, 1.0, 1e-3, 1e-3, 1.0, 1.0, 1.0])
+
+    def state(z):
+        xs = x.copy()
+        for name, value in zip(names[:-1], z[:-1]):
+            xs[X[name]] = value
+        rhs.p[P["T6c"]] = z[-1]
+        _, out = rhs.outputs(0.0, xs)
+        for state_name, out_name in zip(TYRE_STATES, ("fy_ss_r", "fy_ss_f", "mz_ss_r", "mz_ss_f")):
+            xs[X[state_name]] = out[OUT[out_name]]
+        return xs
+
+    def residual(zs):
+        z = zs * scale
+        xs = state(z)
+        dx, out = rhs.outputs(0.0, xs)
+        u1, u2, u3 = xs[X["u1"]], xs[X["u2"]], xs[X["u3"]]
+        return np.array([
+            out[OUT["holonomic"]] * 1e2,
+            (dx[X["u1"]] + u3 * u2) * rr, dx[X["u2"]] - u3 * u1, dx[X["u3"]],
+            dx[X["u4"]], dx[X["u7"]], dx[X["u9"]] * 1e-2, dx[X["u10"]] * 1e-2,
+        ])
+
+    sol = root(residual, z0 / scale, method="hybr", options={"xtol": tol})
+    z = sol.x * scale
+    res = float(np.max(np.abs(residual(sol.x))))
+    if not np.all(np.isfinite(z)) or res > 1e-8:
+        raise FloatingPointError(f"steady state not found at {speed} m/s: {sol.message} (residual {res:.3g})")
+    xs = state(z)
+    out_params = dict(params)
+    out_params["T6c"] = float(z[-1])
+    return SteadyState(xs, out_params, res, dict(zip(names, z)))
