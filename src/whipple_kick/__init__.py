@@ -11,7 +11,7 @@ __version__ = "0.1.0"
 
 _SUBMODULES = (
     "analysis", "benchmark", "bicycles", "cache", "classic", "cli", "codegen", "errors",
-    "control", "derivation", "inputs", "magic_formula", "parameters",
+    "control", "derivation", "inputs", "integrate", "kane", "magic_formula", "parameters",
     "plotting", "riders", "simulation", "slip", "sweep", "symbols", "tyres",
 )
 
