@@ -62,8 +62,9 @@ def gains_dict(K, scale=1.0):
 
 def thesis_gains(rear_load_n):
     """Table 8.4 gains for one of the thesis' rear loads (570, 635 or 701 N)."""
-    key = int(round(float(rear_load_n)))
-    if key not in THESIS_GAINS or abs(float(rear_load_n) - key) > 1e-9:
+    load = check_range("rear load", rear_load_n, 0.0, None, "N", low_open=True)
+    key = int(round(load))
+    if key not in THESIS_GAINS or abs(load - key) > 1e-9:
         raise InputError(f"thesis gains exist for rear loads 570, 635 and 701 N only, got {rear_load_n} N")
     return dict(THESIS_GAINS[key])
 

@@ -319,9 +319,12 @@ def numpy_rhs(t, x, p, with_outputs=False):
     q = x[:len(COORDINATES)]
     u_ind = x[len(COORDINATES):len(COORDINATES) + len(INDEPENDENT)]
     s = x[len(COORDINATES) + len(INDEPENDENT):]
-    A, a0 = mod.stage1([t], q, p)
-    u = _PARTITION.dependent_speeds(A, a0, u_ind)
-    M, f, b, rates, outputs = mod.stage2([t], q, u, s, p)
+    # numpy.select evaluates every branch of a Piecewise, including the
+    # unloaded-tyre branch's 0/0 that C never takes; the selected values are finite.
+    with np.errstate(invalid="ignore", divide="ignore"):
+        A, a0 = mod.stage1([t], q, p)
+        u = _PARTITION.dependent_speeds(A, a0, u_ind)
+        M, f, b, rates, outputs = mod.stage2([t], q, u, s, p)
     udot = _PARTITION.accelerations(M, f, A, b)
     dx = np.concatenate([u, udot[_PARTITION.ind], rates])
     if with_outputs:
@@ -556,3 +559,50 @@ def steady_state(params, speed, tol=1e-13):
     out_params = dict(params)
     out_params["T6c"] = float(z[-1])
     return SteadyState(xs, out_params, res, dict(zip(names, z)))
+
+
+# ---------------------------------------------------------------- linearisation
+
+#: States of the lateral and vertical dynamics about straight running (the
+#: ignorable q1, q2, q6, q8, the dependent q5 and the forward speed u1 left out).
+LINEAR_STATES = ("q3", "q4", "q7", "q9", "q10", "u2", "u3", "u4", "u7", "u9", "u10",
+                 "fyr", "fyf", "mzr", "mzf")
+
+
+def solve_pitch(rhs, x, tol=1e-14, max_iter=30):
+    """Return ``x`` with q5 re-solved so the front contact is on the ground (Newton)."""
+    x = np.array(x, dtype=float)
+    h_step = 1e-7
+    for _ in range(max_iter):
+        h = rhs.outputs(0.0, x)[1][OUT["holonomic"]]
+        xp = x.copy()
+        xp[X["q5"]] += h_step
+        slope = (rhs.outputs(0.0, xp)[1][OUT["holonomic"]] - h) / h_step
+        step = h / slope
+        x[X["q5"]] -= step
+        if abs(step) < tol:
+            return x
+    raise FloatingPointError(f"pitch did not converge (last step {abs(step):.3g} rad)")
+
+
+def linearize(rhs, x, names=LINEAR_STATES, step=1e-7, t=0.0):
+    """Central-difference Jacobian of the compiled right-hand side.
+
+    Perturbed coordinates re-solve the pitch so every evaluated state
+    satisfies the holonomic constraint.
+
+    Returns
+    -------
+    ndarray, shape (len(names), len(names))
+    """
+    idx = [X[n] for n in names]
+    J = np.empty((len(idx), len(idx)))
+    for j, i in enumerate(idx):
+        h = step * max(1.0, abs(x[i])) * (1e2 if STATE_NAMES[i] in TYRE_STATES else 1.0)
+        xp, xm = np.array(x, dtype=float), np.array(x, dtype=float)
+        xp[i] += h
+        xm[i] -= h
+        if STATE_NAMES[i].startswith("q"):
+            xp, xm = solve_pitch(rhs, xp), solve_pitch(rhs, xm)
+        J[:, j] = (rhs(t, xp)[idx] - rhs(t, xm)[idx]) / (2 * h)
+    return J
