@@ -45,3 +45,236 @@ def benchmark_main(argv=None):
     """Console script ``whipple-benchmark``."""
     np.set_printoptions(precision=10)
     sys.exit(_run(_benchmark, argv))
+
+
+# ----------------------------------------------------------------- simulate
+
+class _OneLineParser(argparse.ArgumentParser):
+    """Argument parser whose usage errors are one line on stderr (exit status 2)."""
+
+    def error(self, message):
+        print(f"{self.prog}: error: {message} (see {self.prog} --help)", file=sys.stderr)
+        sys.exit(2)
+
+
+def _number(unit):
+    """argparse type: a finite float, the message naming the unit when it is not."""
+    def parse(text):
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a number ({unit})") from None
+        if value != value or value in (float("inf"), float("-inf")):
+            raise argparse.ArgumentTypeError(f"{text!r} is not a finite number ({unit})")
+        return value
+    return parse
+
+
+def _simulate_parser():
+    from . import simulation, tyres
+    p = _OneLineParser(
+        prog="simulate",
+        description="Kick-plate test on the nonlinear Carvallo-Whipple bicycle-rider model with "
+                    "Magic-Formula tyres (Dell'Orto 2025, Chapter 8): steady running, then the plate "
+                    "under the rear wheel jumps sideways; an LQR steer-torque rider recovers or the "
+                    "bicycle falls. Writes trajectory.csv, summary.json and response.png.",
+        epilog="Time is measured from the kick start. Defaults are the thesis' settings: "
+               "balanceassist_v1 + Yeadon rider for 635 N on the rear tyre, T03 at 400 kPa, 3 m/s, "
+               "LQR designed at 3 m/s, 150 mm kick in 0.150 s (13.3 m/s^2), 6 s. See docs/simulate.md.")
+    g = p.add_argument_group("tyres")
+    g.add_argument("--pressure", type=_number("kPa"), metavar="KPA",
+                   help="inflation pressure of both tyres in kPa (default 400)")
+    g.add_argument("--pressure-front", type=_number("kPa"), metavar="KPA",
+                   help="front tyre pressure in kPa (with --pressure-rear, instead of --pressure)")
+    g.add_argument("--pressure-rear", type=_number("kPa"), metavar="KPA",
+                   help="rear tyre pressure in kPa (with --pressure-front, instead of --pressure)")
+    g.add_argument("--tyre", default="T03", metavar="NAME",
+                   help="tyre on both wheels (default T03; available: %s)" % ", ".join(t[0] for t in tyres.available()))
+    g.add_argument("--coefficient-set", default="table7_9", metavar="SET",
+                   help="Magic-Formula coefficients: table7_9 (default, thesis Table 7.9) or chapter8 "
+                        "(T03 only: the fit the thesis' Chapter 8 code used)")
+    g.add_argument("--friction", choices=tyres.FRICTION_MODES, default="none",
+                   help="friction correction rig -> plate: none (default), plate (peak x 1.30), "
+                        "thesis (whole curves x 1.32, as the thesis' code)")
+    g.add_argument("--symmetric-tyres", action="store_true",
+                   help="zero the tyres' zero-slip offsets (exactly upright steady running)")
+    g = p.add_argument_group("bicycle and rider")
+    g.add_argument("--bicycle", default="balanceassist_v1", metavar="NAME",
+                   help="bicycle parameter set or .toml path (default balanceassist_v1; presets "
+                        "with the rider included: balanceassist_635N, balanceassist_701N, browser_with_rider)")
+    who = g.add_mutually_exclusive_group()
+    who.add_argument("--fz", type=_number("N"), metavar="N",
+                     help="static rear-tyre load in N that the rider's mass is chosen for (default 635)")
+    who.add_argument("--rider-mass", type=_number("kg"), metavar="KG", help="rider mass in kg")
+    g.add_argument("--low-inertia", action="store_true",
+                   help="halve the rear frame's inertias and mass-centre height (thesis Figure 8.9)")
+    g = p.add_argument_group("riding and control")
+    g.add_argument("--speed", type=_number("m/s"), default=3.0, metavar="M/S",
+                   help="forward speed in m/s (default 3)")
+    g.add_argument("--controller", choices=simulation.CONTROLLERS, default="lqr",
+                   help="lqr: designed on the linearised classic model (default); thesis: Table 8.4 "
+                        "gains (570, 635, 701 N only); off: no steer torque")
+    g.add_argument("--design-speed", type=_number("m/s"), default=3.0, metavar="M/S",
+                   help="LQR design speed in m/s (default 3)")
+    g.add_argument("--gain-scale", type=_number("factor"), default=1.0, metavar="FACTOR",
+                   help="multiply every controller gain (default 1; the thesis also ran 0.5)")
+    g = p.add_argument_group("kick")
+    how = g.add_mutually_exclusive_group()
+    how.add_argument("--kick-accel", type=_number("m/s^2"), metavar="M/S2",
+                     help="peak plate acceleration in m/s^2 (sets the duration)")
+    how.add_argument("--kick-duration", type=_number("s"), metavar="S",
+                     help="plate travel time in s (default 0.150)")
+    g.add_argument("--kick-displacement", type=_number("m"), default=0.150, metavar="M",
+                   help="plate travel in m (default 0.150)")
+    g.add_argument("--kick-profile", choices=tuple(simulation.KICK_PROFILES), default="constant",
+                   help="constant acceleration (default, thesis) or smooth (minimum jerk)")
+    g.add_argument("--kick-direction", choices=simulation.DIRECTIONS, default="right",
+                   help="direction the plate moves (default right)")
+    g = p.add_argument_group("run and output")
+    g.add_argument("--duration", type=_number("s"), default=6.0, metavar="S",
+                   help="simulated time after the kick start in s (default 6)")
+    g.add_argument("--settle", type=_number("s"), default=0.5, metavar="S",
+                   help="steady running shown before the kick in s (default 0.5)")
+    g.add_argument("--rtol", type=_number("relative"), default=1e-10, metavar="RTOL",
+                   help="LSODA relative tolerance (default 1e-10; the thesis used 1e-12)")
+    g.add_argument("--out", metavar="DIR",
+                   help="output folder (default: a new folder under the current directory)")
+    g.add_argument("--force", action="store_true",
+                   help="write into an existing non-empty output folder, overwriting the three files")
+    g.add_argument("--no-plot", action="store_true", help="do not write response.png")
+    g.add_argument("--quiet", action="store_true", help="print nothing on success")
+    return p
+
+
+def _scenario_from_args(args):
+    from .simulation import Scenario
+    fronts = (args.pressure_front, args.pressure_rear)
+    if args.pressure is not None and any(v is not None for v in fronts):
+        raise InputError("--pressure sets both tyres; do not combine it with --pressure-front/--pressure-rear")
+    if (fronts[0] is None) != (fronts[1] is None):
+        raise InputError("give both --pressure-front KPA and --pressure-rear KPA (or --pressure KPA for both)")
+    return Scenario(
+        bicycle=args.bicycle, fz_n=args.fz, rider_mass_kg=args.rider_mass, tyre=args.tyre,
+        pressure_kpa=400.0 if args.pressure is None else args.pressure,
+        pressure_front_kpa=args.pressure_front, pressure_rear_kpa=args.pressure_rear,
+        coefficient_set=args.coefficient_set, friction=args.friction,
+        symmetric_tyres=args.symmetric_tyres, speed=args.speed, controller=args.controller,
+        design_speed=args.design_speed, gain_scale=args.gain_scale, low_inertia=args.low_inertia,
+        kick_displacement=args.kick_displacement, kick_duration=args.kick_duration,
+        kick_accel=args.kick_accel, kick_profile=args.kick_profile,
+        kick_direction=args.kick_direction, settle=args.settle, duration=args.duration, rtol=args.rtol,
+    )
+
+
+_OUTPUT_FILES = ("trajectory.csv", "summary.json", "response.png")
+
+
+def _default_out(scenario):
+    """A new folder name under the current directory (never an existing one)."""
+    import datetime
+    import pathlib
+    rear, front = scenario.pressures
+    p = f"{rear:g}kPa" if rear == front else f"{rear:g}-{front:g}kPa"
+    load = f"_{scenario.fz_n:g}N" if scenario.fz_n is not None else ""
+    stamp = datetime.datetime.now().strftime("%Y%m%d-%H%M%S")
+    base = pathlib.Path.cwd() / f"kick_{scenario.tyre}_{p}{load}_{stamp}"
+    out, k = base, 1
+    while out.exists():
+        k += 1
+        out = base.with_name(f"{base.name}-{k}")
+    return out
+
+
+def _prepare_out(path, force):
+    """Create/check the output folder before the (longer) run. Returns (path, created)."""
+    import os
+    import pathlib
+    out = pathlib.Path(path)
+    if out.exists() and not out.is_dir():
+        raise InputError(f"output folder {str(out)!r} exists and is not a folder")
+    if out.is_dir() and any(out.iterdir()) and not force:
+        raise InputError(f"output folder {str(out)!r} exists and is not empty; "
+                         "use --force to overwrite its files or choose another --out")
+    created = not out.exists()
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        probe = out / f".simulate-probe-{os.getpid()}"
+        probe.write_text("")
+        probe.unlink()
+    except OSError as exc:
+        raise InputError(f"output folder {str(out)!r} is not writable: {exc.strerror or exc}") from None
+    return out, created
+
+
+def _print_summary(result, out, files):
+    s = result.summary
+    sc, bike, ctl, kick, st = s["scenario"], s["bicycle"], s["controller"], s["kick"], s["steady_state"]
+    deg = 180.0 / np.pi
+    rider = f" (rider {bike['rider_mass_kg']:.1f} kg)" if bike["rider_mass_kg"] is not None else " (preset with rider)"
+    gains = ", ".join(f"{k}={v:.4g}" for k, v in ctl["gains"].items())
+    print(f"simulate: {sc['tyre']} {s['tyres']['pressure_rear_kpa']:g}/{s['tyres']['pressure_front_kpa']:g} kPa "
+          f"rear/front ({sc['coefficient_set']}, friction {sc['friction']}), {bike['bicycle']}, rear load "
+          f"{bike['static_load_rear_n']:.1f} N{rider}, {sc['speed']:g} m/s")
+    print(f"  controller {ctl['type']} x{ctl['gain_scale']:g}: {gains}")
+    print(f"  kick: {abs(kick['displacement_m']) * 1e3:.0f} mm {kick['direction']} in {kick['duration_s']:.3f} s "
+          f"(peak {kick['peak_acceleration_m_s2']:.1f} m/s^2, {kick['profile']} profile) at t = 0 s")
+    print(f"  steady state: roll {st['roll_rad'] * deg:.2f} deg, steer {st['steer_rad'] * deg:.2f} deg, "
+          f"yaw rate {st['yaw_rate_rad_s']:.4f} rad/s, drive torque {st['drive_torque_n_m']:.4f} N m")
+    if s["fell"]:
+        print(f"  result: FELL (|roll| reached {sc['fall_angle_deg']:g} deg) {s['fall_time_s']:.3f} s after the kick start")
+    else:
+        print(f"  result: no fall in {sc['duration']:g} s")
+    m, rec = s["metrics"], s["recovery"]
+    if m["peak_values"]:
+        print(f"  yaw rate: first peak {m['peak_values'][0]:+.3f} rad/s (from steady) at {m['peak_times'][0]:.3f} s; "
+              + (f"within 5 % of it from {rec['time_s']:.3f} s on" if rec["time_s"] is not None
+                 else f"not recovered to 5 % ({rec['reason']})"))
+    pk = s["peaks"]
+    print(f"  peaks: |roll rate| {pk['max_abs_roll_rate']:.3f} rad/s, |steer rate| {pk['max_abs_steer_rate']:.3f} rad/s, "
+          f"|Fy rear| {pk['max_abs_fy_rear']:.0f} N, |slip rear| {pk['max_abs_slip_rear'] * deg:.1f} deg")
+    n = s["numerics"]
+    print(f"  numerics: LSODA rtol {n['rtol']:g}, {n['nfev']} evaluations, integration {n['integration_wall_s']:.2f} s, "
+          f"run {n['wall_s']:.2f} s")
+    print(f"  wrote {', '.join(files)} in {out}")
+
+
+def _simulate(argv):
+    import json
+    import shutil
+    from . import simulation
+    args = _simulate_parser().parse_args(argv)
+    scenario = _scenario_from_args(args)
+    scenario.validate()
+    out, created = _prepare_out(args.out if args.out else _default_out(scenario), args.force)
+    try:
+        result = simulation.run(scenario)
+    except (InputError, simulation.SimulationError):
+        if created and not any(out.iterdir()):
+            shutil.rmtree(out, ignore_errors=True)
+        raise
+    files = ["trajectory.csv", "summary.json"]
+    result.trajectory.to_csv(out / "trajectory.csv", index=False, float_format="%.12g")
+    (out / "summary.json").write_text(json.dumps(result.summary, indent=2, allow_nan=False) + "\n")
+    if not args.no_plot:
+        from . import plotting
+        k = result.summary["kick"]
+        plotting.response_figure([("", result)], out / "response.png", title=plotting.result_title(result),
+                                 kick=(k["start_s"], k["start_s"] + k["duration_s"]))
+        files.append("response.png")
+    if not args.quiet:
+        _print_summary(result, out, files)
+    return 0
+
+
+def simulate_main(argv=None):
+    """Console script ``simulate``: one kick-plate run (see ``simulate --help``)."""
+    from .simulation import SimulationError
+    try:
+        status = _run(_simulate, argv)
+    except SimulationError as exc:
+        print(f"simulate: numerical failure: {exc}", file=sys.stderr)
+        status = 1
+    except OSError as exc:
+        print(f"simulate: cannot write the results: {exc}", file=sys.stderr)
+        status = 2
+    sys.exit(status)

@@ -1,0 +1,561 @@
+"""One kick-plate run end to end: scenario in, time histories and summary out.
+
+A :class:`Scenario` describes one run of the thesis' kick-plate test
+(Dell'Orto 2025, Sections 8.3-8.4) with the thesis' settings as defaults;
+:func:`run` builds the bicycle with rider, the tyres and the controller,
+finds the steady motion, integrates the compiled slip model piecewise across
+the kick and returns a :class:`Result` (a pandas DataFrame of the time
+histories and a JSON-ready summary).
+
+Time is measured from the start of the kick: the run starts at
+``-settle`` (steady running shown before the kick) and ends at
+``duration`` (or at the fall). docs/simulate.md lists every decision.
+"""
+from dataclasses import asdict, dataclass, field, replace
+import math
+import pathlib
+import time
+
+import numpy as np
+
+from .errors import InputError, check_range
+
+#: Kick-plate profiles the compiled model can represent (its ``kick_profile`` parameter).
+KICK_PROFILES = {"constant": 0, "smooth": 1}
+#: Peak |acceleration| of each profile as a multiple of displacement/duration^2:
+#: constant acceleration 2 D/T^2; minimum-jerk quintic 10/sqrt(3) D/T^2 (at s = 0.2113).
+PEAK_ACCEL_FACTOR = {"constant": 2.0, "smooth": 10.0 / math.sqrt(3.0)}
+CONTROLLERS = ("lqr", "thesis", "off")
+DIRECTIONS = ("right", "left")
+#: Rear-frame entries halved by the "low inertia" variant (thesis Figure 8.9).
+LOW_INERTIA_KEYS = ("IBxx", "IByy", "IBzz", "IBxz", "zB")
+#: Recovery criterion of issue 6: |yaw rate - steady| within this fraction of the first peak.
+RECOVERY_FRACTION = 0.05
+
+# Moore's coordinates and speeds, named for the trajectory table.
+_COORDINATE_COLUMNS = {
+    "q1": ("x_rear", "m"), "q2": ("y_rear", "m"), "q3": ("yaw", "rad"), "q4": ("roll", "rad"),
+    "q5": ("pitch", "rad"), "q6": ("rear_wheel_angle", "rad"), "q7": ("steer", "rad"),
+    "q8": ("front_wheel_angle", "rad"), "q9": ("compression_rear", "m"),
+    "q10": ("compression_front", "m"),
+}
+_SPEED_COLUMNS = {
+    "u1": ("u1", "m/s"), "u2": ("u2", "m/s"), "u3": ("yaw_rate", "rad/s"), "u4": ("roll_rate", "rad/s"),
+    "u5": ("pitch_rate", "rad/s"), "u6": ("rear_wheel_rate", "rad/s"), "u7": ("steer_rate", "rad/s"),
+    "u8": ("front_wheel_rate", "rad/s"), "u9": ("compression_rate_rear", "m/s"),
+    "u10": ("compression_rate_front", "m/s"),
+}
+# Named outputs of the compiled model: output name -> (column, unit).
+_OUTPUT_COLUMNS = {
+    "slip_r": ("slip_rear", "rad"), "slip_f": ("slip_front", "rad"),
+    "camber_r": ("camber_rear", "rad"), "camber_f": ("camber_front", "rad"),
+    "vx_r": ("rolling_speed_rear", "m/s"), "vx_f": ("rolling_speed_front", "m/s"),
+    "fz_r": ("fz_rear", "N"), "fz_f": ("fz_front", "N"),
+    "fy_ss_r": ("fy_steady_rear", "N"), "fy_ss_f": ("fy_steady_front", "N"),
+    "mz_ss_r": ("mz_steady_rear", "N m"), "mz_ss_f": ("mz_steady_front", "N m"),
+    "T7": ("steer_torque", "N m"),
+    "yp": ("plate_y", "m"), "vp": ("plate_velocity", "m/s"), "ap": ("plate_acceleration", "m/s^2"),
+    "kinetic_energy": ("kinetic_energy", "J"), "potential_energy": ("potential_energy", "J"),
+    "spring_energy": ("spring_energy", "J"), "sliding_power": ("sliding_power", "W"),
+    "holonomic": ("holonomic_residual", "m"),
+}
+# Relaxed tyre-force states (what acts on the bicycle).
+_TYRE_STATE_COLUMNS = {
+    "fyr": ("fy_rear", "N"), "fyf": ("fy_front", "N"), "mzr": ("mz_rear", "N m"), "mzf": ("mz_front", "N m"),
+}
+#: Unit of every trajectory column.
+UNITS = {"time": "s", **{c: u for c, u in _COORDINATE_COLUMNS.values()},
+         **{c: u for c, u in _SPEED_COLUMNS.values()},
+         **{c: u for c, u in _TYRE_STATE_COLUMNS.values()},
+         **{c: u for c, u in _OUTPUT_COLUMNS.values()}}
+
+
+class SimulationError(RuntimeError):
+    """The integration failed numerically (not a user mistake)."""
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """One kick-plate run; the defaults are the thesis' simulation settings.
+
+    Units are SI except pressures [kPa]. ``None`` means "the default rule"
+    described per field.
+
+    Attributes
+    ----------
+    bicycle : str
+        Bicycle parameter set (:func:`whipple_kick.bicycles.available`) or a
+        path. A set without rider gets the Yeadon rider seated; a preset with
+        the rider included is used as it is (then ``fz_n`` and
+        ``rider_mass_kg`` must be None).
+    fz_n, rider_mass_kg : float or None
+        Static rear-tyre load [N] the rider's mass is chosen for, or the
+        rider's mass [kg]; at most one. Default 635 N for a bicycle without rider.
+    rider : str
+        Yeadon rider file.
+    tyre : str
+        Tyre on both wheels (default T03, the kick-plate bicycle's tyre).
+    pressure_kpa : float
+        Inflation pressure of both tyres [kPa], unless overridden per wheel by
+        ``pressure_front_kpa`` / ``pressure_rear_kpa``.
+    coefficient_set : str
+        Magic-Formula coefficient set (``"table7_9"`` or, T03 only, ``"chapter8"``,
+        the fit the thesis' Chapter 8 code used).
+    friction : {"none", "plate", "thesis"}
+        Friction mode of both tyres (:data:`whipple_kick.tyres.FRICTION_MODES`).
+    symmetric_tyres : bool
+        Zero the tyres' zero-slip offsets, so the steady motion is exactly upright.
+    speed : float
+        Forward speed [m/s] of the steady motion before the kick.
+    controller : {"lqr", "thesis", "off"}
+        LQR designed on the linearised classic model at ``design_speed``;
+        the thesis' Table 8.4 gains (for 570/635/701 N); or no steer torque.
+    design_speed : float
+        LQR design speed [m/s] (thesis: 3 m/s).
+    gain_scale : float
+        Multiplies every controller gain (thesis Figure 8.7: 0.5).
+    thesis_load_n : float or None
+        Rear load [N] whose Table 8.4 gains ``controller="thesis"`` uses;
+        default ``fz_n`` (needed for presets that already include the rider).
+    low_inertia : bool
+        Halve the rear frame's IBxx, IByy, IBzz, IBxz and mass-centre height zB
+        (thesis Figure 8.9). The LQR is still designed on the unmodified
+        bicycle (the rider's controller does not change, the plant does).
+    kick_displacement : float
+        Plate travel [m] (>= 0; direction by ``kick_direction``).
+    kick_duration, kick_accel : float or None
+        Plate travel time [s] or peak plate acceleration [m/s^2]; at most
+        one. Default 0.150 s (13.3 m/s^2 for the thesis' 0.150 m).
+    kick_profile : {"constant", "smooth"}
+        Constant acceleration (thesis) or minimum-jerk quintic (finite jerk).
+    kick_direction : {"right", "left"}
+        Plate moves to the bicycle's right (+y) or left.
+    settle : float
+        Steady running shown before the kick [s].
+    duration : float
+        Simulated time after the kick starts [s].
+    rtol : float
+        LSODA relative tolerance (thesis 1e-12).
+    output_rate : float
+        Samples per second of the trajectory [Hz].
+    fall_angle_deg : float
+        |roll| [deg] that counts as a fall and ends the run.
+    piecewise : bool
+        Restart the integrator at the kick's start and end (default). False
+        integrates across them in one piece (for comparison only).
+    """
+
+    bicycle: str = "balanceassist_v1"
+    fz_n: float | None = None
+    rider_mass_kg: float | None = None
+    rider: str = "jason"
+    tyre: str = "T03"
+    pressure_kpa: float = 400.0
+    pressure_front_kpa: float | None = None
+    pressure_rear_kpa: float | None = None
+    coefficient_set: str = "table7_9"
+    friction: str = "none"
+    symmetric_tyres: bool = False
+    speed: float = 3.0
+    controller: str = "lqr"
+    design_speed: float = 3.0
+    gain_scale: float = 1.0
+    thesis_load_n: float | None = None
+    low_inertia: bool = False
+    kick_displacement: float = 0.150
+    kick_duration: float | None = None
+    kick_accel: float | None = None
+    kick_profile: str = "constant"
+    kick_direction: str = "right"
+    settle: float = 0.5
+    duration: float = 6.0
+    rtol: float = 1e-10
+    output_rate: float = 1000.0
+    fall_angle_deg: float = 45.0
+    piecewise: bool = True
+
+    @classmethod
+    def thesis(cls, pressure_kpa=400.0, **changes):
+        """The Chapter 8 runs as the authors' code made them.
+
+        Bicycle+rider preset ``balanceassist_635N``, Table 8.4 gains for
+        635 N, T03 with the ``chapter8`` coefficients and the ``thesis``
+        friction mode, LSODA rtol 1e-12. ``changes`` override any field.
+        """
+        base = dict(bicycle="balanceassist_635N", controller="thesis", thesis_load_n=635.0,
+                    coefficient_set="chapter8", friction="thesis", rtol=1e-12,
+                    pressure_kpa=pressure_kpa)
+        base.update(changes)
+        return cls(**base)
+
+    # ------------------------------------------------------------ derived values
+
+    @property
+    def pressures(self):
+        """(rear, front) pressures [kPa]."""
+        rear = self.pressure_kpa if self.pressure_rear_kpa is None else self.pressure_rear_kpa
+        front = self.pressure_kpa if self.pressure_front_kpa is None else self.pressure_front_kpa
+        return rear, front
+
+    def kick_timing(self):
+        """(duration [s], peak |acceleration| [m/s^2], signed displacement [m]) of the kick."""
+        if self.kick_profile not in KICK_PROFILES:
+            if str(self.kick_profile).lower() in ("table", "tabulated", "csv") or str(self.kick_profile).endswith(".csv"):
+                raise InputError(
+                    "kick profile 'table' is not supported: the compiled slip model takes the plate "
+                    "motion only as (start, duration, displacement, profile constant|smooth); "
+                    "choose kick_profile constant or smooth")
+            raise InputError(f"kick profile {self.kick_profile!r} is unknown; choose one of "
+                             f"{', '.join(KICK_PROFILES)}")
+        if self.kick_direction not in DIRECTIONS:
+            raise InputError(f"kick direction {self.kick_direction!r} is unknown; choose right or left")
+        disp = check_range("kick displacement", self.kick_displacement, 0.0, 1.0, "m")
+        factor = PEAK_ACCEL_FACTOR[self.kick_profile]
+        if self.kick_duration is not None and self.kick_accel is not None:
+            raise InputError("give the kick's duration (s) or its peak acceleration (m/s^2), not both")
+        if self.kick_accel is not None:
+            accel = check_range("kick peak acceleration", self.kick_accel, 0.0, 1000.0, "m/s^2", low_open=True)
+            if disp == 0.0:
+                raise InputError("a kick acceleration needs a kick displacement > 0 m")
+            dur = math.sqrt(factor * disp / accel)
+        else:
+            dur = 0.150 if self.kick_duration is None else self.kick_duration
+            dur = check_range("kick duration", dur, 0.0, 10.0, "s", low_open=True)
+            accel = factor * disp / dur**2
+        if dur > self.duration:
+            raise InputError(f"kick duration = {dur:g} s is longer than the run duration "
+                             f"{self.duration:g} s; allowed (0, {self.duration:g}] s")
+        sign = 1.0 if self.kick_direction == "right" else -1.0
+        return dur, accel, sign * disp
+
+    def validate(self):
+        """Check every field; raise :class:`InputError` naming value, range and unit."""
+        check_range("speed", self.speed, 0.0, 15.0, "m/s", low_open=True)
+        check_range("design speed", self.design_speed, 0.0, 15.0, "m/s", low_open=True)
+        check_range("duration", self.duration, 0.0, 120.0, "s", low_open=True)
+        check_range("settle time", self.settle, 0.0, 60.0, "s")
+        check_range("rtol", self.rtol, 1e-14, 1e-3, "(relative)")
+        check_range("output rate", self.output_rate, 1.0, 1e5, "Hz")
+        check_range("fall angle", self.fall_angle_deg, 0.0, 90.0, "deg", low_open=True, high_open=True)
+        check_range("gain scale", self.gain_scale, 0.0, 10.0, "(factor)")
+        if self.controller not in CONTROLLERS:
+            raise InputError(f"controller {self.controller!r} is unknown; choose one of {', '.join(CONTROLLERS)}")
+        if self.controller == "off" and self.gain_scale != 1.0:
+            raise InputError(f"gain scale = {self.gain_scale:g} conflicts with controller off "
+                             "(there are no gains to scale)")
+        if self.fz_n is not None and self.rider_mass_kg is not None:
+            raise InputError("give the rear-tyre load fz (N) or the rider mass (kg), not both")
+        if self.fz_n is not None:
+            check_range("rear-tyre load fz", self.fz_n, 0.0, None, "N", low_open=True)
+        for name, p in (("pressure", self.pressure_kpa), ("front pressure", self.pressure_front_kpa),
+                        ("rear pressure", self.pressure_rear_kpa)):
+            if p is not None:
+                check_range(name, p, 0.0, None, "kPa", low_open=True)
+        self.kick_timing()
+        return self
+
+    def to_dict(self):
+        """Fields as a plain dict (JSON-ready)."""
+        return asdict(self)
+
+
+@dataclass
+class Result:
+    """Outcome of :func:`run`.
+
+    Attributes
+    ----------
+    scenario : Scenario
+    trajectory : pandas.DataFrame
+        Time histories, columns named as in :data:`UNITS` (time from the kick start).
+    summary : dict
+        JSON-ready summary (no NaN): outcome, model set-up, steady state,
+        peaks, recovery metrics, numerics.
+    """
+
+    scenario: Scenario
+    trajectory: "object"
+    summary: dict = field(default_factory=dict)
+
+
+# ------------------------------------------------------------------ model set-up
+
+def build_bicycle(scenario):
+    """Bicycle with rider for ``scenario``: (moore parameters, info dict).
+
+    The info holds the rider mass [kg] and the static loads [N] of the
+    unmodified bicycle; ``moore`` has the low-inertia change applied if asked.
+    ``design`` (also in info) is the unmodified set the LQR is designed on.
+    """
+    from . import benchmark, bicycles, riders
+
+    bike = bicycles.load(scenario.bicycle)
+    if bike.includes_rider:
+        if scenario.fz_n is not None or scenario.rider_mass_kg is not None:
+            raise InputError(f"bicycle {bike.name!r} already includes its rider; "
+                             "do not give a rear-tyre load fz or a rider mass with it")
+        combined, rider_mass = bike, None
+    elif scenario.rider_mass_kg is not None:
+        rider = riders.yeadon_rider(scenario.rider, mass_kg=scenario.rider_mass_kg)
+        combined, rider_mass = riders.seat(bike, rider), float(scenario.rider_mass_kg)
+    else:
+        fz = 635.0 if scenario.fz_n is None else scenario.fz_n
+        combined, rider_mass = riders.for_rear_load(bike, fz, rider=scenario.rider)
+    rear_n, front_n = riders.static_loads(combined)
+    design = dict(combined.moore)
+    moore = dict(design)
+    if scenario.low_inertia:
+        bench = dict(combined.benchmark)
+        for key in LOW_INERTIA_KEYS:
+            bench[key] *= 0.5
+        moore = benchmark.to_moore(bench)
+    info = {"bicycle": bike.name, "includes_rider_preset": bike.includes_rider,
+            "rider_mass_kg": rider_mass, "static_load_rear_n": rear_n, "static_load_front_n": front_n,
+            "total_mass_kg": sum(float(combined.benchmark[k]) for k in ("mR", "mB", "mH", "mF"))}
+    return moore, design, info
+
+
+def controller_gains(scenario, design):
+    """Steer-torque gains by name and the closed-loop poles of the linear design (or None)."""
+    from . import control
+
+    if scenario.controller == "off":
+        return {k: 0.0 for k in control.GAIN_ORDER}, None
+    if scenario.controller == "thesis":
+        load = scenario.thesis_load_n if scenario.thesis_load_n is not None else scenario.fz_n
+        if load is None:
+            if scenario.rider_mass_kg is None and not _includes_rider(scenario):
+                load = 635.0
+            else:
+                raise InputError("controller thesis uses Table 8.4 gains for a rear load of 570, 635 or "
+                                 "701 N: give fz (N) (or thesis_load_n for a preset with rider)")
+        gains = control.thesis_gains(load)
+        return {k: scenario.gain_scale * v for k, v in gains.items()}, None
+    K, poles = control.lqr_gains(design, scenario.design_speed)
+    return control.gains_dict(K, scenario.gain_scale), np.asarray(poles)
+
+
+def _includes_rider(scenario):
+    from . import bicycles
+    return bicycles.load(scenario.bicycle).includes_rider
+
+
+def build_tyres(scenario):
+    """(rear, front) tyres and a list of notes about them."""
+    from . import tyres
+
+    notes = []
+    rear_p, front_p = scenario.pressures
+    loaded = []
+    for p in (rear_p, front_p):
+        try:
+            loaded.append(tyres.load(scenario.tyre, p, coefficient_set=scenario.coefficient_set,
+                                     friction=scenario.friction, missing_moment="error"))
+        except InputError as exc:
+            # Tyres without published M_z data: run with M_z = 0 and say so.
+            if "moment" not in str(exc).lower() and "m_z" not in str(exc).lower():
+                raise
+            loaded.append(tyres.load(scenario.tyre, p, coefficient_set=scenario.coefficient_set,
+                                     friction=scenario.friction, missing_moment="zero"))
+            note = f"{scenario.tyre} has no published aligning-moment data: M_z = 0"
+            if note not in notes:
+                notes.append(note)
+    return loaded[0], loaded[1], notes
+
+
+# -------------------------------------------------------------------- running
+
+def _trajectory_frame(rhs, traj):
+    """DataFrame of states and named outputs at every sample."""
+    import pandas as pd
+    from . import slip
+
+    n = traj.t.size
+    outs = np.empty((n, len(slip.OUTPUT_NAMES)))
+    for i in range(n):
+        _, outs[i] = rhs.outputs(traj.t[i], traj.x[i])
+    cols = {"time": traj.t}
+    for q, (name, _) in _COORDINATE_COLUMNS.items():
+        cols[name] = traj.x[:, slip.X[q]]
+    for u, (name, _) in _SPEED_COLUMNS.items():
+        cols[name] = outs[:, slip.OUT[u]]   # includes the dependent speeds u5 u6 u8
+    for s, (name, _) in _TYRE_STATE_COLUMNS.items():
+        cols[name] = traj.x[:, slip.X[s]]
+    for o, (name, _) in _OUTPUT_COLUMNS.items():
+        cols[name] = outs[:, slip.OUT[o]]
+    return pd.DataFrame(cols)
+
+
+def _recovery(df, baseline, first_peak):
+    """Time after the kick from which |yaw rate - baseline| stays within 5 % of the first peak.
+
+    Returns (time or None, reason or None).
+    """
+    t = df["time"].to_numpy()
+    dev = np.abs(df["yaw_rate"].to_numpy() - baseline)
+    after = t >= 0.0
+    if first_peak is None or first_peak <= 0.0:
+        return None, "no yaw-rate peak after the kick"
+    outside = np.flatnonzero(after & (dev > RECOVERY_FRACTION * first_peak))
+    if outside.size == 0:
+        return 0.0, None
+    j = outside[-1]
+    if j == t.size - 1:
+        return None, (f"yaw rate still outside {RECOVERY_FRACTION:.0%} of its first peak "
+                      f"at the end of the run (t = {t[-1]:.3f} s)")
+    return float(t[j + 1]), None
+
+
+def _clean(value):
+    """JSON-ready copy: numpy scalars/arrays to Python, NaN/inf refused."""
+    if isinstance(value, dict):
+        return {str(k): _clean(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return [_clean(v) for v in value]
+    if isinstance(value, (np.bool_, bool)):
+        return bool(value)
+    if isinstance(value, (np.integer, int)):
+        return int(value)
+    if isinstance(value, (np.floating, float)):
+        v = float(value)
+        if not math.isfinite(v):
+            raise SimulationError(f"non-finite value {v} in the summary")
+        return v
+    if isinstance(value, complex):
+        return [_clean(value.real), _clean(value.imag)]
+    return value
+
+
+def model_hash():
+    """Content hash of the compiled slip model in use (from its library file name)."""
+    from . import slip
+    return pathlib.Path(slip.library()._name).stem
+
+
+def run(scenario):
+    """Run one kick-plate simulation.
+
+    Parameters
+    ----------
+    scenario : Scenario
+
+    Returns
+    -------
+    Result
+
+    Raises
+    ------
+    InputError
+        A field is out of range, unknown or conflicting.
+    SimulationError
+        The integration failed numerically (never NaN in a result).
+    """
+    from . import analysis, integrate, slip
+
+    wall0 = time.perf_counter()
+    scenario.validate()
+    kick_T, kick_accel, kick_D = scenario.kick_timing()
+    moore, design, info = build_bicycle(scenario)
+    gains, poles = controller_gains(scenario, design)
+    rear, front, notes = build_tyres(scenario)
+    params = slip.model_parameters(
+        moore, rear, front, gains=gains, symmetric=scenario.symmetric_tyres,
+        kick=dict(t0=0.0, duration=kick_T, displacement=kick_D, profile=KICK_PROFILES[scenario.kick_profile]))
+    try:
+        steady = slip.steady_state(params, scenario.speed)
+    except FloatingPointError as exc:
+        raise SimulationError(f"no steady motion at {scenario.speed:g} m/s: {exc}") from None
+    rhs = slip.CompiledRHS(steady.params)
+    breakpoints = (0.0, kick_T) if scenario.piecewise else ()
+    t_int = time.perf_counter()
+    try:
+        traj = integrate.integrate(rhs, steady.x, scenario.duration, t_start=-scenario.settle,
+                                   breakpoints=breakpoints, rtol=scenario.rtol,
+                                   output_rate=scenario.output_rate,
+                                   fall_angle=math.radians(scenario.fall_angle_deg))
+    except FloatingPointError as exc:
+        raise SimulationError(f"integration failed: {exc}") from None
+    integration_s = time.perf_counter() - t_int
+    if traj.message.startswith("integration failed"):
+        raise SimulationError(traj.message)
+    df = _trajectory_frame(rhs, traj)
+    if not np.all(np.isfinite(df.to_numpy())):
+        raise SimulationError("non-finite values in the trajectory")
+
+    x0 = steady.x
+    baseline = float(x0[slip.X["u3"]])
+    metrics = analysis.kick_metrics(df, t_kick=0.0, baseline=baseline, include_spectra=False,
+                                    fall_roll=math.radians(scenario.fall_angle_deg))
+    # The integrator's event is exact; kick_metrics sees |roll| only up to the limit.
+    metrics["fell"] = bool(traj.fell)
+    metrics["fall_time"] = traj.fall_time
+    if traj.fell:
+        metrics["unavailable"].pop("fall_time", None)
+    after = df["time"].to_numpy() >= 0.0
+    dev = np.abs(df["yaw_rate"].to_numpy()[after] - baseline)
+    # kick_metrics' peak values are already measured from the baseline.
+    first_peak = abs(metrics["peak_values"][0]) if metrics["peak_values"] else (
+        float(dev.max()) if dev.size else None)
+    rec, rec_reason = _recovery(df, baseline, first_peak)
+    if traj.fell:
+        rec, rec_reason = None, "fell"
+
+    summary = {
+        "fell": bool(traj.fell),
+        "fall_time_s": traj.fall_time,
+        "end_time_s": float(df["time"].iloc[-1]),
+        "message": traj.message,
+        "bicycle": info,
+        "tyres": {
+            "name": scenario.tyre, "coefficient_set": scenario.coefficient_set,
+            "friction": scenario.friction, "symmetric": scenario.symmetric_tyres,
+            "pressure_rear_kpa": scenario.pressures[0], "pressure_front_kpa": scenario.pressures[1],
+            "notes": notes,
+        },
+        "controller": {
+            "type": scenario.controller, "gain_scale": scenario.gain_scale,
+            "design_speed_m_s": scenario.design_speed if scenario.controller == "lqr" else None,
+            "gains": gains,
+            "gain_units": {"kq4": "N m/rad", "kq7": "N m/rad", "ku4": "N m s/rad", "ku7": "N m s/rad"},
+            "law": "T7 = -(kq4 q4 + kq7 q7 + ku4 u4 + ku7 u7)",
+            "linear_closed_loop_poles": None if poles is None else [[p.real, p.imag] for p in poles],
+        },
+        "kick": {"start_s": 0.0, "duration_s": kick_T, "displacement_m": kick_D,
+                 "peak_acceleration_m_s2": kick_accel, "profile": scenario.kick_profile,
+                 "direction": scenario.kick_direction},
+        "steady_state": {
+            "speed_m_s": scenario.speed,
+            "roll_rad": float(x0[slip.X["q4"]]), "steer_rad": float(x0[slip.X["q7"]]),
+            "pitch_rad": float(x0[slip.X["q5"]]), "yaw_rate_rad_s": baseline,
+            "lateral_drift_m_s": float(x0[slip.X["u2"]]),
+            "compression_rear_m": float(x0[slip.X["q9"]]), "compression_front_m": float(x0[slip.X["q10"]]),
+            "drive_torque_n_m": float(steady.params["T6c"]),
+            "residual": float(steady.residual),
+        },
+        "peaks": {f"max_abs_{name}": float(np.max(np.abs(df[name].to_numpy()[after])))
+                  for name in ("yaw_rate", "roll_rate", "steer_rate", "roll", "steer", "slip_rear",
+                               "fy_rear", "fy_front", "steer_torque")},
+        "recovery": {
+            "criterion": f"|yaw rate - steady| <= {RECOVERY_FRACTION:.0%} of the first peak until the end",
+            "first_peak_rad_s": first_peak,
+            "time_s": rec, "reason": rec_reason,
+        },
+        "metrics": {k: v for k, v in metrics.items() if k != "unavailable"},
+        "metrics_unavailable": metrics["unavailable"],
+        "numerics": {
+            "method": "LSODA", "rtol": scenario.rtol, "piecewise": scenario.piecewise,
+            "breakpoints_s": list(breakpoints), "nfev": int(traj.nfev),
+            "integration_wall_s": integration_s,
+            "max_abs_holonomic_m": float(np.max(np.abs(df["holonomic_residual"]))),
+            "model_hash": model_hash(),
+        },
+        "scenario": scenario.to_dict(),
+        "units": UNITS,
+    }
+    summary["numerics"]["wall_s"] = time.perf_counter() - wall0
+    return Result(scenario=scenario, trajectory=df, summary=_clean(summary))
+
+
+def with_changes(scenario, **changes):
+    """Copy of ``scenario`` with fields changed (a convenience for sweeps)."""
+    return replace(scenario, **changes)
