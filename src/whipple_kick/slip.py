@@ -243,9 +243,16 @@ def c_source():
 
 
 def _compiler():
-    cc = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc") or shutil.which("clang")
+    """Path of the C compiler: $CC if set (must exist), else cc, gcc or clang on PATH."""
+    requested = os.environ.get("CC")
+    if requested:
+        cc = shutil.which(requested)
+        if not cc:
+            raise InputError(f"CC={requested!r} is not an executable C compiler; install gcc or fix CC")
+        return cc
+    cc = shutil.which("cc") or shutil.which("gcc") or shutil.which("clang")
     if not cc:
-        raise InputError("no C compiler found: install gcc (or clang) or set CC to a C compiler's path")
+        raise InputError("no C compiler found (looked for cc, gcc, clang on PATH): install gcc or set CC")
     return cc
 
 

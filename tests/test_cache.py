@@ -1,0 +1,65 @@
+"""Generated-code cache: private, keyed by content, safe under concurrent builds."""
+import os
+import subprocess
+import sys
+
+import pytest
+
+from whipple_kick import cache, slip
+from whipple_kick.errors import InputError
+
+
+def test_cache_folder_is_private(tmp_path, monkeypatch):
+    monkeypatch.setenv("WHIPPLE_KICK_CACHE", str(tmp_path / "c"))
+    folder = cache.cache_dir()
+    assert folder.stat().st_mode & 0o777 == 0o700
+
+
+def test_cache_folder_writable_by_others_is_refused(tmp_path, monkeypatch):
+    folder = tmp_path / "shared"
+    folder.mkdir()
+    folder.chmod(0o777)
+    monkeypatch.setenv("WHIPPLE_KICK_CACHE", str(folder))
+    with pytest.raises(PermissionError, match="not private"):
+        cache.cache_dir()
+
+
+def test_cached_file_writable_by_others_is_not_loaded(tmp_path):
+    path = tmp_path / "x.py"
+    path.write_text("")
+    path.chmod(0o666)
+    with pytest.raises(PermissionError, match="writable by others"):
+        cache.check_private_file(path)
+
+
+def test_hash_changes_with_source_and_options():
+    a = cache.source_hash(["derivation"], extra="x")
+    assert a == cache.source_hash(["derivation"], extra="x")
+    assert a != cache.source_hash(["derivation"], extra="y")
+    assert a != cache.source_hash(["derivation", "slip"], extra="x")
+
+
+def test_missing_compiler_is_a_clear_error(monkeypatch):
+    monkeypatch.setenv("CC", "no-such-compiler-xyz")
+    with pytest.raises(InputError, match="CC='no-such-compiler-xyz'"):
+        slip._compiler()
+    monkeypatch.delenv("CC")
+    monkeypatch.setenv("PATH", "")
+    with pytest.raises(InputError, match="no C compiler found"):
+        slip._compiler()
+
+
+def test_concurrent_builds_share_one_library(tmp_path):
+    """Two processes building into the same empty cache both succeed; one library results."""
+    env = dict(os.environ, WHIPPLE_KICK_CACHE=str(tmp_path / "cache"))
+    code = ("from whipple_kick import slip, integrate\n"
+            "import numpy as np\n"
+            "lib = slip.library(); print('ok')\n")
+    procs = [subprocess.Popen([sys.executable, "-c", code], env=env, stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True) for _ in range(2)]
+    outs = [p.communicate(timeout=600) for p in procs]
+    assert all(p.returncode == 0 for p in procs), outs
+    libraries = sorted(f.name for f in (tmp_path / "cache").iterdir() if f.suffix == ".so")
+    assert len(libraries) == 1, libraries
+    leftovers = [f.name for f in (tmp_path / "cache").iterdir() if f.name.endswith(".tmp")]
+    assert not leftovers
