@@ -93,3 +93,27 @@ def check_private_file(path):
     info = pathlib.Path(path).stat()
     if info.st_uid != os.getuid() or info.st_mode & (stat.S_IWGRP | stat.S_IWOTH):
         raise PermissionError(f"cached file {path} is writable by others; refusing to load it")
+
+
+def build_once(name, build):
+    """Path of the cache entry ``name``, building it with ``build(path)`` if absent.
+
+    ``build`` must write the complete entry to the path it is given (a
+    temporary name in the cache folder); it is renamed into place
+    atomically. Concurrent builders of the same entry wait on a lock, and
+    the second finds the entry already built.
+    """
+    path = cache_dir() / name
+    if not path.exists():
+        with locked(path):
+            if not path.exists():
+                tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+                try:
+                    build(tmp)
+                    os.chmod(tmp, 0o600)
+                    os.replace(tmp, path)
+                finally:
+                    if tmp.exists():
+                        tmp.unlink()
+    check_private_file(path)
+    return path

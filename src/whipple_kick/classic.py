@@ -74,12 +74,7 @@ def _generate_source():
 def generated():
     """The generated NumPy module of the classic model (built once, then cached)."""
     key = cache.source_hash(_SOURCES, extra=_LAYOUT)
-    path = cache.cache_dir() / f"classic_{key}.py"
-    if not path.exists():
-        with cache.locked(path):
-            if not path.exists():
-                cache.write_atomic(path, _generate_source())
-    cache.check_private_file(path)
+    path = cache.build_once(f"classic_{key}.py", lambda tmp: tmp.write_text(_generate_source()))
     return codegen.load_module(path, f"whipple_kick_generated_classic_{key}")
 
 

@@ -264,21 +264,16 @@ def library():
     """Load (building and caching if needed) the compiled slip model."""
     cc = _compiler()
     key = cache.source_hash(_SOURCES, extra=f"{os.path.basename(cc)} {' '.join(_CFLAGS)}")
-    folder = cache.cache_dir()
-    lib_path = folder / f"slip_{key}.so"
-    if not lib_path.exists():
-        with cache.locked(lib_path):
-            if not lib_path.exists():
-                src_path = folder / f"slip_{key}.c"
-                cache.write_atomic(src_path, c_source())
-                tmp = folder / f".slip_{key}.{os.getpid()}.so"
-                proc = subprocess.run([cc, *_CFLAGS, "-o", str(tmp), str(src_path), "-lm"],
-                                      capture_output=True, text=True)
-                if proc.returncode != 0:
-                    raise RuntimeError(f"compiling the slip model failed ({cc}):\n{proc.stderr[-4000:]}")
-                os.chmod(tmp, 0o600)
-                os.replace(tmp, lib_path)
-    cache.check_private_file(lib_path)
+
+    def compile_to(tmp):
+        src_path = cache.cache_dir() / f"slip_{key}.c"
+        cache.write_atomic(src_path, c_source())   # kept next to the library for inspection
+        proc = subprocess.run([cc, *_CFLAGS, "-o", str(tmp), str(src_path), "-lm"],
+                              capture_output=True, text=True)
+        if proc.returncode != 0:
+            raise RuntimeError(f"compiling the slip model failed ({cc}):\n{proc.stderr[-4000:]}")
+
+    lib_path = cache.build_once(f"slip_{key}.so", compile_to)
     lib = ctypes.CDLL(str(lib_path))
     lib.wk_slip_rhs.restype = ctypes.c_int
     lib.wk_slip_rhs.argtypes = [ctypes.c_double, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p]
@@ -311,12 +306,7 @@ def numpy_source():
 def numpy_module():
     """The generated NumPy oracle module (cached like the C library)."""
     key = cache.source_hash(_SOURCES, extra="numpy")
-    path = cache.cache_dir() / f"slip_numpy_{key}.py"
-    if not path.exists():
-        with cache.locked(path):
-            if not path.exists():
-                cache.write_atomic(path, numpy_source())
-    cache.check_private_file(path)
+    path = cache.build_once(f"slip_numpy_{key}.py", lambda tmp: tmp.write_text(numpy_source()))
     return codegen.load_module(path, f"whipple_kick_generated_slip_{key}")
 
 
