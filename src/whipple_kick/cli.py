@@ -243,8 +243,7 @@ def _simulate(argv):
     import shutil
     from . import simulation
     args = _simulate_parser().parse_args(argv)
-    scenario = _scenario_from_args(args)
-    scenario.validate()
+    scenario = simulation.preflight(_scenario_from_args(args))
     out, created = _prepare_out(args.out if args.out else _default_out(scenario), args.force)
     try:
         result = simulation.run(scenario)

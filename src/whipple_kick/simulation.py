@@ -348,12 +348,14 @@ def build_tyres(scenario):
     rear_p, front_p = scenario.pressures
     loaded = []
     for p in (rear_p, front_p):
+        tyre = tyres.load(scenario.tyre, p, coefficient_set=scenario.coefficient_set,
+                          friction=scenario.friction, missing_moment="error")
         try:
-            loaded.append(tyres.load(scenario.tyre, p, coefficient_set=scenario.coefficient_set,
-                                     friction=scenario.friction, missing_moment="error"))
+            tyre.blend   # raises when the tyre has no M_z coefficients
+            loaded.append(tyre)
         except InputError as exc:
             # Tyres without published M_z data: run with M_z = 0 and say so.
-            if "moment" not in str(exc).lower() and "m_z" not in str(exc).lower():
+            if "aligning-moment" not in str(exc):
                 raise
             loaded.append(tyres.load(scenario.tyre, p, coefficient_set=scenario.coefficient_set,
                                      friction=scenario.friction, missing_moment="zero"))
@@ -361,6 +363,23 @@ def build_tyres(scenario):
             if note not in notes:
                 notes.append(note)
     return loaded[0], loaded[1], notes
+
+
+def preflight(scenario):
+    """Cheap checks of everything a user can get wrong, before any long work.
+
+    Field ranges, tyre name and pressure range, bicycle name and rider
+    conflicts. Raises :class:`InputError`; returns ``scenario``.
+    """
+    from . import bicycles
+
+    scenario.validate()
+    build_tyres(scenario)
+    bike = bicycles.load(scenario.bicycle)
+    if bike.includes_rider and (scenario.fz_n is not None or scenario.rider_mass_kg is not None):
+        raise InputError(f"bicycle {bike.name!r} already includes its rider; "
+                         "do not give a rear-tyre load fz or a rider mass with it")
+    return scenario
 
 
 # -------------------------------------------------------------------- running
@@ -455,9 +474,10 @@ def run(scenario):
     wall0 = time.perf_counter()
     scenario.validate()
     kick_T, kick_accel, kick_D = scenario.kick_timing()
+    # Tyres first: a pressure outside the measured range is the commonest mistake and cheap to find.
+    rear, front, notes = build_tyres(scenario)
     moore, design, info = build_bicycle(scenario)
     gains, poles = controller_gains(scenario, design)
-    rear, front, notes = build_tyres(scenario)
     params = slip.model_parameters(
         moore, rear, front, gains=gains, symmetric=scenario.symmetric_tyres,
         kick=dict(t0=0.0, duration=kick_T, displacement=kick_D, profile=KICK_PROFILES[scenario.kick_profile]))
