@@ -73,7 +73,7 @@ def _number(unit):
 def _simulate_parser():
     from . import simulation, tyres
     p = _OneLineParser(
-        prog="simulate",
+        prog="simulate", allow_abbrev=False,
         description="Kick-plate test on the nonlinear Carvallo-Whipple bicycle-rider model with "
                     "Magic-Formula tyres (Dell'Orto 2025, Chapter 8): steady running, then the plate "
                     "under the rear wheel jumps sideways; an LQR steer-torque rider recovers or the "

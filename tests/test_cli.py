@@ -1,0 +1,141 @@
+"""The ``simulate`` command: files written, output folder rules, and one-line errors with status 2."""
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+
+from whipple_kick.cli import simulate_main
+
+
+def _simulate(argv, capsys):
+    """Run ``simulate`` in-process; return (status, stdout, stderr)."""
+    with pytest.raises(SystemExit) as info:
+        simulate_main(argv)
+    out, err = capsys.readouterr()
+    return info.value.code, out, err
+
+
+def test_main_job_writes_the_three_files(tmp_path, capsys):
+    """Issue 6 acceptance: ``simulate --pressure 400 --fz 635``."""
+    out = tmp_path / "run"
+    status, stdout, stderr = _simulate(["--pressure", "400", "--fz", "635", "--out", str(out)], capsys)
+    assert status == 0, stderr
+    assert sorted(p.name for p in out.iterdir()) == ["response.png", "summary.json", "trajectory.csv"]
+    assert (out / "response.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert (out / "response.png").stat().st_size > 20_000
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["fell"] is False
+    assert summary["scenario"]["pressure_kpa"] == 400.0 and summary["scenario"]["fz_n"] == 635.0
+    header = (out / "trajectory.csv").read_text().splitlines()[0].split(",")
+    for column in ("time", "yaw_rate", "roll_rate", "steer_rate", "fy_rear", "plate_y", "steer_torque"):
+        assert column in header
+    assert "no fall" in stdout and "trajectory.csv" in stdout
+    assert stderr == ""
+
+
+def test_default_output_folder_is_new(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    argv = ["--duration", "0.3", "--no-plot", "--quiet"]
+    assert _simulate(argv, capsys)[0] == 0
+    assert _simulate(argv, capsys)[0] == 0
+    folders = sorted(p for p in tmp_path.iterdir() if p.is_dir())
+    assert len(folders) == 2      # the second run did not reuse the first one's folder
+    for folder in folders:
+        assert sorted(p.name for p in folder.iterdir()) == ["summary.json", "trajectory.csv"]
+
+
+def test_existing_folder_needs_force(tmp_path, capsys):
+    out = tmp_path / "run"
+    out.mkdir()
+    (out / "notes.txt").write_text("keep me")
+    argv = ["--duration", "0.3", "--no-plot", "--quiet", "--out", str(out)]
+    status, _, err = _simulate(argv, capsys)
+    assert status == 2 and "not empty" in err and "--force" in err
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
+    assert _simulate(argv + ["--force"], capsys)[0] == 0
+    assert (out / "notes.txt").read_text() == "keep me"
+    assert (out / "summary.json").exists()
+
+
+def test_variants_reach_the_scenario(tmp_path, capsys):
+    out = tmp_path / "run"
+    argv = ["--pressure-front", "300", "--pressure-rear", "500", "--rider-mass", "61", "--speed", "4",
+            "--kick-accel", "30", "--kick-profile", "smooth", "--kick-direction", "left",
+            "--controller", "lqr", "--gain-scale", "0.8", "--low-inertia", "--symmetric-tyres",
+            "--friction", "plate", "--rtol", "1e-8", "--duration", "0.5", "--no-plot", "--quiet",
+            "--out", str(out)]
+    status, stdout, err = _simulate(argv, capsys)
+    assert status == 0, err
+    assert stdout == ""
+    s = json.loads((out / "summary.json").read_text())
+    sc = s["scenario"]
+    assert (sc["pressure_front_kpa"], sc["pressure_rear_kpa"], sc["rider_mass_kg"]) == (300.0, 500.0, 61.0)
+    assert sc["low_inertia"] and sc["symmetric_tyres"] and sc["friction"] == "plate"
+    assert s["kick"]["displacement_m"] == -0.15 and s["kick"]["peak_acceleration_m_s2"] == 30.0
+    assert s["controller"]["gain_scale"] == 0.8 and s["numerics"]["rtol"] == 1e-8
+
+
+# Every bad input: (argv, fragments the one-line message must contain).
+BAD_INPUTS = {
+    "pressure-above-range": (["--pressure", "900"], ["900", "[300, 500]", "kPa"]),
+    "pressure-negative": (["--pressure", "-5"], ["-5", "kPa"]),
+    "front-pressure-out-of-range": (["--pressure-front", "250", "--pressure-rear", "400"], ["250", "kPa"]),
+    "negative-load": (["--fz", "-100"], ["-100", "N", "range"]),
+    "load-too-large": (["--fz", "5000"], ["5000", "N", "range"]),
+    "negative-rider-mass": (["--rider-mass", "-3"], ["-3", "kg", "(0, 200]"]),
+    "unknown-tyre": (["--tyre", "T99"], ["T99", "T01", "T05"]),
+    "unknown-coefficient-set": (["--tyre", "T01", "--coefficient-set", "chapter8"], ["chapter8", "T01"]),
+    "unknown-bicycle": (["--bicycle", "nope"], ["nope", "balanceassist_v1"]),
+    "zero-speed": (["--speed", "0"], ["speed", "0", "m/s", "(0, 15]"]),
+    "negative-speed": (["--speed", "-2"], ["speed", "-2", "m/s"]),
+    "malformed-pressure": (["--pressure", "abc"], ["--pressure", "'abc'", "kPa"]),
+    "malformed-load": (["--fz", "6x5"], ["--fz", "'6x5'", "N"]),
+    "malformed-speed": (["--speed", "nan"], ["--speed", "m/s"]),
+    "malformed-kick": (["--kick-accel", "fast"], ["--kick-accel", "m/s^2"]),
+    "zero-kick-accel": (["--kick-accel", "0"], ["kick peak acceleration", "m/s^2"]),
+    "negative-kick-duration": (["--kick-duration", "-0.1"], ["kick duration", "s"]),
+    "negative-displacement": (["--kick-displacement", "-0.1"], ["kick displacement", "m", "[0, 1]"]),
+    "zero-duration": (["--duration", "0"], ["duration", "s"]),
+    "rtol-out-of-range": (["--rtol", "0.1"], ["rtol", "0.1"]),
+    "unwritable-output": (["--out", "/dev/null/run"], ["/dev/null/run", "not writable"]),
+    "load-and-rider-mass": (["--fz", "635", "--rider-mass", "60"], ["--rider-mass", "--fz"]),
+    "accel-and-duration": (["--kick-accel", "30", "--kick-duration", "0.1"], ["--kick-duration", "--kick-accel"]),
+    "pressure-and-front": (["--pressure", "400", "--pressure-front", "300"], ["--pressure", "--pressure-front"]),
+    "front-without-rear": (["--pressure-front", "300"], ["--pressure-rear"]),
+    "gain-scale-with-controller-off": (["--controller", "off", "--gain-scale", "0.5"], ["0.5", "off"]),
+    "thesis-gains-unknown-load": (["--controller", "thesis", "--fz", "600"], ["600", "570, 635 and 701 N"]),
+    "preset-with-rider-and-load": (["--bicycle", "balanceassist_635N", "--fz", "635"], ["already includes"]),
+    "unknown-profile": (["--kick-profile", "table"], ["--kick-profile", "'table'", "constant", "smooth"]),
+    "unknown-controller": (["--controller", "pid"], ["--controller", "'pid'"]),
+    "unknown-flag": (["--pressur", "400"], ["unrecognized", "--pressur"]),
+}
+
+
+@pytest.mark.parametrize("argv, fragments", BAD_INPUTS.values(), ids=BAD_INPUTS.keys())
+def test_bad_input_is_one_line_and_status_2(argv, fragments, tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    status, stdout, err = _simulate(argv + ["--quiet"], capsys)
+    assert status == 2
+    assert stdout == ""
+    assert "Traceback" not in err
+    assert err.endswith("\n") and err.count("\n") == 1, err
+    for fragment in fragments:
+        assert fragment in err, (fragment, err)
+    # Nothing left behind in the working directory.
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_console_script_reports_without_traceback(tmp_path):
+    """The installed console script: status 2 and one stderr line from a fresh process."""
+    exe = os.path.join(os.path.dirname(sys.executable), "simulate")
+    if not os.path.exists(exe):
+        pytest.skip("console script not installed (pip install -e .)")
+    proc = subprocess.run([exe, "--pressure", "900", "--fz", "635"], capture_output=True, text=True,
+                          cwd=tmp_path, timeout=120)
+    assert proc.returncode == 2
+    assert proc.stderr.count("\n") == 1 and "kPa" in proc.stderr and "Traceback" not in proc.stderr
+    help_text = subprocess.run([exe, "--help"], capture_output=True, text=True, timeout=120).stdout
+    for unit in ("KPA", "M/S", "M/S2", "kg", "m/s^2", "in s"):
+        assert unit in help_text
