@@ -224,7 +224,6 @@ def test_speeds_complete(speed):
     _completes(run(Scenario(speed=speed)))
 
 
-@pytest.mark.slow
 @pytest.mark.parametrize("accel", [5.0, 10.0, 20.0, 30.0, 32.5, 35.0, 37.5, 40.0, 60.0, 100.0, 150.0, 200.0])
 @pytest.mark.parametrize("speed", [1.5, 3.0, 5.0, 8.0])
 def test_grid_of_kicks_and_speeds_completes(accel, speed):
