@@ -277,3 +277,60 @@ def simulate_main(argv=None):
         print(f"simulate: cannot write the results: {exc}", file=sys.stderr)
         status = 2
     sys.exit(status)
+
+
+# ------------------------------------------------------------ recommend-pressure
+
+def _recommend(argv):
+    from . import sweep, tyres
+    p = _OneLineParser(
+        prog="recommend-pressure",
+        description="Recommend the tyre inflation pressure with the fastest yaw-rate recovery after "
+                    "a kick-plate kick (Dell'Orto 2025, Section 8.3 and Table 8.9): runs the kick at "
+                    "each pressure for each rear load and ranks the runs by the recovery time (time "
+                    "of the last yaw-rate peak above 8 %% of the largest).",
+        epilog="Both tyres get the same pressure, as in the experiment. Every other setting is the "
+               "simulate default (LQR rider, 3 m/s, 150 mm kick in 0.150 s, 6 s). See docs/sweeps.md.")
+    p.add_argument("--fz", type=_number("N"), nargs="+", required=True, metavar="N",
+                   help="static rear-tyre load(s) in N, e.g. --fz 570 635 701")
+    p.add_argument("--tyre", default="T03", metavar="NAME",
+                   help="tyre on both wheels (default T03; available: %s)"
+                        % ", ".join(t[0] for t in tyres.available()))
+    p.add_argument("--pressures", type=_number("kPa"), nargs="+", metavar="KPA",
+                   help="pressures to try in kPa (default: the tyre's measured ones)")
+    p.add_argument("--fine", action="store_true",
+                   help="also try a grid of interpolated pressures between the measured ones")
+    p.add_argument("--step", type=_number("kPa"), default=10.0, metavar="KPA",
+                   help="step of the --fine grid in kPa (default 10)")
+    p.add_argument("--duration", type=_number("s"), default=6.0, metavar="S",
+                   help="simulated time after the kick in s (default 6)")
+    p.add_argument("--workers", type=int, metavar="N",
+                   help="worker processes (default: one per CPU core)")
+    p.add_argument("--out", metavar="DIR",
+                   help="sweep folder keeping every run (re-running with it resumes)")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    args = p.parse_args(argv)
+    from .simulation import Scenario
+    base = Scenario(duration=args.duration)
+    base.validate()
+    recs = sweep.recommend_pressures(
+        args.fz, tyre=args.tyre, pressures=args.pressures, fine=args.fine, step_kpa=args.step,
+        base=base, workers=args.workers, folder=args.out,
+        progress=not args.no_progress and sys.stderr.isatty())
+    for k, rec in enumerate(recs):
+        if k:
+            print()
+        print(sweep.format_recommendation(rec))
+    return 0
+
+
+def recommend_main(argv=None):
+    """Console script ``recommend-pressure`` (see ``recommend-pressure --help``)."""
+    from .sweep import SweepInterrupted
+    try:
+        status = _run(_recommend, argv)
+    except (SweepInterrupted, OSError) as exc:
+        # An unwritable --out folder is the user's to fix (2); lost worker processes are not (1).
+        print(f"recommend-pressure: {exc}", file=sys.stderr)
+        status = 2 if isinstance(exc, OSError) else 1
+    sys.exit(status)

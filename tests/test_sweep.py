@@ -1,0 +1,230 @@
+"""Sweeps: the table, the folder, executors (process pool, Dask), resume, failures, recommender."""
+import concurrent.futures as cf
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from whipple_kick import simulation, sweep
+from whipple_kick.errors import InputError
+
+# Short runs: the sweep machinery, not the physics, is under test here.
+BASE = simulation.Scenario(duration=3.0, settle=0.1, output_rate=200.0, fz_n=635.0)
+# 600 kPa is outside T03's measured 300-500 kPa: that case fails with an InputError.
+GRID = {"pressure_kpa": [300, 400, 500, 600]}
+
+
+@pytest.fixture(scope="module")
+def default_run(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("sweep") / "grid"
+    table = sweep.sweep(GRID, base=BASE, folder=folder, progress=False)
+    return folder, table
+
+
+def test_table_has_one_row_per_case_with_inputs_and_metrics(default_run):
+    folder, table = default_run
+    assert list(table["pressure_kpa"]) == [300.0, 400.0, 500.0, 600.0]
+    assert list(table["status"]) == ["ok", "ok", "ok", "failed"]
+    assert table["error"].iloc[:3].isna().all()
+    # Every scenario field is a column, then the flattened results.
+    for column in ("fz_n", "tyre", "duration", "recovery_time", "damping_ratio_1_3", "recovery.time_s",
+                   "steady_state.roll_rad", "controller.gains.kq4", "numerics.model_hash", "run.worker"):
+        assert column in table.columns, column
+    assert table["case_id"].is_unique
+    assert table["case_id"].iloc[1] == sweep.case_id(simulation.with_changes(BASE, pressure_kpa=400.0))
+
+
+def test_failing_case_is_recorded_with_its_error(default_run):
+    folder, table = default_run
+    row = table.iloc[3]
+    assert row["error"].startswith("InputError: ") and "600" in row["error"] and "kPa" in row["error"]
+    assert np.isnan(row["recovery_time"])
+    log = sweep.read_log(folder)
+    assert log[row["case_id"]]["status"] == "failed"
+    assert not sweep.trajectory_path(folder, row["case_id"]).exists()
+
+
+def test_sweep_results_equal_a_direct_run(default_run):
+    # The per-process cache of rider and LQR must not change any number.
+    _, table = default_run
+    direct = simulation.run(simulation.with_changes(BASE, pressure_kpa=400.0)).summary
+    flat = sweep.flatten_summary(direct)
+    row = table.iloc[1]
+    assert flat["recovery_time"] is not None
+    for key, value in flat.items():
+        if key in sweep.VOLATILE_COLUMNS:
+            continue
+        if value is None:
+            assert pd.isna(row[key]), key
+        else:
+            assert row[key] == value, key
+
+
+def test_folder_holds_manifest_table_and_trajectories(default_run):
+    folder, table = default_run
+    manifest = sweep.read_manifest(folder)
+    assert manifest["status"] == "complete"
+    assert (manifest["n_ok"], manifest["n_failed"]) == (3, 1)
+    assert manifest["model_hash"] == simulation.model_hash()
+    assert manifest["versions"]["numpy"] == np.__version__
+    assert manifest["base_scenario"]["duration"] == 3.0
+    assert [c["case_id"] for c in manifest["cases"]] == list(table["case_id"])
+    assert manifest["cases"][0]["overrides"] == {"pressure_kpa": 300.0}
+    on_disk = pd.read_csv(folder / sweep.TABLE_FILE)
+    assert list(on_disk["case_id"]) == list(table["case_id"])
+    np.testing.assert_allclose(on_disk["recovery_time"], table["recovery_time"], rtol=1e-11)
+    traj, summary = sweep.load_trajectory(folder, table["case_id"].iloc[0])
+    assert list(traj.columns) == list(sweep.DEFAULT_TRAJECTORY_COLUMNS)
+    assert traj["yaw_rate"].dtype == np.float32
+    assert len(traj) == 621   # -0.1 .. 3.0 s at 200 Hz
+    assert summary["scenario"]["pressure_kpa"] == 300.0
+
+
+def test_dask_executor_gives_the_same_table(default_run):
+    distributed = pytest.importorskip("distributed")
+    _, table = default_run
+    with distributed.LocalCluster(processes=True, n_workers=2, threads_per_worker=1,
+                                  dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+        dask_table = sweep.sweep(GRID, base=BASE, executor=client.get_executor(), progress=False)
+        workers = set(dask_table["run.worker"])
+    assert len(workers) == 2   # both Dask workers ran cases
+    keep = [c for c in table.columns if c not in sweep.VOLATILE_COLUMNS]
+    pd.testing.assert_frame_equal(dask_table[keep], table[keep])
+
+
+# -------------------------------------------------------------------------- resume
+
+class KillAfter(cf.Executor):
+    """A one-process pool whose worker is killed instead of running case ``n + 1``.
+
+    Cases 1..n run normally; the worker then exits in the middle of the sweep
+    (``os._exit``), which breaks the pool, so every later case is lost.
+    """
+
+    def __init__(self, n):
+        self.pool = cf.ProcessPoolExecutor(max_workers=1)
+        self.n, self.submitted = n, 0
+
+    def submit(self, fn, *args, **kwargs):
+        self.submitted += 1
+        if self.submitted == self.n + 1:
+            return self.pool.submit(os._exit, 1)
+        return self.pool.submit(fn, *args, **kwargs)
+
+    def shutdown(self, wait=True, *, cancel_futures=False):
+        self.pool.shutdown(wait=wait, cancel_futures=cancel_futures)
+
+
+def test_interrupted_sweep_resumes_without_redoing_or_losing_cases(tmp_path):
+    folder = tmp_path / "resume"
+    grid = {"pressure_kpa": [300, 350, 400, 450, 500]}
+    killer = KillAfter(2)
+    with pytest.raises(sweep.SweepInterrupted, match="3 of 5 cases were not run"):
+        sweep.sweep(grid, base=BASE, folder=folder, executor=killer, progress=False)
+    killer.shutdown()
+    first = sweep.read_log(folder)
+    assert len(first) == 2 and all(r["status"] == "ok" for r in first.values())
+    assert sweep.read_manifest(folder)["status"] == "incomplete"
+    assert len(pd.read_csv(folder / sweep.TABLE_FILE)) == 2
+    assert len(list((folder / sweep.TRAJECTORY_DIR).glob("*.npz"))) == 2
+
+    table = sweep.sweep(grid, base=BASE, folder=folder, progress=False)
+    assert list(table["pressure_kpa"]) == [300.0, 350.0, 400.0, 450.0, 500.0]
+    assert (table["status"] == "ok").all()
+    lines = (folder / sweep.LOG_FILE).read_text().splitlines()
+    assert len(lines) == 5          # each case ran exactly once over both runs
+    finished = dict(zip(table["case_id"], table["run.finished"]))
+    for cid, rec in first.items():  # the first run's cases were kept, not redone
+        assert finished[cid] == rec["run"]["finished"]
+    assert sweep.read_manifest(folder)["status"] == "complete"
+
+    # A third run finds everything done and runs nothing.
+    again = sweep.sweep(grid, base=BASE, folder=folder, progress=False)
+    assert len((folder / sweep.LOG_FILE).read_text().splitlines()) == 5
+    pd.testing.assert_frame_equal(again, table)
+
+
+def test_truncated_log_line_is_ignored_and_the_case_rerun(tmp_path):
+    folder = tmp_path / "crash"
+    grid = {"pressure_kpa": [300, 400]}
+    sweep.sweep(grid, base=BASE, folder=folder, progress=False, trajectory_columns=None)
+    log = folder / sweep.LOG_FILE
+    lines = log.read_text().splitlines()
+    log.write_text(lines[0] + "\n" + lines[1][: len(lines[1]) // 2])   # a crash mid-write
+    table = sweep.sweep(grid, base=BASE, folder=folder, progress=False, trajectory_columns=None)
+    assert (table["status"] == "ok").all()
+
+
+def test_folder_of_another_sweep_is_refused_unless_extended(default_run, tmp_path):
+    folder, table = default_run
+    with pytest.raises(InputError, match="holds a different sweep"):
+        sweep.sweep({"pressure_kpa": [300]}, base=BASE, folder=folder, progress=False)
+    small = tmp_path / "small"
+    sweep.sweep({"pressure_kpa": [300]}, base=BASE, folder=small, progress=False)
+    both = sweep.sweep({"pressure_kpa": [500]}, base=BASE, folder=small, progress=False, extend=True)
+    assert list(both["pressure_kpa"]) == [300.0, 500.0]
+
+
+def test_case_ids_and_input_errors():
+    a = simulation.with_changes(BASE, pressure_kpa=400)
+    b = simulation.with_changes(BASE, pressure_kpa=np.float64(400.0))
+    assert sweep.case_id(a) == sweep.case_id(b) == sweep.case_id(BASE.__class__(**BASE.to_dict()))
+    assert sweep.case_id(a) != sweep.case_id(simulation.with_changes(BASE, pressure_kpa=400.001))
+    cases = sweep.make_cases({"speed": [2, 3], "tyre": "T04"}, cases=[{"fz_n": 570}, {"fz_n": 701}])
+    assert [c[0] for c in cases] == [
+        {"fz_n": 570.0, "speed": 2.0, "tyre": "T04"}, {"fz_n": 570.0, "speed": 3.0, "tyre": "T04"},
+        {"fz_n": 701.0, "speed": 2.0, "tyre": "T04"}, {"fz_n": 701.0, "speed": 3.0, "tyre": "T04"}]
+    with pytest.raises(InputError, match="unknown scenario field.*'presure_kpa'"):
+        sweep.make_cases({"presure_kpa": [300]})
+    with pytest.raises(InputError, match="no values"):
+        sweep.make_cases({"pressure_kpa": []})
+    with pytest.raises(InputError, match="workers"):
+        sweep.sweep({"pressure_kpa": [300]}, base=BASE, workers=0)
+
+
+# --------------------------------------------------------------------- recommender
+
+def _cli(*args):
+    exe = os.path.join(os.path.dirname(sys.executable), "recommend-pressure")
+    return subprocess.run([exe, *args], capture_output=True, text=True, timeout=600)
+
+
+def test_recommend_pressure_prints_table_and_recommendation_for_thesis_loads():
+    proc = _cli("--fz", "570", "635", "701")
+    assert proc.returncode == 0, proc.stderr
+    out = proc.stdout
+    for fz in (570, 635, 701):
+        assert f"rear load {fz} N, tyre T03" in out
+        assert f"recommendation for {fz} N: " in out
+    # Three pressures per load, each a table row with the recovery time.
+    rows = [line.split() for line in out.splitlines() if line.strip().startswith(("300 ", "400 ", "500 "))]
+    assert len(rows) == 9 and all(float(r[2]) > 0 for r in rows)
+
+
+@pytest.mark.parametrize("args, message", [
+    (("--fz", "-3"), "rear-tyre load fz = -3.0 N is outside"),
+    (("--fz", "635", "--pressures", "700"), "700.0 kPa is outside the allowed range [300, 500] kPa"),
+    (("--fz", "635", "--tyre", "T99"), "tyre = 'T99' is unknown"),
+    (("--fz", "x"), "'x' is not a number (N)"),
+])
+def test_recommend_pressure_bad_input_is_one_line_exit_2(args, message):
+    proc = _cli(*args)
+    assert proc.returncode == 2
+    assert message in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
+    assert proc.stdout == ""
+
+
+def test_recommend_pressure_function_fine_grid():
+    base = simulation.Scenario(duration=3.0, output_rate=200.0)
+    rec = sweep.recommend_pressure(701, pressures=[300, 500], fine=True, step_kpa=50, base=base)
+    assert list(rec.table["pressure_kpa"]) == [300.0, 350.0, 400.0, 450.0, 500.0]
+    assert list(rec.table["measured"]) == [True, False, True, False, True]
+    best = rec.table.loc[rec.table["rank"] == 1]
+    assert float(best["pressure_kpa"].iloc[0]) == rec.best_pressure_kpa
+    assert float(best["recovery_time"].iloc[0]) == rec.table["recovery_time"].min()
+    assert rec.best_measured_kpa in (300.0, 400.0, 500.0)
+    assert "recommendation for 701 N:" in sweep.format_recommendation(rec)
