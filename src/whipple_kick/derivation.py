@@ -297,8 +297,12 @@ def kick_plate_motion(t):
     ``kick_t0`` for ``kick_T`` seconds, then held at ``D`` (the plate stops
     instantly, as in the thesis' Figure 8.5). Profile 1: minimum-jerk quintic
     ``D (10 s^3 - 15 s^4 + 6 s^5)``, ``s = (t - t0)/T``, with finite jerk.
+    Profile 2: one cubic segment ``c0 + c1 tau + c2 tau^2 + c3 tau^3``,
+    ``tau = t - t0``, at all times; a tabulated y(t) is followed exactly by
+    integrating one spline segment at a time with its coefficients.
     """
     t0, T, D, profile = S.syms(["kick_t0", "kick_T", "kick_D", "kick_profile"])
+    c0, c1, c2, c3 = S.syms(["kick_c0", "kick_c1", "kick_c2", "kick_c3"])
     tau = t - t0
     s = tau / T
     acc = 2 * D / T**2
@@ -306,11 +310,14 @@ def kick_plate_motion(t):
     smooth = (D * (10 * s**3 - 15 * s**4 + 6 * s**5),
               D * (30 * s**2 - 60 * s**3 + 30 * s**4) / T,
               D * (60 * s - 180 * s**2 + 120 * s**3) / T**2)
+    segment = (c0 + c1 * tau + c2 * tau**2 + c3 * tau**3, c1 + 2 * c2 * tau + 3 * c3 * tau**2,
+               2 * c2 + 6 * c3 * tau)
     out = []
-    for k, (c_expr, s_expr) in enumerate(zip(const, smooth)):
+    for k in range(3):
         after = D if k == 0 else sm.S(0)
-        moving = sm.Piecewise((c_expr, profile < sm.Rational(1, 2)), (s_expr, True))
-        out.append(sm.Piecewise((sm.S(0), tau < 0), (moving, tau < T), (after, True)))
+        moving = sm.Piecewise((const[k], profile < sm.Rational(1, 2)), (smooth[k], True))
+        once = sm.Piecewise((sm.S(0), tau < 0), (moving, tau < T), (after, True))
+        out.append(sm.Piecewise((segment[k], profile > sm.Rational(3, 2)), (once, True)))
     return tuple(out)
 
 

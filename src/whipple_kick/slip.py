@@ -469,7 +469,10 @@ def model_parameters(moore, rear_tyre, front_tyre, gains=None, kick=None,
         ``T7 = -(kq4 q4 + kq7 q7 + ku4 u4 + ku7 u7 + kq3 q3 + ku3 u3)``.
     kick : mapping, optional
         ``t0`` [s], ``duration`` [s], ``displacement`` [m, + to the right],
-        ``profile`` (0 constant acceleration, 1 minimum jerk). Default: no kick.
+        ``profile`` (0 constant acceleration, 1 minimum jerk, 2 one cubic
+        segment ``c0 + c1 tau + c2 tau^2 + c3 tau^3`` with ``tau = t - t0``,
+        given as ``coefficients`` = (c0, c1, c2, c3) in m, m/s, m/s^2, m/s^3;
+        see :func:`cubic_segments`). Default: no kick.
     symmetric, lateral : bool
         See :func:`tyre_parameters`.
     drive_torque : float
@@ -489,6 +492,7 @@ def model_parameters(moore, rear_tyre, front_tyre, gains=None, kick=None,
         "kick_T": float(kick.get("duration", 0.15)),
         "kick_D": float(kick.get("displacement", 0.0)),
         "kick_profile": float(kick.get("profile", 0)),
+        **{f"kick_c{i}": float(c) for i, c in enumerate(kick.get("coefficients", (0.0, 0.0, 0.0, 0.0)))},
         "T6c": float(drive_torque),
     })
     return params
@@ -620,3 +624,38 @@ def linearize(rhs, x, names=LINEAR_STATES, step=1e-7, t=0.0):
             xp, xm = solve_pitch(rhs, xp), solve_pitch(rhs, xm)
         J[:, j] = (rhs(t, xp)[idx] - rhs(t, xm)[idx]) / (2 * h)
     return J
+
+
+def cubic_segments(times, displacements):
+    """Cubic-spline segments through a tabulated plate displacement y(t).
+
+    The spline is clamped (zero plate velocity at both ends, so the plate
+    starts from rest and is held afterwards) and passes through every table
+    point; y, y' and y'' are continuous.
+
+    Parameters
+    ----------
+    times : array_like
+        Strictly increasing times [s], at least 2.
+    displacements : array_like
+        Plate displacement [m] at those times (positive to the right).
+
+    Returns
+    -------
+    list of (t_start, t_end, (c0, c1, c2, c3))
+        One entry per table interval; ``kick=dict(profile=2, t0=t_start,
+        coefficients=...)`` reproduces the segment.
+    """
+    from scipy.interpolate import CubicSpline
+    t = np.asarray(times, dtype=float)
+    y = np.asarray(displacements, dtype=float)
+    if t.ndim != 1 or t.shape != y.shape or t.size < 2:
+        raise InputError(f"a kick table needs matching time and displacement columns with at least 2 rows, "
+                         f"got {t.size} times and {y.size} displacements")
+    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(y))):
+        raise InputError("the kick table has non-finite entries")
+    if np.any(np.diff(t) <= 0):
+        raise InputError("kick table times must increase strictly (s)")
+    spline = CubicSpline(t, y, bc_type="clamped")
+    # CubicSpline stores c[m, k] for (x - t_k)^(3 - m).
+    return [(t[k], t[k + 1], tuple(float(spline.c[3 - m, k]) for m in range(4))) for k in range(t.size - 1)]

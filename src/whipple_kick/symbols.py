@@ -110,7 +110,11 @@ def _entries():
         ("kick_t0", "time at which the kick plate starts to move", "s", c),
         ("kick_T", "duration of the kick plate's motion", "s", c),
         ("kick_D", "kick plate displacement (signed: positive along N.y, to the right)", "m", c),
-        ("kick_profile", "kick profile: 0 constant acceleration (thesis), 1 minimum-jerk quintic", "-", c),
+        ("kick_profile", "kick profile: 0 constant acceleration (thesis), 1 minimum-jerk quintic, 2 cubic segment", "-", c),
+        ("kick_c0", "cubic-segment plate profile: displacement at kick_t0", "m", c),
+        ("kick_c1", "cubic-segment plate profile: velocity at kick_t0", "m/s", c),
+        ("kick_c2", "cubic-segment plate profile: half the acceleration at kick_t0", "m/s^2", c),
+        ("kick_c3", "cubic-segment plate profile: a sixth of the jerk", "m/s^3", c),
         ("kq3", "steer-torque feedback gain on yaw angle q3", "N m/rad", c),
         ("kq4", "steer-torque feedback gain on roll angle q4", "N m/rad", c),
         ("kq7", "steer-torque feedback gain on steer angle q7", "N m/rad", c),
@@ -151,7 +155,7 @@ CLASSIC_CONSTANTS = (
 SLIP_CONSTANTS = CLASSIC_CONSTANTS + (
     "rtr", "rtf", "kzr", "kzf", "czr", "czf", "sigr", "sigf",
     "wr", "wf", "mur", "muf", "lamr", "lamf",
-    "kick_t0", "kick_T", "kick_D", "kick_profile",
+    "kick_t0", "kick_T", "kick_D", "kick_profile", "kick_c0", "kick_c1", "kick_c2", "kick_c3",
     "kq3", "kq4", "kq7", "ku3", "ku4", "ku7", "T6c",
 ) + tuple(f"{kind}{wheel}{k}_{i}" for wheel in "rf" for k in (1, 2)
           for kind, n in (("a", 14), ("c", 18)) for i in range(n))
