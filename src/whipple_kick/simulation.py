@@ -11,7 +11,8 @@ Time is measured from the start of the kick: the run starts at
 ``-settle`` (steady running shown before the kick) and ends at
 ``duration`` (or at the fall). docs/simulate.md lists every decision.
 """
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import asdict, dataclass, field, fields, replace
+import functools
 import math
 import pathlib
 import time
@@ -22,6 +23,13 @@ from .errors import InputError, check_range
 
 #: Kick-plate profiles the compiled model can represent (its ``kick_profile`` parameter).
 KICK_PROFILES = {"constant": 0, "smooth": 1}
+#: Tabulated plate motion: a clamped cubic spline through ``kick_table``, one
+#: compiled-model segment (``kick_profile`` 2) per table interval.
+TABLE_PROFILE = "table"
+#: Every ``Scenario.kick_profile`` value.
+PROFILES = (*KICK_PROFILES, TABLE_PROFILE)
+#: The compiled model's cubic-segment profile (y = c0 + c1 tau + c2 tau^2 + c3 tau^3).
+_SEGMENT_PROFILE = 2
 #: Peak |acceleration| of each profile as a multiple of displacement/duration^2:
 #: constant acceleration 2 D/T^2; minimum-jerk quintic 10/sqrt(3) D/T^2 (at s = 0.2113).
 PEAK_ACCEL_FACTOR = {"constant": 2.0, "smooth": 10.0 / math.sqrt(3.0)}
@@ -122,14 +130,26 @@ class Scenario:
         (thesis Figure 8.9). The LQR is still designed on the unmodified
         bicycle (the rider's controller does not change, the plant does).
     kick_displacement : float
-        Plate travel [m] (>= 0; direction by ``kick_direction``).
+        Plate travel [m] (>= 0; direction by ``kick_direction``). With a
+        table the travel comes from the table: leave it at its default.
     kick_duration, kick_accel : float or None
         Plate travel time [s] or peak plate acceleration [m/s^2]; at most
-        one. Default 0.150 s (13.3 m/s^2 for the thesis' 0.150 m).
-    kick_profile : {"constant", "smooth"}
-        Constant acceleration (thesis) or minimum-jerk quintic (finite jerk).
+        one. Default 0.150 s (13.3 m/s^2 for the thesis' 0.150 m). Not with
+        a table.
+    kick_profile : {"constant", "smooth", "table"}
+        Constant acceleration (thesis), minimum-jerk quintic (finite jerk),
+        or the plate displacement tabulated in ``kick_table``.
+    kick_table : str or None
+        CSV of the plate's lateral displacement (``kick_profile="table"``
+        only; see :func:`load_kick_table`): columns ``time`` [s, from the
+        kick start, the trajectory's clock] and ``y`` [m, + to the right].
+        The plate follows the clamped cubic spline through the rows
+        (:func:`whipple_kick.slip.cubic_segments`), rests at the first
+        row's y before the first time and at the last row's y after the
+        last; the table must lie within [-settle, duration].
     kick_direction : {"right", "left"}
-        Plate moves to the bicycle's right (+y) or left.
+        Plate moves to the bicycle's right (+y) or left; ``left`` mirrors a
+        table's y.
     settle : float
         Steady running shown before the kick [s].
     duration : float
@@ -142,7 +162,8 @@ class Scenario:
         |roll| [deg] that counts as a fall and ends the run.
     piecewise : bool
         Restart the integrator at the kick's start and end (default). False
-        integrates across them in one piece (for comparison only).
+        integrates across them in one piece (for comparison only; not with
+        a table, whose every interval is its own parameter set).
     """
 
     bicycle: str = "balanceassist_v1"
@@ -166,6 +187,7 @@ class Scenario:
     kick_duration: float | None = None
     kick_accel: float | None = None
     kick_profile: str = "constant"
+    kick_table: str | None = None
     kick_direction: str = "right"
     settle: float = 0.5
     duration: float = 6.0
@@ -198,17 +220,22 @@ class Scenario:
         return rear, front
 
     def kick_timing(self):
-        """(duration [s], peak |acceleration| [m/s^2], signed displacement [m]) of the kick."""
-        if self.kick_profile not in KICK_PROFILES:
-            if str(self.kick_profile).lower() in ("table", "tabulated", "csv") or str(self.kick_profile).endswith(".csv"):
-                raise InputError(
-                    "kick profile 'table' is not supported: the compiled slip model takes the plate "
-                    "motion only as (start, duration, displacement, profile constant|smooth); "
-                    "choose kick_profile constant or smooth")
-            raise InputError(f"kick profile {self.kick_profile!r} is unknown; choose one of "
-                             f"{', '.join(KICK_PROFILES)}")
+        """(duration [s], peak |acceleration| [m/s^2], signed displacement [m]) of the kick.
+
+        For a table: the table's time span, the spline's peak |y''| and its
+        net travel y(last) - y(first), mirrored for ``kick_direction="left"``.
+        """
         if self.kick_direction not in DIRECTIONS:
             raise InputError(f"kick direction {self.kick_direction!r} is unknown; choose right or left")
+        if self.kick_profile == TABLE_PROFILE or self.kick_table is not None:
+            table = self.kick_table_spline()
+            return table.duration, table.peak_acceleration, table.displacement
+        if self.kick_profile not in KICK_PROFILES:
+            hint = ""
+            if str(self.kick_profile).lower() in ("tabulated", "csv") or str(self.kick_profile).endswith(".csv"):
+                hint = "; for a tabulated plate motion use kick_profile='table' with kick_table='FILE.csv'"
+            raise InputError(f"kick profile {self.kick_profile!r} is unknown; choose one of "
+                             f"{', '.join(PROFILES)}{hint}")
         disp = check_range("kick displacement", self.kick_displacement, 0.0, 1.0, "m")
         factor = PEAK_ACCEL_FACTOR[self.kick_profile]
         if self.kick_duration is not None and self.kick_accel is not None:
@@ -227,6 +254,44 @@ class Scenario:
                              f"{self.duration:g} s; allowed (0, {self.duration:g}] s")
         sign = 1.0 if self.kick_direction == "right" else -1.0
         return dur, accel, sign * disp
+
+    def kick_table_spline(self):
+        """The tabulated kick, checked against the other fields: a :class:`KickTable`.
+
+        Raises
+        ------
+        InputError
+            No table with ``kick_profile="table"``, a table with another
+            profile, a conflicting kick field, a bad file (one line naming
+            the file and the problem) or a table outside [-settle, duration].
+        """
+        if self.kick_profile != TABLE_PROFILE:
+            raise InputError(f"kick table {self.kick_table!r} needs kick_profile 'table', "
+                             f"not {self.kick_profile!r}")
+        if self.kick_table is None:
+            raise InputError("kick profile 'table' needs a kick table: kick_table='FILE.csv' "
+                             "with columns time (s) and y (m)")
+        # The table alone sets the plate motion; a second description of it is a mistake.
+        for name, value, unit in (("kick duration", self.kick_duration, "s"),
+                                  ("kick peak acceleration", self.kick_accel, "m/s^2")):
+            if value is not None:
+                raise InputError(f"{name} = {value!r} {unit} conflicts with kick table {str(self.kick_table)!r} "
+                                 "(the table sets the plate motion)")
+        default_disp = next(f.default for f in fields(Scenario) if f.name == "kick_displacement")
+        if self.kick_displacement != default_disp:
+            raise InputError(f"kick displacement = {self.kick_displacement!r} m conflicts with kick table "
+                             f"{str(self.kick_table)!r} (the table sets the plate travel)")
+        if not self.piecewise:
+            raise InputError(f"piecewise = False is not possible with kick table {str(self.kick_table)!r}: "
+                             "every table interval is integrated with its own parameters")
+        times, y = load_kick_table(self.kick_table)
+        name = str(self.kick_table)
+        if times[0] < -self.settle or times[-1] > self.duration:
+            raise InputError(f"kick table {name!r} spans [{times[0]:g}, {times[-1]:g}] s, outside the run "
+                             f"[-settle, duration] = [{-self.settle:g}, {self.duration:g}] s; times are "
+                             "from the kick start: trim the table or change settle/duration")
+        sign = 1.0 if self.kick_direction == "right" else -1.0
+        return KickTable.from_points(name, times, sign * y)
 
     def validate(self):
         """Check every field; raise :class:`InputError` naming value, range and unit."""
@@ -257,6 +322,284 @@ class Scenario:
     def to_dict(self):
         """Fields as a plain dict (JSON-ready)."""
         return asdict(self)
+
+
+# ------------------------------------------------------------ tabulated kick
+
+def load_kick_table(path):
+    """Read a kick-plate table: (times [s], y [m]) as float arrays.
+
+    The file is comma-separated text (UTF-8). Blank lines and lines starting
+    with ``#`` are skipped. With a header row, the columns named ``time``
+    and ``y`` are used (case-insensitive; a unit suffix such as
+    ``time [s]`` or ``y (m)`` is allowed; other columns are ignored).
+    Without a header, i.e. when the first row is all numbers, the file must
+    have exactly two columns, time then y: a header-less file with more
+    columns is ambiguous and refused.
+
+    Parameters
+    ----------
+    path : str or path-like
+
+    Returns
+    -------
+    times, y : ndarray
+        At least 2 rows, finite, times strictly increasing.
+
+    Raises
+    ------
+    InputError
+        One line naming the file and the problem (missing file, missing
+        column, non-numeric or non-finite entry with its line, non-increasing
+        time, fewer than 2 rows).
+    """
+    p = pathlib.Path(path)
+    if not p.is_file():
+        what = "is not a file" if p.exists() else "does not exist"
+        raise InputError(f"kick table {str(path)!r} {what}")
+    st = p.stat()
+    # Cached by content identity: validate() and run() both read the table.
+    times, y = _read_kick_table(str(p.resolve()), str(path), st.st_mtime_ns, st.st_size)
+    return times.copy(), y.copy()
+
+
+@functools.lru_cache(maxsize=16)
+def _read_kick_table(resolved, name, mtime_ns, size):
+    import re
+
+    def fail(problem):
+        raise InputError(f"kick table {name!r}: {problem}")
+
+    try:
+        text = pathlib.Path(resolved).read_text(encoding="utf-8-sig")
+    except UnicodeDecodeError:
+        fail("is not a UTF-8 text file (expected CSV with columns time (s) and y (m))")
+    except OSError as exc:
+        fail(f"cannot be read: {exc.strerror or exc}")
+    rows = [(k + 1, [f.strip() for f in line.split(",")]) for k, line in enumerate(text.splitlines())
+            if line.strip() and not line.lstrip().startswith("#")]
+    if not rows:
+        fail("has no rows (expected CSV with columns time (s) and y (m))")
+
+    def number(text):
+        try:
+            return float(text)
+        except ValueError:
+            return None
+
+    first_line, first = rows[0]
+    if all(number(f) is not None for f in first):
+        if len(first) != 2:
+            fail(f"line {first_line} has {len(first)} columns and no header; a file without header "
+                 "must have exactly two columns, time (s) then y (m)")
+        columns, data = {"time": 0, "y": 1}, rows
+    else:
+        names = [re.sub(r"\s*[\[(][^\])]*[\])]$", "", f).strip().lower() for f in first]
+        columns = {}
+        for want in ("time", "y"):
+            hits = [i for i, n in enumerate(names) if n == want]
+            if not hits:
+                fail(f"has no column {want!r} (header: {', '.join(first)}); name the columns "
+                     "time (s) and y (m)")
+            if len(hits) > 1:
+                fail(f"has {len(hits)} columns named {want!r}")
+            columns[want] = hits[0]
+        data = rows[1:]
+    width = len(first)
+    times, ys, lines = [], [], []
+    for line, cells in data:
+        if len(cells) != width:
+            fail(f"line {line} has {len(cells)} column{'s' if len(cells) != 1 else ''}, expected {width}")
+        values = []
+        for col in ("time", "y"):
+            cell = cells[columns[col]]
+            v = number(cell)
+            if v is None:
+                fail(f"line {line}: {cell!r} in column {col} is not a number")
+            if not math.isfinite(v):
+                fail(f"line {line}: {col} = {cell} is not finite")
+            values.append(v)
+        times.append(values[0])
+        ys.append(values[1])
+        lines.append(line)
+    if len(times) < 2:
+        fail(f"has {len(times)} data row{'s' if len(times) != 1 else ''}; at least 2 are needed")
+    t = np.array(times)
+    bad = np.flatnonzero(np.diff(t) <= 0.0)
+    if bad.size:
+        k = bad[0] + 1
+        fail(f"line {lines[k]}: time {times[k]!r} s is not after the previous row's {times[k - 1]!r} s "
+             "(times must increase strictly)")
+    t.flags.writeable = False
+    y = np.array(ys)
+    y.flags.writeable = False
+    return t, y
+
+
+@dataclass(frozen=True)
+class KickTable:
+    """A tabulated plate motion as the compiled model follows it.
+
+    Attributes
+    ----------
+    name : str
+        The table's file as given.
+    times, y : ndarray
+        Table rows [s], [m] (y signed: + to the right, after ``kick_direction``).
+    segments : list of (t_start, t_end, (c0, c1, c2, c3))
+        Clamped cubic spline, one cubic per table interval
+        (:func:`whipple_kick.slip.cubic_segments`).
+    """
+
+    name: str
+    times: np.ndarray
+    y: np.ndarray
+    segments: list
+
+    @classmethod
+    def from_points(cls, name, times, y):
+        """Fit the spline through ``(times, y)``."""
+        from . import slip
+        return cls(name, np.asarray(times, float), np.asarray(y, float), slip.cubic_segments(times, y))
+
+    @property
+    def duration(self):
+        """Time from the first to the last row [s]."""
+        return float(self.times[-1] - self.times[0])
+
+    @property
+    def displacement(self):
+        """Net plate travel y(last) - y(first) [m], signed."""
+        return float(self.y[-1] - self.y[0])
+
+    @property
+    def peak_acceleration(self):
+        """Peak |y''| of the spline [m/s^2].
+
+        y'' = 2 c2 + 6 c3 tau is linear in each segment, so its extremes are
+        at the segment ends.
+        """
+        return float(max(max(abs(2 * c[2]), abs(2 * c[2] + 6 * c[3] * (b - a))) for a, b, c in self.segments))
+
+    @property
+    def peak_velocity(self):
+        """Peak |y'| of the spline [m/s] (from the roots of y'' in each segment)."""
+        peak = 0.0
+        for a, b, c in self.segments:
+            taus = [0.0, b - a]
+            if c[3] != 0.0 and 0.0 < -c[2] / (3 * c[3]) < b - a:
+                taus.append(-c[2] / (3 * c[3]))
+            peak = max(peak, *(abs(c[1] + 2 * c[2] * s + 3 * c[3] * s * s) for s in taus))
+        return float(peak)
+
+    def pieces(self, t_start, t_end):
+        """Pieces covering [t_start, t_end]: list of (a, b, t0, (c0, c1, c2, c3)).
+
+        Rest at the first row's y before the table, one spline segment per
+        table interval, rest at the last row's y afterwards; clipped to the
+        span (empty pieces dropped). ``t0`` is the cubic's origin.
+        """
+        t_first, t_last = float(self.times[0]), float(self.times[-1])
+        raw = [(t_start, t_first, t_first, (float(self.y[0]), 0.0, 0.0, 0.0))]
+        raw += [(float(a), float(b), float(a), c) for a, b, c in self.segments]
+        raw.append((t_last, t_end, t_last, (float(self.y[-1]), 0.0, 0.0, 0.0)))
+        out = []
+        for a, b, t0, c in raw:
+            a, b = max(a, t_start), min(b, t_end)
+            if b > a:
+                out.append((a, b, t0, c))
+        return out
+
+
+def _segment_parameters(params, t0, coefficients):
+    """``params`` with the plate following one cubic (everything else, e.g. T6c, kept)."""
+    out = dict(params)
+    out["kick_profile"] = float(_SEGMENT_PROFILE)
+    out["kick_t0"] = float(t0)
+    out.update({f"kick_c{i}": float(c) for i, c in enumerate(coefficients)})
+    return out
+
+
+def _integrate_table(params, x0, table, scenario, chunk):
+    """Integrate a tabulated kick piece by piece on the run's global output grid.
+
+    Each piece (rest before, one spline segment per table interval, rest
+    after) has its own parameter set and compiled right-hand side, and
+    :func:`whipple_kick.integrate.integrate` restarts at its bounds; the end
+    state carries over. The output grid is the one a single
+    ``integrate.integrate(..., t_start=-settle, output_rate=...)`` call
+    uses; a piece whose bounds are not on it is integrated as up to three
+    calls: bound to the first grid sample inside, across the samples inside
+    (which ``integrate`` then lays on the same grid), last sample to bound.
+    Samples are kept by their grid index, so a boundary shared by two
+    pieces (or calls) appears once, and every grid sample appears once.
+
+    Returns
+    -------
+    trajectory : integrate.Trajectory
+    rhs : list of slip.CompiledRHS
+        One per piece.
+    piece : ndarray of int
+        Index into ``rhs`` of the piece that produced each sample.
+    """
+    from . import integrate, slip
+
+    t_start, t_end, rate = -scenario.settle, scenario.duration, scenario.output_rate
+    n = int(round((t_end - t_start) * rate)) + 1
+    grid = np.linspace(t_start, t_end, n)   # as integrate.integrate lays it out
+    dt = (t_end - t_start) / (n - 1)
+    # A table time this close to a grid time counts as on the grid: the
+    # sample is then the piece's end state (a 1e-9-of-a-sample shift in its
+    # label, ~1e-12 s at 1 kHz), not a separate sub-ulp LSODA call.
+    eps = 1e-9 * dt + 1e-14 * max(abs(t_start), abs(t_end))
+    fall_angle = math.radians(scenario.fall_angle_deg)
+
+    ts, xs, owner, rhss = [], [], [], []
+    next_index, nfev = 0, 0
+    x = np.asarray(x0, dtype=float)
+    fell, fall_time, message = False, None, "completed"
+    for k, (a, b, t0, coefficients) in enumerate(table.pieces(t_start, t_end)):
+        rhs = slip.CompiledRHS(_segment_parameters(params, t0, coefficients))
+        rhss.append(rhs)
+        lo = int(np.searchsorted(grid, a + eps, side="right"))
+        hi = int(np.searchsorted(grid, b - eps, side="left"))
+        calls = []
+        if hi <= lo:
+            calls.append((a, b, 1.0 / (b - a)))              # no sample strictly inside
+        else:
+            g1, g2 = grid[lo], grid[hi - 1]
+            calls.append((a, g1, 1.0 / (g1 - a)))
+            if hi - lo > 1:
+                calls.append((g1, g2, (hi - lo - 1) / (g2 - g1)))
+            calls.append((g2, b, 1.0 / (b - g2)))
+        for c0, c1, c_rate in calls:
+            traj = integrate.integrate(rhs, x, c1, t_start=c0, rtol=scenario.rtol, output_rate=c_rate,
+                                       fall_angle=fall_angle, chunk=chunk)
+            nfev += traj.nfev
+            if traj.message.startswith("integration failed"):
+                return integrate.Trajectory(np.array(ts), np.array(xs), False, None, nfev, traj.message), \
+                    rhss, np.array(owner, dtype=int)
+            for t, state in zip(traj.t, traj.x):
+                i = int(round((t - t_start) / dt))
+                if 0 <= i < n and abs(grid[i] - t) <= eps:
+                    if i >= next_index:
+                        ts.append(grid[i])
+                        xs.append(state)
+                        owner.append(k)
+                        next_index = i + 1
+                elif traj.fell and t == traj.fall_time:
+                    ts.append(t)
+                    xs.append(state)
+                    owner.append(k)
+            if traj.fell:
+                fell, fall_time, message = True, traj.fall_time, traj.message
+                break
+            x = traj.x[-1]
+        if fell:
+            break
+    traj = integrate.Trajectory(np.array(ts), np.array(xs).reshape(len(ts), len(x)), fell, fall_time,
+                                nfev, message)
+    return traj, rhss, np.array(owner, dtype=int)
 
 
 @dataclass
@@ -384,15 +727,20 @@ def preflight(scenario):
 
 # -------------------------------------------------------------------- running
 
-def _trajectory_frame(rhs, traj):
-    """DataFrame of states and named outputs at every sample."""
+def _trajectory_frame(rhs, traj, owner=None):
+    """DataFrame of states and named outputs at every sample.
+
+    ``rhs`` is one compiled right-hand side, or (tabulated kick) a list of
+    them with ``owner[i]`` the one that produced sample ``i``.
+    """
     import pandas as pd
     from . import slip
 
     n = traj.t.size
     outs = np.empty((n, len(slip.OUTPUT_NAMES)))
     for i in range(n):
-        _, outs[i] = rhs.outputs(traj.t[i], traj.x[i])
+        f = rhs if owner is None else rhs[owner[i]]
+        _, outs[i] = f.outputs(traj.t[i], traj.x[i])
     cols = {"time": traj.t}
     for q, (name, _) in _COORDINATE_COLUMNS.items():
         cols[name] = traj.x[:, slip.X[q]]
@@ -474,34 +822,50 @@ def run(scenario):
     wall0 = time.perf_counter()
     scenario.validate()
     kick_T, kick_accel, kick_D = scenario.kick_timing()
+    table = scenario.kick_table_spline() if scenario.kick_profile == TABLE_PROFILE else None
     # Tyres first: a pressure outside the measured range is the commonest mistake and cheap to find.
     rear, front, notes = build_tyres(scenario)
     moore, design, info = build_bicycle(scenario)
     gains, poles = controller_gains(scenario, design)
-    params = slip.model_parameters(
-        moore, rear, front, gains=gains, symmetric=scenario.symmetric_tyres,
-        kick=dict(t0=0.0, duration=kick_T, displacement=kick_D, profile=KICK_PROFILES[scenario.kick_profile]))
+    if table is None:
+        kick = dict(t0=0.0, duration=kick_T, displacement=kick_D, profile=KICK_PROFILES[scenario.kick_profile])
+        kick_start = 0.0
+    else:
+        # Steady running with the plate at rest at the table's first y
+        # (only the plate's velocity enters the tyre slip, so any y0 is steady).
+        kick_start = float(table.times[0])
+        kick = dict(profile=_SEGMENT_PROFILE, t0=kick_start, coefficients=(float(table.y[0]), 0.0, 0.0, 0.0))
+    params = slip.model_parameters(moore, rear, front, gains=gains, symmetric=scenario.symmetric_tyres,
+                                   kick=kick)
     try:
         steady = slip.steady_state(params, scenario.speed)
     except FloatingPointError as exc:
         raise SimulationError(f"no steady motion at {scenario.speed:g} m/s: {exc}") from None
-    rhs = slip.CompiledRHS(steady.params)
     # piecewise=False is the comparison case: one LSODA run across the kick,
     # not even restarted at the integrator's chunk boundaries.
-    breakpoints = (0.0, kick_T) if scenario.piecewise else ()
+    if table is None:
+        breakpoints = (0.0, kick_T) if scenario.piecewise else ()
+    else:
+        breakpoints = tuple(float(t) for t in table.times if -scenario.settle < t < scenario.duration)
     chunk = integrate.DEFAULT_CHUNK if scenario.piecewise else math.inf
     t_int = time.perf_counter()
+    owner = None
     try:
-        traj = integrate.integrate(rhs, steady.x, scenario.duration, t_start=-scenario.settle,
-                                   breakpoints=breakpoints, rtol=scenario.rtol,
-                                   output_rate=scenario.output_rate,
-                                   fall_angle=math.radians(scenario.fall_angle_deg), chunk=chunk)
+        if table is None:
+            rhs = slip.CompiledRHS(steady.params)
+            traj = integrate.integrate(rhs, steady.x, scenario.duration, t_start=-scenario.settle,
+                                       breakpoints=breakpoints, rtol=scenario.rtol,
+                                       output_rate=scenario.output_rate,
+                                       fall_angle=math.radians(scenario.fall_angle_deg), chunk=chunk)
+        else:
+            # The drive torque T6c found for the steady motion stays in every piece's parameters.
+            traj, rhs, owner = _integrate_table(steady.params, steady.x, table, scenario, chunk)
     except FloatingPointError as exc:
         raise SimulationError(f"integration failed: {exc}") from None
     integration_s = time.perf_counter() - t_int
     if traj.message.startswith("integration failed"):
         raise SimulationError(traj.message)
-    df = _trajectory_frame(rhs, traj)
+    df = _trajectory_frame(rhs, traj, owner)
     if not np.all(np.isfinite(df.to_numpy())):
         raise SimulationError("non-finite values in the trajectory")
 
@@ -543,9 +907,15 @@ def run(scenario):
             "law": "T7 = -(kq4 q4 + kq7 q7 + ku4 u4 + ku7 u7)",
             "linear_closed_loop_poles": None if poles is None else [[p.real, p.imag] for p in poles],
         },
-        "kick": {"start_s": 0.0, "duration_s": kick_T, "displacement_m": kick_D,
+        "kick": {"start_s": kick_start, "duration_s": kick_T, "displacement_m": kick_D,
                  "peak_acceleration_m_s2": kick_accel, "profile": scenario.kick_profile,
-                 "direction": scenario.kick_direction},
+                 "direction": scenario.kick_direction,
+                 **({} if table is None else {"table": {
+                     "file": table.name, "rows": int(table.times.size),
+                     "y_first_m": float(table.y[0]), "y_last_m": float(table.y[-1]),
+                     "peak_abs_y_m": float(np.max(np.abs(table.y))),
+                     "peak_velocity_m_s": table.peak_velocity,
+                     "spline": "clamped cubic (plate at rest at both ends; y, y', y'' continuous)"}})},
         "steady_state": {
             "speed_m_s": scenario.speed,
             "roll_rad": float(x0[slip.X["q4"]]), "steer_rad": float(x0[slip.X["q7"]]),
