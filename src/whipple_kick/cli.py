@@ -124,10 +124,18 @@ def _simulate_parser():
                      help="peak plate acceleration in m/s^2 (sets the duration)")
     how.add_argument("--kick-duration", type=_number("s"), metavar="S",
                      help="plate travel time in s (default 0.150)")
-    g.add_argument("--kick-displacement", type=_number("m"), default=0.150, metavar="M",
+    # No default here: an explicit --kick-displacement must be told apart from
+    # the default so that it can be refused with --kick-table.
+    g.add_argument("--kick-displacement", type=_number("m"), metavar="M",
                    help="plate travel in m (default 0.150)")
-    g.add_argument("--kick-profile", choices=tuple(simulation.KICK_PROFILES), default="constant",
-                   help="constant acceleration (default, thesis) or smooth (minimum jerk)")
+    g.add_argument("--kick-profile", choices=simulation.PROFILES,
+                   help="constant acceleration (default, thesis), smooth (minimum jerk) or table "
+                        "(plate displacement from --kick-table)")
+    g.add_argument("--kick-table", metavar="FILE",
+                   help="CSV of the plate's displacement, columns time (in s, from the kick start) and "
+                        "y (in m, + right); a header-less file is read as two columns time, y. The plate "
+                        "follows the clamped cubic spline through the rows (implies --kick-profile table; "
+                        "not with --kick-accel/--kick-duration/--kick-displacement)")
     g.add_argument("--kick-direction", choices=simulation.DIRECTIONS, default="right",
                    help="direction the plate moves (default right)")
     g = p.add_argument_group("run and output")
@@ -153,6 +161,17 @@ def _scenario_from_args(args):
         raise InputError("--pressure sets both tyres; do not combine it with --pressure-front/--pressure-rear")
     if (fronts[0] is None) != (fronts[1] is None):
         raise InputError("give both --pressure-front KPA and --pressure-rear KPA (or --pressure KPA for both)")
+    profile = args.kick_profile
+    if args.kick_table is not None:
+        if profile not in (None, "table"):
+            raise InputError(f"--kick-table gives the plate motion; do not combine it with --kick-profile {profile}")
+        for flag, value in (("--kick-accel", args.kick_accel), ("--kick-duration", args.kick_duration),
+                            ("--kick-displacement", args.kick_displacement)):
+            if value is not None:
+                raise InputError(f"--kick-table gives the plate motion; do not combine it with {flag}")
+        profile = "table"
+    elif profile == "table":
+        raise InputError("--kick-profile table needs --kick-table FILE (CSV with columns time in s, y in m)")
     return Scenario(
         bicycle=args.bicycle, fz_n=args.fz, rider_mass_kg=args.rider_mass, tyre=args.tyre,
         pressure_kpa=400.0 if args.pressure is None else args.pressure,
@@ -160,8 +179,9 @@ def _scenario_from_args(args):
         coefficient_set=args.coefficient_set, friction=args.friction,
         symmetric_tyres=args.symmetric_tyres, speed=args.speed, controller=args.controller,
         design_speed=args.design_speed, gain_scale=args.gain_scale, low_inertia=args.low_inertia,
-        kick_displacement=args.kick_displacement, kick_duration=args.kick_duration,
-        kick_accel=args.kick_accel, kick_profile=args.kick_profile,
+        kick_displacement=0.150 if args.kick_displacement is None else args.kick_displacement,
+        kick_duration=args.kick_duration, kick_accel=args.kick_accel,
+        kick_profile="constant" if profile is None else profile, kick_table=args.kick_table,
         kick_direction=args.kick_direction, settle=args.settle, duration=args.duration, rtol=args.rtol,
     )
 
@@ -216,8 +236,14 @@ def _print_summary(result, out, files):
           f"rear/front ({sc['coefficient_set']}, friction {sc['friction']}), {bike['bicycle']}, rear load "
           f"{bike['static_load_rear_n']:.1f} N{rider}, {sc['speed']:g} m/s")
     print(f"  controller {ctl['type']} x{ctl['gain_scale']:g}: {gains}")
-    print(f"  kick: {abs(kick['displacement_m']) * 1e3:.0f} mm {kick['direction']} in {kick['duration_s']:.3f} s "
-          f"(peak {kick['peak_acceleration_m_s2']:.1f} m/s^2, {kick['profile']} profile) at t = 0 s")
+    if "table" in kick:
+        tab = kick["table"]
+        print(f"  kick: table {tab['file']} ({tab['rows']} rows), net {kick['displacement_m'] * 1e3:+.0f} mm "
+              f"(+ right) in {kick['duration_s']:.3f} s from t = {kick['start_s']:g} s (spline peak "
+              f"{kick['peak_acceleration_m_s2']:.1f} m/s^2, {tab['peak_velocity_m_s']:.2f} m/s)")
+    else:
+        print(f"  kick: {abs(kick['displacement_m']) * 1e3:.0f} mm {kick['direction']} in {kick['duration_s']:.3f} s "
+              f"(peak {kick['peak_acceleration_m_s2']:.1f} m/s^2, {kick['profile']} profile) at t = 0 s")
     print(f"  steady state: roll {st['roll_rad'] * deg:.2f} deg, steer {st['steer_rad'] * deg:.2f} deg, "
           f"yaw rate {st['yaw_rate_rad_s']:.4f} rad/s, drive torque {st['drive_torque_n_m']:.4f} N m")
     if s["fell"]:
