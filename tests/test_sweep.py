@@ -228,3 +228,17 @@ def test_recommend_pressure_function_fine_grid():
     assert float(best["recovery_time"].iloc[0]) == rec.table["recovery_time"].min()
     assert rec.best_measured_kpa in (300.0, 400.0, 500.0)
     assert "recommendation for 701 N:" in sweep.format_recommendation(rec)
+
+
+def test_saved_trajectory_is_thinned_and_keeps_the_fall():
+    scenario = simulation.Scenario(duration=2.0, settle=0.1, controller="off", fz_n=635.0)
+    spec = {"columns": ("time", "roll"), "dtype": "float64", "rate_hz": 100.0}
+    record = sweep.run_case(scenario, "x", spec)
+    t = record["trajectory"]["time"]
+    summary = json.loads(record["summary"])
+    assert summary["fell"]
+    np.testing.assert_allclose(np.diff(t[:-1]), 0.01, rtol=1e-9)   # 1000 Hz output, every 10th
+    assert t[-1] == summary["end_time_s"] == pytest.approx(summary["fall_time_s"])
+    assert abs(record["trajectory"]["roll"][-1]) == pytest.approx(np.radians(45.0))
+    with pytest.raises(InputError, match="trajectory_rate"):
+        sweep.sweep({"pressure_kpa": [300]}, base=BASE, trajectory_rate=0)
