@@ -328,6 +328,9 @@ def _recommend(argv):
                    help="also try a grid of interpolated pressures between the measured ones")
     p.add_argument("--step", type=_number("kPa"), default=10.0, metavar="KPA",
                    help="step of the --fine grid in kPa (default 10)")
+    p.add_argument("--criterion", choices=tuple(sweep.CRITERIA), default="last_peak",
+                   help="last_peak: time of the last yaw-rate peak above 8 %% of the largest (thesis, "
+                        "default); settling: time from which the yaw rate stays within 5 %% of its first peak")
     p.add_argument("--duration", type=_number("s"), default=6.0, metavar="S",
                    help="simulated time after the kick in s (default 6)")
     p.add_argument("--workers", type=int, metavar="N",
@@ -341,7 +344,7 @@ def _recommend(argv):
     base.validate()
     recs = sweep.recommend_pressures(
         args.fz, tyre=args.tyre, pressures=args.pressures, fine=args.fine, step_kpa=args.step,
-        base=base, workers=args.workers, folder=args.out,
+        base=base, criterion=args.criterion, workers=args.workers, folder=args.out,
         progress=not args.no_progress and sys.stderr.isatty())
     for k, rec in enumerate(recs):
         if k:

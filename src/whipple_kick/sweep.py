@@ -705,10 +705,15 @@ def _collect(executor, todo, records, store, progress, total, spec, table_interv
 
 # --------------------------------------------------------------- the pressure recommender
 
-#: Ranking of the recommender: thesis recovery time (time of the last yaw-rate
-#: peak above 8 % of the largest, Section 8.3 / Table 8.9), then the time after
-#: which the yaw rate stays within 5 % of its first peak as the tie-break.
-RANKING = ("recovery_time", "recovery.time_s")
+#: Recommender criteria: the table columns ranked, the first deciding, the
+#: second breaking ties. ``last_peak`` is the thesis' recovery time (time of
+#: the last yaw-rate peak above 8 % of the largest, Section 8.3, Table 8.9);
+#: ``settling`` the time from which |yaw rate - steady| stays within 5 % of
+#: its first peak (``summary["recovery"]``).
+CRITERIA = {"last_peak": ("recovery_time", "recovery.time_s"),
+            "settling": ("recovery.time_s", "recovery_time")}
+_CRITERION_TEXT = {"last_peak": "recovery time (last yaw-rate peak above 8 %)",
+                   "settling": "5 % settling time of the yaw rate"}
 
 
 @dataclasses.dataclass
@@ -724,16 +729,20 @@ class Recommendation:
         Pressure [kPa] with the shortest recovery time (None if no case recovered).
     best_measured_kpa : float or None
         The same among the measured pressures only.
+    criterion : str
+        Key of :data:`CRITERIA` the pressures were ranked by.
     table : pandas.DataFrame
         One row per pressure: ``pressure_kpa``, ``measured``, ``recovery_time``
-        [s], ``recovery.time_s`` [s], ``damping_ratio_1_3``, ``period``,
-        ``max_abs_roll`` [rad], ``fell``, ``status``, ``error``, ``rank``.
+        [s], ``recovery.time_s`` [s], ``n_peaks``, ``damping_ratio_1_3``,
+        ``period`` [s], ``max_abs_roll`` [rad], ``fell``, ``status``, ``error``,
+        ``rank``.
     """
 
     fz_n: float
     tyre: str
     best_pressure_kpa: float | None
     best_measured_kpa: float | None
+    criterion: str
     table: "object"
 
 
@@ -780,17 +789,23 @@ def pressure_grid(tyre="T03", pressures=None, fine=False, step_kpa=10.0, coeffic
     return sorted(out), set(measured)
 
 
-def _rank(table):
-    """Sort key columns: unavailable (fell, not recovered, failed) last."""
-    keys = []
-    for col in RANKING:
-        values = table[col] if col in table else np.full(len(table), np.nan)
-        keys.append(np.where(np.isfinite(values.astype(float)), values.astype(float), np.inf))
+def _rank(table, criterion):
+    """Row order by the criterion's columns, rows without a value (fell, not recovered, failed) last."""
+    keys = [np.where(np.isfinite(v), v, np.inf)
+            for v in (table[col].astype(float).to_numpy() for col in CRITERIA[criterion])]
     return np.lexsort(keys[::-1])
 
 
+def _best(rows, criterion):
+    """Pressure of the best-ranked row with a value of the criterion, or None."""
+    if rows.empty:
+        return None
+    top = rows.iloc[_rank(rows, criterion)[0]]
+    return float(top["pressure_kpa"]) if math.isfinite(_num(top[CRITERIA[criterion][0]])) else None
+
+
 def recommend_pressures(loads, tyre="T03", pressures=None, fine=False, step_kpa=10.0, base=None,
-                        **sweep_options):
+                        criterion="last_peak", **sweep_options):
     """:func:`recommend_pressure` for several rear loads in one sweep.
 
     Returns
@@ -798,9 +813,9 @@ def recommend_pressures(loads, tyre="T03", pressures=None, fine=False, step_kpa=
     list of Recommendation
         In the order of ``loads``.
     """
-    import pandas as pd
-
     base = simulation.Scenario() if base is None else base
+    if criterion not in CRITERIA:
+        raise InputError(f"criterion = {criterion!r} is unknown; choose one of {', '.join(CRITERIA)}")
     loads = [check_range("rear-tyre load fz", f, 0.0, None, "N", low_open=True) for f in loads]
     if not loads:
         raise InputError("give at least one rear load fz (N)")
@@ -808,38 +823,34 @@ def recommend_pressures(loads, tyre="T03", pressures=None, fine=False, step_kpa=
     sweep_options.setdefault("progress", False)
     table = sweep({"fz_n": loads, "pressure_kpa": grid}, base=dataclasses.replace(base, tyre=tyre),
                   **sweep_options)
+    keep = ["pressure_kpa", "measured", "recovery_time", "recovery.time_s", "n_peaks",
+            "damping_ratio_1_3", "period", "max_abs_roll", "fell", "status", "error"]
     out = []
-    keep = ["pressure_kpa", "measured", "recovery_time", "recovery.time_s", "damping_ratio_1_3",
-            "period", "max_abs_roll", "fell", "status", "error"]
     for fz in loads:
         rows = table[table["fz_n"] == fz].copy()
         rows["measured"] = rows["pressure_kpa"].isin(measured)
         for col in keep:
-            if col not in rows:
-                rows[col] = None
+            if col not in rows:   # every case failed: no result columns at all
+                rows[col] = np.nan
         rows = rows[keep].sort_values("pressure_kpa").reset_index(drop=True)
-        order = _rank(rows)
-        rows["rank"] = pd.Series(np.argsort(order) + 1, index=rows.index)
-        ok = np.isfinite(rows["recovery_time"].astype(float).to_numpy())
-        best = float(rows["pressure_kpa"].iloc[order[0]]) if ok.any() else None
-        meas = rows[rows["measured"]]
-        m_order = _rank(meas.reset_index(drop=True))
-        m_ok = np.isfinite(meas["recovery_time"].astype(float).to_numpy())
-        best_measured = float(meas["pressure_kpa"].iloc[m_order[0]]) if m_ok.any() else None
-        out.append(Recommendation(fz, tyre, best, best_measured, rows))
+        rows["rank"] = np.argsort(_rank(rows, criterion)) + 1
+        out.append(Recommendation(fz, tyre, _best(rows, criterion),
+                                  _best(rows[rows["measured"]].reset_index(drop=True), criterion),
+                                  criterion, rows))
     return out
 
 
 def recommend_pressure(fz_n, tyre="T03", pressures=None, fine=False, step_kpa=10.0, base=None,
-                       **sweep_options):
+                       criterion="last_peak", **sweep_options):
     """The inflation pressure with the fastest yaw-rate recovery after a kick.
 
     Runs ``base`` (default: the thesis' kick on the default bicycle with a
     rider for ``fz_n`` and the LQR rider) at each pressure and ranks the
     cases by the thesis' recovery time (time of the last yaw-rate peak above
     8 % of the largest; :func:`whipple_kick.analysis.recovery_time`), ties
-    broken by the 5 % settling time (``recovery.time_s``). Cases that fell
-    or did not recover rank last.
+    broken by the 5 % settling time (``recovery.time_s``), or the other way
+    round with ``criterion="settling"``. Cases that fell or did not recover
+    rank last. docs/sweeps.md compares the result with thesis Table 8.9.
 
     Parameters
     ----------
@@ -858,6 +869,8 @@ def recommend_pressure(fz_n, tyre="T03", pressures=None, fine=False, step_kpa=10
     base : Scenario, optional
         Everything else about the run (``fz_n``, ``tyre`` and the pressure
         are set here).
+    criterion : {"last_peak", "settling"}
+        What "fastest recovery" means (:data:`CRITERIA`).
     **sweep_options
         Passed to :func:`sweep` (``folder``, ``executor``, ``workers``,
         ``progress``, ...).
@@ -866,7 +879,8 @@ def recommend_pressure(fz_n, tyre="T03", pressures=None, fine=False, step_kpa=10
     -------
     Recommendation
     """
-    return recommend_pressures([fz_n], tyre, pressures, fine, step_kpa, base, **sweep_options)[0]
+    return recommend_pressures([fz_n], tyre, pressures, fine, step_kpa, base, criterion,
+                               **sweep_options)[0]
 
 
 def _num(value):
@@ -883,29 +897,32 @@ def format_recommendation(rec):
         v = _num(value) * scale
         return fmt.format(v) if math.isfinite(v) else "-"
 
-    lines = [f"rear load {rec.fz_n:g} N, tyre {rec.tyre}: yaw-rate recovery after the kick",
-             f"{'p [kPa]':>8} {'meas.':>5} {'recovery [s]':>12} {'5% settle [s]':>13} "
+    lines = [f"rear load {rec.fz_n:g} N, tyre {rec.tyre}: yaw-rate recovery after the kick, "
+             f"ranked by {_CRITERION_TEXT[rec.criterion]}",
+             f"{'p [kPa]':>8} {'meas.':>5} {'recovery [s]':>12} {'5% settle [s]':>13} {'peaks':>5} "
              f"{'zeta 1-3':>8} {'period [s]':>10} {'max roll [deg]':>14} {'rank':>4}  note"]
     for _, r in rec.table.iterrows():
         if r["status"] != "ok":
             note = f"failed: {r['error']}"
         elif r["fell"] is True or _num(r["fell"]) == 1.0:
             note = "fell"
-        elif not math.isfinite(_num(r["recovery_time"])):
+        elif not math.isfinite(_num(r[CRITERIA[rec.criterion][0]])):
             note = "not recovered"
         else:
             note = "best" if r["pressure_kpa"] == rec.best_pressure_kpa else ""
         lines.append(
             f"{r['pressure_kpa']:8g} {'yes' if r['measured'] else '':>5} "
             f"{cell(r['recovery_time'], '{:.3f}'):>12} {cell(r['recovery.time_s'], '{:.3f}'):>13} "
+            f"{cell(r['n_peaks'], '{:.0f}'):>5} "
             f"{cell(r['damping_ratio_1_3'], '{:.4f}'):>8} {cell(r['period'], '{:.4f}'):>10} "
             f"{cell(r['max_abs_roll'], '{:.2f}', 180.0 / math.pi):>14} {int(r['rank']):4d}  {note}")
     if rec.best_pressure_kpa is None:
         lines.append(f"recommendation for {rec.fz_n:g} N: none (no pressure recovered within the run)")
     else:
         best = rec.table[rec.table["pressure_kpa"] == rec.best_pressure_kpa].iloc[0]
+        column = CRITERIA[rec.criterion][0]
         text = (f"recommendation for {rec.fz_n:g} N: {rec.best_pressure_kpa:g} kPa "
-                f"(recovery time {_num(best['recovery_time']):.3f} s)")
+                f"({_CRITERION_TEXT[rec.criterion]} {_num(best[column]):.3f} s)")
         if rec.best_measured_kpa is not None and rec.best_measured_kpa != rec.best_pressure_kpa:
             text += f"; best measured pressure {rec.best_measured_kpa:g} kPa"
         lines.append(text)
