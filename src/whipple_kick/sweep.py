@@ -225,7 +225,8 @@ def install_setup_cache():
     or kick sweep shares them; memoising ``simulation.build_bicycle`` and
     ``simulation.controller_gains`` saves ~15 % of a 6 s case (~0.16 s).
     Results are bit-identical (the same functions, called once per key).
-    Installed in every sweep worker process.
+    Installed by :func:`run_case`, i.e. in every worker process (and in the
+    calling process if the executor runs cases there, e.g. threads).
     """
     global _cache_installed
     with _cache_lock:
@@ -291,6 +292,8 @@ def _trajectory_spec(columns, dtype, rate_hz):
     """What :func:`run_case` returns of the trajectory (None: nothing)."""
     if columns is None:
         return None
+    if isinstance(columns, str) and columns != "all":
+        columns = (columns,)   # one column, not its letters
     if rate_hz is not None and not (isinstance(rate_hz, (int, float)) and rate_hz > 0):
         raise InputError(f"trajectory_rate = {rate_hz!r} Hz must be > 0 Hz (or None for every sample)")
     np.dtype(dtype)   # a bad dtype fails here, not in every case
@@ -611,7 +614,8 @@ def sweep(grid=None, cases=None, *, base=None, folder=None, executor=None, worke
     case_list = make_cases(grid, cases, base)
     base = simulation.Scenario() if base is None else base
     spec = _trajectory_spec(trajectory_columns, trajectory_dtype, trajectory_rate)
-    if workers is not None and (isinstance(workers, bool) or int(workers) != workers or workers < 1):
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, (int, np.integer))
+                                or workers < 1):
         raise InputError(f"workers = {workers!r} must be a whole number >= 1")
     # Loads (or builds) the compiled model here, so forked workers inherit it.
     store = _Folder(folder, case_list, base, extend, spec) if folder is not None else None
