@@ -737,10 +737,15 @@ def _trajectory_frame(rhs, traj, owner=None):
     from . import slip
 
     n = traj.t.size
-    outs = np.empty((n, len(slip.OUTPUT_NAMES)))
-    for i in range(n):
-        f = rhs if owner is None else rhs[owner[i]]
-        _, outs[i] = f.outputs(traj.t[i], traj.x[i])
+    if owner is None:
+        outs = rhs.outputs_at(traj.t, traj.x)
+    else:
+        # Each segment's compiled model evaluates the samples it produced.
+        owner = np.asarray(owner)
+        outs = np.empty((n, len(slip.OUTPUT_NAMES)))
+        for k in np.unique(owner):
+            rows = owner == k
+            outs[rows] = rhs[k].outputs_at(traj.t[rows], traj.x[rows])
     cols = {"time": traj.t}
     for q, (name, _) in _COORDINATE_COLUMNS.items():
         cols[name] = traj.x[:, slip.X[q]]

@@ -238,6 +238,16 @@ def c_source():
     lines.append("    for (int i = 0; i < %d; i++) if (!isfinite(dx[i])) return 2;" % len(STATE_NAMES))
     lines.append("    return 0;")
     lines.append("}")
+    # Outputs at many samples in one call (post-processing a trajectory).
+    lines.append("int wk_slip_outputs(int n, const double *t, const double *x, const double *p, double *out)")
+    lines.append("{")
+    lines.append(f"    double dx[{len(STATE_NAMES)}];")
+    lines.append("    for (int i = 0; i < n; i++) {")
+    lines.append(f"        int status = wk_slip_rhs(t[i], x + (long)i * {len(STATE_NAMES)}, p, dx, out + (long)i * {len(OUTPUT_NAMES)});")
+    lines.append("        if (status) return status;")
+    lines.append("    }")
+    lines.append("    return 0;")
+    lines.append("}")
     lines.append(f"int wk_slip_sizes(int *sizes) {{ sizes[0] = {len(STATE_NAMES)}; sizes[1] = {len(PARAMETER_NAMES)}; sizes[2] = {len(OUTPUT_NAMES)}; return 0; }}")
     return "\n".join(lines) + "\n"
 
@@ -277,6 +287,8 @@ def library():
     lib = ctypes.CDLL(str(lib_path))
     lib.wk_slip_rhs.restype = ctypes.c_int
     lib.wk_slip_rhs.argtypes = [ctypes.c_double, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p]
+    lib.wk_slip_outputs.restype = ctypes.c_int
+    lib.wk_slip_outputs.argtypes = [ctypes.c_int, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p]
     sizes = (ctypes.c_int * 3)()
     lib.wk_slip_sizes(sizes)
     if tuple(sizes) != (len(STATE_NAMES), len(PARAMETER_NAMES), len(OUTPUT_NAMES)):
@@ -392,6 +404,30 @@ class CompiledRHS:
                 raise FloatingPointError(_STATUS.get(status, f"status {status}") + f" at t = {t:.6g} s")
             return dx.copy()
         return f
+
+    def outputs_at(self, t, X):
+        """Named outputs (:data:`OUTPUT_NAMES`) at many samples, in one C call.
+
+        Parameters
+        ----------
+        t : array_like, shape (n,)
+            Times [s].
+        X : array_like, shape (n, len(STATE_NAMES))
+            States.
+
+        Returns
+        -------
+        ndarray, shape (n, len(OUTPUT_NAMES))
+        """
+        t = np.ascontiguousarray(t, dtype=float)
+        X = np.ascontiguousarray(X, dtype=float)
+        if X.shape != (t.size, len(STATE_NAMES)):
+            raise ValueError(f"states must have shape ({t.size}, {len(STATE_NAMES)}), got {X.shape}")
+        out = np.empty((t.size, len(OUTPUT_NAMES)))
+        status = self.lib.wk_slip_outputs(t.size, t.ctypes.data, X.ctypes.data, self._p_ptr, out.ctypes.data)
+        if status:
+            raise FloatingPointError(_STATUS.get(status, f"status {status}") + " while evaluating outputs")
+        return out
 
     def outputs(self, t, x):
         """Derivatives and named outputs (:data:`OUTPUT_NAMES`) at one state."""
