@@ -17,6 +17,7 @@ Example
 ...                     folder="thesis_grid")                    # doctest: +SKIP
 >>> table.pivot(index="fz_n", columns="pressure_kpa", values="recovery_time")  # doctest: +SKIP
 """
+import atexit
 import concurrent.futures as cf
 import copy
 import dataclasses
@@ -571,7 +572,8 @@ def sweep(grid=None, cases=None, *, base=None, folder=None, executor=None, worke
         the same sweep is resumed. Without it nothing is written.
     executor : concurrent.futures.Executor, optional
         Where the cases run, e.g. ``dask.distributed.Client(...).get_executor()``;
-        it is not shut down. Default: a local process pool of ``workers``.
+        it is not shut down. Default: a local process pool of ``workers``,
+        kept alive for later sweeps in this process.
     workers : int, optional
         Size of the default process pool (default: one per CPU core, at most
         one per case).
@@ -642,15 +644,13 @@ def sweep(grid=None, cases=None, *, base=None, folder=None, executor=None, worke
 
     own = executor is None and todo
     if own:
-        n = min(len(todo), workers or os.cpu_count() or 1)
-        _preload()
-        executor = cf.ProcessPoolExecutor(max_workers=n)
+        executor = _default_pool(workers or os.cpu_count() or 1)
     lost = []
     try:
         _collect(executor, todo, records, store, progress, len(unique), spec, table_interval, lost)
     finally:
-        if own:
-            executor.shutdown(wait=True, cancel_futures=True)
+        if own and lost:
+            _discard_default_pool()
         if store is not None:
             n_ok = sum(1 for cid, _ in unique if records.get(cid, {}).get("status") == "ok")
             n_failed = sum(1 for cid, _ in unique if records.get(cid, {}).get("status") == "failed")
@@ -663,6 +663,38 @@ def sweep(grid=None, cases=None, *, base=None, folder=None, executor=None, worke
         raise SweepInterrupted(f"{len(lost)} of {len(unique)} cases were not run: the executor failed "
                                f"({lost[0]}){where}")
     return _table(case_list, records)
+
+
+_pool = None          # the default executor, kept between sweeps in this process
+_pool_workers = None
+
+
+def _default_pool(n):
+    """The process pool sweeps use when no executor is given, kept alive between sweeps.
+
+    Starting a pool and warming each worker (imports, compiled model, rider
+    and LQR caches) costs about as much as a case; a researcher running
+    sweep after sweep in one session pays it once. A broken pool (a worker
+    died) or a different worker count gets a fresh one.
+    """
+    global _pool, _pool_workers
+    if _pool is not None and (_pool_workers != n or getattr(_pool, "_broken", False)):
+        _discard_default_pool()
+    if _pool is None:
+        _preload()
+        _pool = cf.ProcessPoolExecutor(max_workers=n)
+        _pool_workers = n
+    return _pool
+
+
+def _discard_default_pool():
+    global _pool, _pool_workers
+    if _pool is not None:
+        _pool.shutdown(wait=False, cancel_futures=True)
+    _pool, _pool_workers = None, None
+
+
+atexit.register(_discard_default_pool)
 
 
 def _preload():
