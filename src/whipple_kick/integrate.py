@@ -72,7 +72,13 @@ def _fast_chunk(rhs, x, times, rtol, atol, roll_index, fall_angle):
     """
     # Stop as soon as the bicycle is past the limit: odeint has no events,
     # and integrating a fallen bicycle onwards is wasted work.
-    guarded = rhs.guarded(roll_index, fall_angle, _PastTheLimit)
+    if hasattr(rhs, "guarded"):
+        guarded = rhs.guarded(roll_index, fall_angle, _PastTheLimit)
+    else:   # any f(t, x), e.g. the NumPy oracle
+        def guarded(t, x):
+            if abs(x[roll_index]) > fall_angle:
+                raise _PastTheLimit
+            return rhs(t, x)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
@@ -98,8 +104,8 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
 
     Parameters
     ----------
-    rhs : slip.CompiledRHS
-        Compiled right-hand side with its parameters.
+    rhs : slip.CompiledRHS or callable
+        Compiled right-hand side with its parameters, or any ``f(t, x)``.
     x0 : array_like
         Initial state (:data:`slip.STATE_NAMES`).
     t_end, t_start : float
