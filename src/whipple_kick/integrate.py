@@ -26,6 +26,7 @@ class Trajectory:
     fall_time: float | None  # time of the fall event [s]
     nfev: int                # right-hand-side evaluations
     message: str
+    end_state: np.ndarray | None = None   # exact state at t_end (or at the fall)
 
     def state(self, name):
         """Time history of one state by name."""
@@ -92,7 +93,7 @@ def _fast_chunk(rhs, x, times, rtol, atol, roll_index, fall_angle):
 
 
 def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None,
-              output_rate=1000.0, fall_angle=np.deg2rad(45.0), chunk=None):
+              output_rate=1000.0, fall_angle=np.deg2rad(45.0), chunk=None, samples=None):
     """Integrate ``rhs`` from ``x0`` piecewise between breakpoints with LSODA.
 
     Each smooth piece is integrated in chunks of about ``chunk`` seconds
@@ -117,21 +118,34 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
     atol : array_like, optional
         Absolute tolerances (default :func:`default_atol`).
     output_rate : float
-        Sample rate of the output [Hz].
+        Sample rate of the output [Hz] (when ``samples`` is not given).
     fall_angle : float
         |roll| limit [rad] ending the run.
     chunk : float, optional
         Length of the fast-path chunks [s] (default :data:`DEFAULT_CHUNK`;
         ``inf`` for one LSODA run per piece).
+    samples : array_like, optional
+        Output times [s] (increasing); those in ``[t_start, t_end]`` are
+        returned. Default: ``output_rate`` from ``t_start``. A sample within
+        a billionth of the sample spacing of a piece's edge is given the
+        state at that edge rather than a sub-ulp integration of its own.
 
     Returns
     -------
     Trajectory
+        With ``end_state`` the exact state at ``t_end`` (or at the fall),
+        whether or not ``t_end`` is a sample time.
     """
     atol = default_atol(rtol) if atol is None else atol
     chunk = DEFAULT_CHUNK if chunk is None else chunk
-    n_samples = int(round((t_end - t_start) * output_rate)) + 1
-    samples = np.linspace(t_start, t_end, n_samples)
+    if samples is None:
+        n_samples = int(round((t_end - t_start) * output_rate)) + 1
+        samples = np.linspace(t_start, t_end, n_samples)
+    else:
+        samples = np.asarray(samples, dtype=float)
+        samples = samples[(samples >= t_start) & (samples <= t_end)]
+    spacing = np.min(np.diff(samples)) if samples.size > 1 else (t_end - t_start)
+    eps = 1e-9 * spacing + 1e-14 * max(abs(t_start), abs(t_end))
     edges = [t_start] + sorted(b for b in set(breakpoints) if t_start < b < t_end) + [t_end]
     roll = slip.X["q4"]
 
@@ -155,12 +169,18 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
     fell, fall_time, message = False, None, "completed"
     done = False
     for a, b in zip(edges[:-1], edges[1:]):
-        inside = samples[(samples >= a) & (samples <= b)]
+        at_a = samples[np.abs(samples - a) <= eps]
+        at_b = samples[(np.abs(samples - b) <= eps) & (samples > a + eps)]
+        inside = samples[(samples > a + eps) & (samples < b - eps)]
+        emit(at_a, np.repeat(x[None, :], at_a.size, axis=0))
         # Chunk boundaries: the piece's start, sample times about `chunk`
         # apart, and the piece's end (so the exact end state carries over).
-        grid = np.unique(np.concatenate([[a], inside, [b]]))
-        step = len(grid) if np.isinf(chunk) else max(1, int(round(chunk * output_rate)))
-        cuts = list(range(0, len(grid) - 1, step)) + [len(grid) - 1]
+        grid = np.concatenate([[a], inside, [b]])
+        if np.isinf(chunk):
+            cuts = [0, len(grid) - 1]
+        else:
+            marks = np.searchsorted(grid, a + chunk * np.arange(1, int(np.ceil((b - a) / chunk))))
+            cuts = sorted({0, len(grid) - 1, *(int(m) for m in marks if 0 < m < len(grid) - 1)})
         for i0, i1 in zip(cuts[:-1], cuts[1:]):
             times = grid[i0:i1 + 1]
             fast = _fast_chunk(rhs, x, times, rtol, atol, roll, fall_angle)
@@ -175,9 +195,10 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
             emit(sol.t, sol.y.T)
             if sol.status == 1:
                 fell, fall_time = True, float(sol.t_events[0][0])
+                x = sol.y_events[0][0]
                 if fall_time > last_t:
                     ts.append(np.array([fall_time]))
-                    xs.append(sol.y_events[0][:1])
+                    xs.append(x[None, :])
                 message = f"fell: |roll| reached {np.rad2deg(fall_angle):.0f} deg at t = {fall_time:.4f} s"
                 done = True
                 break
@@ -187,8 +208,9 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
             x = sol.y[:, -1]
         if done:
             break
+        emit(at_b, np.repeat(x[None, :], at_b.size, axis=0))
     t = np.concatenate(ts) if ts else np.array([])
     X = np.concatenate(xs) if xs else np.empty((0, len(x)))
     if X.size and not np.all(np.isfinite(X)):
         raise FloatingPointError("non-finite state in the integration result")
-    return Trajectory(t, X, fell, fall_time, nfev, message)
+    return Trajectory(t, X, fell, fall_time, nfev, message, end_state=x)

@@ -11,6 +11,7 @@ Time is measured from the start of the kick: the run starts at
 ``-settle`` (steady running shown before the kick) and ends at
 ``duration`` (or at the fall). docs/simulate.md lists every decision.
 """
+import copy
 from dataclasses import asdict, dataclass, field, fields, replace
 import functools
 import math
@@ -524,15 +525,9 @@ def _integrate_table(params, x0, table, scenario, chunk):
     """Integrate a tabulated kick piece by piece on the run's global output grid.
 
     Each piece (rest before, one spline segment per table interval, rest
-    after) has its own parameter set and compiled right-hand side, and
-    :func:`whipple_kick.integrate.integrate` restarts at its bounds; the end
-    state carries over. The output grid is the one a single
-    ``integrate.integrate(..., t_start=-settle, output_rate=...)`` call
-    uses; a piece whose bounds are not on it is integrated as up to three
-    calls: bound to the first grid sample inside, across the samples inside
-    (which ``integrate`` then lays on the same grid), last sample to bound.
-    Samples are kept by their grid index, so a boundary shared by two
-    pieces (or calls) appears once, and every grid sample appears once.
+    after) has its own parameter set and compiled right-hand side; each is
+    one :func:`whipple_kick.integrate.integrate` call on the samples not yet
+    produced, starting from the previous piece's exact end state.
 
     Returns
     -------
@@ -545,61 +540,28 @@ def _integrate_table(params, x0, table, scenario, chunk):
     from . import integrate, slip
 
     t_start, t_end, rate = -scenario.settle, scenario.duration, scenario.output_rate
-    n = int(round((t_end - t_start) * rate)) + 1
-    grid = np.linspace(t_start, t_end, n)   # as integrate.integrate lays it out
-    dt = (t_end - t_start) / (n - 1)
-    # A table time this close to a grid time counts as on the grid: the
-    # sample is then the piece's end state (a 1e-9-of-a-sample shift in its
-    # label, ~1e-12 s at 1 kHz), not a separate sub-ulp LSODA call.
-    eps = 1e-9 * dt + 1e-14 * max(abs(t_start), abs(t_end))
+    pending = np.linspace(t_start, t_end, int(round((t_end - t_start) * rate)) + 1)
     fall_angle = math.radians(scenario.fall_angle_deg)
-
-    ts, xs, owner, rhss = [], [], [], []
-    next_index, nfev = 0, 0
+    ts, xs, owner, rhss, nfev = [], [], [], [], 0
     x = np.asarray(x0, dtype=float)
-    fell, fall_time, message = False, None, "completed"
+    traj = None
     for k, (a, b, t0, coefficients) in enumerate(table.pieces(t_start, t_end)):
         rhs = slip.CompiledRHS(_segment_parameters(params, t0, coefficients))
         rhss.append(rhs)
-        lo = int(np.searchsorted(grid, a + eps, side="right"))
-        hi = int(np.searchsorted(grid, b - eps, side="left"))
-        calls = []
-        if hi <= lo:
-            calls.append((a, b, 1.0 / (b - a)))              # no sample strictly inside
-        else:
-            g1, g2 = grid[lo], grid[hi - 1]
-            calls.append((a, g1, 1.0 / (g1 - a)))
-            if hi - lo > 1:
-                calls.append((g1, g2, (hi - lo - 1) / (g2 - g1)))
-            calls.append((g2, b, 1.0 / (b - g2)))
-        for c0, c1, c_rate in calls:
-            traj = integrate.integrate(rhs, x, c1, t_start=c0, rtol=scenario.rtol, output_rate=c_rate,
-                                       fall_angle=fall_angle, chunk=chunk)
-            nfev += traj.nfev
-            if traj.message.startswith("integration failed"):
-                return integrate.Trajectory(np.array(ts), np.array(xs), False, None, nfev, traj.message), \
-                    rhss, np.array(owner, dtype=int)
-            for t, state in zip(traj.t, traj.x):
-                i = int(round((t - t_start) / dt))
-                if 0 <= i < n and abs(grid[i] - t) <= eps:
-                    if i >= next_index:
-                        ts.append(grid[i])
-                        xs.append(state)
-                        owner.append(k)
-                        next_index = i + 1
-                elif traj.fell and t == traj.fall_time:
-                    ts.append(t)
-                    xs.append(state)
-                    owner.append(k)
-            if traj.fell:
-                fell, fall_time, message = True, traj.fall_time, traj.message
-                break
-            x = traj.x[-1]
-        if fell:
+        traj = integrate.integrate(rhs, x, b, t_start=a, rtol=scenario.rtol, fall_angle=fall_angle,
+                                   chunk=chunk, samples=pending)
+        nfev += traj.nfev
+        ts.append(traj.t)
+        xs.append(traj.x)
+        owner.append(np.full(traj.t.size, k))
+        if traj.t.size:
+            pending = pending[pending > traj.t[-1]]
+        x = traj.end_state
+        if traj.fell:
             break
-    traj = integrate.Trajectory(np.array(ts), np.array(xs).reshape(len(ts), len(x)), fell, fall_time,
-                                nfev, message)
-    return traj, rhss, np.array(owner, dtype=int)
+    trajectory = integrate.Trajectory(np.concatenate(ts), np.concatenate(xs), traj.fell, traj.fall_time,
+                                      nfev, traj.message, end_state=x)
+    return trajectory, rhss, np.concatenate(owner).astype(int)
 
 
 @dataclass
@@ -624,30 +586,45 @@ class Result:
 # ------------------------------------------------------------------ model set-up
 
 def build_bicycle(scenario):
-    """Bicycle with rider for ``scenario``: (moore parameters, info dict).
+    """Bicycle with rider for ``scenario``: (moore parameters, design parameters, info dict).
 
     The info holds the rider mass [kg] and the static loads [N] of the
     unmodified bicycle; ``moore`` has the low-inertia change applied if asked.
-    ``design`` (also in info) is the unmodified set the LQR is designed on.
+    ``design`` is the unmodified set the LQR is designed on. Cached per
+    process on the fields it reads (a sweep over pressures, speeds or kicks
+    seats the Yeadon rider once); callers get their own copies.
     """
+    key = (scenario.bicycle, _file_stamp(scenario.bicycle), scenario.fz_n, scenario.rider_mass_kg,
+           scenario.rider, scenario.low_inertia)
+    return copy.deepcopy(_bicycle_setup(*key))
+
+
+def _file_stamp(name):
+    """Modification time of a parameter file given by path (so an edited file is re-read)."""
+    path = pathlib.Path(str(name))
+    return path.stat().st_mtime_ns if path.suffix == ".toml" and path.is_file() else None
+
+
+@functools.lru_cache(maxsize=256)
+def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia):
     from . import benchmark, bicycles, riders
 
-    bike = bicycles.load(scenario.bicycle)
+    bike = bicycles.load(bicycle)
     if bike.includes_rider:
-        if scenario.fz_n is not None or scenario.rider_mass_kg is not None:
+        if fz_n is not None or rider_mass_kg is not None:
             raise InputError(f"bicycle {bike.name!r} already includes its rider; "
                              "do not give a rear-tyre load fz or a rider mass with it")
         combined, rider_mass = bike, None
-    elif scenario.rider_mass_kg is not None:
-        rider = riders.yeadon_rider(scenario.rider, mass_kg=scenario.rider_mass_kg)
-        combined, rider_mass = riders.seat(bike, rider), float(scenario.rider_mass_kg)
+    elif rider_mass_kg is not None:
+        rider = riders.yeadon_rider(rider_name, mass_kg=rider_mass_kg)
+        combined, rider_mass = riders.seat(bike, rider), float(rider_mass_kg)
     else:
-        fz = 635.0 if scenario.fz_n is None else scenario.fz_n
-        combined, rider_mass = riders.for_rear_load(bike, fz, rider=scenario.rider)
+        fz = 635.0 if fz_n is None else fz_n
+        combined, rider_mass = riders.for_rear_load(bike, fz, rider=rider_name)
     rear_n, front_n = riders.static_loads(combined)
     design = dict(combined.moore)
     moore = dict(design)
-    if scenario.low_inertia:
+    if low_inertia:
         bench = dict(combined.benchmark)
         for key in LOW_INERTIA_KEYS:
             bench[key] *= 0.5
@@ -656,6 +633,13 @@ def build_bicycle(scenario):
             "rider_mass_kg": rider_mass, "static_load_rear_n": rear_n, "static_load_front_n": front_n,
             "total_mass_kg": sum(float(combined.benchmark[k]) for k in ("mR", "mB", "mH", "mF"))}
     return moore, design, info
+
+
+@functools.lru_cache(maxsize=256)
+def _lqr(design_items, speed):
+    from . import control
+    K, poles = control.lqr_gains(dict(design_items), speed)
+    return tuple(np.ravel(K)), tuple(np.ravel(poles))
 
 
 def controller_gains(scenario, design):
@@ -674,7 +658,7 @@ def controller_gains(scenario, design):
                                  "701 N: give fz (N) (or thesis_load_n for a preset with rider)")
         gains = control.thesis_gains(load)
         return {k: scenario.gain_scale * v for k, v in gains.items()}, None
-    K, poles = control.lqr_gains(design, scenario.design_speed)
+    K, poles = _lqr(tuple(sorted(design.items())), float(scenario.design_speed))
     return control.gains_dict(K, scenario.gain_scale), np.asarray(poles)
 
 
@@ -868,8 +852,6 @@ def run(scenario):
     except FloatingPointError as exc:
         raise SimulationError(f"integration failed: {exc}") from None
     integration_s = time.perf_counter() - t_int
-    if traj.message.startswith("integration failed"):
-        raise SimulationError(traj.message)
     df = _trajectory_frame(rhs, traj, owner)
     if not np.all(np.isfinite(df.to_numpy())):
         raise SimulationError("non-finite values in the trajectory")

@@ -19,7 +19,6 @@ Example
 """
 import atexit
 import concurrent.futures as cf
-import copy
 import dataclasses
 import datetime
 import hashlib
@@ -28,10 +27,8 @@ import json
 import math
 import os
 import pathlib
-import pickle
 import platform
 import socket
-import threading
 import time
 
 import numpy as np
@@ -179,68 +176,6 @@ def make_cases(grid=None, cases=None, base=None):
     return out
 
 
-# ------------------------------------------------------------- per-process set-up cache
-
-# Scenario fields that cannot change the bicycle with rider (build_bicycle) or
-# the controller gains (controller_gains): the tyres, the riding speed, the
-# kick and the numerics. Everything else, including fields added later, is
-# part of the cache key, so an unknown field can only cost a cache miss.
-_NOT_SETUP_FIELDS = frozenset((
-    "tyre", "pressure_kpa", "pressure_front_kpa", "pressure_rear_kpa", "coefficient_set",
-    "friction", "symmetric_tyres", "speed", "kick_displacement", "kick_duration", "kick_accel",
-    "kick_profile", "kick_direction", "settle", "duration", "rtol", "output_rate",
-    "fall_angle_deg", "piecewise",
-))
-_CACHE_LIMIT = 256
-_cache_lock = threading.Lock()
-_cache_installed = False
-
-
-def _setup_key(scenario, rest):
-    fixed = tuple((f.name, getattr(scenario, f.name)) for f in dataclasses.fields(scenario)
-                  if f.name not in _NOT_SETUP_FIELDS)
-    return fixed, pickle.dumps(rest, protocol=4)
-
-
-def _memoised(function, cache):
-    def wrapper(scenario, *rest):
-        key = (function.__name__,) + _setup_key(scenario, rest)
-        if key not in cache:
-            value = function(scenario, *rest)
-            with _cache_lock:
-                if len(cache) >= _CACHE_LIMIT:
-                    cache.clear()
-                cache[key] = value
-        # run() gets its own copy, so nothing it does can leak into later cases.
-        return copy.deepcopy(cache[key])
-    wrapper.__wrapped__ = function
-    wrapper.__doc__ = function.__doc__
-    return wrapper
-
-
-def install_setup_cache():
-    """Cache the rider model and the LQR design per process (idempotent).
-
-    :func:`simulation.run` rebuilds the Yeadon rider (~23 ms) and solves the
-    LQR Riccati equation (~4 ms) for every case, although a pressure, speed
-    or kick sweep shares them; memoising ``simulation.build_bicycle`` and
-    ``simulation.controller_gains`` saves ~15 % of a 6 s case (~0.16 s).
-    Results are bit-identical (the same functions, called once per key).
-    Installed by :func:`run_case`, i.e. in every worker process (and in the
-    calling process if the executor runs cases there, e.g. threads).
-    """
-    global _cache_installed
-    with _cache_lock:
-        if _cache_installed:
-            return
-        cache = {}
-        for name in ("build_bicycle", "controller_gains"):
-            setattr(simulation, name, _memoised(getattr(simulation, name), cache))
-        _cache_installed = True
-
-
-# ------------------------------------------------------------------------ one case
-
 def _flat_value(value):
     """A summary value as a table cell, or the sentinel ``_SKIP`` for what is not a scalar."""
     if value is None or isinstance(value, (bool, int, float, str)):
@@ -342,7 +277,6 @@ def run_case(scenario, case_id, trajectory=None):
     """
     from threadpoolctl import threadpool_limits
 
-    install_setup_cache()
     _preload()
     started = time.time()
     wall0, cpu0 = time.perf_counter(), time.process_time()
