@@ -8,7 +8,6 @@ import importlib.util
 import sys
 
 import sympy as sm
-import sympy.physics.mechanics as me
 from sympy.printing.numpy import NumPyPrinter
 
 
@@ -90,4 +89,4 @@ def load_module(path, module_name):
     return module
 
 
-__all__ = ["plain", "plain_symbol", "numpy_function", "load_module", "me"]
+__all__ = ["plain", "plain_symbol", "numpy_function", "load_module"]

@@ -339,7 +339,6 @@ def slip_equations():
     """
     from . import magic_formula as mf
 
-    t = me.dynamicsymbols._t
     kin = kinematics(tyre_model=True)
     N, A, C, D, E, F = (kin.frames[k] for k in "NACDEF")
     q, u = kin.q, kin.u

@@ -302,7 +302,7 @@ def _rx(angle):
 
 def _body123(a, b, c):
     """yeadon's body-fixed 1-2-3 rotation (x, then new y, then new z)."""
-    ca, sa, cb, sb, cc, sc = math.cos(a), math.sin(a), math.cos(b), math.sin(b), math.cos(c), math.sin(c)
+    cb, sb, cc, sc = math.cos(b), math.sin(b), math.cos(c), math.sin(c)
     ry = np.array([[cb, 0.0, sb], [0.0, 1.0, 0.0], [-sb, 0.0, cb]])
     rz = np.array([[cc, -sc, 0.0], [sc, cc, 0.0], [0.0, 0.0, 1.0]])
     return _rx(a) @ ry @ rz

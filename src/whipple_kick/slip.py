@@ -178,7 +178,7 @@ def c_source():
         lines.append(f"    u[{idx}] = x[{len(COORDINATES) + j}];")
     lines.append(f"    double Adep[{m * m}], rhs1[{m * (k + 1)}];")
     lines.append(f"    for (int i = 0; i < {m}; i++) {{")
-    lines.append(f"        double s = a0[i];")
+    lines.append("        double s = a0[i];")
     for jj, idx in enumerate(dep):
         lines.append(f"        Adep[i * {m} + {jj}] = A[i * {n} + {idx}];")
     for jj, idx in enumerate(ind):
@@ -202,7 +202,7 @@ def c_source():
     lines.append("    }")
     # Kane's reduced equations: T = [I; C], C = -A_dep^-1 A_ind, t0 = [0; d], d = -A_dep^-1 b.
     lines.append(f"    double T[{n * k}], t0[{n}], d[{m}];")
-    lines.append(f"    memset(T, 0, sizeof T); memset(t0, 0, sizeof t0);")
+    lines.append("    memset(T, 0, sizeof T); memset(t0, 0, sizeof t0);")
     for jj, idx in enumerate(ind):
         lines.append(f"    T[{idx} * {k} + {jj}] = 1.0;")
     lines.append(f"    double Adep2[{m * m}], rhs2[{m}];")
@@ -222,9 +222,9 @@ def c_source():
     lines.append(f"        double s = 0.0; for (int l = 0; l < {n}; l++) s += M[i * {n} + l] * T[l * {k} + j]; MT[i * {k} + j] = s; }}")
     lines.append(f"    for (int i = 0; i < {k}; i++) {{")
     lines.append(f"        for (int j = 0; j < {k}; j++) {{ double s = 0.0; for (int l = 0; l < {n}; l++) s += T[l * {k} + i] * MT[l * {k} + j]; Mr[i * {k} + j] = s; }}")
-    lines.append(f"        double s = 0.0;")
+    lines.append("        double s = 0.0;")
     lines.append(f"        for (int l = 0; l < {n}; l++) {{ double g = f[l]; for (int c = 0; c < {n}; c++) g -= M[l * {n} + c] * t0[c]; s += T[l * {k} + i] * g; }}")
-    lines.append(f"        r[i] = s;")
+    lines.append("        r[i] = s;")
     lines.append("    }")
     lines.append(f"    if (lu_solve({k}, Mr, 1, r)) return 1;")
     # Outputs.
@@ -378,12 +378,10 @@ class CompiledRHS:
         self._dx_ptr = self._dx.ctypes.data
         self._out = np.empty(len(OUTPUT_NAMES))
         self._out_ptr = self._out.ctypes.data
-        self.calls = 0
 
     def __call__(self, t, x):
         x = np.ascontiguousarray(x, dtype=float)
         status = self.lib.wk_slip_rhs(t, x.ctypes.data, self._p_ptr, self._dx_ptr, None)
-        self.calls += 1
         if status:
             raise FloatingPointError(_STATUS.get(status, f"status {status}") + f" at t = {t:.6g} s")
         return self._dx.copy()
