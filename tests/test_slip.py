@@ -87,6 +87,54 @@ def test_stiff_tyres_approach_the_classic_model(speed):
     assert errors[-1] < 1e-4
 
 
+def test_linearisation_predicts_the_response_about_a_steady_turn(rider_bike, gains, t03):
+    """Heading-frame Jacobian against the nonlinear model, about the offset-balancing turn.
+
+    A small perturbation (1e-3 in roll rate and steer rate) is integrated
+    with the nonlinear model and with exp(A t); the difference is second
+    order in the perturbation, so it must be a small fraction of it.
+    """
+    from scipy.linalg import expm
+    ss = slip.steady_state(slip.model_parameters(rider_bike, t03, t03, gains=gains), 3.0)
+    assert abs(ss.x[slip.X["u3"]]) > 0.05          # really a turn (measured 0.095 rad/s)
+    rhs = slip.CompiledRHS(ss.params)
+    A = slip.linearize(rhs, ss.x)
+    x0 = ss.x.copy()
+    x0[slip.X["u4"]] += 1e-3
+    x0[slip.X["u7"]] += 1e-3
+    tr = integrate.integrate(rhs, x0, 2.0, rtol=1e-11, output_rate=100)
+    z_ref = slip.heading_state(ss.x)
+    dz0 = slip.heading_state(x0) - z_ref
+    worst = 0.0
+    for t, x in zip(tr.t[::10], tr.x[::10]):
+        dz_nonlinear = slip.heading_state(x) - z_ref
+        dz_linear = expm(A * t) @ dz0
+        worst = max(worst, np.abs(dz_nonlinear - dz_linear)[:11].max())
+    # Measured 8e-7 (second order: (1e-3)^2 times the model's curvature);
+    # an error in A of 1 % would give ~1e-5 over the 2 s.
+    assert worst < 5e-6
+
+
+def test_steer_torque_input_matrix_matches_the_classic_model():
+    """Stiff tyres: eigenvalues of A - B K equal the classic closed loop, so B is right."""
+    moore = benchmark.to_moore(benchmark.meijaard2007_parameters())
+    K, _ = wk.control.lqr_gains(moore, 4.0)
+    tyre = _linear_tyre(1e4, 1e-4, 1e9)
+    ss = slip.steady_state(slip.model_parameters(moore, tyre, tyre, gains=wk.control.gains_dict(K)), 4.0)
+    A, B, Kfull = slip.linear_state_space(ss.params, ss.x)
+    ref = np.linalg.eigvals(wk.control.closed_loop_matrix(moore, 4.0, K))
+    for Amat, expected in ((A - B @ Kfull, ref), (A, classic.eigenvalues(moore, [4.0])[0])):
+        ev = np.linalg.eigvals(Amat)
+        matched = np.array([ev[np.argmin(np.abs(ev - r))] for r in expected])
+        # Measured 9e-5 for both: the finite tyre stiffness, as in the stiff-tyre test above.
+        assert np.max(np.abs(matched - expected) / np.abs(expected)) < 1e-3
+    # The input is linear in T7: bumping another gain gives the same B.
+    bumped = dict(ss.params, kq4=ss.params["kq4"] + 1.0)
+    A_b = slip.linearize(slip.CompiledRHS(bumped), ss.x)
+    j = slip.LINEAR_STATES.index("q4")
+    np.testing.assert_allclose(A_b[:, j], (A - B @ Kfull)[:, j] - B[:, 0], atol=1e-6 * np.abs(B).max())
+
+
 def test_energy_never_increases_with_slip_and_damping(rider_bike, t03):
     par = slip.model_parameters(rider_bike, t03, t03, symmetric=True)
     ss = slip.steady_state(par, 4.5)

@@ -615,9 +615,14 @@ def steady_state(params, speed, tol=1e-13):
 
 # ---------------------------------------------------------------- linearisation
 
-#: States of the lateral and vertical dynamics about straight running (the
-#: ignorable q1, q2, q6, q8, the dependent q5 and the forward speed u1 left out).
-LINEAR_STATES = ("q3", "q4", "q7", "q9", "q10", "u2", "u3", "u4", "u7", "u9", "u10",
+#: States of the linearisation in the heading frame: every state except the
+#: ignorable position q1, q2 and wheel angles q6, q8, the yaw angle q3 (the
+#: model is invariant to heading while the plate is at rest), the dependent
+#: pitch q5, with the rear-contact velocity [m/s] resolved in the heading
+#: frame: ``v_fwd`` along N.x and ``v_lat`` along N.y, both turned by the yaw
+#: angle q3 about N.z (N.z points down, so ``v_lat`` > 0 is a drift to the
+#: right). See :func:`linearize`.
+LINEAR_STATES = ("q4", "q7", "q9", "q10", "v_fwd", "v_lat", "u3", "u4", "u7", "u9", "u10",
                  "fyr", "fyf", "mzr", "mzf")
 
 
@@ -637,27 +642,98 @@ def solve_pitch(rhs, x, tol=1e-14, max_iter=30):
     raise FloatingPointError(f"pitch did not converge (last step {abs(step):.3g} rad)")
 
 
-def linearize(rhs, x, names=LINEAR_STATES, step=1e-7, t=0.0):
-    """Central-difference Jacobian of the compiled right-hand side.
+def heading_state(x):
+    """The :data:`LINEAR_STATES` values of a full state ``x`` (velocities along the heading)."""
+    c, s = np.cos(x[X["q3"]]), np.sin(x[X["q3"]])
+    u1, u2 = x[X["u1"]], x[X["u2"]]
+    z = np.array([x[X[n]] if n in X else 0.0 for n in LINEAR_STATES])
+    z[LINEAR_STATES.index("v_fwd")] = c * u1 + s * u2
+    z[LINEAR_STATES.index("v_lat")] = -s * u1 + c * u2
+    return z
 
-    Perturbed coordinates re-solve the pitch so every evaluated state
-    satisfies the holonomic constraint.
+
+def _heading_derivative(rhs, x_ref, z, t):
+    """d/dt of the heading-frame state ``z`` (yaw set to 0, pitch re-solved)."""
+    x = np.array(x_ref, dtype=float)
+    x[X["q3"]] = 0.0
+    for name, value in zip(LINEAR_STATES, z):
+        if name == "v_fwd":
+            x[X["u1"]] = value
+        elif name == "v_lat":
+            x[X["u2"]] = value
+        else:
+            x[X[name]] = value
+    x = solve_pitch(rhs, x)
+    dx = rhs(t, x)
+    u1, u2, u3 = x[X["u1"]], x[X["u2"]], x[X["u3"]]
+    # Rotating-frame rates at q3 = 0: d(v_fwd)/dt = u1' + u3 u2, d(v_lat)/dt = u2' - u3 u1.
+    rates = {"v_fwd": dx[X["u1"]] + u3 * u2, "v_lat": dx[X["u2"]] - u3 * u1}
+    return np.array([rates[n] if n in rates else dx[X[n]] for n in LINEAR_STATES])
+
+
+def linearize(rhs, x, step=1e-7, t=0.0):
+    """Jacobian of the slip model in the heading frame, about the state ``x``.
+
+    Resolving the rear-contact velocity along the heading removes the yaw
+    angle from the equations (the plate must be at rest), so a steady turn,
+    which rotates u1 and u2, is an equilibrium of the linearised system and
+    its eigenvalues are exact. States :data:`LINEAR_STATES`; perturbed
+    coordinates re-solve the pitch so every evaluated state satisfies the
+    holonomic constraint. Central differences.
+
+    Parameters
+    ----------
+    rhs : CompiledRHS
+    x : array_like
+        Full state (e.g. ``SteadyState.x``); its q3 is ignored.
+    step : float
+        Relative finite-difference step (tyre force states use 100 times it).
+    t : float
+        Time [s] at which to evaluate (the plate must be at rest then).
 
     Returns
     -------
-    ndarray, shape (len(names), len(names))
+    ndarray, shape (15, 15)
     """
-    idx = [X[n] for n in names]
-    J = np.empty((len(idx), len(idx)))
-    for j, i in enumerate(idx):
-        h = step * max(1.0, abs(x[i])) * (1e2 if STATE_NAMES[i] in TYRE_STATES else 1.0)
-        xp, xm = np.array(x, dtype=float), np.array(x, dtype=float)
-        xp[i] += h
-        xm[i] -= h
-        if STATE_NAMES[i].startswith("q"):
-            xp, xm = solve_pitch(rhs, xp), solve_pitch(rhs, xm)
-        J[:, j] = (rhs(t, xp)[idx] - rhs(t, xm)[idx]) / (2 * h)
+    z0 = heading_state(x)
+    J = np.empty((z0.size, z0.size))
+    for j, name in enumerate(LINEAR_STATES):
+        h = step * max(1.0, abs(z0[j])) * (1e2 if name in TYRE_STATES else 1.0)
+        zp, zm = z0.copy(), z0.copy()
+        zp[j] += h
+        zm[j] -= h
+        J[:, j] = (_heading_derivative(rhs, x, zp, t) - _heading_derivative(rhs, x, zm, t)) / (2 * h)
     return J
+
+
+def linear_state_space(params, x, step=1e-7):
+    """Open-loop ``A`` and steer-torque input ``B`` of the slip model about ``x``.
+
+    ``x`` is a steady state of the closed loop with the gains in ``params``
+    (the steady steer torque ``-K x`` stays applied as a constant). Because
+    the controller enters as ``T7 = -K x``, the closed-loop Jacobian is
+    ``A - B K``; ``B`` is the change of that Jacobian when the steer-rate
+    gain grows by 1 N m s/rad, so both come from the compiled model.
+
+    Returns
+    -------
+    A : ndarray (15, 15)
+    B : ndarray (15, 1)
+        Per unit steer torque T7 [N m].
+    K : ndarray (1, 15)
+        The gains of ``params`` on :data:`LINEAR_STATES` (so ``A - B K`` is the closed loop).
+    """
+    if params.get("kq3", 0.0):
+        raise InputError("linear_state_space: a yaw-angle gain kq3 breaks the heading invariance")
+    A_cl = linearize(CompiledRHS(params), x, step)
+    bumped = dict(params)
+    bumped["ku7"] = params["ku7"] + 1.0
+    j = LINEAR_STATES.index("u7")
+    B = (A_cl[:, j] - linearize(CompiledRHS(bumped), x, step)[:, j]).reshape(-1, 1)
+    K = np.zeros((1, len(LINEAR_STATES)))
+    for gain, state in (("kq4", "q4"), ("kq7", "q7"), ("ku3", "u3"), ("ku4", "u4"), ("ku7", "u7")):
+        K[0, LINEAR_STATES.index(state)] = params[gain]
+    return A_cl + B @ K, B, K
 
 
 def cubic_segments(times, displacements):
