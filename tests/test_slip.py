@@ -1,5 +1,4 @@
 """The slip model: compiled C vs NumPy oracle, limit to the classic model, invariants, tyre physics."""
-import types
 
 import numpy as np
 import pytest
@@ -59,14 +58,8 @@ def test_c_agrees_with_numpy_oracle(rider_bike, gains, t03):
 
 
 def _linear_tyre(kappa, sigma, kz):
-    """A Magic-Formula tyre that is linear over any relevant slip: F = -kappa Fz slip, no moment."""
-    a4 = 1e4  # kN: sin(2 atan(Fz/a4)) = 2 Fz/a4 to 1e-8
-    fy = np.zeros(14)
-    fy[0], fy[2], fy[3], fy[4] = 1.0, 1e8, kappa * 1000 * np.pi / 180 * a4 / 2, a4
-    mz = wk.tyres.ZERO_MOMENT_COEFFICIENTS
-    return types.SimpleNamespace(crown_radius=0.0, vertical_stiffness=kz, vertical_damping=np.sqrt(kz * 50),
-                                 relaxation_length=sigma, blend=[(1.0, fy, mz)],
-                                 friction_scale=1.0, curve_scale=1.0)
+    """F = -kappa Fz slip, no camber force, no moment; vertical damping sqrt(50 kz)."""
+    return wk.tyres.linear_tyre(kappa, sigma, kz)
 
 
 @pytest.mark.parametrize("speed", [3.0, 5.0, 7.0])

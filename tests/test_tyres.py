@@ -6,7 +6,7 @@ import warnings
 import numpy as np
 import pytest
 
-from whipple_kick import tyres
+from whipple_kick import magic_formula, tyres
 from whipple_kick.errors import InputError
 
 DEG = np.pi / 180.0
@@ -311,3 +311,17 @@ def test_file_name_must_match_tyre_name(tmp_path):
     shutil.move(path, tmp_path / "TY.toml")
     with pytest.raises(InputError, match=r"name: 'TX' must match the file name 'TY'"):
         tyres.load("TY", 400, directory=tmp_path)
+
+
+def test_linear_tyre_is_linear_without_camber_force_or_moment():
+    """The no-slip check tyre: F_y = -C F_z slip to 1e-6 up to 0.2 rad, nothing from camber."""
+    tyre = tyres.linear_tyre(12.0, 0.05, 2e5)
+    (_, fy, mz), = tyre.blend
+    slip = np.linspace(-0.2, 0.2, 9)
+    for fz in (50.0, 600.0, 1500.0):
+        force = magic_formula.lateral_force_numpy(slip, 0.0, fz, fy)
+        np.testing.assert_allclose(force, -12.0 * fz * slip, rtol=1e-6, atol=1e-9)
+        assert np.all(magic_formula.lateral_force_numpy(0.0, np.array([-0.3, 0.3]), fz, fy) == 0.0)
+        assert np.all(magic_formula.aligning_moment_numpy(slip, 0.1, fz, mz) == 0.0)
+    with pytest.raises(InputError, match="cornering coefficient"):
+        tyres.linear_tyre(-1.0, 0.05, 2e5)

@@ -26,7 +26,7 @@ from . import magic_formula as mf
 from .errors import InputError, check_range
 from .parameters import PARAMETER_DIR, load_toml, require_finite
 
-__all__ = ["Tyre", "TyreFile", "available", "load", "read_tyre_file",
+__all__ = ["Tyre", "TyreFile", "LinearTyre", "available", "linear_tyre", "load", "read_tyre_file",
            "DEFAULT_COEFFICIENT_SET", "FRICTION_MODES", "MISSING_MOMENT_MODES",
            "ZERO_MOMENT_COEFFICIENTS"]
 
@@ -473,6 +473,56 @@ class Tyre:
         factors["D"] = factors["D"] * self.curve_scale
         factors["Sv"] = factors["Sv"] * self.curve_scale
         return factors
+
+
+class LinearTyre:
+    """A tyre that is linear in slip and has no camber force or moment.
+
+    ``F_y = -cornering_coefficient * F_z * slip`` over any slip a simulation
+    reaches, written as a Magic Formula with a huge peak factor so the slip
+    model evaluates it unchanged. Made for checks against the no-slip
+    (knife-edge) model: as the coefficient and the vertical stiffness grow
+    and the relaxation length shrinks, the slip model approaches it.
+
+    Attributes match those of :class:`Tyre` that the slip model reads.
+    """
+
+    def __init__(self, cornering_coefficient, relaxation_length, vertical_stiffness,
+                 vertical_damping=None):
+        self.cornering_coefficient = check_range("cornering coefficient", cornering_coefficient,
+                                                 0.0, None, "1/rad", low_open=True)
+        self.relaxation_length = check_range("relaxation length", relaxation_length, 0.0, None, "m",
+                                             low_open=True)
+        self.vertical_stiffness = check_range("vertical stiffness", vertical_stiffness, 0.0, None, "N/m",
+                                              low_open=True)
+        if vertical_damping is None:
+            # About 0.1 of critical damping for a 50 kg share of the mass (no ringing, little loss).
+            vertical_damping = math.sqrt(self.vertical_stiffness * 50.0)
+        self.vertical_damping = check_range("vertical damping", vertical_damping, 0.0, None, "N s/m")
+        self.name = f"linear({self.cornering_coefficient:g}/rad)"
+        self.description = "linear cornering force, no camber force, no aligning moment"
+        self.pressure_kpa = None
+        self.crown_radius = 0.0
+        self.friction_scale = 1.0
+        self.curve_scale = 1.0
+        self.has_aligning_moment = False
+        # Pacejka 1989 F_y in the formula's units (deg, kN, N):
+        # BCD = a3 sin(2 atan(Fz/a4)) = 2 a3 Fz/a4 to 1e-8 for Fz << a4, and
+        # with C = 1 and D = a2 Fz huge, F = BCD * slip(deg) exactly enough.
+        a4 = 1e4
+        fy = np.zeros(14)
+        fy[0], fy[2], fy[4] = 1.0, 1e8, a4
+        fy[3] = self.cornering_coefficient * 1000.0 * math.pi / 180.0 * a4 / 2.0
+        self.blend = [(1.0, fy, ZERO_MOMENT_COEFFICIENTS.copy())]
+
+    def __repr__(self):
+        return (f"LinearTyre({self.cornering_coefficient:g}/rad, relaxation {self.relaxation_length:g} m, "
+                f"kz {self.vertical_stiffness:g} N/m)")
+
+
+def linear_tyre(cornering_coefficient, relaxation_length, vertical_stiffness, vertical_damping=None):
+    """A :class:`LinearTyre` (cornering coefficient [1/rad], relaxation length [m], stiffness [N/m])."""
+    return LinearTyre(cornering_coefficient, relaxation_length, vertical_stiffness, vertical_damping)
 
 
 def _finite(name, values, unit):
