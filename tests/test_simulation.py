@@ -152,16 +152,70 @@ def test_numerical_failure_is_an_exception(monkeypatch):
         run(Scenario(duration=0.3))
 
 
+def test_recovery_is_reported_for_yaw_roll_and_steer_rates(base):
+    rec = base.summary["recovery"]
+    signals = rec["signals"]
+    assert set(signals) == {"yaw_rate", "roll_rate", "steer_rate"}
+    assert signals["yaw_rate"]["time_s"] == rec["time_s"]
+    df = base.trajectory
+    after = df["time"].to_numpy() >= 0.0
+    for name, entry in signals.items():
+        t_rec, peak = entry["time_s"], entry["first_peak_rad_s"]
+        assert 0.0 < t_rec < 6.0 and peak > 0.0 and entry["reason"] is None
+        steady = df[name].iloc[0]
+        dev = np.abs(df[name].to_numpy() - steady)
+        # Within 5 % of the first peak from t_rec on, and outside it just before.
+        assert np.all(dev[df["time"].to_numpy() >= t_rec] <= 0.05 * peak)
+        assert dev[np.flatnonzero(after & (df["time"].to_numpy() < t_rec))[-1]] > 0.05 * peak
+        # (the yaw-rate peak is refined between samples, so it may exceed them slightly)
+        assert peak <= dev[after].max() * (1 + 1e-5)
+
+
+def test_custom_gains_reproduce_the_named_controller(base):
+    gains = base.summary["controller"]["gains"]
+    again = run(Scenario(pressure_kpa=400.0, fz_n=635.0), gains=gains)
+    assert again.summary["controller"]["type"] == "custom gains"
+    cols = ["yaw_rate", "roll", "steer", "fy_rear", "steer_torque"]
+    assert np.array_equal(again.trajectory[cols].to_numpy(), base.trajectory[cols].to_numpy())
+
+
+@pytest.mark.parametrize("gains, fragment", [
+    ({"kq5": 1.0}, "unknown steer-torque gain(s) ['kq5']"),
+    ({"kq4": float("nan")}, "gain kq4"),
+    ({"ku7": "fast"}, "gain ku7"),
+])
+def test_custom_gains_are_checked(gains, fragment):
+    with pytest.raises(InputError) as err:
+        run(Scenario(duration=0.3), gains=gains)
+    assert fragment in str(err.value) and "\n" not in str(err.value)
+
+
+def test_custom_tyres_are_used_and_named():
+    rigid = wk.tyres.linear_tyre(100.0, 0.01, 1e7)
+    r = run(Scenario(duration=0.5, symmetric_tyres=True), tyres=(rigid, rigid))
+    assert "LinearTyre(100/rad" in r.summary["tyres"]["name"]
+    assert "custom tyre objects" in r.summary["tyres"]["notes"][0]
+    # No camber force and 100/rad cornering: the rear force is -100 Fz slip (relaxed, 1e-2 m).
+    df = r.trajectory
+    late = df["time"].to_numpy() > 0.3
+    np.testing.assert_allclose(df["fy_steady_rear"][late], -100.0 * df["fz_rear"][late] * df["slip_rear"][late],
+                               rtol=1e-6, atol=1e-6)
+
+
 # ------------------------------------------------------- thesis behaviour (issue 6)
 
 # Measured with the current slip model, our LQR gains and T03 table7_9 (rtol
-# 1e-10): the yaw rate gets back within 5 % of its first peak (and stays)
-# only 2.5-5.2 s after the kick: 570 N: 3.90/5.25/2.84 s, 635 N: 4.30/4.24/2.48 s,
-# 701 N: 4.92/3.60/3.70 s at 300/400/500 kPa. Roll and steer settle in ~1.5 s;
-# the yaw rate decays slowly because nothing controls the heading. The thesis
-# reports recovery within 2 s. Reported to the lead; not tuned.
-_RECOVERY_XFAIL = ("issue 6 acceptance not met by the current model: yaw rate back within 5 % of its "
-                   "first peak only 2.5-5.2 s after the kick (400 kPa/635 N: 4.24 s), thesis: < 2 s")
+# 1e-10; scripts/recovery_study.py): the yaw rate gets back within 5 % of its
+# first peak (and stays) only 2.5-5.2 s after the kick: 570 N: 3.90/5.25/2.84 s,
+# 635 N: 4.30/4.24/2.48 s, 701 N: 4.92/3.60/3.70 s at 300/400/500 kPa. Not a
+# tyre artefact alone: 2.24 s in the near-rigid-tyre (no-slip) limit and
+# 2.32 s for a 0.005 m kick (linear regime). The thesis' own Table 8.4 rider
+# settles roll and steer rates in about 1 s there, as the thesis says of its
+# model, but its yaw rate needs >= 3.3 s in every case (a closed-loop real pole
+# at -0.6 1/s: a balance-only rider does not steer the heading back; see
+# test_table_8_4_rider_in_the_no_slip_limit). Reported to the lead; not tuned.
+_RECOVERY_XFAIL = ("issue 6 acceptance not met: yaw rate back within 5 % of its first peak only 2.5-5.2 s "
+                   "after the kick (400 kPa/635 N: 4.24 s; no-slip limit 2.24 s; Table 8.4 rider >= 3.3 s)")
 
 
 @pytest.mark.xfail(strict=True, reason=_RECOVERY_XFAIL)
@@ -180,6 +234,37 @@ def test_controller_keeps_the_bicycle_up(pressure, fz):
     r = run(Scenario(pressure_kpa=pressure, fz_n=fz))
     assert not r.summary["fell"]
     assert _recovery(r) is not None and _recovery(r) < 5.5
+
+
+def test_table_8_4_rider_in_the_no_slip_limit():
+    """The thesis' rider on near-rigid tyres: roll and steer rates settle in about 1 s, yaw rate does not.
+
+    Thesis Section 8.4: its controlled model returns to steady state "in about
+    1 s, if we look at the steer angular rate and roll rate signals". With
+    near-rigid tyres (the no-slip limit) the slip model reproduces that, and
+    the yaw rate's slow tail is the classic closed loop's real pole at about
+    -0.6 1/s (docs/riders.md), which the linearised slip model must find too.
+    """
+    rigid = wk.tyres.linear_tyre(100.0, 0.01, 1e7)
+    scenario = Scenario(pressure_kpa=400.0, fz_n=635.0, controller="thesis", symmetric_tyres=True)
+    r = run(scenario, tyres=(rigid, rigid))
+    signals = r.summary["recovery"]["signals"]
+    # Measured 0.83 s and 0.64 s; the yaw rate 3.69 s.
+    assert signals["roll_rate"]["time_s"] < 1.2 and signals["steer_rate"]["time_s"] < 1.2
+    assert signals["yaw_rate"]["time_s"] > 3.0
+    moore, design, _ = simulation.build_bicycle(scenario)
+    gains = wk.control.thesis_gains(635.0)
+    K = [gains[k] for k in wk.control.GAIN_ORDER]
+    classic_poles = np.linalg.eigvals(wk.control.closed_loop_matrix(moore, 3.0, K))
+    slow_classic = classic_poles[np.argmax(classic_poles.real)]
+    steady = wk.slip.steady_state(wk.slip.model_parameters(moore, rigid, rigid, gains=gains, symmetric=True), 3.0)
+    A, B, Kfull = wk.slip.linear_state_space(steady.params, steady.x)
+    poles = np.linalg.eigvals(A - B @ Kfull)
+    poles = poles[np.abs(poles) > 1e-2]          # leave out the forward-speed mode (0)
+    slow = poles[np.argmax(poles.real)]
+    assert slow_classic.imag == 0.0 and abs(slow.imag) < 1e-9
+    # Measured -0.603 (classic) and -0.61 (tyre stiffness 100/rad, not infinite).
+    assert slow.real == pytest.approx(slow_classic.real, rel=0.05)
 
 
 @pytest.mark.parametrize("pressure", [300.0, 400.0, 500.0])
