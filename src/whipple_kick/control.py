@@ -6,12 +6,22 @@ the steer torque ``T7``. The law is ``T7 = -K x`` (python-control's
 law without the minus sign; with the signs of its Table 8.4 gains (kq4 < 0,
 kq7 > 0) only ``-K x`` stabilises, which ``tests/test_control.py`` proves on
 the linear and the nonlinear model.
+
+python-control is the solver, but importing it costs more than a second
+(it pulls in scipy.signal), so it is imported only when a design is really
+solved. :func:`cached_lqr_gains` keeps each design in the per-user cache
+(:mod:`.cache`), keyed by everything the result depends on, so a repeated
+design (every ``simulate`` run after the first) never imports it.
 """
-import control as ct
+import hashlib
+import json
+import pathlib
+
 import numpy as np
 
-from . import classic
+from . import cache, classic
 from .errors import InputError, check_range
+from .symbols import CLASSIC_CONSTANTS
 
 GAIN_ORDER = ("kq4", "kq7", "ku4", "ku7")
 
@@ -46,13 +56,123 @@ def lqr_gains(moore, speed=3.0, Q=None, R=1.0):
     poles : ndarray, shape (4,), complex
         Closed-loop eigenvalues of ``A - B K``.
     """
+    import control as ct   # slow import: only here, where a design is solved
+
     check_range("design speed", speed, 0.0, None, "m/s", low_open=True)
     A, B = classic.linear_state_space(moore, speed)
+    Qm = _weight(Q)
+    K, _, poles = ct.lqr(A, B[:, [1]], Qm, np.atleast_2d(float(R)))
+    return np.asarray(K).ravel(), np.asarray(poles)
+
+
+def _weight(Q):
     Qm = np.eye(4) if Q is None else np.asarray(Q, dtype=float)
     if Qm.shape != (4, 4):
         raise InputError(f"Q must be 4x4, got shape {Qm.shape}")
-    K, _, poles = ct.lqr(A, B[:, [1]], Qm, np.atleast_2d(float(R)))
-    return np.asarray(K).ravel(), np.asarray(poles)
+    return Qm
+
+
+# ------------------------------------------------------------ cached designs
+
+#: Package modules the design depends on: this one, the linearisation and
+#: the generated classic model it evaluates (classic.generated's sources).
+_LQR_SOURCES = ("control", "classic", "kane", "benchmark", *classic._SOURCES)
+_LQR_LAYOUT = "lqr-v1"   # bump when the entry's contents change
+
+
+def _solver_versions():
+    """Versions of the numerical libraries the solution comes from (without importing python-control)."""
+    import importlib.metadata
+    import importlib.util
+    import scipy
+
+    try:
+        control_version = importlib.metadata.version("control")
+    except importlib.metadata.PackageNotFoundError:
+        control_version = "unknown"
+    slycot = importlib.util.find_spec("slycot") is not None   # python-control's lqr prefers it
+    return f"control {control_version}; slycot {slycot}; numpy {np.__version__}; scipy {scipy.__version__}"
+
+
+def lqr_cache_key(moore, speed=3.0, Q=None, R=1.0):
+    """(entry name, key material) of the cached design of :func:`cached_lqr_gains`.
+
+    The material lists exactly what :func:`lqr_gains` reads: the classic
+    model's parameters by name (``repr``, full float precision), the speed,
+    ``Q`` and ``R``, plus a hash of the package sources and the solver
+    library versions, so that a code or library change misses the cache.
+    """
+    material = {
+        "layout": _LQR_LAYOUT,
+        "sources": cache.source_hash(_LQR_SOURCES, extra=_solver_versions()),
+        "parameters": {name: repr(float(moore[name])) for name in CLASSIC_CONSTANTS},
+        "speed": repr(float(speed)),
+        "Q": [[repr(float(v)) for v in row] for row in _weight(Q)],
+        "R": repr(float(R)),
+    }
+    text = json.dumps(material, sort_keys=True)
+    return f"lqr_{hashlib.sha256(text.encode()).hexdigest()[:24]}.json", material
+
+
+def _read_entry(path, material):
+    """(K, poles) from a cache entry, or None if it is unreadable, corrupt or for other inputs."""
+    try:
+        cache.check_private_file(path)
+        data = json.loads(pathlib.Path(path).read_text())
+        if data["key"] != material:
+            return None
+        K = np.array([float(v) for v in data["gains"]])
+        poles = np.array([complex(float(re), float(im)) for re, im in data["poles"]])
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+    if K.shape != (4,) or poles.shape != (4,) or not (np.isfinite(K).all() and np.isfinite(poles).all()):
+        return None
+    return K, poles
+
+
+def _entry_text(material, K, poles):
+    # json writes floats with repr, which reads back bit for bit.
+    return json.dumps({"key": material, "gains": [float(k) for k in K],
+                       "poles": [[float(p.real), float(p.imag)] for p in np.asarray(poles, dtype=complex)]},
+                      indent=1, allow_nan=False) + "\n"
+
+
+def cached_lqr_gains(moore, speed=3.0, Q=None, R=1.0):
+    """:func:`lqr_gains`, kept in the per-user cache between processes.
+
+    The first call for a design solves it with python-control and stores
+    the gains and closed-loop poles (JSON, exact float round trip) under a
+    hash of :func:`lqr_cache_key`; later calls, in any process, read them
+    back without importing python-control. An entry that cannot be read,
+    is corrupt or is not private to this user is solved again and replaced.
+    """
+    check_range("design speed", speed, 0.0, None, "m/s", low_open=True)
+    missing = [n for n in CLASSIC_CONSTANTS if n not in moore]
+    if missing:
+        return lqr_gains(moore, speed, Q, R)   # raises the InputError naming them
+    name, material = lqr_cache_key(moore, speed, Q, R)
+    solved = []
+
+    def build(tmp):
+        solved.append(lqr_gains(moore, speed, Q, R))
+        tmp.write_text(_entry_text(material, *solved[0]))
+
+    path = cache.cache_dir() / name   # a folder another user can write to is refused, as for generated code
+    try:
+        cache.build_once(name, build)
+    except OSError:
+        pass   # e.g. an entry another user could have written (PermissionError): replaced below
+    if solved:
+        return solved[0]
+    entry = _read_entry(path, material)
+    if entry is None:
+        entry = lqr_gains(moore, speed, Q, R)
+        try:
+            with cache.locked(path):
+                cache.write_atomic(path, _entry_text(material, *entry))
+        except OSError:
+            pass   # the design is right; the next process solves it again
+    return entry
 
 
 def gains_dict(K, scale=1.0):

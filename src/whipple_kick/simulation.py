@@ -637,8 +637,9 @@ def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia
 
 @functools.lru_cache(maxsize=256)
 def _lqr(design_items, speed):
+    # In front of the on-disk cache, which spares later processes python-control's import.
     from . import control
-    K, poles = control.lqr_gains(dict(design_items), speed)
+    K, poles = control.cached_lqr_gains(dict(design_items), speed)
     return tuple(np.ravel(K)), tuple(np.ravel(poles))
 
 
