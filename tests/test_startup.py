@@ -1,9 +1,12 @@
-"""Start-up cost of ``simulate``: the on-disk LQR design cache.
+"""Start-up cost of ``simulate``: the on-disk LQR design cache and the exact, fast trajectory CSV.
 
 python-control's import costs over a second, so a design is solved once and
 kept in the per-user cache (``control.cached_lqr_gains``); a warm ``simulate``
-must not import python-control at all. No timings here (see ``scripts/bench.py cli``).
+must not import python-control at all. ``trajectory.csv`` is written with each
+float's ``repr`` so that reading it back gives the identical float64 table.
+No timings here (see ``scripts/bench.py cli``).
 """
+import io
 import json
 import os
 import pathlib
@@ -12,10 +15,12 @@ import subprocess
 import sys
 
 import numpy as np
+import pandas as pd
 import pytest
 
 import whipple_kick as wk
 from whipple_kick import cache, control, simulation
+from whipple_kick.cli import simulate_main, write_trajectory_csv
 
 
 @pytest.fixture(scope="module")
@@ -182,3 +187,66 @@ def test_warm_simulate_does_not_import_python_control(tmp_path):
     assert imported_control("cold")                           # the test can see the import
     assert len(_entries(folder)) == 1
     assert not imported_control("warm")
+
+
+# ------------------------------------------------------------------ trajectory.csv
+
+def _bits(frame):
+    return frame.to_numpy(dtype=np.float64).view(np.int64)
+
+
+def test_trajectory_csv_reads_back_bit_for_bit(tmp_path, capsys, monkeypatch):
+    """The CLI's trajectory.csv is the run's DataFrame exactly: columns, order, every bit."""
+    runs = []
+    real_run = simulation.run
+    monkeypatch.setattr(simulation, "run", lambda scenario: runs.append(real_run(scenario)) or runs[-1])
+    out = tmp_path / "run"
+    with pytest.raises(SystemExit) as status:
+        simulate_main(["--duration", "0.5", "--no-plot", "--quiet", "--out", str(out)])
+    assert status.value.code == 0, capsys.readouterr().err
+    frame = runs[0].trajectory
+    text = (out / "trajectory.csv").read_text()
+    assert text.splitlines()[0] == ",".join(frame.columns)   # the header pandas writes
+    back = pd.read_csv(out / "trajectory.csv")
+    assert list(back.columns) == list(frame.columns)
+    assert (back.dtypes == np.float64).all()
+    assert np.array_equal(_bits(back), _bits(frame))
+
+
+def test_csv_writer_is_exact_for_awkward_floats(tmp_path):
+    rng = np.random.default_rng(0)
+    raw = rng.integers(0, 2**63 - 1, size=2000, dtype=np.int64).view(np.float64)
+    raw = raw[np.isfinite(raw)]
+    special = np.array([0.0, -0.0, 5e-324, -5e-324, 2.2250738585072014e-308, 1.7976931348623157e308,
+                        -1.7976931348623157e308, 0.1 + 0.2, np.nextafter(1.0, 2.0), 1e16, 123456789012345678.0,
+                        1 / 3, -2.5, 1.0])
+    n = len(special)
+    frame = pd.DataFrame({
+        "time": np.arange(n) * 1e-3,
+        "random": raw[:n],
+        "special": special,
+        "zeros": np.zeros(n),                                  # must stay a float column
+        "negative zeros": np.full(n, -0.0),
+        "whole": np.arange(n, dtype=float),
+    })
+    path = tmp_path / "t.csv"
+    write_trajectory_csv(frame, path)
+    back = pd.read_csv(path)
+    assert list(back.columns) == list(frame.columns) and (back.dtypes == np.float64).all()
+    assert np.array_equal(_bits(back), _bits(frame))
+    reference = io.StringIO()
+    frame.to_csv(reference, index=False, lineterminator="\n")
+    assert path.read_text().splitlines()[0] == reference.getvalue().splitlines()[0]
+    # Longer than one write chunk, every random bit pattern.
+    many = pd.DataFrame({"a": raw[: len(raw) // 2 * 2].reshape(-1, 2)[:, 0],
+                         "b": raw[: len(raw) // 2 * 2].reshape(-1, 2)[:, 1]})
+    many = pd.concat([many] * 3, ignore_index=True)
+    write_trajectory_csv(many, path)
+    assert np.array_equal(_bits(pd.read_csv(path)), _bits(many))
+
+
+def test_csv_writer_falls_back_to_pandas_for_other_tables(tmp_path):
+    frame = pd.DataFrame({"time": [0.0, 0.1], "x": [np.nan, 1.5], "n": [1, 2]})
+    path = tmp_path / "t.csv"
+    write_trajectory_csv(frame, path)
+    assert path.read_text() == frame.to_csv(index=False, lineterminator="\n")
