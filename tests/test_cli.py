@@ -32,6 +32,8 @@ def test_main_job_writes_the_three_files(tmp_path, capsys):
     for column in ("time", "yaw_rate", "roll_rate", "steer_rate", "fy_rear", "plate_y", "steer_torque"):
         assert column in header
     assert "no fall" in stdout and "trajectory.csv" in stdout
+    roll = summary["recovery"]["signals"]["roll_rate"]["time_s"]
+    assert f"roll rate {roll:.2f} s" in stdout
     assert stderr == ""
 
 

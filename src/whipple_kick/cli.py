@@ -255,6 +255,11 @@ def _print_summary(result, out, files):
         print(f"  yaw rate: first peak {m['peak_values'][0]:+.3f} rad/s (from steady) at {m['peak_times'][0]:.3f} s; "
               + (f"within 5 % of it from {rec['time_s']:.3f} s on" if rec["time_s"] is not None
                  else f"not recovered to 5 % ({rec['reason']})"))
+    settled = [f"{label} {sig['time_s']:.2f} s" if sig["time_s"] is not None else f"{label} not within the run"
+               for label, sig in (("roll rate", rec["signals"]["roll_rate"]),
+                                  ("steer rate", rec["signals"]["steer_rate"]))]
+    if not s["fell"]:
+        print("  within 5 % of their first peak from: " + ", ".join(settled))
     pk = s["peaks"]
     print(f"  peaks: |roll rate| {pk['max_abs_roll_rate']:.3f} rad/s, |steer rate| {pk['max_abs_steer_rate']:.3f} rad/s, "
           f"|Fy rear| {pk['max_abs_fy_rear']:.0f} N, |slip rear| {pk['max_abs_slip_rear'] * deg:.1f} deg")
