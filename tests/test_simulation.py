@@ -175,6 +175,7 @@ def test_custom_gains_reproduce_the_named_controller(base):
     gains = base.summary["controller"]["gains"]
     again = run(Scenario(pressure_kpa=400.0, fz_n=635.0), gains=gains)
     assert again.summary["controller"]["type"] == "custom gains"
+    assert again.summary["controller"]["gain_scale"] is None
     cols = ["yaw_rate", "roll", "steer", "fy_rear", "steer_torque"]
     assert np.array_equal(again.trajectory[cols].to_numpy(), base.trajectory[cols].to_numpy())
 
@@ -195,6 +196,7 @@ def test_custom_tyres_are_used_and_named():
     r = run(Scenario(duration=0.5, symmetric_tyres=True), tyres=(rigid, rigid))
     assert "LinearTyre(100/rad" in r.summary["tyres"]["name"]
     assert "custom tyre objects" in r.summary["tyres"]["notes"][0]
+    assert r.summary["tyres"]["pressure_rear_kpa"] is None   # the scenario's pressure was not used
     # No camber force and 100/rad cornering: the rear force is -100 Fz slip (relaxed, 1e-2 m).
     df = r.trajectory
     late = df["time"].to_numpy() > 0.3
