@@ -764,14 +764,12 @@ def _recovery(df, baseline, first_peak, column="yaw_rate", label="yaw rate"):
 
 
 def _first_peak(df, column, baseline):
-    """First local maximum of |signal - baseline| after the kick that is at least half the largest."""
-    t = df["time"].to_numpy()
-    dev = np.abs(df[column].to_numpy()[t >= 0.0] - baseline)
-    if dev.size < 3 or dev.max() <= 0.0:
-        return None
-    interior = (dev[1:-1] >= dev[:-2]) & (dev[1:-1] >= dev[2:]) & (dev[1:-1] >= 0.5 * dev.max())
-    peaks = np.flatnonzero(interior) + 1
-    return float(dev[peaks[0]]) if peaks.size else float(dev.max())
+    """First peak of |signal - baseline| after the kick reaching half the largest (``analysis.yaw_rate_peaks``)."""
+    from . import analysis
+
+    peaks = analysis.yaw_rate_peaks(df["time"].to_numpy(), df[column].to_numpy(), t_kick=0.0,
+                                    threshold=0.5, baseline=baseline)
+    return float(abs(peaks.values[0])) if peaks.values.size else None
 
 
 def _custom_gains(gains):
