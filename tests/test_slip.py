@@ -57,11 +57,6 @@ def test_c_agrees_with_numpy_oracle(rider_bike, gains, t03):
     assert worst < 1e-10
 
 
-def _linear_tyre(kappa, sigma, kz):
-    """F = -kappa Fz slip, no camber force, no moment; vertical damping sqrt(50 kz)."""
-    return wk.tyres.linear_tyre(kappa, sigma, kz)
-
-
 @pytest.mark.parametrize("speed", [3.0, 5.0, 7.0])
 def test_stiff_tyres_approach_the_classic_model(speed):
     """Cornering stiffness -> inf, relaxation length -> 0, vertical stiffness -> inf: classic eigenvalues."""
@@ -69,7 +64,7 @@ def test_stiff_tyres_approach_the_classic_model(speed):
     ref = classic.eigenvalues(moore, [speed])[0]
     errors = []
     for kappa, sigma, kz in ((1e2, 1e-2, 1e7), (1e3, 1e-3, 1e8), (1e5, 1e-5, 1e10)):
-        tyre = _linear_tyre(kappa, sigma, kz)
+        tyre = wk.tyres.linear_tyre(kappa, sigma, kz)
         ss = slip.steady_state(slip.model_parameters(moore, tyre, tyre), speed)
         ev = np.linalg.eigvals(slip.linearize(slip.CompiledRHS(ss.params), ss.x))
         matched = np.array([ev[np.argmin(np.abs(ev - r))] for r in ref])
@@ -112,7 +107,7 @@ def test_steer_torque_input_matrix_matches_the_classic_model():
     """Stiff tyres: eigenvalues of A - B K equal the classic closed loop, so B is right."""
     moore = benchmark.to_moore(benchmark.meijaard2007_parameters())
     K, _ = wk.control.lqr_gains(moore, 4.0)
-    tyre = _linear_tyre(1e4, 1e-4, 1e9)
+    tyre = wk.tyres.linear_tyre(1e4, 1e-4, 1e9)
     ss = slip.steady_state(slip.model_parameters(moore, tyre, tyre, gains=wk.control.gains_dict(K)), 4.0)
     A, B, Kfull = slip.linear_state_space(ss.params, ss.x)
     ref = np.linalg.eigvals(wk.control.closed_loop_matrix(moore, 4.0, K))

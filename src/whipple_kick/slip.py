@@ -652,8 +652,8 @@ def heading_state(x):
     return z
 
 
-def _heading_derivative(rhs, x_ref, z, t):
-    """d/dt of the heading-frame state ``z`` (yaw set to 0, pitch re-solved)."""
+def _heading_derivative(rhs, x_ref, z, t, resolve_pitch):
+    """d/dt of the heading-frame state ``z`` (yaw set to 0; pitch re-solved if a coordinate moved)."""
     x = np.array(x_ref, dtype=float)
     x[X["q3"]] = 0.0
     for name, value in zip(LINEAR_STATES, z):
@@ -663,7 +663,8 @@ def _heading_derivative(rhs, x_ref, z, t):
             x[X["u2"]] = value
         else:
             x[X[name]] = value
-    x = solve_pitch(rhs, x)
+    if resolve_pitch:
+        x = solve_pitch(rhs, x)
     dx = rhs(t, x)
     u1, u2, u3 = x[X["u1"]], x[X["u2"]], x[X["u3"]]
     # Rotating-frame rates at q3 = 0: d(v_fwd)/dt = u1' + u3 u2, d(v_lat)/dt = u2' - u3 u1.
@@ -696,13 +697,15 @@ def linearize(rhs, x, step=1e-7, t=0.0):
     ndarray, shape (15, 15)
     """
     z0 = heading_state(x)
+    x = solve_pitch(rhs, x)   # once for the reference; again only when a coordinate is perturbed
     J = np.empty((z0.size, z0.size))
     for j, name in enumerate(LINEAR_STATES):
         h = step * max(1.0, abs(z0[j])) * (1e2 if name in TYRE_STATES else 1.0)
         zp, zm = z0.copy(), z0.copy()
         zp[j] += h
         zm[j] -= h
-        J[:, j] = (_heading_derivative(rhs, x, zp, t) - _heading_derivative(rhs, x, zm, t)) / (2 * h)
+        moved = name.startswith("q")
+        J[:, j] = (_heading_derivative(rhs, x, zp, t, moved) - _heading_derivative(rhs, x, zm, t, moved)) / (2 * h)
     return J
 
 
