@@ -220,3 +220,76 @@ def test_lqr_input_errors(combined):
     for speed in (0.0, -3.0):
         with pytest.raises(InputError):
             control.lqr_gains(moore, speed)
+
+
+# --- (6) the heading-holding rider (yaw angle as a fifth state) --------------
+
+def test_yaw_rate_map_is_the_benchmark_kinematics():
+    # Meijaard et al. (2007) eq. (A.27) linearised: yaw rate = (v delta +
+    # c delta') cos(lambda) / w, with no roll terms. Independent of our
+    # constraint solution; both are exact, so 1e-12 relative is round-off.
+    bench = wk.benchmark.meijaard2007_parameters()
+    moore = wk.benchmark.to_moore(bench)
+    scale = np.cos(bench["lam"]) / bench["w"]
+    for speed in (1.0, 3.0, 6.0):
+        expected = [0.0, speed * scale, 0.0, bench["c"] * scale]
+        np.testing.assert_allclose(classic.yaw_rate_map(moore, speed), expected, rtol=1e-12, atol=1e-14)
+
+
+def test_heading_lqr_solves_its_riccati_equation_and_is_stable(combined):
+    moore = combined[635]
+    A, b = control.heading_state_space(moore, DESIGN_SPEED)
+    P = solve_continuous_are(A, b, np.eye(5), np.eye(1))
+    K, poles = control.heading_lqr_gains(moore, DESIGN_SPEED)
+    np.testing.assert_allclose(K, (b.T @ P).ravel(), rtol=1e-8)
+    assert np.max(poles.real) < -0.5
+    # Yaw is cyclic (column q3 of A is zero), so the (q3, q3) entry of the
+    # Riccati equation reads (P b)_0^2 = Q_00 R: |kq3| = sqrt(Q_00 / R) exactly.
+    for q00, r in ((1.0, 1.0), (4.0, 1.0), (1.0, 9.0)):
+        Q = np.eye(5)
+        Q[0, 0] = q00
+        np.testing.assert_allclose(abs(control.heading_lqr_gains(moore, DESIGN_SPEED, Q=Q, R=r)[0][0]),
+                                   np.sqrt(q00 / r), rtol=1e-8)
+
+
+def test_heading_lqr_without_yaw_weight_is_the_balance_lqr(combined):
+    # As the yaw weight goes to 0 the design forgets the heading: kq3 -> 0
+    # (= 1e-5 by the identity above) and the other gains tend to lqr_gains'
+    # (measured 2e-6 relative at a weight of 1e-10).
+    moore = combined[635]
+    Q = np.eye(5)
+    Q[0, 0] = 1e-10
+    K5, _ = control.heading_lqr_gains(moore, DESIGN_SPEED, Q=Q)
+    K4, _ = control.lqr_gains(moore, DESIGN_SPEED)
+    np.testing.assert_allclose(K5[1:], K4, rtol=1e-4)
+
+
+def test_heading_rider_steers_back_to_the_heading_on_the_nonlinear_model(combined):
+    # From 0.01 rad of roll the balance-only rider ends up in a new heading;
+    # with the yaw-angle gain the nonlinear classic model returns to the old
+    # one. Slowest pole -0.85 1/s: after 10 s the heading is back within
+    # 1 % of its largest excursion (measured below 1e-3 of it), while the
+    # balance-only rider keeps a heading change of half its excursion or more.
+    moore = combined[635]
+    K5, _ = control.heading_lqr_gains(moore, DESIGN_SPEED)
+    K4, _ = control.lqr_gains(moore, DESIGN_SPEED)
+
+    def heading_law(t, q, u):
+        return -(K5 @ np.array([q[2], q[IQ4], q[IQ7], u[IU4], u[IU7]]))
+
+    q0, u0 = classic.upright_state(moore, DESIGN_SPEED, roll=0.01)
+    t = np.linspace(0.0, 10.0, 501)
+    held = classic.simulate(moore, q0, u0, 10.0, steer_torque=heading_law, t_eval=t)
+    free = classic.simulate(moore, q0, u0, 10.0, steer_torque=_feedback(K4), t_eval=t)
+    assert held.status == 0 and free.status == 0
+    held_yaw, free_yaw = held.y[2], free.y[2]
+    assert np.max(np.abs(held_yaw)) > 1e-3
+    assert abs(held_yaw[-1]) < 0.01 * np.max(np.abs(held_yaw))
+    assert abs(free_yaw[-1]) > 0.5 * np.max(np.abs(free_yaw))
+
+
+def test_heading_lqr_input_errors(combined):
+    with pytest.raises(InputError, match="Q must be 5x5"):
+        control.heading_lqr_gains(combined[635], DESIGN_SPEED, Q=np.eye(4))
+    with pytest.raises(InputError, match="design speed"):
+        control.heading_lqr_gains(combined[635], 0.0)

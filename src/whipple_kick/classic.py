@@ -210,6 +210,33 @@ def linear_state_space(moore, speed):
     return A, B
 
 
+def yaw_rate_map(moore, speed):
+    """Yaw rate of upright running at ``speed`` [m/s], to first order in the state.
+
+    The yaw angle is cyclic in the no-slip model, so it is not one of the
+    four states of :func:`linear_state_space`; its rate is a dependent speed
+    fixed by the rolling constraints.
+
+    Returns
+    -------
+    ndarray, shape (4,)
+        ``c`` with ``u3 = c @ [q4, q7, u4, u7]`` (1/s for the angles, - for
+        the rates); q3 and u3 are about Moore's downward z, like the steer.
+    """
+    p = parameter_array(moore)
+    u6 = -float(speed) / float(moore["rr"])
+    row = np.empty(4)
+    for j in range(4):
+        x = np.zeros(4, dtype=complex)
+        x[j] += 1j * _STEP
+        q = np.zeros(8, dtype=complex)
+        q[Q["q4"]], q[Q["q7"]] = x[0], x[1]
+        q[Q["q5"]] = _nominal_pitch(tuple(p))
+        q = solve_pitch(q, p)
+        row[j] = speeds(q, np.array([x[2], u6, x[3]]), p)[U["u3"]].imag / _STEP
+    return row
+
+
 def canonical_matrices(moore, speeds=(0.0, 1.0, 2.0)):
     """Benchmark canonical form ``M, C1, K0, K2`` recovered from :func:`linear_state_space`.
 

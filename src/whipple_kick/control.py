@@ -24,6 +24,11 @@ from .errors import InputError, check_range
 from .symbols import CLASSIC_CONSTANTS
 
 GAIN_ORDER = ("kq4", "kq7", "ku4", "ku7")
+#: Gains of :func:`heading_lqr_gains`, whose state adds the yaw angle q3.
+HEADING_GAIN_ORDER = ("kq3",) + GAIN_ORDER
+#: Units of every steer-torque gain the compiled model carries.
+GAIN_UNITS = {"kq3": "N m/rad", "kq4": "N m/rad", "kq7": "N m/rad",
+              "ku3": "N m s/rad", "ku4": "N m s/rad", "ku7": "N m s/rad"}
 
 #: Thesis Table 8.4: gains used for the Chapter 8 simulations, per rear load
 #: [N]; units N m/rad (kq4, kq7) and N m s/rad (ku4, ku7). Applied as
@@ -56,19 +61,65 @@ def lqr_gains(moore, speed=3.0, Q=None, R=1.0):
     poles : ndarray, shape (4,), complex
         Closed-loop eigenvalues of ``A - B K``.
     """
-    import control as ct   # slow import: only here, where a design is solved
-
     check_range("design speed", speed, 0.0, None, "m/s", low_open=True)
     A, B = classic.linear_state_space(moore, speed)
-    Qm = _weight(Q)
-    K, _, poles = ct.lqr(A, B[:, [1]], Qm, np.atleast_2d(float(R)))
+    return _solve_lqr(A, B[:, [1]], _weight(Q), R)
+
+
+def _solve_lqr(A, b, Qm, R):
+    """python-control's LQR for one input: (K as a flat array, closed-loop poles)."""
+    import control as ct   # slow import: only here, where a design is solved
+
+    K, _, poles = ct.lqr(A, b, Qm, np.atleast_2d(float(R)))
     return np.asarray(K).ravel(), np.asarray(poles)
 
 
-def _weight(Q):
-    Qm = np.eye(4) if Q is None else np.asarray(Q, dtype=float)
-    if Qm.shape != (4, 4):
-        raise InputError(f"Q must be 4x4, got shape {Qm.shape}")
+def heading_state_space(moore, speed):
+    """Classic model with the yaw angle as a fifth state, for a heading-holding rider.
+
+    Returns
+    -------
+    A : ndarray, shape (5, 5)
+        For x = [q3, q4, q7, u4, u7]; the q3 row is
+        :func:`classic.yaw_rate_map` (q3 itself enters nothing: yaw is cyclic).
+    b : ndarray, shape (5, 1)
+        Steer-torque column.
+    """
+    A4, B4 = classic.linear_state_space(moore, speed)
+    A = np.zeros((5, 5))
+    A[1:, 1:] = A4
+    A[0, 1:] = classic.yaw_rate_map(moore, speed)
+    b = np.zeros((5, 1))
+    b[1:, 0] = B4[:, 1]
+    return A, b
+
+
+def heading_lqr_gains(moore, speed=3.0, Q=None, R=1.0):
+    """LQR rider who also steers back to the heading held before a disturbance.
+
+    Same design as :func:`lqr_gains` on the state x = [q3, q4, q7, u4, u7]
+    of :func:`heading_state_space`: ``T7 = -K x``. Not the thesis' rider
+    (its law has no yaw term); made to measure what holding a heading
+    changes. Use the gains with ``simulation.run(..., gains=...)`` on a
+    scenario whose steady motion is straight (e.g. symmetric tyres).
+    Parameters as for :func:`lqr_gains`, with ``Q`` 5x5.
+
+    Returns
+    -------
+    K : ndarray, shape (5,)
+        ``[kq3, kq4, kq7, ku4, ku7]`` (:data:`HEADING_GAIN_ORDER`).
+    poles : ndarray, shape (5,), complex
+        Closed-loop eigenvalues.
+    """
+    check_range("design speed", speed, 0.0, None, "m/s", low_open=True)
+    A, b = heading_state_space(moore, speed)
+    return _solve_lqr(A, b, _weight(Q, size=5), R)
+
+
+def _weight(Q, size=4):
+    Qm = np.eye(size) if Q is None else np.asarray(Q, dtype=float)
+    if Qm.shape != (size, size):
+        raise InputError(f"Q must be {size}x{size}, got shape {Qm.shape}")
     return Qm
 
 

@@ -40,6 +40,8 @@ DIRECTIONS = ("right", "left")
 LOW_INERTIA_KEYS = ("IBxx", "IByy", "IBzz", "IBxz", "zB")
 #: Recovery criterion of issue 6: |yaw rate - steady| within this fraction of the first peak.
 RECOVERY_FRACTION = 0.05
+#: |steady yaw rate| [rad/s] below which steady running counts as straight (a yaw-angle gain needs it).
+_STRAIGHT_YAW_RATE = 1e-9
 
 # Moore's coordinates and speeds, named for the trajectory table.
 _COORDINATE_COLUMNS = {
@@ -776,14 +778,20 @@ def _custom_gains(gains):
     """Check user-given steer-torque gains (by name) and fill the missing ones with 0."""
     from . import control
 
-    unknown = sorted(set(gains) - set(control.GAIN_ORDER))
+    known = list(control.GAIN_UNITS)
+    unknown = sorted(set(gains) - set(known))
     if unknown:
-        raise InputError(f"unknown steer-torque gain(s) {unknown}; known: {list(control.GAIN_ORDER)}")
-    out = {}
-    for name in control.GAIN_ORDER:
-        unit = "N m/rad" if name.startswith("kq") else "N m s/rad"
-        out[name] = check_range(f"gain {name}", gains.get(name, 0.0), None, None, unit)
-    return out
+        raise InputError(f"unknown steer-torque gain(s) {unknown}; known: {known}")
+    # The four of the thesis' law always; the yaw gains only when given.
+    names = control.GAIN_ORDER + tuple(n for n in ("kq3", "ku3") if n in gains)
+    return {name: check_range(f"gain {name}", gains.get(name, 0.0), None, None, control.GAIN_UNITS[name])
+            for name in names}
+
+
+def _control_law(gains):
+    """``T7 = -(...)`` with the gains in use, for the summary."""
+    terms = {"kq3": "kq3 q3", "kq4": "kq4 q4", "kq7": "kq7 q7", "ku3": "ku3 u3", "ku4": "ku4 u4", "ku7": "ku7 u7"}
+    return "T7 = -(" + " + ".join(terms[n] for n in gains) + ")"
 
 
 def _clean(value):
@@ -823,9 +831,12 @@ def run(scenario, *, tyres=None, gains=None):
         e.g. :func:`whipple_kick.tyres.linear_tyre` or a :class:`~whipple_kick.tyres.Tyre`
         loaded with other options. The summary names them.
     gains : mapping, optional
-        Steer-torque gains by name (``kq4 kq7 ku4 ku7``; N m/rad, N m s/rad;
-        missing ones are 0) instead of the scenario's controller; the law is
-        still ``T7 = -K x``. ``scenario.gain_scale`` does not apply to them.
+        Steer-torque gains by name (``kq4 kq7 ku4 ku7``, and the yaw gains
+        ``kq3 ku3``; N m/rad, N m s/rad; missing ones are 0) instead of the
+        scenario's controller; the law is still ``T7 = -K x``.
+        ``scenario.gain_scale`` does not apply to them. A yaw-angle gain
+        (e.g. from :func:`whipple_kick.control.heading_lqr_gains`) needs a
+        straight steady motion, so tyres without zero-slip offsets.
 
     Returns
     -------
@@ -838,7 +849,7 @@ def run(scenario, *, tyres=None, gains=None):
     SimulationError
         The integration failed numerically (never NaN in a result).
     """
-    from . import analysis, integrate, slip
+    from . import analysis, control, integrate, slip
 
     wall0 = time.perf_counter()
     scenario.validate()
@@ -872,6 +883,12 @@ def run(scenario, *, tyres=None, gains=None):
         steady = slip.steady_state(params, scenario.speed)
     except FloatingPointError as exc:
         raise SimulationError(f"no steady motion at {scenario.speed:g} m/s: {exc}") from None
+    steady_yaw_rate = float(steady.x[slip.X["u3"]])
+    if gains.get("kq3", 0.0) and abs(steady_yaw_rate) > _STRAIGHT_YAW_RATE:
+        # In a steady turn the yaw angle grows without bound, and so would kq3's torque.
+        raise InputError(f"a yaw-angle gain kq3 needs straight steady running, but the steady yaw rate is "
+                         f"{steady_yaw_rate:.3g} rad/s (allowed |yaw rate| <= {_STRAIGHT_YAW_RATE:g} rad/s): "
+                         f"use tyres without zero-slip offsets (symmetric_tyres=True)")
     # piecewise=False is the comparison case: one LSODA run across the kick,
     # not even restarted at the integrator's chunk boundaries.
     if table is None:
@@ -942,8 +959,8 @@ def run(scenario, *, tyres=None, gains=None):
             "type": controller_type, "gain_scale": scenario.gain_scale if custom_gains is None else None,
             "design_speed_m_s": scenario.design_speed if controller_type == "lqr" else None,
             "gains": gains,
-            "gain_units": {"kq4": "N m/rad", "kq7": "N m/rad", "ku4": "N m s/rad", "ku7": "N m s/rad"},
-            "law": "T7 = -(kq4 q4 + kq7 q7 + ku4 u4 + ku7 u7)",
+            "gain_units": {name: control.GAIN_UNITS[name] for name in gains},
+            "law": _control_law(gains),
             "linear_closed_loop_poles": None if poles is None else [[p.real, p.imag] for p in poles],
         },
         "kick": {"start_s": kick_start, "duration_s": kick_T, "displacement_m": kick_D,
