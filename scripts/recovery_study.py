@@ -2,24 +2,29 @@
 
 Issue 6 asks for the yaw rate to be back within 5 % of its first peak
 within 2 s of the kick. This script measures what sets the recovery time,
-one factor at a time, and prints two Markdown tables:
+one factor at a time, and prints three Markdown tables:
 
 1. the nine thesis cases (300/400/500 kPa x 570/635/701 N) with our LQR
    rider: recovery times of yaw rate, roll rate and steer rate, the largest
-   change of roll from its steady value, and the slowest pole of the slip model linearised (heading frame)
-   about its steady motion with the rider's gains;
-2. at 400 kPa, 635 N: the same quantities with one thing changed at a time:
-   symmetric tyres, a near-rigid linear tyre (the no-slip limit), a small
-   kick (linear regime), Table 8.4's gains, and gains designed on the slip
+   change of roll from its steady value, and the slowest pole of the slip
+   model linearised (heading frame) about its steady motion with the
+   rider's gains;
+2. the slowest linear pole at 400 kPa, 635 N with one tyre property
+   switched off at a time (aligning moment front/rear, camber force) and
+   linear tyres from T03's cornering stiffness to near-rigid;
+3. at 400 kPa, 635 N: the quantities of table 1 with one thing changed at a
+   time: symmetric tyres, a near-rigid linear tyre (the no-slip limit), a
+   small kick (linear regime), Table 8.4's gains, gains designed on the slip
    model itself (4-gain output-feedback LQR with the same Q = I, R = 1, found
-   by minimising the LQR cost with its analytic gradient).
+   by minimising the LQR cost with its analytic gradient), LQR with
+   Q = 10 I and 100 I, a heading-holding LQR rider, and T03 without M_z.
 
 Recovery time of a signal: the time after the kick from which
 |signal - steady value| stays within 5 % of its first peak after the kick
 (``summary["recovery"]["signals"]`` of a simulation result).
 
-Usage: ``python scripts/recovery_study.py [--quick]`` (``--quick``: table 2
-only). About 20 s.
+Usage: ``python scripts/recovery_study.py [--quick]`` (``--quick``: tables 2
+and 3 only). About 5 s.
 """
 import argparse
 import math
@@ -86,6 +91,33 @@ def output_feedback_lqr(A, B, K0, weight=1.0):
     return best.x, best.fun, cost_and_gradient(np.asarray(K0, dtype=float))[0]
 
 
+class ToggledTyre:
+    """A tyre as loaded, with its aligning moment and/or its camber force switched off.
+
+    Study-only: the slip model reads ``blend``; the Pacejka 1989 terms in
+    camber are a5, a8, a11 of F_y (see ``magic_formula.lateral_force_factors``).
+    """
+
+    def __init__(self, tyre, moment=True, camber_force=True):
+        self._tyre, self._moment, self._camber_force = tyre, moment, camber_force
+
+    def __getattr__(self, name):
+        return getattr(self._tyre, name)
+
+    def __repr__(self):
+        off = [n for n, on in (("M_z", self._moment), ("camber force", self._camber_force)) if not on]
+        return f"{self._tyre!r} without {' and '.join(off)}"
+
+    @property
+    def blend(self):
+        out = []
+        for weight, fy, mz in self._tyre.blend:
+            if not self._camber_force:
+                fy[[5, 8, 11]] = 0.0
+            out.append((weight, fy, mz if self._moment else tyres.ZERO_MOMENT_COEFFICIENTS.copy()))
+        return out
+
+
 def describe(label, result, pole):
     rec = recovery_times(result)
     cell = lambda t: "> run" if t is None else f"{t:.2f}"
@@ -93,8 +125,13 @@ def describe(label, result, pole):
     roll = math.degrees(np.abs(df["roll"] - result.summary["steady_state"]["roll_rad"]).max())
     fell = " (fell)" if result.summary["fell"] else ""
     return (f"| {label}{fell} | {cell(rec['yaw_rate'])} | {cell(rec['roll_rate'])} | {cell(rec['steer_rate'])} "
-            f"| {roll:.1f} | {pole.real:.2f} {'+-' if pole.imag else ''}"
-            f"{f' {abs(pole.imag):.2f}j' if pole.imag else ''} |")
+            f"| {roll:.1f} | {pole_text(pole)} |")
+
+
+def pole_text(pole):
+    if pole is None:
+        return "n/a"
+    return f"{pole.real:.2f}" + (f" +- {abs(pole.imag):.2f}j" if pole.imag else "")
 
 
 HEADER = ("| case | yaw rate [s] | roll rate [s] | steer rate [s] | largest roll change [deg] | slowest linear pole [1/s] |\n"
@@ -136,26 +173,83 @@ def one_at_a_time(duration):
         ("Table 8.4 gains, near-rigid linear tyre", simulation.with_changes(thesis, symmetric_tyres=True),
          {"tyres": (rigid, rigid)}, (rigid, rigid)),
         ("gains designed on the slip model", base, {"gains": slip_gains}, None),
+        ("LQR with Q = 10 I (a 10x more demanding rider)", base, {"gains": lqr_gains(base, 10.0)}, None),
+        ("LQR with Q = 100 I", base, {"gains": lqr_gains(base, 100.0)}, None),
+        ("heading-holding LQR (yaw angle as 5th state, Q = I), symmetric T03",
+         simulation.with_changes(base, symmetric_tyres=True), {"gains": heading_gains(base)}, None),
+        ("T03 without aligning moment M_z", base, {"tyres": measured_pair(base, moment=False)},
+         measured_pair(base, moment=False)),
     ]
     for label, scenario, overrides, pair in rows:
         gains = overrides.get("gains")
         if scenario.controller == "thesis":
             gains = control.thesis_gains(635.0)
-        pole = slowest_pole(*linear_model(scenario, gains=gains, tyre_pair=pair))
+        # The heading-frame linearisation has no yaw angle, so no pole for a kq3 rider.
+        pole = None if gains and "kq3" in gains else slowest_pole(
+            *linear_model(scenario, gains=gains, tyre_pair=pair))
         print(describe(label, simulation.run(scenario, **overrides), pole))
     print(f"\nGains designed on the slip model [kq4, kq7, ku4, ku7]: {np.round(k_slip, 3).tolist()} "
           f"(LQR cost on the slip model {j_slip:.2f}, against {j_classic:.2f} for the classic design "
           f"{np.round(gains0, 3).tolist()})")
 
 
+def lqr_gains(scenario, weight):
+    """Our LQR rider with Q = weight * I, R = 1, by name."""
+    design = simulation.build_bicycle(scenario)[1]
+    return control.gains_dict(control.lqr_gains(design, scenario.design_speed, Q=weight * np.eye(4))[0])
+
+
+def heading_gains(scenario):
+    """The heading-holding LQR rider (Q = I, R = 1), by name."""
+    design = simulation.build_bicycle(scenario)[1]
+    K, _ = control.heading_lqr_gains(design, scenario.design_speed)
+    return dict(zip(control.HEADING_GAIN_ORDER, K))
+
+
+def measured_pair(scenario, **switches):
+    rear, front, _ = simulation.build_tyres(scenario)
+    return ToggledTyre(rear, **switches), ToggledTyre(front, **switches)
+
+
+def tyre_properties():
+    """Slowest closed-loop pole (our LQR rider, 400 kPa, 635 N) with one tyre property at a time."""
+    base = Scenario(pressure_kpa=400.0, fz_n=635.0)
+    symmetric = simulation.with_changes(base, symmetric_tyres=True)
+    rear, front, _ = simulation.build_tyres(base)
+    moore, _, info = simulation.build_bicycle(base)
+    loads = (info["static_load_rear_n"], info["static_load_front_n"])
+    coefficient = [t.cornering_stiffness(fz) / fz for t, fz in zip((rear, front), loads)]
+
+    def linear(c, sigma=rear.relaxation_length, kz=rear.vertical_stiffness):
+        return tuple(tyres.linear_tyre(ci, sigma, kz) for ci in c)
+
+    print("Linear regime, 400 kPa, 635 N, our LQR rider: which tyre property costs damping\n")
+    print("| tyres (symmetric: zero-slip offsets removed) | slowest pole [1/s] |\n|---|---|")
+    rows = [
+        ("T03 as measured", None),
+        ("T03 without M_z on either wheel", measured_pair(base, moment=False)),
+        ("T03 without M_z on the front wheel", (rear, ToggledTyre(front, moment=False))),
+        ("T03 without M_z on the rear wheel", (ToggledTyre(rear, moment=False), front)),
+        ("T03 without camber force", measured_pair(base, camber_force=False)),
+        (f"linear, T03's cornering coefficients ({coefficient[0]:.1f}, {coefficient[1]:.1f} /rad), "
+         f"relaxation length and vertical stiffness; no camber force, no M_z", linear(coefficient)),
+        ("the same with 10x the cornering coefficients", linear([10 * c for c in coefficient])),
+        ("near-rigid linear tyre (100/rad, 0.01 m, 1e7 N/m)", linear([100.0, 100.0], 0.01, 1e7)),
+    ]
+    for label, pair in rows:
+        print(f"| {label} | {pole_text(slowest_pole(*linear_model(symmetric, tyre_pair=pair)))} |")
+    print()
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help="only the one-at-a-time table")
+    parser.add_argument("--quick", action="store_true", help="leave out the nine-case table")
     parser.add_argument("--duration", type=float, default=8.0, help="simulated time after the kick [s]")
     args = parser.parse_args(argv)
     print(f"slip model {simulation.model_hash()}\n")
     if not args.quick:
         nine_cases(args.duration)
+    tyre_properties()
     one_at_a_time(args.duration)
     return 0
 
