@@ -163,13 +163,18 @@ def upright_state(moore, speed, roll=0.0, steer=0.0):
     return q, np.array([0.0, -speed / moore["rr"], 0.0])
 
 
-def _reduced_rhs(x, u6, p, r):
-    """[q4, q7, u4, u7] -> their rates, with pitch and dependent speeds re-solved."""
+def _near_upright(x, u6, p):
+    """Coordinates (pitch re-solved) and independent speeds for x = [q4, q7, u4, u7] (complex allowed)."""
     q = np.zeros(8, dtype=np.result_type(x, float))
     q[Q["q4"]], q[Q["q7"]] = x[0], x[1]
     q[Q["q5"]] = _nominal_pitch(tuple(p))
     q = solve_pitch(q, p)
-    u_ind = np.array([x[2], u6, x[3]], dtype=q.dtype)
+    return q, np.array([x[2], u6, x[3]], dtype=q.dtype)
+
+
+def _reduced_rhs(x, u6, p, r):
+    """[q4, q7, u4, u7] -> their rates, with pitch and dependent speeds re-solved."""
+    q, u_ind = _near_upright(x, u6, p)
     _, udot = _derivatives(q, u_ind, p, r)
     return np.array([x[2], x[3], udot[U["u4"]], udot[U["u7"]]])
 
@@ -229,11 +234,7 @@ def yaw_rate_map(moore, speed):
     for j in range(4):
         x = np.zeros(4, dtype=complex)
         x[j] += 1j * _STEP
-        q = np.zeros(8, dtype=complex)
-        q[Q["q4"]], q[Q["q7"]] = x[0], x[1]
-        q[Q["q5"]] = _nominal_pitch(tuple(p))
-        q = solve_pitch(q, p)
-        row[j] = speeds(q, np.array([x[2], u6, x[3]]), p)[U["u3"]].imag / _STEP
+        row[j] = speeds(*_near_upright(x, u6, p), p)[U["u3"]].imag / _STEP
     return row
 
 

@@ -26,9 +26,6 @@ from .symbols import CLASSIC_CONSTANTS
 GAIN_ORDER = ("kq4", "kq7", "ku4", "ku7")
 #: Gains of :func:`heading_lqr_gains`, whose state adds the yaw angle q3.
 HEADING_GAIN_ORDER = ("kq3",) + GAIN_ORDER
-#: Units of every steer-torque gain the compiled model carries.
-GAIN_UNITS = {"kq3": "N m/rad", "kq4": "N m/rad", "kq7": "N m/rad",
-              "ku3": "N m s/rad", "ku4": "N m s/rad", "ku7": "N m s/rad"}
 
 #: Thesis Table 8.4: gains used for the Chapter 8 simulations, per rear load
 #: [N]; units N m/rad (kq4, kq7) and N m s/rad (ku4, ku7). Applied as

@@ -776,22 +776,20 @@ def _first_peak(df, column, baseline):
 
 def _custom_gains(gains):
     """Check user-given steer-torque gains (by name) and fill the missing ones with 0."""
-    from . import control
+    from . import control, slip, symbols
 
-    known = list(control.GAIN_UNITS)
-    unknown = sorted(set(gains) - set(known))
+    unknown = sorted(set(gains) - set(slip.GAIN_NAMES))
     if unknown:
-        raise InputError(f"unknown steer-torque gain(s) {unknown}; known: {known}")
+        raise InputError(f"unknown steer-torque gain(s) {unknown}; known: {list(slip.GAIN_NAMES)}")
     # The four of the thesis' law always; the yaw gains only when given.
     names = control.GAIN_ORDER + tuple(n for n in ("kq3", "ku3") if n in gains)
-    return {name: check_range(f"gain {name}", gains.get(name, 0.0), None, None, control.GAIN_UNITS[name])
+    return {name: check_range(f"gain {name}", gains.get(name, 0.0), None, None, symbols.info(name).unit)
             for name in names}
 
 
 def _control_law(gains):
-    """``T7 = -(...)`` with the gains in use, for the summary."""
-    terms = {"kq3": "kq3 q3", "kq4": "kq4 q4", "kq7": "kq7 q7", "ku3": "ku3 u3", "ku4": "ku4 u4", "ku7": "ku7 u7"}
-    return "T7 = -(" + " + ".join(terms[n] for n in gains) + ")"
+    """``T7 = -(kq4 q4 + ...)`` with the gains in use (gain k<x> multiplies state <x>), for the summary."""
+    return "T7 = -(" + " + ".join(f"{name} {name[1:]}" for name in gains) + ")"
 
 
 def _clean(value):
@@ -849,7 +847,7 @@ def run(scenario, *, tyres=None, gains=None):
     SimulationError
         The integration failed numerically (never NaN in a result).
     """
-    from . import analysis, control, integrate, slip
+    from . import analysis, integrate, slip, symbols
 
     wall0 = time.perf_counter()
     scenario.validate()
@@ -959,7 +957,7 @@ def run(scenario, *, tyres=None, gains=None):
             "type": controller_type, "gain_scale": scenario.gain_scale if custom_gains is None else None,
             "design_speed_m_s": scenario.design_speed if controller_type == "lqr" else None,
             "gains": gains,
-            "gain_units": {name: control.GAIN_UNITS[name] for name in gains},
+            "gain_units": {name: symbols.info(name).unit for name in gains},
             "law": _control_law(gains),
             "linear_closed_loop_poles": None if poles is None else [[p.real, p.imag] for p in poles],
         },
