@@ -157,6 +157,7 @@ def one_at_a_time(duration):
     k_slip, j_slip, j_classic = output_feedback_lqr(A, B, gains0)
     slip_gains = control.gains_dict(k_slip)
     thesis = simulation.with_changes(base, controller="thesis")
+    no_moment = measured_pair(base, moment=False)
 
     print("400 kPa, 635 N: one change at a time\n")
     print(HEADER)
@@ -177,8 +178,7 @@ def one_at_a_time(duration):
         ("LQR with Q = 100 I", base, {"gains": lqr_gains(base, 100.0)}, None),
         ("heading-holding LQR (yaw angle as 5th state, Q = I), symmetric T03",
          simulation.with_changes(base, symmetric_tyres=True), {"gains": heading_gains(base)}, None),
-        ("T03 without aligning moment M_z", base, {"tyres": measured_pair(base, moment=False)},
-         measured_pair(base, moment=False)),
+        ("T03 without aligning moment M_z", base, {"tyres": no_moment}, no_moment),
     ]
     for label, scenario, overrides, pair in rows:
         gains = overrides.get("gains")
