@@ -10,8 +10,8 @@ import importlib
 __version__ = "0.1.0"
 
 _SUBMODULES = (
-    "analysis", "benchmark", "bicycles", "cache", "classic", "cli", "codegen", "errors",
-    "control", "derivation", "inputs", "integrate", "kane", "magic_formula", "parameters",
+    "analysis", "animation", "benchmark", "bicycles", "cache", "classic", "cli", "codegen", "errors",
+    "control", "derivation", "geometry", "inputs", "integrate", "kane", "magic_formula", "parameters",
     "plotting", "riders", "simulation", "slip", "sweep", "symbols", "tyres",
 )
 

@@ -1,15 +1,24 @@
-"""Figures of kick responses: the four signals of the thesis' Figure 8.6.
+"""Figures of kick responses: the four signals of the thesis' Figure 8.6, and the animation's entry point.
 
 Yaw rate, roll rate, steer rate [rad/s] and the rear tyre's lateral force
 [N] (the relaxed force acting on the bicycle, model convention: + to the
 right) against time from the kick start. Several runs overlay in one
-figure (thesis Figures 8.6-8.9). Matplotlib's non-interactive Agg backend is
-used, so plotting works without a display.
+figure (thesis Figures 8.6-8.9). The figure says what happened: the kick
+band is labelled, a fall is marked by a vertical line and "fell at t s",
+the axis limits come from the motion before the fall (a falling bicycle's
+last few tenths of a second would otherwise stretch them 50-fold), and the
+yaw-rate baseline (the steady turn before the kick) is drawn and named.
+Matplotlib's non-interactive Agg backend is used, so plotting works without
+a display.
 """
+import math
+
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.transforms as mtransforms  # noqa: E402
+import numpy as np  # noqa: E402
 
 #: (column, axis label) of the four panels, top to bottom.
 RESPONSE_PANELS = (
@@ -18,11 +27,68 @@ RESPONSE_PANELS = (
     ("steer_rate", "steer rate [rad/s]"),
     ("fy_rear", "rear lateral force $F_y$ [N]"),
 )
+#: Fall angle [deg] assumed for a bare DataFrame (the Scenario default).
+DEFAULT_FALL_ANGLE_DEG = 45.0
+#: Fraction of the fall angle up to which the motion sets the axis limits.
+LIMIT_ROLL_FRACTION = 0.5
+#: Margin added on both sides of the data range, as a fraction of it.
+LIMIT_PADDING = 0.08
 
 
 def _frame_of(run):
     """The trajectory DataFrame of a Result or a DataFrame itself."""
     return getattr(run, "trajectory", run)
+
+
+def motion_limits(time, values, roll, fall_roll, time_range=None):
+    """Axis limits of a signal from the motion before the fall.
+
+    Only the samples before the bicycle first leans past
+    :data:`LIMIT_ROLL_FRACTION` of the fall angle count (all of them if it
+    never does), within ``time_range`` if given; the range is padded by
+    :data:`LIMIT_PADDING` on both sides.
+
+    Parameters
+    ----------
+    time, values, roll : array_like
+        Time [s], the signal, roll angle [rad] at the same samples.
+    fall_roll : float
+        |roll| [rad] that counts as a fall.
+    time_range : (float, float), optional
+        Only samples within it count [s].
+
+    Returns
+    -------
+    (float, float)
+
+    Example
+    -------
+    >>> t = np.linspace(0.0, 1.0, 11)
+    >>> roll = np.where(t < 0.8, 0.0, 1.0)          # leans over at 0.8 s
+    >>> motion_limits(t, np.where(t < 0.8, np.sin(t), 50.0), roll, math.radians(45))
+    (-0.05738848727..., 0.77474946...)
+    """
+    t = np.asarray(time, dtype=float)
+    y = np.asarray(values, dtype=float)
+    over = np.flatnonzero(np.abs(np.asarray(roll, dtype=float)) >= LIMIT_ROLL_FRACTION * fall_roll)
+    keep = np.arange(t.size) < (over[0] if over.size else t.size)
+    if time_range is not None:
+        keep &= (t >= time_range[0]) & (t <= time_range[1])
+    if not keep.any():
+        keep = np.ones(t.size, dtype=bool)
+    lo, hi = float(np.min(y[keep])), float(np.max(y[keep]))
+    span = hi - lo if hi > lo else max(abs(hi), 1e-3)
+    return lo - LIMIT_PADDING * span, hi + LIMIT_PADDING * span
+
+
+def _outcome(run):
+    """(fell, fall time or None, steady yaw rate or None, fall angle [rad]) of a Result; DataFrames: unknown."""
+    summary = getattr(run, "summary", None) or {}
+    scenario = getattr(run, "scenario", None)
+    fall_angle = math.radians(getattr(scenario, "fall_angle_deg", DEFAULT_FALL_ANGLE_DEG))
+    fell = bool(summary.get("fell", False))
+    baseline = summary.get("steady_state", {}).get("yaw_rate_rad_s")
+    return fell, summary.get("fall_time_s") if fell else None, baseline, fall_angle
 
 
 def response_figure(runs, path=None, title=None, kick=None, time_range=None, dpi=150):
@@ -31,14 +97,15 @@ def response_figure(runs, path=None, title=None, kick=None, time_range=None, dpi
     Parameters
     ----------
     runs : sequence of (label, Result or DataFrame)
-        Runs to overlay; DataFrames need the columns of :data:`RESPONSE_PANELS`
-        and ``time`` [s].
+        Runs to overlay; DataFrames need the columns of :data:`RESPONSE_PANELS`,
+        ``time`` [s] and ``roll`` [rad]. A Result's fall and steady turn are
+        marked.
     path : str or pathlib.Path, optional
         Write a PNG there (and close the figure).
     title : str, optional
         Figure title.
     kick : (float, float), optional
-        Start and end of the kick [s], shaded in every panel.
+        Start and end of the kick [s], shaded and labelled in every panel.
     time_range : (float, float), optional
         Time axis limits [s]; default the runs' span.
     dpi : int
@@ -48,20 +115,54 @@ def response_figure(runs, path=None, title=None, kick=None, time_range=None, dpi
     -------
     matplotlib.figure.Figure or None
         The figure, or None when it was written to ``path``.
+
+    Example
+    -------
+    >>> import whipple_kick as wk
+    >>> result = wk.simulation.run(wk.simulation.Scenario(controller="off", duration=2.0))
+    >>> fig = response_figure([("", result)], kick=(0.0, 0.15))
+    >>> [t.get_text() for t in fig.axes[0].texts if t.get_text().startswith("fell")]
+    ['fell at 1.345 s']
     """
     fig, axes = plt.subplots(len(RESPONSE_PANELS), 1, sharex=True, figsize=(8.0, 9.0))
-    for label, run in runs:
+    limits = {column: [] for column, _ in RESPONSE_PANELS}
+    baselines = []
+    for k, (label, run) in enumerate(runs):
         df = _frame_of(run)
-        fell = bool(getattr(run, "summary", {}).get("fell", False))
-        text = f"{label} (fell)" if fell and label else label
+        fell, fall_time, baseline, fall_angle = _outcome(run)
+        color = f"C{k}"
+        text = f"{label} (fell at {fall_time:.3f} s)" if fell and label else label
+        t = df["time"].to_numpy()
         for ax, (column, _) in zip(axes, RESPONSE_PANELS):
-            ax.plot(df["time"], df[column], lw=1.2, label=text)
-    for ax, (_, ylabel) in zip(axes, RESPONSE_PANELS):
+            ax.plot(t, df[column], lw=1.2, label=text, color=color)
+            limits[column].append(motion_limits(t, df[column], df["roll"], fall_angle, time_range))
+            if fell:
+                ax.axvline(fall_time, color=color, lw=1.0, ls="--", gid="fall")
+        if fell:
+            # Stacked below the top panel's upper edge when several runs fall.
+            axes[0].text(fall_time, 0.97 - 0.09 * k, f"fell at {fall_time:.3f} s", color=color, fontsize=8,
+                         ha="right", va="top", transform=mtransforms.blended_transform_factory(
+                             axes[0].transData, axes[0].transAxes), gid="fall")
+        if baseline is not None:
+            axes[0].axhline(baseline, color=color, lw=0.8, ls=":", gid="baseline")
+            baselines.append(baseline)
+    for ax, (column, ylabel) in zip(axes, RESPONSE_PANELS):
         ax.set_ylabel(ylabel)
         ax.grid(True, lw=0.4, alpha=0.5)
         ax.axvline(0.0, color="0.4", lw=0.6, ls=":")
         if kick is not None:
             ax.axvspan(kick[0], kick[1], color="0.85", zorder=0)
+        if limits[column]:
+            ax.set_ylim(min(lo for lo, _ in limits[column]), max(hi for _, hi in limits[column]))
+    if kick is not None:
+        axes[0].text(kick[1], 0.03, f" kick ({(kick[1] - kick[0]) * 1e3:.0f} ms)", fontsize=8, color="0.3",
+                     ha="left", va="bottom", gid="kick",
+                     transform=mtransforms.blended_transform_factory(axes[0].transData, axes[0].transAxes))
+    if baselines:
+        value = (f"{baselines[0]:.3f} rad/s" if np.ptp(baselines) < 5e-4 else
+                 f"{min(baselines):.3f} to {max(baselines):.3f} rad/s")
+        axes[0].text(0.01, 0.03, f"dotted: steady turn before the kick, {value} (the yaw-rate baseline)",
+                     fontsize=7.5, color="0.25", transform=axes[0].transAxes, ha="left", va="bottom", gid="baseline")
     axes[-1].set_xlabel("time from kick start [s]")
     if time_range is not None:
         axes[-1].set_xlim(*time_range)
@@ -77,13 +178,39 @@ def response_figure(runs, path=None, title=None, kick=None, time_range=None, dpi
     return None
 
 
+def controller_text(summary):
+    """The rider model of a run in words, gain scale spelled out (e.g. "LQR rider (designed at 3 m/s), gains x 1")."""
+    sc = summary["scenario"]
+    if summary.get("controller", {}).get("type") == "custom gains":
+        return "rider with custom steer-torque gains"
+    if sc["controller"] == "off":
+        return "no rider control (steer torque off)"
+    what = (f"LQR rider (designed at {sc['design_speed']:g} m/s)" if sc["controller"] == "lqr"
+            else "thesis Table 8.4 rider gains")
+    return f"{what}, gains scaled by {sc['gain_scale']:g}"
+
+
 def result_title(result):
     """One-line description of a run for a figure title."""
     s = result.summary
     sc = s["scenario"]
     load = s["bicycle"]["static_load_rear_n"]
     return (f"{sc['tyre']} {s['tyres']['pressure_rear_kpa']:g}/{s['tyres']['pressure_front_kpa']:g} kPa "
-            f"(rear/front), rear load {load:.0f} N, {sc['speed']:g} m/s, controller {sc['controller']}"
-            f" x{sc['gain_scale']:g}; kick {abs(s['kick']['displacement_m']) * 1e3:.0f} mm "
+            f"(rear/front), rear load {load:.0f} N, {sc['speed']:g} m/s, {controller_text(s)}; "
+            f"kick {abs(s['kick']['displacement_m']) * 1e3:.0f} mm "
             f"{s['kick']['direction']} in {s['kick']['duration_s']:.3f} s "
             f"({s['kick']['peak_acceleration_m_s2']:.1f} m/s$^2$)")
+
+
+def animate(result, path, **options):
+    """Write an animation of a run (mp4 or gif): :func:`whipple_kick.animation.animate`.
+
+    Example
+    -------
+    >>> import whipple_kick as wk
+    >>> result = wk.simulation.run(wk.simulation.Scenario(duration=1.0))
+    >>> wk.plotting.animate(result, "kick.gif", fps=10, size=(320, 180)).frames
+    56
+    """
+    from .animation import animate as _animate
+    return _animate(result, path, **options)
