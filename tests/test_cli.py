@@ -119,6 +119,9 @@ BAD_INPUTS = {
     "table-and-smooth": (["--kick-table", "k.csv", "--kick-profile", "smooth"],
                          ["--kick-table", "--kick-profile smooth"]),
     "unknown-controller": (["--controller", "pid"], ["--controller", "'pid'"]),
+    "animation-option-alone": (["--fps", "10"], ["--fps", "--animate"]),
+    "animation-fps-zero": (["--animate", "--fps", "0"], ["frame rate", "[1, 120]", "frames/s"]),
+    "animation-slow-motion": (["--animate", "--slow-motion", "5"], ["slow-motion factor", "(0, 1]"]),
     "unknown-flag": (["--pressur", "400"], ["unrecognized", "--pressur"]),
 }
 
@@ -213,3 +216,45 @@ def test_bad_kick_table_is_one_line_and_status_2(content, fragments, tmp_path, c
     for fragment in ["plate.csv"] + fragments:
         assert fragment in err, (fragment, err)
     assert list(work.iterdir()) == []            # checked before any output folder is made
+
+
+# ------------------------------------------------------------------ animation
+
+def test_animate_writes_a_playable_mp4(tmp_path, capsys):
+    """Acceptance: ``simulate --animate`` writes an mp4 with the expected frames, read back by imageio-ffmpeg.
+
+    1.5 s of run (0.5 s before the kick, 1 s after) at 10 frames/s with the
+    default 0.2x slow motion from the kick start to 1 s after its end
+    (clipped to the run's end): 0.5 s + 1 s / 0.2 = 5.5 video s, 56 frames.
+    """
+    import imageio_ffmpeg
+
+    out = tmp_path / "run"
+    status, stdout, err = _simulate(["--duration", "1.0", "--animate", "--fps", "10", "--out", str(out)], capsys)
+    assert status == 0, err
+    assert sorted(p.name for p in out.iterdir()) == ["animation.mp4", "response.png", "summary.json",
+                                                     "trajectory.csv"]
+    path = str(out / "animation.mp4")
+    frames, seconds = imageio_ffmpeg.count_frames_and_secs(path)
+    reader = imageio_ffmpeg.read_frames(path)
+    meta = next(reader)
+    assert frames == sum(1 for _ in reader) == 56
+    assert tuple(meta["size"]) == (1280, 720) and meta["fps"] == 10.0
+    assert "animation.mp4 (56 frames, 5.6 s)" in stdout
+
+
+def test_animate_without_an_encoder_writes_a_gif(tmp_path, capsys, monkeypatch):
+    """No ffmpeg: the same animation as a GIF (Pillow), with a note saying how to get mp4."""
+    from PIL import Image
+
+    from whipple_kick import animation
+
+    monkeypatch.setattr(animation, "video_encoder", lambda: None)
+    out = tmp_path / "run"
+    status, stdout, err = _simulate(["--duration", "1.0", "--animate", "--fps", "10", "--slow-motion", "1",
+                                     "--no-plot", "--out", str(out)], capsys)
+    assert status == 0, err
+    assert sorted(p.name for p in out.iterdir()) == ["animation.gif", "summary.json", "trajectory.csv"]
+    with Image.open(out / "animation.gif") as image:
+        assert image.n_frames == 16 and image.size == (640, 360)
+    assert "whipple_kick[video]" in stdout

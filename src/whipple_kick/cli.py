@@ -148,10 +148,39 @@ def _simulate_parser():
     g.add_argument("--out", metavar="DIR",
                    help="output folder (default: a new folder under the current directory)")
     g.add_argument("--force", action="store_true",
-                   help="write into an existing non-empty output folder, overwriting the three files")
+                   help="write into an existing non-empty output folder, overwriting the files written")
     g.add_argument("--no-plot", action="store_true", help="do not write response.png")
     g.add_argument("--quiet", action="store_true", help="print nothing on success")
+    g = p.add_argument_group("animation")
+    g.add_argument("--animate", action="store_true",
+                   help="also write animation.mp4 (animation.gif when no video encoder is installed: "
+                        "pip install 'whipple_kick[video]' for mp4); see docs/animation.md")
+    # No defaults here: an option given without --animate is refused rather than ignored.
+    g.add_argument("--fps", type=_number("frames/s"), metavar="FPS",
+                   help="frames per second of the animation (default 30)")
+    g.add_argument("--slow-motion", type=_number("playback speed"), metavar="FACTOR",
+                   help="playback speed during the kick and --slow-after seconds after it, in (0, 1] "
+                        "(default 0.2; 1 = real time throughout)")
+    g.add_argument("--slow-after", type=_number("s"), metavar="S",
+                   help="simulated seconds after the kick's end still played slowed (default 1)")
     return p
+
+
+_ANIMATION_DEFAULTS = {"fps": 30.0, "slow_motion": 0.2, "slow_after": 1.0}
+
+
+def _animation_options(args):
+    """The animation's options with defaults, or None without --animate (refusing options given alone)."""
+    given = {name: getattr(args, name) for name in _ANIMATION_DEFAULTS if getattr(args, name) is not None}
+    if not args.animate:
+        if given:
+            flag = "--" + next(iter(given)).replace("_", "-")
+            raise InputError(f"{flag} sets the animation; add --animate")
+        return None
+    from . import animation
+    options = {**_ANIMATION_DEFAULTS, **given}
+    animation.check_options(**options)
+    return options
 
 
 def _scenario_from_args(args):
@@ -300,6 +329,7 @@ def _simulate(argv):
     from . import simulation
     args = _simulate_parser().parse_args(argv)
     scenario = simulation.preflight(_scenario_from_args(args))
+    movie_options = _animation_options(args)
     out, created = _prepare_out(args.out if args.out else _default_out(scenario), args.force)
     try:
         result = simulation.run(scenario)
@@ -316,8 +346,18 @@ def _simulate(argv):
         plotting.response_figure([("", result)], out / "response.png", title=plotting.result_title(result),
                                  kick=(k["start_s"], k["start_s"] + k["duration_s"]))
         files.append("response.png")
+    note = None
+    if movie_options is not None:
+        from . import animation
+        suffix = "mp4" if animation.video_encoder() else "gif"
+        if suffix == "gif":
+            note = "no video encoder installed: wrote a GIF (pip install 'whipple_kick[video]' for mp4)"
+        movie = animation.animate(result, out / f"animation.{suffix}", **movie_options)
+        files.append(f"{movie.path.name} ({movie.frames} frames, {movie.video_duration_s:.1f} s)")
     if not args.quiet:
         _print_summary(result, out, files)
+        if note:
+            print(f"  note: {note}")
     return 0
 
 

@@ -1,0 +1,97 @@
+"""Response figures that say what happened, tested through the figure objects (artists, texts), not pixels."""
+import math
+
+import matplotlib.pyplot as plt
+import numpy as np
+import pytest
+
+from whipple_kick import plotting, simulation
+
+
+@pytest.fixture(scope="module")
+def fall():
+    """Controller off: the bicycle falls at 1.345 s, its steer rate reaching -67 rad/s at the end."""
+    result = simulation.run(simulation.Scenario(controller="off", duration=2.0))
+    assert result.summary["fell"]
+    return result
+
+
+@pytest.fixture(scope="module")
+def recovers():
+    return simulation.run(simulation.Scenario(duration=1.0))
+
+
+def _texts(fig):
+    return [t.get_text() for ax in fig.axes for t in ax.texts] + [t.get_text() for t in fig.texts]
+
+
+def test_fall_is_marked(fall):
+    """Acceptance: a vertical line at the fall time in every panel and "fell at 1.345 s"."""
+    fall_time = fall.summary["fall_time_s"]
+    fig = plotting.response_figure([("", fall)], kick=(0.0, 0.15))
+    try:
+        for ax in fig.axes:
+            marks = [line for line in ax.lines if line.get_gid() == "fall"]
+            assert len(marks) == 1
+            assert tuple(marks[0].get_xdata()) == (fall_time, fall_time)
+        assert f"fell at {fall_time:.3f} s" in _texts(fig)
+    finally:
+        plt.close(fig)
+
+
+def test_axis_limits_come_from_the_motion_before_the_fall(fall):
+    """The fall's last tenths (steer rate -67 rad/s) do not set the limits; the kick response does.
+
+    Limits: the samples before |roll| first reaches half the fall angle
+    (22.5 deg, at 0.98 s here), padded by 8 %: steer rate within about
+    +-1.65 rad/s, so the kick response fills the panel.
+    """
+    fig = plotting.response_figure([("", fall)], kick=(0.0, 0.15))
+    try:
+        panels = dict(zip((c for c, _ in plotting.RESPONSE_PANELS), fig.axes))
+        df = fall.trajectory
+        low, high = panels["steer_rate"].get_ylim()
+        assert df["steer_rate"].min() < -60.0           # the fall itself ...
+        assert -2.0 < low < -1.0 and 1.0 < high < 2.0   # ... is off the scale
+        before = np.abs(df["roll"].to_numpy()) < 0.5 * math.radians(45.0)
+        peak = np.max(np.abs(df["steer_rate"].to_numpy()[before]))
+        assert max(-low, high) == pytest.approx(peak * 1.16, rel=0.1)
+    finally:
+        plt.close(fig)
+
+
+def test_kick_baseline_and_gain_scale_are_said(recovers):
+    """The kick band is labelled, the steady-turn baseline drawn and named, the gain scale spelled out."""
+    baseline = recovers.summary["steady_state"]["yaw_rate_rad_s"]
+    title = plotting.result_title(recovers)
+    fig = plotting.response_figure([("", recovers)], kick=(0.0, 0.15), title=title)
+    try:
+        texts = _texts(fig)
+        assert any(t.strip() == "kick (150 ms)" for t in texts)
+        assert any("steady turn before the kick" in t and f"{baseline:.3f} rad/s" in t for t in texts)
+        lines = [line for line in fig.axes[0].lines if line.get_gid() == "baseline"]
+        assert len(lines) == 1 and tuple(lines[0].get_ydata()) == (baseline, baseline)
+        assert not any(line.get_gid() == "fall" for ax in fig.axes for line in ax.lines)
+        assert "gains scaled by 1" in fig._suptitle.get_text()
+        assert " x1" not in fig._suptitle.get_text()
+    finally:
+        plt.close(fig)
+
+
+def test_several_runs_name_their_fall_in_the_legend(fall, recovers):
+    fig = plotting.response_figure([("off", fall), ("lqr", recovers)], kick=(0.0, 0.15))
+    try:
+        labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+        assert labels == [f"off (fell at {fall.summary['fall_time_s']:.3f} s)", "lqr"]
+    finally:
+        plt.close(fig)
+
+
+def test_motion_limits_ignore_samples_after_half_the_fall_angle():
+    t = np.linspace(0.0, 1.0, 11)
+    roll = np.where(t < 0.75, 0.1, 0.5)         # passes 22.5 deg (0.39 rad) at 0.8 s
+    y = np.where(t < 0.75, t, 100.0)
+    low, high = plotting.motion_limits(t, y, roll, math.radians(45.0))
+    assert (low, high) == pytest.approx((-0.056, 0.756))
+    assert plotting.motion_limits(t, y, roll, math.radians(45.0), time_range=(0.0, 0.5)) == pytest.approx(
+        (-0.04, 0.54))
