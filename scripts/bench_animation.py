@@ -11,9 +11,16 @@ running + 6 s after the kick) animated at 30 frames per second in real time
   for gif) saving the same number of frames of an empty figure of the same
   size and dpi, with the same ffmpeg, codec and output arguments.
 
+``--compare-3d`` also times drawing alone (no file), per frame: this
+module's renderer against matplotlib's 3D axes (mpl_toolkits.mplot3d, what
+symmeplot draws with) showing the same scene: wheel discs, the rider's
+solids as their 3D convex hulls (triangles), the frame tubes and the ground
+polygons, updated in place and redrawn each frame.
+
 Usage:
     python scripts/bench_animation.py              # mp4 and gif, 5 repeats
     python scripts/bench_animation.py --format mp4 --repeats 7
+    python scripts/bench_animation.py --format none --compare-3d
 """
 import argparse
 import pathlib
@@ -47,9 +54,64 @@ def _empty_frames(fmt, path, frames, size, fps, dpi):
     return time.perf_counter() - t0
 
 
+def _compare_3d(result, repeats, fps=30.0, size=(1280, 720), dpi=100):
+    """Median ms per frame: this renderer vs mplot3d on the same scene (drawing only)."""
+    import numpy as np
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
+    from scipy.spatial import ConvexHull
+
+    from whipple_kick import animation
+
+    t = result.trajectory["time"].to_numpy()
+    times = animation.frame_times(float(t[0]), float(t[-1]), fps)
+    frames = animation._frames(result, times, size, dpi, None, True, (0.0, 0.0), 1.0)
+    scene = frames.scene
+    fig = Figure(figsize=(size[0] / dpi, size[1] / dpi), dpi=dpi)
+    canvas = FigureCanvasAgg(fig)
+    ax = fig.add_subplot(projection="3d")
+    faces = {item.name: ConvexHull(item.points[0]).simplices for item in scene.items if item.kind == "hull"}
+
+    def polygons(k):
+        out = [item.points[k] for item in scene.items if item.kind == "disc"]
+        for item in scene.items:
+            if item.kind == "hull":
+                out += list(item.points[k][faces[item.name]])
+        return out + [scene.plate[k]]
+
+    def tubes(k):
+        return [item.points[k] for item in scene.items if item.kind in ("tube", "arrow", "arc", "axis")]
+
+    solids = ax.add_collection3d(Poly3DCollection(polygons(0), facecolor="0.7", edgecolor="k", linewidths=0.3))
+    lines = ax.add_collection3d(Line3DCollection(tubes(0), colors="b", linewidths=2))
+    ours, theirs = [], []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        for k in range(times.size):
+            frames.render(k)
+        ours.append(1e3 * (time.perf_counter() - t0) / times.size)
+        t0 = time.perf_counter()
+        for k in range(times.size):
+            centre = scene.camera_target[k]
+            solids.set_verts(polygons(k))
+            lines.set_segments(tubes(k))
+            ax.set_xlim(centre[0] - 1.5, centre[0] + 1.5)
+            ax.set_ylim(centre[1] - 1.5, centre[1] + 1.5)
+            ax.set_zlim(0.5, -2.0)
+            canvas.draw()
+            np.asarray(canvas.buffer_rgba())
+        theirs.append(1e3 * (time.perf_counter() - t0) / times.size)
+    print(f"drawing only, {times.size} frames {size[0]}x{size[1]}, {repeats} repeats:")
+    print(f"  whipple_kick.animation (NumPy projection, 2D artists): median {statistics.median(ours):.1f} ms/frame")
+    print(f"  matplotlib 3D axes, same scene redrawn:               median {statistics.median(theirs):.1f} ms/frame"
+          f"  (ratio {statistics.median(theirs) / statistics.median(ours):.1f})")
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("--format", choices=("mp4", "gif", "both"), default="both")
+    p.add_argument("--format", choices=("mp4", "gif", "both", "none"), default="both")
+    p.add_argument("--compare-3d", action="store_true", help="also time matplotlib 3D axes drawing the same scene")
     p.add_argument("--repeats", type=int, default=5)
     p.add_argument("--fps", type=float, default=30.0)
     args = p.parse_args(argv)
@@ -58,7 +120,7 @@ def main(argv=None):
     from whipple_kick.simulation import Scenario, run
 
     result = run(Scenario())
-    formats = ("mp4", "gif") if args.format == "both" else (args.format,)
+    formats = {"both": ("mp4", "gif"), "none": ()}.get(args.format, (args.format,))
     with tempfile.TemporaryDirectory() as tmp:
         for fmt in formats:
             if fmt == "mp4" and wk.animation.video_encoder() is None:
@@ -85,6 +147,8 @@ def main(argv=None):
                   + " ".join(f"{v:.2f}" for v in empty))
             print(f"  ratio animate / empty: median {statistics.median(ratios):.2f} (per repeat "
                   + " ".join(f"{v:.2f}" for v in ratios) + "; bound: at most 3)")
+    if args.compare_3d:
+        _compare_3d(result, args.repeats, args.fps)
     return 0
 
 

@@ -241,3 +241,30 @@ def test_unknown_suffix_and_custom_tyres_are_input_errors(tmp_path):
         animation.animate(result, tmp_path / "x.gif", size=(160, 90))
     movie = animation.animate(result, tmp_path / "x.gif", size=(160, 90), tyres=(tyre, tyre))
     assert movie.frames > 1
+
+
+def test_lumped_rider_is_the_rear_frame_inertia_ellipsoid():
+    """A preset with the rider lumped into the rear frame is drawn as the uniform ellipsoid of its inertia.
+
+    The drawn surface's extents along the principal axes are the semi-axes
+    a, b, c; m (b^2 + c^2) / 5 etc. give back the rear frame's principal
+    moments of inertia to 1e-12 relative (round-off).
+    """
+    moore = wk.bicycles.load("balanceassist_635N").moore
+    inertia = np.array([[moore["ic11"], 0.0, moore["ic31"]], [0.0, moore["ic22"], 0.0],
+                        [moore["ic31"], 0.0, moore["ic33"]]])
+    points = animation._inertia_ellipsoid(moore["mc"], inertia)
+    moments, axes = np.linalg.eigh(inertia)
+    a, b, c = np.max(np.abs(points @ axes), axis=0)
+    rebuilt = moore["mc"] / 5.0 * np.array([b * b + c * c, a * a + c * c, a * a + b * b])
+    np.testing.assert_allclose(rebuilt, moments, rtol=1e-12)
+
+
+def test_a_preset_with_the_rider_included_animates(tmp_path):
+    """The thesis' own set-up (rider lumped into the rear frame, no seating geometry) draws and writes."""
+    result = simulation.run(simulation.Scenario.thesis(duration=0.3, settle=0.1))
+    scene = animation.build_scene(result, result.trajectory["time"].to_numpy()[::50])
+    names = [item.name for item in scene.items if item.kind == "hull"]
+    assert names == ["C rear frame and rider (lumped)"]
+    movie = animation.animate(result, tmp_path / "thesis.gif", fps=10, size=(160, 90))
+    assert movie.times[-1] == pytest.approx(0.3)

@@ -15,7 +15,7 @@ is installed):
 * the kick plate (500 x 500 mm, thesis Section 8.3) moves with the run's
   ``plate_y``; the lane follows the steady motion before the kick, so the
   distance between the bicycle and the lane's centre line is the kick's
-  effect; a 1 m ground grid is fixed to the ground;
+  effect; a 2 m ground grid is fixed to the ground;
 * arrows at the contacts: lateral tyre force (red) and normal load (grey)
   at one scale, 0.5 m per static rear load, so their ratio is the friction
   used; arcs for the self-aligning moments;
@@ -161,7 +161,7 @@ _SEGMENT_GROUPS = {
     "J2": {"left shank": 6, "left foot": 6},
     "K2": {"right shank": 6, "right foot": 6},
 }
-#: Colour of each drawn part of the rider (by the start of its name).
+#: Colour of each drawn part of the rider, by the part's name (Yeadon segment label or group).
 _RIDER_COLOURS = {"P": "#3b3b48", "J1": "#3b3b48", "K1": "#3b3b48", "T": "#2f7fb8", "chest": "#2f7fb8",
                   "A1": "#2f7fb8", "B1": "#2f7fb8", "left forearm": "#e0b48c", "right forearm": "#e0b48c",
                   "head": "#e0b48c", "left hand": "#e0b48c", "right hand": "#e0b48c",
@@ -174,8 +174,8 @@ def _yeadon_segments(human, seat, to_bike):
     segments = {}
     for segment in human.segments:
         points = []
+        rot = np.asarray(segment.rot_mat)      # a segment's solids share its orientation; z along the limb
         for solid in segment.solids:
-            rot = np.asarray(solid._rot_mat if hasattr(solid, "_rot_mat") else segment.rot_mat)
             start = np.ravel(solid.pos)
             if hasattr(solid, "stads"):
                 for level, stadium in zip((0.0, solid.height), solid.stads):
@@ -197,7 +197,7 @@ def _yeadon_segments(human, seat, to_bike):
     return segments
 
 
-def _inertia_ellipsoid(mass, inertia, vertices=10):
+def _inertia_ellipsoid(mass, inertia, vertices=16):
     """Surface points of the uniform solid ellipsoid with this mass and inertia [m], about its centre.
 
     A uniform ellipsoid of semi-axes a, b, c has principal moments
@@ -207,7 +207,7 @@ def _inertia_ellipsoid(mass, inertia, vertices=10):
     sums = np.array([moments[1] + moments[2] - moments[0], moments[0] + moments[2] - moments[1],
                      moments[0] + moments[1] - moments[2]])
     semi = np.sqrt(np.maximum(sums, 0.0) * 5.0 / (2.0 * mass))
-    u, v = np.meshgrid(np.linspace(0, 2 * math.pi, vertices, endpoint=False), np.linspace(-1.3, 1.3, 5))
+    u, v = np.meshgrid(np.linspace(0, 2 * math.pi, vertices, endpoint=False), np.linspace(-1.3, 1.3, 7))
     unit = np.c_[(np.cos(u) * np.cos(v)).ravel(), (np.sin(u) * np.cos(v)).ravel(), np.sin(v).ravel()]
     unit = np.r_[unit, [[0, 0, 1], [0, 0, -1]]]
     return (unit * semi) @ axes.T
@@ -224,7 +224,7 @@ class Body:
     lines : dict of str -> ndarray (m, 3)
         Polylines [m] in body axes from the body's wheel centre.
     solids : dict of str -> ndarray (m, 3)
-        Point clouds [m] drawn as their projected convex hull.
+        Point clouds [m] of convex bodies, drawn as the outline of their projection.
     """
 
     frame: str
@@ -601,7 +601,7 @@ _STYLE = {
     "sky": "#dfe9f1", "ground": "#cfd6c4", "grid": "#b9c1ad", "asphalt": "#8c8f93", "lane": "white",
     "pit": "#555555", "plate": "#c9a66b", "tyre": "#1b1b1b", "disc": (0.85, 0.85, 0.85, 0.75),
     "spokes": "#7a7a7a", "rear frame": "#1f4e99", "front frame": "#d9822b", "axis": "#444444",
-    "lumped": "#8fa8c8", "force": "#d62728", "load": "#5f5f5f", "moment": "#9467bd",
+    "lumped": (0.56, 0.66, 0.78, 0.6), "force": "#d62728", "load": "#5f5f5f", "moment": "#9467bd",
 }
 
 
@@ -731,6 +731,8 @@ class _Frames:
         if arcs:
             legend += f"; purple arcs: aligning\nmoment, a quarter turn = {(math.pi / 2) / MOMENT_ARC_RAD_PER_NM:g} N m"
         legend += f"\nLane: the steady path before the kick\n({LANE_WIDTH_M:g} m wide); ground grid {_GRID_SPACING_M:g} m"
+        if any("lumped" in item.name for item in scene.items):
+            legend += "\nEllipsoid: rear frame and rider lumped\n(uniform, same mass and inertia)"
         self.fig.text(0.765, 0.015, legend, fontsize=7, color="#222222", va="bottom", linespacing=1.25)
         self.clock = _PixelText(size, (0.765, 0.965), "t = -00.000 s\nslow motion 0.25x\nplate moving", 11, dpi,
                                 "black")
@@ -749,8 +751,10 @@ class _Frames:
             y = frame[COLUMNS[key]].to_numpy()
             tax.plot(t, y, color="#1f77b4", lw=0.9)
             tax.axvspan(kick["start_s"], kick["start_s"] + kick["duration_s"], color="0.85", zorder=0)
-            tax.set_ylim(*plotting.motion_limits(t, y, frame[COLUMNS["q4"]].to_numpy(), fall_roll))
-            tax.set_xlim(t[0], t[-1])
+            # The part of the run animated (a still shows the whole run).
+            shown = (float(scene.times[0]), float(scene.times[-1])) if scene.times.size > 1 else (t[0], t[-1])
+            tax.set_ylim(*plotting.motion_limits(t, y, frame[COLUMNS["q4"]].to_numpy(), fall_roll, shown))
+            tax.set_xlim(*shown)
             tax.set_title(label, fontsize=8, loc="left")
             tax.tick_params(labelsize=7)
             tax.grid(True, lw=0.3, alpha=0.6)

@@ -156,8 +156,9 @@ def response_figure(runs, path=None, title=None, kick=None, time_range=None, dpi
         if limits[column]:
             ax.set_ylim(min(lo for lo, _ in limits[column]), max(hi for _, hi in limits[column]))
     if kick is not None:
-        axes[0].text(kick[1], 0.03, f" kick ({(kick[1] - kick[0]) * 1e3:.0f} ms)", fontsize=8, color="0.3",
-                     ha="left", va="bottom", gid="kick",
+        # Upright in the band, from its top: clear of the baseline note and the fall marks.
+        axes[0].text(0.5 * (kick[0] + kick[1]), 0.97, f"kick ({(kick[1] - kick[0]) * 1e3:.0f} ms)", fontsize=7.5,
+                     color="0.3", rotation=90, ha="center", va="top", gid="kick",
                      transform=mtransforms.blended_transform_factory(axes[0].transData, axes[0].transAxes))
     if baselines:
         value = (f"{baselines[0]:.3f} rad/s" if np.ptp(baselines) < 5e-4 else
