@@ -77,7 +77,8 @@ def _simulate_parser():
         description="Kick-plate test on the nonlinear Carvallo-Whipple bicycle-rider model with "
                     "Magic-Formula tyres (Dell'Orto 2025, Chapter 8): steady running, then the plate "
                     "under the rear wheel jumps sideways; an LQR steer-torque rider recovers or the "
-                    "bicycle falls. Writes trajectory.csv, summary.json and response.png.",
+                    "bicycle falls. Writes trajectory.csv, summary.json and response.png (and, with --animate, "
+                    "animation.mp4).",
         epilog="Time is measured from the kick start. Defaults are the thesis' settings: "
                "balanceassist_v1 + Yeadon rider for 635 N on the rear tyre, T03 at 400 kPa, 3 m/s, "
                "LQR designed at 3 m/s, 150 mm kick in 0.150 s (13.3 m/s^2), 6 s. See docs/simulate.md.")
