@@ -245,7 +245,7 @@ def _print_summary(result, out, files):
         print(f"  kick: {abs(kick['displacement_m']) * 1e3:.0f} mm {kick['direction']} in {kick['duration_s']:.3f} s "
               f"(peak {kick['peak_acceleration_m_s2']:.1f} m/s^2, {kick['profile']} profile) at t = 0 s")
     print(f"  steady state: roll {st['roll_rad'] * deg:.2f} deg, steer {st['steer_rad'] * deg:.2f} deg, "
-          f"yaw rate {st['yaw_rate_rad_s']:.4f} rad/s, drive torque {st['drive_torque_n_m']:.4f} N m")
+          f"yaw rate {st['yaw_rate_rad_s']:.4f} rad/s, rear-wheel torque {st['rear_wheel_torque_n_m']:+.4f} N m ({st['rear_wheel_torque_role']})")
     if s["fell"]:
         print(f"  result: FELL (|roll| reached {sc['fall_angle_deg']:g} deg) {s['fall_time_s']:.3f} s after the kick start")
     else:

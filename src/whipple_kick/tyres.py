@@ -447,6 +447,31 @@ class Tyre:
             w * mf.cornering_stiffness_numpy(fz, fy, self.friction_scale)
             for w, fy, _ in self._sets)
 
+    def secant_ratio(self, slip, fz):
+        """Secant ratio of the pure-slip lateral-force curve [-] (blended like the force).
+
+        ``g = F_sym(slip) / (C0 slip)`` with F_sym the curve at zero camber
+        without its zero-slip offsets and C0 its slope at zero: 1 at zero
+        slip, falling as the force saturates (:func:`magic_formula.lateral_secant_model`).
+        The contact-patch transient's relaxation length is the tyre's
+        ``relaxation_length`` times this (floored, :data:`whipple_kick.transient.G_MIN`).
+
+        Parameters
+        ----------
+        slip : array_like
+            Slip angle [rad].
+        fz : array_like
+            Normal load [N], > 0 (a shape: independent of the curve scale).
+        """
+        slip, _, fz = _finite_inputs(slip, 0.0, fz)
+        fz = _load(fz, "normal load fz", 0.0, low_open=True)
+        num = den = 0.0
+        for w, fy, _ in self._sets:
+            slope, ratio = mf.lateral_secant_numpy(slip, fz, fy, self.friction_scale)
+            num = num + w * slope * ratio
+            den = den + w * slope
+        return num / den
+
     def magic_formula_factors(self, fz, camber=0.0):
         """Magic Formula factors of F_y in the formula's units, at a measured pressure.
 
