@@ -206,16 +206,18 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
             cuts = sorted({0, len(grid) - 1, *(int(m) for m in marks if 0 < m < len(grid) - 1)})
         for i0, i1 in zip(cuts[:-1], cuts[1:]):
             times = grid[i0:i1 + 1]
+            # A sample at the piece's end is emitted after the jump map (below).
+            last = -1 if i1 == len(grid) - 1 else None
             fast = _fast_chunk(rhs, x, times, rtol, atol, roll, fall_angle, jac)
             if fast is not None:
                 y, n = fast
                 nfev += n
-                emit(times, y)
+                emit(times[:last], y[:last])
                 x = y[-1]
                 continue
             sol = _careful_chunk(rhs, x, times, rtol, atol, fall, jac)
             nfev += sol.nfev
-            emit(sol.t, sol.y.T)
+            emit(sol.t[:last] if sol.status != 1 else sol.t, sol.y.T[:last] if sol.status != 1 else sol.y.T)
             if sol.status == 1:
                 fell, fall_time = True, float(sol.t_events[0][0])
                 x = sol.y_events[0][0]
