@@ -58,7 +58,7 @@ import numpy as np
 import sympy as sm
 
 __all__ = [
-    "N_FY_COEFFICIENTS", "N_MZ_COEFFICIENTS",
+    "N_FY_COEFFICIENTS", "N_MZ_COEFFICIENTS", "FY_OFFSET_INDICES", "MZ_OFFSET_INDICES",
     "lateral_force_factors", "aligning_moment_factors",
     "lateral_force_formula", "aligning_moment_formula",
     "lateral_force_model", "aligning_moment_model", "cornering_stiffness_model", "lateral_secant_model",
@@ -71,6 +71,12 @@ __all__ = [
 N_FY_COEFFICIENTS = 14
 #: Number of Pacejka 1989 aligning-moment coefficients c0..c17.
 N_MZ_COEFFICIENTS = 18
+
+#: Coefficients that shift the curves at zero slip and camber (the Sh and Sv
+#: terms not multiplied by camber): zeroing them gives a tyre with no
+#: zero-slip force or moment ("symmetric tyres").
+FY_OFFSET_INDICES = (9, 10, 12, 13)
+MZ_OFFSET_INDICES = (12, 13, 16, 17)
 
 _DEG_PER_RAD = sm.S(180) / sm.pi
 _N_PER_KN = sm.S(1000)

@@ -30,7 +30,7 @@ import numpy as np
 import sympy as sm
 from sympy.printing.c import C99CodePrinter
 
-from . import cache, codegen, energy, kane, transient
+from . import cache, codegen, energy, kane, magic_formula, transient
 from . import symbols as S
 from .errors import InputError
 
@@ -99,7 +99,7 @@ def _wheel_parameters(wheel, letter):
 
 def _set_curve(kind, wheel, k, slip, camber, fz):
     """One coefficient set's raw steady curve (friction scale applied, no blend weight or curve scale)."""
-    from . import magic_formula as mf
+    mf = magic_formula
     letter = "a" if kind == "fy" else "c"
     sets, _, mu, _ = _wheel_parameters(wheel, letter)
     builder = mf.lateral_force_model if kind == "fy" else mf.aligning_moment_model
@@ -108,9 +108,8 @@ def _set_curve(kind, wheel, k, slip, camber, fz):
 
 def _set_secant(wheel, k, slip, fz):
     """(slope, secant ratio) of one coefficient set (:func:`magic_formula.lateral_secant_model`)."""
-    from . import magic_formula as mf
     sets, _, mu, _ = _wheel_parameters(wheel, "a")
-    return mf.lateral_secant_model(slip, fz, sets[k - 1], friction_scale=mu)
+    return magic_formula.lateral_secant_model(slip, fz, sets[k - 1], friction_scale=mu)
 
 
 def _inline_curves():
@@ -765,8 +764,8 @@ _STATUS = {
 
 #: Magic-Formula coefficients that shift the curves at zero slip and camber
 #: (Sh and Sv terms not multiplied by camber). "Symmetric tyres" zero them.
-FY_OFFSET_INDICES = (9, 10, 12, 13)
-MZ_OFFSET_INDICES = (12, 13, 16, 17)
+FY_OFFSET_INDICES = magic_formula.FY_OFFSET_INDICES
+MZ_OFFSET_INDICES = magic_formula.MZ_OFFSET_INDICES
 GAIN_NAMES = ("kq3", "kq4", "kq7", "ku3", "ku4", "ku7")
 
 

@@ -16,6 +16,7 @@ OUTPUTS of the two bracketing measured coefficient sets linearly; see
 :attr:`Tyre.blend` for what a simulation must evaluate. docs/tyres.md has the
 data's provenance, the friction modes and the known limits of the fits.
 """
+import copy
 import math
 import pathlib
 import warnings
@@ -394,6 +395,26 @@ class Tyre:
         raise InputError(f"tyre {self.name} has no measured aligning-moment (M_z) coefficients "
                          f"(the thesis publishes M_z fits for T03 only); load it with "
                          f"missing_moment='zero' to use a zero aligning moment")
+
+    def without_offsets(self):
+        """A copy with the zero-slip offsets zeroed (as ``symmetric_tyres`` runs use it).
+
+        Example
+        -------
+        >>> import whipple_kick as wk
+        >>> float(wk.tyres.load("T03", 400).without_offsets().lateral_force(0.0, 0.0, 600.0))
+        0.0
+        """
+        twin = copy.copy(self)
+        twin._sets = []
+        for w, fy, mz in self._sets:
+            fy = fy.copy()
+            fy[list(mf.FY_OFFSET_INDICES)] = 0.0
+            if mz is not None:
+                mz = mz.copy()
+                mz[list(mf.MZ_OFFSET_INDICES)] = 0.0
+            twin._sets.append((w, fy, mz))
+        return twin
 
     # -- symbolic -------------------------------------------------------------
 
