@@ -564,10 +564,25 @@ class KickTable:
         return out
 
 
-def _sample_grid(scenario):
-    """The run's output times [s]: from -settle to duration at ``output_rate``."""
-    t_start, t_end = -scenario.settle, scenario.duration
-    return np.linspace(t_start, t_end, int(round((t_end - t_start) * scenario.output_rate)) + 1)
+def sample_times(scenario):
+    """The run's output times [s]: the multiples of 1/``output_rate`` on the kick's clock, plus -settle and duration.
+
+    On the kick's clock (t = 0 at the nominal kick start), so the samples
+    after the kick do not depend on ``settle``: k / rate for the integers k
+    with -settle <= k / rate <= duration, and the run's ends if they fall
+    between multiples.
+
+    Example
+    -------
+    >>> sample_times(Scenario(settle=0.002, duration=0.003, output_rate=1000.0)).tolist()
+    [-0.002, -0.001, 0.0, 0.001, 0.002, 0.003]
+    """
+    rate, t_start, t_end = scenario.output_rate, 0.0 - scenario.settle, scenario.duration   # no -0.0
+    tiny = 1e-9   # of a sample spacing: a product like 0.5 * 1000 is an integer to round-off
+    k = np.arange(math.ceil(t_start * rate - tiny), math.floor(t_end * rate + tiny) + 1)
+    times = k / rate
+    times = times[(times > t_start + tiny / rate) & (times < t_end - tiny / rate)]
+    return np.concatenate([[t_start], times, [t_end]])
 
 
 def _integrate_run(steady, scenario, kick_T, table, kick_start):
@@ -600,7 +615,7 @@ def _integrate_run(steady, scenario, kick_T, table, kick_start):
     # piecewise=False is the comparison case: one LSODA run across the kick,
     # not even restarted at the integrator's chunk boundaries.
     chunk = integrate.DEFAULT_CHUNK if scenario.piecewise else math.inf
-    samples = _sample_grid(scenario)
+    samples = sample_times(scenario)
     t_start, t_end = float(samples[0]), scenario.duration
     rhs = slip.CompiledRHS(steady.params)   # the plate at rest at the kick start (a table's first row)
     fixed = scenario.kick_heading == "fixed"
@@ -684,7 +699,7 @@ def _integrate_table(params, x0, table, scenario, chunk, t_start=None):
     from . import integrate, slip
 
     t_end = scenario.duration
-    pending = _sample_grid(scenario)
+    pending = sample_times(scenario)
     t_start = pending[0] if t_start is None else t_start
     pending = pending[pending >= t_start]
     fall_angle = math.radians(scenario.fall_angle_deg)
