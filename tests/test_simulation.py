@@ -167,8 +167,10 @@ def test_recovery_is_reported_for_yaw_roll_and_steer_rates(base):
         # Within 5 % of the first peak from t_rec on, and outside it just before.
         assert np.all(dev[df["time"].to_numpy() >= t_rec] <= 0.05 * peak)
         assert dev[np.flatnonzero(after & (df["time"].to_numpy() < t_rec))[-1]] > 0.05 * peak
-        # (the yaw-rate peak is refined between samples, so it may exceed them slightly)
-        assert peak <= dev[after].max() * (1 + 1e-5)
+        # The yaw-rate peak is refined between samples, so it may exceed them slightly: the first one
+        # comes 2.3 ms after the plate stop's impulse and is sharp (measured 2.2e-4 above the 1 kHz
+        # samples, 7e-6 above those of a 20 kHz run).
+        assert peak <= dev[after].max() * (1 + 5e-4)
 
 
 def test_custom_gains_reproduce_the_named_controller(base):
@@ -219,13 +221,15 @@ def test_heading_rider_gains_are_applied_and_reported():
     def heading_change(result):
         return abs(result.trajectory["yaw"].iloc[-1])   # the steady motion starts at yaw 0 and is straight
 
-    assert heading_change(free) > 0.5
+    assert heading_change(free) > 0.2     # measured 0.36 rad (1.18 rad with the thesis' force lag)
     assert heading_change(held) < 0.02 * heading_change(free)
 
 
 def test_custom_tyres_are_used_and_named():
     rigid = wk.tyres.linear_tyre(100.0, 0.01, 1e7)
-    r = run(Scenario(duration=0.5, symmetric_tyres=True), tyres=(rigid, rigid))
+    # A small kick (the linear regime): a linear tyre has no friction limit, and after the full kick's
+    # instant plate stop its contact-patch force follows the load spikes at once (tens of kN).
+    r = run(Scenario(duration=0.5, symmetric_tyres=True, kick_displacement=0.005), tyres=(rigid, rigid))
     assert "LinearTyre(100/rad" in r.summary["tyres"]["name"]
     assert "custom tyre objects" in r.summary["tyres"]["notes"][0]
     assert r.summary["tyres"]["pressure_rear_kpa"] is None   # the scenario's pressure was not used
@@ -315,7 +319,9 @@ def test_half_gains_recover_more_slowly(pressure):
 
 @pytest.mark.parametrize("pressure", [300.0, 400.0, 500.0])
 def test_controller_off_falls_within_2_s(pressure):
-    r = run(Scenario(pressure_kpa=pressure, fz_n=635.0, controller="off"))
+    """The thesis' form (its model fell in about 0.9 s; measured 1.35-1.61 s here). With the default
+    contact-patch tyre the fall is later (300 and 400 kPa: 2.27 and 2.15 s, below)."""
+    r = run(Scenario(pressure_kpa=pressure, fz_n=635.0, controller="off", tyre_transient="force_lag"))
     assert r.summary["fell"]
     assert 0.0 < r.summary["fall_time_s"] <= 2.0
     roll = r.trajectory["roll"].to_numpy()
@@ -333,6 +339,13 @@ def _completes(result):
         assert df["time"].iloc[-1] == pytest.approx(s["fall_time_s"])
     else:
         assert df["time"].iloc[-1] == pytest.approx(result.scenario.duration)
+
+
+@pytest.mark.parametrize("pressure", [300.0, 400.0])
+def test_controller_off_falls_with_the_contact_patch_tyre(pressure):
+    r = run(Scenario(pressure_kpa=pressure, fz_n=635.0, controller="off"))
+    assert r.summary["fell"]
+    assert 1.5 < r.summary["fall_time_s"] <= 2.5     # measured 2.27 s (300 kPa), 2.15 s (400 kPa)
 
 
 @pytest.mark.parametrize("accel", [30.0, 35.0, 40.0])
