@@ -528,7 +528,11 @@ class LinearTyre:
     reaches, written as a Magic Formula with a huge peak factor so the slip
     model evaluates it unchanged. Made for checks against the no-slip
     (knife-edge) model: as the coefficient and the vertical stiffness grow
-    and the relaxation length shrinks, the slip model approaches it.
+    and the relaxation length shrinks, the slip model approaches it. It has
+    no friction limit: under large slip (the thesis kick's instant plate
+    stop) the contact-patch transient's force follows load spikes at once
+    and reaches tens of kN; use small kicks, or ``tyre_transient="force_lag"``,
+    for no-slip-limit checks.
 
     Attributes match those of :class:`Tyre` that the slip model reads.
     """
