@@ -10,9 +10,9 @@ import importlib
 __version__ = "0.1.0"
 
 _SUBMODULES = (
-    "analysis", "benchmark", "bicycles", "cache", "classic", "cli", "codegen", "errors",
+    "analysis", "benchmark", "bicycles", "cache", "classic", "cli", "codegen", "energy", "errors",
     "control", "derivation", "inputs", "integrate", "kane", "magic_formula", "parameters",
-    "plotting", "riders", "simulation", "slip", "sweep", "symbols", "tyres",
+    "plotting", "riders", "simulation", "slip", "sweep", "symbols", "transient", "tyres",
 )
 
 
