@@ -15,6 +15,8 @@ Tables (400 kPa, 635 N, T03 table7_9, our LQR rider, 3 m/s, thesis kick):
 * ``carcass``: passivity of the carcass: integrated carcass power against the
   constant-load-and-camber storage function at the samples, split into the
   zero-slip force's part and the rest; and the sign of the sliding dissipation.
+* ``bounds``: |F_y| and |M_z| against the steady curve's largest value over
+  slip at each sample's load, with the patch camber and with the wheel's.
 * ``steady``: the steady motion's rear-wheel torque and what feeds it, and the
   speed reached with T6c = 0.
 * ``secant``: the secant ratio of T03 at 400 kPa, 635 N at a few slips.
@@ -193,7 +195,47 @@ def secant():
     print(", ".join(f"{math.degrees(s):g} deg: {g:.4f}" for s, g in zip(slips, ratio)))
 
 
-TABLES = {"forms": forms, "gmin": gmin, "plate_stop": plate_stop, "carcass": carcass, "steady": steady,
+def _curve_peak(tyre, camber, fz, kind):
+    """Largest |F_y| (or |M_z|) of the steady curve over slip in [-90, 90] deg at each (camber, load)."""
+    slips = np.radians(np.linspace(-90.0, 90.0, 3601))[None, :]
+    curve = tyre.lateral_force if kind == "fy" else tyre.aligning_moment
+    out = np.empty(camber.size)
+    for start in range(0, camber.size, 500):
+        rows = slice(start, start + 500)
+        out[rows] = np.max(np.abs(curve(slips, camber[rows, None], fz[rows, None])), axis=1)
+    return out
+
+
+def bounds():
+    """|F_y| and |M_z| against the steady curve's largest value at the sample's load and camber."""
+    print("| run | form | wheel | max |F_y|/peak, patch camber | same, wheel camber | max |M_z|/peak, patch camber "
+          "| same, wheel camber | largest |F_y| while unloaded [N] |")
+    print("|---|---|---|---|---|---|---|---|")
+    for label, changes in (("default", {}), ("controller off", {"controller": "off"}),
+                           ("40 m/s^2 kick", {"kick_accel": 40.0})):
+        for name in ("contact_patch", "force_lag"):
+            scenario = dataclasses.replace(BASE, tyre_transient=name, **changes)
+            r = run(scenario)
+            df = r.trajectory
+            rear, front, _ = build_tyres(scenario)
+            for wheel, tyre in (("rear", rear), ("front", front)):
+                fz = df[f"fz_{wheel}"].to_numpy()
+                loaded = fz > 0.0
+                cells = []
+                for kind, column in (("fy", f"fy_{wheel}"), ("mz", f"mz_{wheel}")):
+                    value = np.abs(df[column].to_numpy())
+                    for camber_column in (f"camber_patch_{wheel}", f"camber_{wheel}"):
+                        if camber_column not in df:
+                            cells.append("-")
+                            continue
+                        peak = _curve_peak(tyre, df[camber_column].to_numpy()[loaded], fz[loaded], kind)
+                        cells.append(f"{np.max(value[loaded] / peak):.4f}")
+                unloaded = np.abs(df[f"fy_{wheel}"].to_numpy()[~loaded])
+                print(f"| {label} | {name} | {wheel} | " + " | ".join(cells)
+                      + f" | {unloaded.max() if unloaded.size else 0.0:.1f} |")
+
+
+TABLES = {"forms": forms, "bounds": bounds, "gmin": gmin, "plate_stop": plate_stop, "carcass": carcass, "steady": steady,
           "secant": secant}
 
 

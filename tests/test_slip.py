@@ -427,3 +427,18 @@ def test_plate_stop_impulse_is_the_limit_of_a_short_stop(rider_bike, gains, t03)
     # The re-solve of the dependent speeds alone loses about 30 times more (measured 0.98 J).
     _, resolve = slip.velocity_jump(rhs, T, x_stop, impulse=False)
     assert resolve["kinetic_energy_change_j"] < 20 * info["kinetic_energy_change_j"] < 0.0
+
+
+@pytest.mark.parametrize("pressure", [300.0, 400.0, 500.0])
+def test_t03_curve_opposes_the_slip_at_every_camber_and_load(pressure):
+    """The sliding dissipation -(F - F0) V' >= 0 needs F_ss(a', g', Fz) - F_ss(0, g', Fz) to oppose a':
+    T03 table7_9 over +-90 deg of slip, 50-1200 N, +-45 deg of camber (the chapter8 fit does not)."""
+    tyre = wk.tyres.load("T03", pressure_kpa=pressure)
+    slips = np.radians(np.linspace(-90.0, 90.0, 721))[None, None, :]
+    loads = np.array([50.0, 100.0, 200.0, 343.0, 500.0, 635.0, 800.0, 1000.0, 1200.0])[:, None, None]
+    cambers = np.radians(np.linspace(-45.0, 45.0, 37))[None, :, None]
+    excess = tyre.lateral_force(slips, cambers, loads) - tyre.lateral_force(0.0 * slips, cambers, loads)
+    assert np.all(excess * np.sign(slips) <= 0.0)
+    chapter8 = wk.tyres.load("T03", pressure_kpa=pressure, coefficient_set="chapter8")
+    excess = chapter8.lateral_force(slips, cambers, loads) - chapter8.lateral_force(0.0 * slips, cambers, loads)
+    assert np.any(excess * np.sign(slips) > 0.0)
