@@ -1155,7 +1155,7 @@ def run(scenario, *, tyres=None, gains=None):
             "model_hash": model_hash(),
         },
         "scenario": scenario.to_dict(),
-        "units": UNITS,
+        "units": {column: UNITS[column] for column in df.columns},
     }
     summary["numerics"]["wall_s"] = time.perf_counter() - wall0
     return Result(scenario=scenario, trajectory=df, summary=_clean(summary))
