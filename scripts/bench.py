@@ -6,6 +6,10 @@ Usage:
     python scripts/bench.py run        # the 6 s kick-plate base case at rtol 1e-12 and 1e-8, C vs NumPy RHS
     python scripts/bench.py cli        # end to end: `simulate --pressure 400 --fz 635 --out NEW --quiet`, warm cache
     python scripts/bench.py all
+    python scripts/bench.py compare --against DIR [--against-cache DIR]
+                                       # this checkout against another one (e.g. main) in the same session:
+                                       # RHS call cost (both compiled libraries in one process, interleaved
+                                       # rounds) and the 6 s default run (interleaved fresh processes)
 """
 import argparse
 import os
@@ -127,12 +131,97 @@ def bench_cli(repeats):
           f"median {statistics.median(times):.2f} s  runs {[round(v, 2) for v in times]}")
 
 
+# Runs in either checkout (no newer API): dumps the base case's state and parameters and the library path.
+_DUMP = r"""
+import sys, numpy as np
+import whipple_kick as wk
+from whipple_kick import slip
+bike = wk.bicycles.load("balanceassist_v1")
+combined, _ = wk.riders.for_rear_load(bike, fz_n=635.0)
+K, _ = wk.control.lqr_gains(combined, 3.0)
+tyre = wk.tyres.load("T03", pressure_kpa=400)
+par = slip.model_parameters(combined, tyre, tyre, gains=wk.control.gains_dict(K),
+                            kick=dict(t0=0.0, duration=0.15, displacement=0.15))
+ss = slip.steady_state(par, 3.0)
+x = ss.x.copy(); x[slip.X["u4"]] = 0.1
+np.save(sys.argv[1] + "_x.npy", x); np.save(sys.argv[1] + "_p.npy", slip.parameter_vector(ss.params))
+print(slip.library()._name)
+"""
+_RUN = r"""
+import json, statistics
+from whipple_kick.simulation import Scenario, run
+run(Scenario(duration=0.2))
+runs = [run(Scenario()).summary["numerics"] for _ in range(3)]
+print(json.dumps([statistics.median(r[k] for r in runs) for k in ("integration_wall_s", "wall_s", "nfev")]))
+"""
+
+
+def _environments(args):
+    """{label: environment} of this checkout and of the one compared against."""
+    here = dict(os.environ)
+    other = dict(os.environ, PYTHONPATH=str(pathlib.Path(args.against).resolve() / "src"))
+    other["WHIPPLE_KICK_CACHE"] = args.against_cache or os.path.join(tempfile.gettempdir(), "wkcache_bench_against")
+    here.pop("PYTHONPATH", None)
+    return {"this": here, "against": other}
+
+
+def bench_compare(args):
+    """RHS call and 6 s run of this checkout against ``--against`` (ratios this/against)."""
+    import ctypes
+    import json
+    envs = _environments(args)
+    libs = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for label, env in envs.items():
+            out = subprocess.run([sys.executable, "-c", _DUMP, os.path.join(tmp, label)], env=env,
+                                 capture_output=True, text=True, check=True, cwd=tmp)
+            lib = ctypes.CDLL(out.stdout.strip().splitlines()[-1])
+            lib.wk_slip_rhs.restype = ctypes.c_int
+            lib.wk_slip_rhs.argtypes = [ctypes.c_double] + [ctypes.c_void_p] * 4
+            x = np.load(os.path.join(tmp, f"{label}_x.npy"))
+            libs[label] = (lib, x, np.load(os.path.join(tmp, f"{label}_p.npy")), np.empty(x.size))
+
+    def loop(label, n):
+        lib, x, p, dx = libs[label]
+        fn, p_ptr, dx_ptr = lib.wk_slip_rhs, p.ctypes.data, dx.ctypes.data
+        t0 = time.perf_counter()
+        for _ in range(n):   # as CompiledRHS.__call__: contiguous input, C call, copy
+            fn(0.05, np.ascontiguousarray(x, dtype=float).ctypes.data, p_ptr, dx_ptr, None)
+            dx.copy()
+        return (time.perf_counter() - t0) / n
+
+    times = {label: [] for label in libs}
+    for _ in range(max(args.repeats, 1) * 8):
+        for label in libs:
+            times[label].append(loop(label, 5000))
+    this, against = (statistics.median(times[k]) for k in ("this", "against"))
+    print(f"RHS call (ctypes + copy): this {this * 1e6:.2f} us, against {against * 1e6:.2f} us, "
+          f"ratio {this / against:.3f} (medians of {len(times['this'])} interleaved rounds of 5000 calls)")
+    runs = {label: [] for label in envs}
+    for _ in range(args.repeats):
+        for label, env in envs.items():
+            out = subprocess.run([sys.executable, "-c", _RUN], env=env, capture_output=True, text=True,
+                                 check=True, cwd=tempfile.gettempdir())
+            runs[label].append(json.loads(out.stdout.strip().splitlines()[-1]))
+    for k, name in enumerate(("integration", "run() wall", "RHS evaluations")):
+        this, against = (statistics.median(r[k] for r in runs[label]) for label in ("this", "against"))
+        print(f"6 s default run, {name}: this {this:.4g}, against {against:.4g}, ratio {this / against:.3f} "
+              f"(medians of {args.repeats} interleaved processes x 3 runs)")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("what", choices=("rhs", "build", "run", "cli", "all"))
+    parser.add_argument("what", choices=("rhs", "build", "run", "cli", "all", "compare"))
     parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--against", metavar="DIR", help="checkout to compare with (its src/ is imported)")
+    parser.add_argument("--against-cache", metavar="DIR", help="model cache of that checkout (default: a temp dir)")
     args = parser.parse_args()
     np.set_printoptions(precision=4)
+    if args.what == "compare":
+        if not args.against:
+            parser.error("compare needs --against DIR")
+        bench_compare(args)
+        return
     for name, fn in (("rhs", bench_rhs), ("build", bench_build), ("run", bench_run), ("cli", bench_cli)):
         if args.what in (name, "all"):
             fn(args.repeats)

@@ -3,16 +3,25 @@
 Usage:
     python scripts/regenerate_regression.py --reason "why the reference runs changed"
 
-Writes ``tests/data/regression/<name>.npz`` for the cases in :data:`CASES`
-and appends a line (date, model hash, reason) to
-``tests/data/regression/CHANGELOG.md``. ``tests/test_regression.py`` reruns
-each stored scenario and compares.
+Writes ``tests/data/regression/<name>.npz`` for the cases in :func:`cases`
+(the project's default model) and appends a line (date, model hash, reason)
+to ``tests/data/regression/CHANGELOG.md``. ``tests/test_regression.py``
+reruns each stored scenario and compares.
+
+``tests/data/regression/thesis_form/`` holds the references made with the
+thesis' tyre transient before the contact-patch form, the plate stop's
+impulse and the fixed heading at the kick existed; their stored scenarios
+name the options that reproduce them (``tyre_transient="force_lag"``,
+``plate_stop="resolve"``, ``kick_heading="settled"``). This script never
+rewrites them: they pin the thesis' form.
 
 Each file holds float32 arrays at 200 Hz of the columns in :data:`COLUMNS`
-(time from the kick start, SI units), plus ``scenario_json`` (every Scenario
-field, so the test needs nothing else to rerun the case), ``model_hash`` and
-``generated`` (UTC time stamp). float32 keeps ~7 significant digits: its
-rounding (~6e-8 of a signal's peak) is far below the test's tolerance.
+that the run has (time from the kick start, SI units), plus
+``scenario_json`` (every Scenario field, so the test needs nothing else to
+rerun the case; a kick table is named relative to this folder),
+``model_hash`` and ``generated`` (UTC time stamp). float32 keeps ~7
+significant digits: its rounding (~6e-8 of a signal's peak) is far below the
+test's tolerance.
 """
 import argparse
 import dataclasses
@@ -26,30 +35,60 @@ import numpy as np
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 OUT = ROOT / "tests" / "data" / "regression"
 CHANGELOG = OUT / "CHANGELOG.md"
-#: Stored columns (analysis.COLUMNS names): yaw, roll and steer rates, roll, steer, rear F_y.
-COLUMNS = ("time", "yaw_rate", "roll_rate", "steer_rate", "roll", "steer", "fy_rear")
+#: Stored columns (those the run has): the thesis' response signals, both tyres' loads, slips and the
+#: energy accounting's main terms, so a swapped label or a changed tyre shows.
+COLUMNS = ("time", "yaw_rate", "roll_rate", "steer_rate", "roll", "steer", "yaw", "y_rear",
+           "fy_rear", "fy_front", "mz_rear", "mz_front", "fz_rear", "fz_front", "slip_rear", "slip_front",
+           "slip_patch_rear", "slip_patch_front", "steer_torque", "plate_work", "sliding_dissipation")
 RATE_HZ = 200.0
+#: Kick table of the tabulated case (minimum-jerk 150 mm in 150 ms, rows every 10 ms), in :data:`OUT`.
+KICK_TABLE = "kick_table_smooth_10ms.csv"
+
+
+def _write_kick_table(path):
+    times = np.arange(16) * 0.010
+    s = times / 0.150
+    y = 0.150 * (10 * s**3 - 15 * s**4 + 6 * s**5)
+    lines = ["# minimum-jerk plate motion, 150 mm in 150 ms, rows every 10 ms (regression case)", "time,y"]
+    lines += [f"{t!r},{v!r}" for t, v in zip(times.tolist(), y.tolist())]
+    path.write_text("\n".join(lines) + "\n")
 
 
 def cases():
-    """{name: Scenario}: the nine thesis cases, the controller-off case and a 40 m/s^2 kick."""
+    """{name: Scenario}: the nine thesis cases, controller off, a 40 m/s^2 kick, and one case per variant:
+    the thesis preset, the plate friction mode, the smooth and the tabulated kicks, T04, 350 kPa, 5 m/s."""
     from whipple_kick.simulation import Scenario
     base = Scenario(output_rate=RATE_HZ)    # defaults: LQR rider, T03, 3 m/s, 150 mm in 0.150 s, 6 s
     out = {}
     for fz in (570, 635, 701):
         for p in (300, 400, 500):
             out[f"lqr_{p}kPa_{fz}N"] = dataclasses.replace(base, pressure_kpa=float(p), fz_n=float(fz))
-    out["off_400kPa_635N"] = dataclasses.replace(base, pressure_kpa=400.0, fz_n=635.0, controller="off")
-    out["kick40_400kPa_635N"] = dataclasses.replace(base, pressure_kpa=400.0, fz_n=635.0, kick_accel=40.0)
+    one = dataclasses.replace(base, pressure_kpa=400.0, fz_n=635.0)
+    out["off_400kPa_635N"] = dataclasses.replace(one, controller="off")
+    out["kick40_400kPa_635N"] = dataclasses.replace(one, kick_accel=40.0)
+    out["thesis_400kPa"] = Scenario.thesis(pressure_kpa=400.0, output_rate=RATE_HZ)
+    out["plate_400kPa_635N"] = dataclasses.replace(one, friction="plate")
+    out["smooth_400kPa_635N"] = dataclasses.replace(one, kick_profile="smooth")
+    out["table_400kPa_635N"] = dataclasses.replace(one, kick_profile="table", kick_table=KICK_TABLE)
+    out["T04_400kPa_635N"] = dataclasses.replace(one, tyre="T04")
+    out["lqr_350kPa_635N"] = dataclasses.replace(one, pressure_kpa=350.0)
+    out["speed5_400kPa_635N"] = dataclasses.replace(one, speed=5.0)   # LQR designed at 3 m/s (default)
     return out
+
+
+def runnable(scenario, folder=OUT):
+    """``scenario`` with a kick table named relative to ``folder`` made a path (as stored it is a name)."""
+    if scenario.kick_table is None or pathlib.Path(scenario.kick_table).is_absolute():
+        return scenario
+    return dataclasses.replace(scenario, kick_table=str(folder / scenario.kick_table))
 
 
 def write_case(name, scenario, path):
     """Run ``scenario`` and store its trajectory in ``path`` (NPZ)."""
     from whipple_kick import simulation
-    result = simulation.run(scenario)
+    result = simulation.run(runnable(scenario, path.parent))
     df = result.trajectory
-    arrays = {c: df[c].to_numpy(dtype=np.float32) for c in COLUMNS}
+    arrays = {c: df[c].to_numpy(dtype=np.float32) for c in COLUMNS if c in df.columns}
     np.savez_compressed(path, **arrays, name=np.array(name),
                         scenario_json=np.array(json.dumps(scenario.to_dict(), sort_keys=True)),
                         model_hash=np.array(simulation.model_hash()),
@@ -71,6 +110,7 @@ def main(argv=None):
         parser.error("--reason must not be empty")
     from whipple_kick import simulation
     OUT.mkdir(parents=True, exist_ok=True)
+    _write_kick_table(OUT / KICK_TABLE)
     for name, scenario in cases().items():
         result = write_case(name, scenario, OUT / f"{name}.npz")
         s = result.summary

@@ -79,6 +79,24 @@ def test_variants_reach_the_scenario(tmp_path, capsys):
     assert s["controller"]["gain_scale"] == 0.8 and s["numerics"]["rtol"] == 1e-8
 
 
+def test_thesis_tyre_transient_and_earlier_options_reach_the_summary(tmp_path, capsys):
+    """--tyre-transient force_lag (the thesis' form), --plate-stop resolve, --kick-heading settled."""
+    out = tmp_path / "run"
+    argv = ["--tyre-transient", "force_lag", "--plate-stop", "resolve", "--kick-heading", "settled",
+            "--duration", "0.5", "--no-plot", "--out", str(out)]
+    status, stdout, err = _simulate(argv, capsys)
+    assert status == 0, err
+    s = json.loads((out / "summary.json").read_text())
+    assert s["tyres"]["transient"] == "force_lag" and s["scenario"]["tyre_transient"] == "force_lag"
+    assert s["numerics"]["plate_stop"] == "resolve" and s["numerics"]["kick_heading"] == "settled"
+    jump, = s["energy"]["velocity_jumps"]
+    assert jump["impulse_work_j"] is None and jump["kinetic_energy_change_j"] < -0.1
+    assert "transient force_lag" in stdout and "plate stop (resolve)" in stdout
+    header = (out / "trajectory.csv").read_text().splitlines()[0].split(",")
+    assert "fy_rear" in header and "plate_work" in header and "slip_patch_rear" not in header
+    assert s["steady_state"]["rear_wheel_torque_role"] == "brake" and "brake" in stdout
+
+
 # Every bad input: (argv, fragments the one-line message must contain).
 BAD_INPUTS = {
     "pressure-above-range": (["--pressure", "900"], ["900", "[300, 500]", "kPa"]),
@@ -122,6 +140,9 @@ BAD_INPUTS = {
     "animation-option-alone": (["--fps", "10"], ["--fps", "--animate"]),
     "animation-fps-zero": (["--animate", "--fps", "0"], ["frame rate", "[1, 120]", "frames/s"]),
     "animation-slow-motion": (["--animate", "--slow-motion", "5"], ["slow-motion factor", "(0, 1]"]),
+    "unknown-tyre-transient": (["--tyre-transient", "lag"], ["--tyre-transient", "'lag'", "contact_patch",
+                                                              "force_lag"]),
+    "unknown-plate-stop": (["--plate-stop", "hold"], ["--plate-stop", "'hold'", "impulse", "resolve"]),
     "unknown-flag": (["--pressur", "400"], ["unrecognized", "--pressur"]),
 }
 

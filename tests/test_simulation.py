@@ -167,8 +167,10 @@ def test_recovery_is_reported_for_yaw_roll_and_steer_rates(base):
         # Within 5 % of the first peak from t_rec on, and outside it just before.
         assert np.all(dev[df["time"].to_numpy() >= t_rec] <= 0.05 * peak)
         assert dev[np.flatnonzero(after & (df["time"].to_numpy() < t_rec))[-1]] > 0.05 * peak
-        # (the yaw-rate peak is refined between samples, so it may exceed them slightly)
-        assert peak <= dev[after].max() * (1 + 1e-5)
+        # The yaw-rate peak is refined between samples, so it may exceed them slightly: the first one
+        # comes 2.3 ms after the plate stop's impulse and is sharp (measured 2.2e-4 above the 1 kHz
+        # samples, 7e-6 above those of a 20 kHz run).
+        assert peak <= dev[after].max() * (1 + 5e-4)
 
 
 def test_custom_gains_reproduce_the_named_controller(base):
@@ -219,13 +221,15 @@ def test_heading_rider_gains_are_applied_and_reported():
     def heading_change(result):
         return abs(result.trajectory["yaw"].iloc[-1])   # the steady motion starts at yaw 0 and is straight
 
-    assert heading_change(free) > 0.5
+    assert heading_change(free) > 0.2     # measured 0.36 rad (1.18 rad with the thesis' force lag)
     assert heading_change(held) < 0.02 * heading_change(free)
 
 
 def test_custom_tyres_are_used_and_named():
     rigid = wk.tyres.linear_tyre(100.0, 0.01, 1e7)
-    r = run(Scenario(duration=0.5, symmetric_tyres=True), tyres=(rigid, rigid))
+    # A small kick (the linear regime): a linear tyre has no friction limit, and after the full kick's
+    # instant plate stop its contact-patch force follows the load spikes at once (tens of kN).
+    r = run(Scenario(duration=0.5, symmetric_tyres=True, kick_displacement=0.005), tyres=(rigid, rigid))
     assert "LinearTyre(100/rad" in r.summary["tyres"]["name"]
     assert "custom tyre objects" in r.summary["tyres"]["notes"][0]
     assert r.summary["tyres"]["pressure_rear_kpa"] is None   # the scenario's pressure was not used
@@ -280,7 +284,11 @@ def test_table_8_4_rider_in_the_no_slip_limit():
     -0.6 1/s (docs/riders.md), which the linearised slip model must find too.
     """
     rigid = wk.tyres.linear_tyre(100.0, 0.01, 1e7)
-    scenario = Scenario(pressure_kpa=400.0, fz_n=635.0, controller="thesis", symmetric_tyres=True)
+    # The thesis' force lag: a linear tyre has no friction limit, and at the instant plate stop the
+    # contact-patch form's force follows the load spike at once (-27 kN at 1.9 kN load, the rear wheel
+    # hops and the bicycle falls), which says nothing about the rider in the no-slip limit.
+    scenario = Scenario(pressure_kpa=400.0, fz_n=635.0, controller="thesis", symmetric_tyres=True,
+                        tyre_transient="force_lag")
     r = run(scenario, tyres=(rigid, rigid))
     signals = r.summary["recovery"]["signals"]
     # Measured 0.83 s and 0.64 s; the yaw rate 3.69 s.
@@ -311,7 +319,9 @@ def test_half_gains_recover_more_slowly(pressure):
 
 @pytest.mark.parametrize("pressure", [300.0, 400.0, 500.0])
 def test_controller_off_falls_within_2_s(pressure):
-    r = run(Scenario(pressure_kpa=pressure, fz_n=635.0, controller="off"))
+    """The thesis' form (its model fell in about 0.9 s; measured 1.35-1.61 s here). With the default
+    contact-patch tyre the fall is later (300 and 400 kPa: 2.27 and 2.15 s, below)."""
+    r = run(Scenario(pressure_kpa=pressure, fz_n=635.0, controller="off", tyre_transient="force_lag"))
     assert r.summary["fell"]
     assert 0.0 < r.summary["fall_time_s"] <= 2.0
     roll = r.trajectory["roll"].to_numpy()
@@ -329,6 +339,13 @@ def _completes(result):
         assert df["time"].iloc[-1] == pytest.approx(s["fall_time_s"])
     else:
         assert df["time"].iloc[-1] == pytest.approx(result.scenario.duration)
+
+
+@pytest.mark.parametrize("pressure", [300.0, 400.0])
+def test_controller_off_falls_with_the_contact_patch_tyre(pressure):
+    r = run(Scenario(pressure_kpa=pressure, fz_n=635.0, controller="off"))
+    assert r.summary["fell"]
+    assert 1.5 < r.summary["fall_time_s"] <= 2.5     # measured 2.27 s (300 kPa), 2.15 s (400 kPa)
 
 
 @pytest.mark.parametrize("accel", [30.0, 35.0, 40.0])
@@ -384,13 +401,17 @@ def test_metrics_converge_between_rtol_1e8_and_1e12(changes):
         assert coarse[key] == pytest.approx(fine[key], rel=1e-5, abs=1e-3), key
 
 
-def test_piecewise_vs_single_integration_from_a_steady_turn(base):
-    """Default run (tyre offsets give a steady turn): one LSODA piece across the kick agrees to ~rtol."""
+def test_piecewise_vs_single_integration_from_a_steady_turn():
+    """Default run (tyre offsets give a steady turn): one LSODA piece across the kick agrees to ~rtol
+    with the piecewise run that, like it, only re-solves the dependent speeds at the plate stop (the
+    single piece cannot apply the impulse; with it the yaw rates differ by 9e-3 rad/s)."""
+    piecewise = run(Scenario(pressure_kpa=400.0, fz_n=635.0, plate_stop="resolve"))
     single = run(Scenario(pressure_kpa=400.0, fz_n=635.0, piecewise=False))
-    d = np.max(np.abs(single.trajectory["yaw_rate"].to_numpy() - base.trajectory["yaw_rate"].to_numpy()))
-    assert d < 1e-7   # measured 8e-10 rad/s at rtol 1e-10
+    d = np.max(np.abs(single.trajectory["yaw_rate"].to_numpy() - piecewise.trajectory["yaw_rate"].to_numpy()))
+    assert d < 1e-7   # measured 8e-10 rad/s at rtol 1e-10 before the impulse existed
     assert single.summary["metrics"]["peak_values"][0] == pytest.approx(
-        base.summary["metrics"]["peak_values"][0], rel=1e-8)
+        piecewise.summary["metrics"]["peak_values"][0], rel=1e-8)
+    assert single.summary["energy"]["velocity_jumps"] == []
 
 
 @pytest.mark.parametrize("rtol", [1e-8, 1e-12])
@@ -513,10 +534,14 @@ def test_table_with_an_offset_start_and_off_grid_times(tables):
     path.write_text("# plate of the test rig\nTime [s],y (m),note\n"
                     + "".join(f"{float(a)!r},{float(b)!r},x\n" for a, b in zip(t, y)))
     path = str(path)
-    sc = Scenario(kick_profile="table", kick_table=path, kick_direction="left", duration=1.0, output_rate=300.0)
+    # Both runs below start the steady turn at heading 0 at -0.5 s (kick_heading="settled"): with the
+    # heading fixed at each kick's start instead, they would differ by the 0.2 s of turning between the
+    # table's first row and the built-in kick's start (0.019 rad, a yaw-rate difference of 0.013 rad/s).
+    sc = Scenario(kick_profile="table", kick_table=path, kick_direction="left", duration=1.0, output_rate=300.0,
+                  kick_heading="settled")
     r = run(sc)
     df = r.trajectory
-    grid = np.linspace(-0.5, 1.0, 451)
+    grid = np.arange(-150, 301) / 300.0   # the output grid on the kick's clock
     np.testing.assert_array_equal(df["time"].to_numpy(), grid)
     assert np.all(df["plate_y"][df["time"] < -0.2] == -0.02)
     assert df["plate_y"].iloc[-1] == -y[-1]
@@ -530,7 +555,8 @@ def test_table_with_an_offset_start_and_off_grid_times(tables):
     # And it is close to the built-in minimum-jerk kick; not closer because the spline through these
     # uneven rows (a 0.2 s first interval, a 0.5 ms last one) departs from the quintic by up to 0.29 mm
     # and 0.09 m/s (measured yaw-rate difference 3.9e-4 rad/s, 0.05 % of the peak).
-    ref = run(Scenario(kick_profile="smooth", kick_direction="left", duration=1.0, output_rate=300.0))
+    ref = run(Scenario(kick_profile="smooth", kick_direction="left", duration=1.0, output_rate=300.0,
+                       kick_heading="settled"))
     assert np.max(np.abs(df["yaw_rate"] - ref.trajectory["yaw_rate"])) < 1e-3
 
 
@@ -538,7 +564,7 @@ def test_tabulated_run_is_continuous_across_segment_boundaries(smooth_pair):
     """No sample duplicated or missing where the pieces meet, and no jump in the states there."""
     df = smooth_pair[1].trajectory
     t = df["time"].to_numpy()
-    np.testing.assert_array_equal(t, np.linspace(-0.5, 6.0, 6501))
+    np.testing.assert_array_equal(t, np.arange(-500, 6001) / 1000.0)   # the output grid on the kick's clock
     assert np.unique(t).size == t.size
     # The yaw rate's second difference at the 1 ms table boundaries is no larger than between them:
     # a state restarted wrongly at a boundary would show as a spike.
@@ -612,3 +638,189 @@ def test_table_conflicts_with_the_other_kick_fields(tables):
         base = {"kick_profile": "table", "kick_table": path, **changes}
         with pytest.raises(InputError, match=re.escape(fragment)):
             Scenario(**base).validate()
+
+
+# ------------------------------------------- tyre transient, energy accounting, plate stop, heading
+
+@pytest.fixture(scope="module")
+def kicks():
+    """The controller-off run and a 40 m/s^2 kick (default tyre transient)."""
+    return {"controller off": run(Scenario(pressure_kpa=400.0, fz_n=635.0, controller="off")),
+            "40 m/s^2": run(Scenario(pressure_kpa=400.0, fz_n=635.0, kick_accel=40.0))}
+
+
+def _steady_curve_peaks(tyre, camber, fz):
+    """Largest |F_y| and |M_z| of the steady curves over slip in [-90, 90] deg at each (camber, load)."""
+    slips = np.radians(np.linspace(-90.0, 90.0, 3601))[None, :]
+    peaks_f, peaks_m = np.empty(camber.size), np.empty(camber.size)
+    for start in range(0, camber.size, 500):
+        rows = slice(start, start + 500)
+        g, load = camber[rows, None], fz[rows, None]
+        peaks_f[rows] = np.max(np.abs(tyre.lateral_force(slips, g, load)), axis=1)
+        peaks_m[rows] = np.max(np.abs(tyre.aligning_moment(slips, g, load)), axis=1)
+    return peaks_f, peaks_m
+
+
+def _force_bound_ratios(result):
+    """max over samples of |F|/peak and |M|/peak per wheel (patch camber), and the unloaded samples' loads."""
+    rear, front, _ = simulation.build_tyres(result.scenario)
+    df = result.trajectory
+    out = {}
+    for wheel, tyre in (("rear", rear), ("front", front)):
+        fz = df[f"fz_{wheel}"].to_numpy()
+        force, moment = df[f"fy_{wheel}"].to_numpy(), df[f"mz_{wheel}"].to_numpy()
+        camber = df[f"camber_patch_{wheel}"].to_numpy()
+        peak_f, peak_m = _steady_curve_peaks(tyre, camber, fz)
+        loaded = fz > 0.0
+        out[wheel] = (np.max(np.abs(force[loaded]) / peak_f[loaded]), np.max(np.abs(moment[loaded]) / peak_m[loaded]),
+                      np.abs(force[~loaded]).tolist() + np.abs(moment[~loaded]).tolist())
+    return out
+
+
+@pytest.mark.parametrize("case", ["default", "controller off", "40 m/s^2"])
+def test_tyre_loads_never_exceed_the_steady_curve(base, kicks, case):
+    """Issue acceptance: at every sample |F_y| <= 1.001 x the largest |F_y| of the steady curve over slip at
+    that sample's load and patch camber, |M_z| likewise, and an unloaded tyre carries nothing. The contact-
+    patch form applies the steady curve of its own patch slip, so the measured ratio is <= 1 to round-off."""
+    result = base if case == "default" else kicks[case]
+    for wheel, (ratio_f, ratio_m, unloaded) in _force_bound_ratios(result).items():
+        assert ratio_f <= 1.001 and ratio_m <= 1.001, (wheel, ratio_f, ratio_m)
+        assert all(v == 0.0 for v in unloaded), wheel
+    if case == "controller off":
+        # The front wheel really does lift off in this fall (so the zero-load check is not empty).
+        assert np.any(result.trajectory["fz_front"] == 0.0)
+
+
+def test_thesis_force_lag_keeps_force_on_an_unloaded_tyre():
+    """Why the default changed (issue): in the thesis' form the lagged front force survives lift-off."""
+    r = run(Scenario(pressure_kpa=400.0, fz_n=635.0, controller="off", tyre_transient="force_lag"))
+    df = r.trajectory
+    unloaded = df["fz_front"].to_numpy() == 0.0
+    assert unloaded.any()
+    # Measured: up to ~700 N and ~20 N m while the front tyre carries no load.
+    assert np.max(np.abs(df["fy_front"].to_numpy()[unloaded])) > 100.0
+
+
+def test_energy_balance_closes_over_the_default_run(base):
+    """Issue acceptance: kinetic + gravity + tyre springs + carcasses against the cumulative works and
+    dissipations closes to 1e-3 J over the whole run, across the kick start and the plate stop (measured
+    8.7e-9 J at rtol 1e-10); the plate stop's impulse is in the plate's work."""
+    df, energy = base.trajectory, base.summary["energy"]
+    residual = df[simulation.BALANCE_COLUMN].to_numpy()
+    assert np.max(np.abs(residual)) < 1e-3
+    assert energy["balance_residual_max_abs_j"] == pytest.approx(np.max(np.abs(residual)))
+    # The terms are not trivially small (measured plate 16.3 J, sliding 29.0 J).
+    assert energy["plate_work_j"] > 10.0 and energy["sliding_dissipation_j"] > 10.0
+    jump, = energy["velocity_jumps"]
+    assert jump["time_s"] == pytest.approx(0.15)
+    assert jump["impulse_work_j"] == pytest.approx(jump["kinetic_energy_change_j"], abs=1e-9)
+    # Quadratures are cumulative from the kick start.
+    t = df["time"].to_numpy()
+    for column, _ in wk.energy.COLUMNS.values():
+        assert df[column].to_numpy()[t == 0.0][0] == 0.0, column
+    for name in ("plate_work", "carcass_energy_rear", "slip_patch_rear", simulation.BALANCE_COLUMN):
+        assert name in simulation.UNITS
+
+
+def test_dissipation_never_decreases_with_symmetric_tyres():
+    """Issue acceptance: sliding + damper dissipation never decreases (tyres without zero-slip offsets,
+    whose curves oppose the slip everywhere). Measured: no decrease between samples larger than 1e-12 J."""
+    r = run(Scenario(pressure_kpa=400.0, fz_n=635.0, symmetric_tyres=True))
+    df = r.trajectory
+    dissipation = df["sliding_dissipation"].to_numpy() + df["damper_dissipation"].to_numpy()
+    assert np.min(np.diff(dissipation)) > -1e-9
+    assert dissipation[-1] > 10.0
+    assert np.max(np.abs(df[simulation.BALANCE_COLUMN])) < 1e-3
+
+
+def test_post_kick_motion_does_not_depend_on_settle():
+    """Issue acceptance: settle 0, 0.5 and 5 s give the same trajectory after the kick (time from the kick)
+    to 1e-9 of each column's largest value. Measured: identical except the two round-off diagnostics."""
+    runs = {s: run(Scenario(pressure_kpa=400.0, fz_n=635.0, settle=s)).trajectory for s in (0.0, 0.5, 5.0)}
+    ref = runs[0.0]
+    for settle in (0.5, 5.0):
+        df = runs[settle]
+        post = df[df["time"].to_numpy() >= 0.0].reset_index(drop=True)
+        assert len(post) == len(ref)
+        np.testing.assert_allclose(post["time"], ref["time"], rtol=0, atol=1e-12)
+        for column in ref.columns:
+            if column in ("holonomic_residual", simulation.BALANCE_COLUMN):
+                continue
+            scale = max(np.max(np.abs(ref[column])), 1e-12)
+            assert np.max(np.abs(post[column] - ref[column])) <= 1e-9 * scale, (settle, column)
+        assert np.max(np.abs(post["holonomic_residual"])) < 1e-12
+        # The settle shows the steady turn arriving at heading 0 (yaw rate 0.095 rad/s: -0.47 rad at -5 s).
+        before = df[df["time"] < 0.0]
+        assert before["yaw"].iloc[0] == pytest.approx(-settle * ref["yaw_rate"].iloc[0], rel=1e-9)
+        assert np.ptp(before["yaw_rate"]) < 1e-8
+
+
+def test_settled_heading_is_the_earlier_model():
+    """kick_heading='settled' starts the steady motion at heading 0 at -settle (before this option
+    existed): the heading at the kick is then the steady yaw rate times the settle."""
+    r = run(Scenario(pressure_kpa=400.0, fz_n=635.0, settle=1.0, duration=0.2, kick_heading="settled"))
+    df = r.trajectory
+    assert df["yaw"].iloc[0] == 0.0
+    kick = df["time"].to_numpy() == 0.0
+    assert df["yaw"].to_numpy()[kick][0] == pytest.approx(r.summary["steady_state"]["yaw_rate_rad_s"], rel=1e-6)
+
+
+def test_plate_stop_options_and_their_energy():
+    """The re-solve loses about 30 times the impulse's kinetic energy at the stop and the balance shows it
+    (measured: re-solve 0.98 J, impulse 0.030 J; unaccounted in the balance 0.98 J and 0)."""
+    results = {stop: run(Scenario(pressure_kpa=400.0, fz_n=635.0, duration=0.3, plate_stop=stop))
+               for stop in simulation.PLATE_STOPS}
+    impulse, resolve = (results[k].summary["energy"] for k in ("impulse", "resolve"))
+    lost_impulse = impulse["velocity_jumps"][0]["kinetic_energy_change_j"]
+    lost_resolve = resolve["velocity_jumps"][0]["kinetic_energy_change_j"]
+    assert resolve["velocity_jumps"][0]["impulse_work_j"] is None
+    assert lost_resolve < 20 * lost_impulse < 0.0
+    assert impulse["balance_residual_max_abs_j"] < 1e-3
+    assert resolve["balance_residual_max_abs_j"] == pytest.approx(-lost_resolve, rel=1e-3)
+    # Smooth profiles have no velocity jump.
+    smooth = run(Scenario(duration=0.3, kick_profile="smooth"))
+    assert smooth.summary["energy"]["velocity_jumps"] == []
+
+
+def test_steady_rear_wheel_torque_is_a_brake_fed_by_the_tyres():
+    """T03's zero-slip offsets feed energy into the rolling bicycle, so the torque holding 3 m/s brakes
+    (positive about C.y opposes forward rolling); the steady powers cancel. Measured: T6c = +0.0289 N m,
+    -0.253 W; zero-slip forces +0.404 W, aligning moments +0.055 W, sliding -0.206 W."""
+    r = run(Scenario(pressure_kpa=400.0, fz_n=635.0, duration=0.2))
+    st = r.summary["steady_state"]
+    assert st["rear_wheel_torque_n_m"] > 0.0 and st["rear_wheel_torque_role"] == "brake"
+    power = st["steady_power_w"]
+    assert power["rear_wheel_torque"] < 0.0 and power["zero_slip_forces"] > 0.0
+    assert abs(sum(power.values())) < 1e-9
+    assert "drive_torque_n_m" not in st
+    # Without the brake the tyres speed the bicycle up.
+    from whipple_kick import integrate, slip
+    sc = r.scenario
+    moore, design, _ = simulation.build_bicycle(sc)
+    gains, _ = simulation.controller_gains(sc, design)
+    rear, front, _ = simulation.build_tyres(sc)
+    ss = slip.steady_state(slip.model_parameters(moore, rear, front, gains=gains), 3.0)
+    tr = integrate.integrate(slip.CompiledRHS(dict(ss.params, T6c=0.0)), ss.x, 5.0, output_rate=10)
+    assert np.hypot(tr.state("u1"), tr.state("u2"))[-1] > 3.001     # measured 3.004 m/s after 5 s
+
+
+@pytest.mark.parametrize("transient", ["slip_lag", "force_lag"])
+def test_transient_option_is_used_and_recorded(transient):
+    r = run(Scenario(duration=0.3, tyre_transient=transient))
+    assert r.summary["tyres"]["transient"] == transient
+    assert ("slip_patch_rear" in r.trajectory.columns) == (transient != "force_lag")
+    assert np.max(np.abs(r.trajectory[simulation.BALANCE_COLUMN])) < 1e-3
+    if transient == "slip_lag":
+        np.testing.assert_allclose(r.trajectory["relaxation_length_rear"], 0.175, rtol=1e-12)
+
+
+def test_bad_model_options_are_input_errors():
+    for field_name, value, fragment in (("tyre_transient", "lagged", "tyre transient 'lagged' is unknown"),
+                                        ("plate_stop", "stop", "plate stop 'stop' is unknown"),
+                                        ("kick_heading", "north", "kick heading 'north' is unknown")):
+        with pytest.raises(InputError, match=re.escape(fragment)):
+            Scenario(**{field_name: value}).validate()
+
+
+def test_thesis_preset_uses_the_force_lag():
+    assert Scenario.thesis().tyre_transient == "force_lag"

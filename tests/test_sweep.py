@@ -231,7 +231,7 @@ def test_recommend_pressure_function_fine_grid():
 
 
 def test_saved_trajectory_is_thinned_and_keeps_the_fall():
-    scenario = simulation.Scenario(duration=2.0, settle=0.1, controller="off", fz_n=635.0)
+    scenario = simulation.Scenario(duration=3.0, settle=0.1, controller="off", fz_n=635.0)   # falls at 2.15 s
     spec = {"columns": ("time", "roll"), "dtype": "float64", "rate_hz": 100.0}
     record = sweep.run_case(scenario, "x", spec)
     t = record["trajectory"]["time"]

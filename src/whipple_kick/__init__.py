@@ -10,9 +10,9 @@ import importlib
 __version__ = "0.1.0"
 
 _SUBMODULES = (
-    "analysis", "animation", "benchmark", "bicycles", "cache", "classic", "cli", "codegen", "errors",
-    "control", "derivation", "geometry", "inputs", "integrate", "kane", "magic_formula", "parameters",
-    "plotting", "riders", "simulation", "slip", "sweep", "symbols", "tyres",
+    "analysis", "animation", "benchmark", "bicycles", "cache", "classic", "cli", "codegen", "energy",
+    "errors", "control", "derivation", "geometry", "inputs", "integrate", "kane", "magic_formula",
+    "parameters", "plotting", "riders", "simulation", "slip", "sweep", "symbols", "transient", "tyres",
 )
 
 

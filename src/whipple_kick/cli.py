@@ -99,6 +99,10 @@ def _simulate_parser():
                         "thesis (whole curves x 1.32, as the thesis' code)")
     g.add_argument("--symmetric-tyres", action="store_true",
                    help="zero the tyres' zero-slip offsets (exactly upright steady running)")
+    g.add_argument("--tyre-transient", choices=simulation.TYRE_TRANSIENTS, default="contact_patch",
+                   help="how the tyre forces build up: contact_patch (default: lagged contact-patch slip and "
+                        "camber, relaxation length shortening as the force saturates; passive, friction-limited), "
+                        "slip_lag (the same with a constant relaxation length) or force_lag (the thesis' lagged force)")
     g = p.add_argument_group("bicycle and rider")
     g.add_argument("--bicycle", default="balanceassist_v1", metavar="NAME",
                    help="bicycle parameter set or .toml path (default balanceassist_v1; presets "
@@ -139,6 +143,12 @@ def _simulate_parser():
                         "not with --kick-accel/--kick-duration/--kick-displacement)")
     g.add_argument("--kick-direction", choices=simulation.DIRECTIONS, default="right",
                    help="direction the plate moves (default right)")
+    g.add_argument("--plate-stop", choices=simulation.PLATE_STOPS, default="impulse",
+                   help="speeds across the constant profile's instant plate stop: impulse (default: the rear "
+                        "no-slip constraint's impulse) or resolve (dependent speeds only, the earlier model)")
+    g.add_argument("--kick-heading", choices=simulation.KICK_HEADINGS, default="fixed",
+                   help="fixed (default): heading perpendicular to the plate at the kick start, whatever --settle; "
+                        "settled: the steady motion starts so at -settle (the earlier model)")
     g = p.add_argument_group("run and output")
     g.add_argument("--duration", type=_number("s"), default=6.0, metavar="S",
                    help="simulated time after the kick start in s (default 6)")
@@ -213,6 +223,7 @@ def _scenario_from_args(args):
         kick_duration=args.kick_duration, kick_accel=args.kick_accel,
         kick_profile="constant" if profile is None else profile, kick_table=args.kick_table,
         kick_direction=args.kick_direction, settle=args.settle, duration=args.duration, rtol=args.rtol,
+        tyre_transient=args.tyre_transient, plate_stop=args.plate_stop, kick_heading=args.kick_heading,
     )
 
 
@@ -263,7 +274,8 @@ def _print_summary(result, out, files):
     rider = f" (rider {bike['rider_mass_kg']:.1f} kg)" if bike["rider_mass_kg"] is not None else " (preset with rider)"
     gains = ", ".join(f"{k}={v:.4g}" for k, v in ctl["gains"].items())
     print(f"simulate: {sc['tyre']} {s['tyres']['pressure_rear_kpa']:g}/{s['tyres']['pressure_front_kpa']:g} kPa "
-          f"rear/front ({sc['coefficient_set']}, friction {sc['friction']}), {bike['bicycle']}, rear load "
+          f"rear/front ({sc['coefficient_set']}, friction {sc['friction']}, transient {sc['tyre_transient']}), "
+          f"{bike['bicycle']}, rear load "
           f"{bike['static_load_rear_n']:.1f} N{rider}, {sc['speed']:g} m/s")
     print(f"  controller {ctl['type']} x{ctl['gain_scale']:g}: {gains}")
     if "table" in kick:
@@ -275,7 +287,7 @@ def _print_summary(result, out, files):
         print(f"  kick: {abs(kick['displacement_m']) * 1e3:.0f} mm {kick['direction']} in {kick['duration_s']:.3f} s "
               f"(peak {kick['peak_acceleration_m_s2']:.1f} m/s^2, {kick['profile']} profile) at t = 0 s")
     print(f"  steady state: roll {st['roll_rad'] * deg:.2f} deg, steer {st['steer_rad'] * deg:.2f} deg, "
-          f"yaw rate {st['yaw_rate_rad_s']:.4f} rad/s, drive torque {st['drive_torque_n_m']:.4f} N m")
+          f"yaw rate {st['yaw_rate_rad_s']:.4f} rad/s, rear-wheel torque {st['rear_wheel_torque_n_m']:+.4f} N m ({st['rear_wheel_torque_role']})")
     if s["fell"]:
         print(f"  result: FELL (|roll| reached {sc['fall_angle_deg']:g} deg) {s['fall_time_s']:.3f} s after the kick start")
     else:
@@ -293,6 +305,11 @@ def _print_summary(result, out, files):
     pk = s["peaks"]
     print(f"  peaks: |roll rate| {pk['max_abs_roll_rate']:.3f} rad/s, |steer rate| {pk['max_abs_steer_rate']:.3f} rad/s, "
           f"|Fy rear| {pk['max_abs_fy_rear']:.0f} N, |slip rear| {pk['max_abs_slip_rear'] * deg:.1f} deg")
+    e = s["energy"]
+    jumps = "".join(f", plate stop ({e['plate_stop']}) {j['kinetic_energy_change_j']:+.3f} J kinetic"
+                    for j in e["velocity_jumps"])
+    print(f"  energy after the kick: plate work {e['plate_work_j']:+.2f} J, sliding {e['sliding_dissipation_j']:.2f} J, "
+          f"dampers {e['damper_dissipation_j']:.2f} J{jumps}; balance residual {e['balance_residual_max_abs_j']:.1e} J")
     n = s["numerics"]
     print(f"  numerics: LSODA rtol {n['rtol']:g}, {n['nfev']} evaluations, integration {n['integration_wall_s']:.2f} s, "
           f"run {n['wall_s']:.2f} s")

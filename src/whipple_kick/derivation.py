@@ -322,30 +322,37 @@ def kick_plate_motion(t):
 
 
 def slip_equations():
-    """Derive the slip model: toroidal tyres, vertical compliance, Magic-Formula lateral forces.
+    """Derive the slip model: toroidal tyres, vertical compliance, lateral tyre loads as inputs.
 
     Constraints: rolling without longitudinal slip at both wheels (the rear
     relative to the kick plate) and the front contact on the ground.
     Dependent speeds u5 (pitch rate), u6, u8 (wheel spin rates);
-    independent u1, u2, u3, u4, u7, u9, u10. Tyre force states fyr, fyf, mzr,
-    mzf follow ``(sigma/|v_x|) dF/dt + F = F_steady``.
+    independent u1, u2, u3, u4, u7, u9, u10. The lateral forces and aligning
+    moments the tyres apply (``Fy_r Fy_f Mz_r Mz_f``) stay symbols here:
+    Kane's forcing is linear in them, and the tyre's transient form
+    (:mod:`whipple_kick.transient`) computes them from its own states and
+    the kinematic quantities in ``extra``.
 
     Returns
     -------
     EquationsOfMotion
-        With ``extra`` holding the named outputs (slip and camber angles,
-        normal forces, steady tyre forces, steer torque, plate motion,
-        tyre-state rates, spring energy).
+        ``inputs`` = (plate velocity, plate acceleration, Fy_r, Fy_f, Mz_r,
+        Mz_f); ``extra`` holds named expressions: the tyre block's inputs
+        (``vsy_* vx_* camber_* fz_*``), the power kinematics (``vplate_r``
+        plate velocity along the rear lateral axis, ``wz_*`` wheel rates
+        about the ground normal), the plate motion ``yp vp ap``, the steer
+        torque ``T7``, the spring energy and the damper dissipation rate
+        (the normal force acts on the material contact points, whose
+        velocity along the ground normal is u9 and u10: at the rear by the
+        geometry, checked symbolically, at the front by the constraint).
     """
-    from . import magic_formula as mf
-
     kin = kinematics(tyre_model=True)
     N, A, C, D, E, F = (kin.frames[k] for k in "NACDEF")
     q, u = kin.q, kin.u
     Q = {f"q{i + 1}": qi for i, qi in enumerate(q)}
     U = {f"u{i + 1}": ui for i, ui in enumerate(u)}
     par = {n: S.sym(n) for n in S.SLIP_CONSTANTS}
-    fyr, fyf, mzr, mzf = S.dyns(["fyr", "fyf", "mzr", "mzf"])
+    Fy_r, Fy_f, Mz_r, Mz_f = S.syms(["Fy_r", "Fy_f", "Mz_r", "Mz_f"])
     yp, vp, ap = kick_plate_motion(sm.Symbol("t", real=True))
     vp_s, ap_s = S.syms(["vp", "ap"])   # placeholders, replaced by the profile at code generation
 
@@ -363,10 +370,10 @@ def slip_equations():
     dn_mat, fn_mat = kin.points["dn_mat"], kin.points["fn_mat"]
     loads = list(kin.gravity_loads)
     loads += [
-        (dn_mat, -fz_r * A.z + fyr * kin.rear_lateral),
-        (fn_mat, -fz_f * A.z + fyf * kin.front_lateral),
-        (D, mzr * A.z + T6 * C.y),
-        (F, mzf * A.z),
+        (dn_mat, -fz_r * A.z + Fy_r * kin.rear_lateral),
+        (fn_mat, -fz_f * A.z + Fy_f * kin.front_lateral),
+        (D, Mz_r * A.z + T6 * C.y),
+        (F, Mz_f * A.z),
         (C, -T6 * C.y - T7 * C.z),
         (E, T7 * C.z),
     ]
@@ -383,44 +390,28 @@ def slip_equations():
     ]
     A_c, a0, b = constraint_terms(rows, kin, time_terms={vp_s: ap_s})
 
-    # Slip and camber angles (model convention: slip > 0 slides to the right,
-    # camber > 0 leans right) and rolling speeds along each heading.
-    vx_r = (kin.points["do"].vel(N) - plate_vel).dot(kin.rear_heading)
-    vx_f = kin.points["fo"].vel(N).dot(kin.front_heading)
-    slip_r = sm.atan2(v_r_slide.dot(kin.rear_lateral), sm.Abs(vx_r))
-    slip_f = sm.atan2(v_f_slide.dot(kin.front_lateral), sm.Abs(vx_f))
-    camber_r = sm.asin(kin.frames["B"].y.dot(A.z))
-    camber_f = sm.asin(E.y.dot(A.z))
-
-    def steady(builder, slip, camber, fz, wheel, letter):
-        sets = [[par[f"{letter}{wheel}{k}_{i}"] for i in range(14 if letter == "a" else 18)] for k in (1, 2)]
-        w = par[f"w{wheel}"]
-        mu = par[f"mu{wheel}"]
-        lam = par[f"lam{wheel}"]
-        return lam * ((1 - w) * builder(slip, camber, fz, sets[0], friction_scale=mu)
-                      + w * builder(slip, camber, fz, sets[1], friction_scale=mu))
-
-    fy_ss_r = steady(mf.lateral_force_model, slip_r, camber_r, fz_r, "r", "a")
-    fy_ss_f = steady(mf.lateral_force_model, slip_f, camber_f, fz_f, "f", "a")
-    mz_ss_r = steady(mf.aligning_moment_model, slip_r, camber_r, fz_r, "r", "c")
-    mz_ss_f = steady(mf.aligning_moment_model, slip_f, camber_f, fz_f, "f", "c")
-    rate_r = sm.Abs(vx_r) / par["sigr"]
-    rate_f = sm.Abs(vx_f) / par["sigf"]
-
-    # Spring energy counts only while the tyre is compressed.
+    # Spring energy counts only while the tyre is compressed; the damper
+    # dissipates Fz dq/dt - kz max(q, 0) dq/dt >= 0 in every branch of the
+    # never-pulling spring-damper (docs/validation.md).
     spring = (par["kzr"] * sm.Max(0, Q["q9"])**2 + par["kzf"] * sm.Max(0, Q["q10"])**2) / 2
+    damper = (fz_r * U["u9"] - par["kzr"] * sm.Max(0, Q["q9"]) * U["u9"]
+              + fz_f * U["u10"] - par["kzf"] * sm.Max(0, Q["q10"]) * U["u10"])
     extra = {
         "yp": yp, "vp": vp, "ap": ap,
-        "slip_r": slip_r, "slip_f": slip_f, "camber_r": camber_r, "camber_f": camber_f,
-        "vx_r": vx_r, "vx_f": vx_f, "fz_r": fz_r, "fz_f": fz_f,
-        "fy_ss_r": fy_ss_r, "fy_ss_f": fy_ss_f, "mz_ss_r": mz_ss_r, "mz_ss_f": mz_ss_f,
-        "dfyr": rate_r * (fy_ss_r - fyr), "dfyf": rate_f * (fy_ss_f - fyf),
-        "dmzr": rate_r * (mz_ss_r - mzr), "dmzf": rate_f * (mz_ss_f - mzf),
-        "T7": T7, "spring_energy": spring,
-        "sliding_power": fyr * v_r_slide.dot(kin.rear_lateral) + fyf * v_f_slide.dot(kin.front_lateral),
+        # Inputs of the tyre block (model convention: slip > 0 slides to the
+        # right, camber > 0 leans right), rolling speeds along each heading.
+        "vsy_r": v_r_slide.dot(kin.rear_lateral), "vsy_f": v_f_slide.dot(kin.front_lateral),
+        "vx_r": (kin.points["do"].vel(N) - plate_vel).dot(kin.rear_heading),
+        "vx_f": kin.points["fo"].vel(N).dot(kin.front_heading),
+        "camber_r": sm.asin(kin.frames["B"].y.dot(A.z)), "camber_f": sm.asin(E.y.dot(A.z)),
+        "fz_r": fz_r, "fz_f": fz_f,
+        # Power kinematics of the energy accounting.
+        "vplate_r": plate_vel.dot(kin.rear_lateral),
+        "wz_r": D.ang_vel_in(N).dot(A.z), "wz_f": F.ang_vel_in(N).dot(A.z),
+        "T7": T7, "spring_energy": spring, "damper_dissipation_rate": damper,
     }
     return EquationsOfMotion(
-        q=q, u=u, dependent=("u5", "u6", "u8"), inputs=(vp_s, ap_s),
+        q=q, u=u, dependent=("u5", "u6", "u8"), inputs=(vp_s, ap_s, Fy_r, Fy_f, Mz_r, Mz_f),
         mass_matrix=mass_matrix, forcing=forcing,
         constraint_matrix=A_c, constraint_offset=a0, constraint_accel=b,
         holonomic=kin.holonomic,

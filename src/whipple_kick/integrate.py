@@ -3,8 +3,11 @@
 The kick plate's acceleration (and, for the thesis profile, its velocity)
 jumps at the start and end of the kick. Asking an adaptive integrator to
 step over such a jump costs accuracy and steps; instead each smooth piece
-is integrated on its own and the state is carried across the breakpoint.
+is integrated on its own and the state is carried across the breakpoint,
+through a jump map where the caller gives one (the plate stop's impulse).
 A fall (|roll| beyond a limit) ends the run as an event, not an error.
+LSODA's stiff steps use the compiled model's Jacobian (forward differences
+in C over the dynamic states; the energy quadratures feed nothing back).
 """
 from dataclasses import dataclass
 
@@ -40,24 +43,35 @@ class Trajectory:
 DEFAULT_CHUNK = 0.5
 
 
-def default_atol(rtol):
+#: Absolute tolerance of the energy quadratures [J]: so large that they never
+#: control LSODA's step (they are pure quadratures of the dynamic states, so
+#: their accuracy follows the dynamic states' steps).
+QUADRATURE_ATOL = 1e6
+
+
+def default_atol(rtol, transient="contact_patch"):
     """Absolute tolerances per state, scaled to each state's typical size.
 
     Angles and displacements (~1e-2..1) and speeds (~1) get ``rtol`` x 1e-2
-    of their scale; the tyre force states (~100 N) x 1e2 more.
+    of their scale, the compressions x 1e-4; the tyre slots are angles too
+    except in the ``force_lag`` form, whose force states (~100 N) get
+    ``rtol``; the energy quadratures :data:`QUADRATURE_ATOL`.
     """
     atol = np.full(len(slip.STATE_NAMES), rtol * 1e-2)
     for name in ("q9", "q10", "u9", "u10"):
         atol[slip.X[name]] = rtol * 1e-4   # compressions are millimetres
-    for name in slip.TYRE_STATES:
-        atol[slip.X[name]] = rtol
+    if transient == "force_lag":
+        for name in slip.TYRE_STATES:
+            atol[slip.X[name]] = rtol
+    for name in slip.QUADRATURE_STATES:
+        atol[slip.X[name]] = QUADRATURE_ATOL
     return atol
 
 
-def _careful_chunk(rhs, x, times, rtol, atol, fall):
+def _careful_chunk(rhs, x, times, rtol, atol, fall, jac):
     """Integrate one chunk with solve_ivp's LSODA and the fall event (exact event time)."""
     sol = solve_ivp(rhs, (times[0], times[-1]), x, method="LSODA", t_eval=times, events=fall,
-                    rtol=rtol, atol=atol)
+                    rtol=rtol, atol=atol, jac=jac)
     return sol
 
 
@@ -65,7 +79,7 @@ class _PastTheLimit(Exception):
     """Raised inside the fast path once the roll limit is passed."""
 
 
-def _fast_chunk(rhs, x, times, rtol, atol, roll_index, fall_angle):
+def _fast_chunk(rhs, x, times, rtol, atol, roll_index, fall_angle, jac):
     """Integrate one chunk with odeint's LSODA (the step loop stays in Fortran).
 
     Returns ``(states, nfev)``, or ``None`` if the roll limit was passed or
@@ -83,7 +97,7 @@ def _fast_chunk(rhs, x, times, rtol, atol, roll_index, fall_angle):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
-            y, info = odeint(guarded, x, times, rtol=rtol, atol=atol, tfirst=True, full_output=True,
+            y, info = odeint(guarded, x, times, Dfun=jac, rtol=rtol, atol=atol, tfirst=True, full_output=True,
                              mxstep=100000)
         except (_PastTheLimit, FloatingPointError):
             return None
@@ -93,7 +107,7 @@ def _fast_chunk(rhs, x, times, rtol, atol, roll_index, fall_angle):
 
 
 def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None,
-              output_rate=1000.0, fall_angle=np.deg2rad(45.0), chunk=None, samples=None):
+              output_rate=1000.0, fall_angle=np.deg2rad(45.0), chunk=None, samples=None, jumps=None):
     """Integrate ``rhs`` from ``x0`` piecewise between breakpoints with LSODA.
 
     Each smooth piece is integrated in chunks of about ``chunk`` seconds
@@ -116,7 +130,9 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
     rtol : float
         LSODA relative tolerance.
     atol : array_like, optional
-        Absolute tolerances (default :func:`default_atol`).
+        Absolute tolerances (default :func:`default_atol` of the form of
+        ``rhs``). With a compiled ``rhs`` its C Jacobian is used, with steps
+        scaled by ``atol / rtol`` (each state's typical size).
     output_rate : float
         Sample rate of the output [Hz] (when ``samples`` is not given).
     fall_angle : float
@@ -129,6 +145,10 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
         returned. Default: ``output_rate`` from ``t_start``. A sample within
         a billionth of the sample spacing of a piece's edge is given the
         state at that edge rather than a sub-ulp integration of its own.
+    jumps : mapping, optional
+        ``{breakpoint: g(t, x) -> x}``: the state leaving the piece that
+        ends at the breakpoint is mapped by ``g`` before the next piece
+        starts (a sample at the breakpoint gets the mapped state).
 
     Returns
     -------
@@ -136,7 +156,10 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
         With ``end_state`` the exact state at ``t_end`` (or at the fall),
         whether or not ``t_end`` is a sample time.
     """
-    atol = default_atol(rtol) if atol is None else atol
+    transient = getattr(rhs, "transient", "contact_patch")
+    atol = default_atol(rtol, transient) if atol is None else np.asarray(atol, dtype=float)
+    jac = rhs.jacobian_function(atol / rtol) if hasattr(rhs, "jacobian_function") else None
+    jumps = dict(jumps or {})
     chunk = DEFAULT_CHUNK if chunk is None else chunk
     if samples is None:
         n_samples = int(round((t_end - t_start) * output_rate)) + 1
@@ -183,16 +206,18 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
             cuts = sorted({0, len(grid) - 1, *(int(m) for m in marks if 0 < m < len(grid) - 1)})
         for i0, i1 in zip(cuts[:-1], cuts[1:]):
             times = grid[i0:i1 + 1]
-            fast = _fast_chunk(rhs, x, times, rtol, atol, roll, fall_angle)
+            # A sample at the piece's end is emitted after the jump map (below).
+            last = -1 if i1 == len(grid) - 1 else None
+            fast = _fast_chunk(rhs, x, times, rtol, atol, roll, fall_angle, jac)
             if fast is not None:
                 y, n = fast
                 nfev += n
-                emit(times, y)
+                emit(times[:last], y[:last])
                 x = y[-1]
                 continue
-            sol = _careful_chunk(rhs, x, times, rtol, atol, fall)
+            sol = _careful_chunk(rhs, x, times, rtol, atol, fall, jac)
             nfev += sol.nfev
-            emit(sol.t, sol.y.T)
+            emit(sol.t[:last] if sol.status != 1 else sol.t, sol.y.T[:last] if sol.status != 1 else sol.y.T)
             if sol.status == 1:
                 fell, fall_time = True, float(sol.t_events[0][0])
                 x = sol.y_events[0][0]
@@ -208,6 +233,8 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
             x = sol.y[:, -1]
         if done:
             break
+        if b in jumps:
+            x = np.asarray(jumps[b](b, x), dtype=float)
         emit(at_b, np.repeat(x[None, :], at_b.size, axis=0))
     t = np.concatenate(ts) if ts else np.array([])
     X = np.concatenate(xs) if xs else np.empty((0, len(x)))

@@ -50,3 +50,46 @@ class ConstraintPartition:
         t0[self.dep] = d
         ud_ind = np.linalg.solve(T.T @ M @ T, T.T @ (f - M @ t0))
         return T @ ud_ind + t0
+
+
+def constraint_power(M, f, u, udot):
+    """Power of the constraint forces, ``u . (M du/dt - f)`` [W].
+
+    Kane's full equations read ``M du/dt = f + A^T lambda``, so this is
+    ``lambda . (A u) = -lambda . a0``: zero for fixed constraints, the work
+    rate of a moving one (the rear no-slip constraint on the kick plate).
+    """
+    return float(np.dot(u, M @ udot - f))
+
+
+def impulsive_projection(M, A, u_minus, a0_plus):
+    """Speeds just after a jump of the constraint offset, by the impulse it takes.
+
+    Solves ``M (u+ - u-) = A^T L`` with ``A u+ + a0_plus = 0`` (the
+    generalised momentum jump carried by the constraints' impulse ``L``) as
+    one KKT system, so ``M`` need only be positive definite on the null
+    space of ``A`` (the slip model's front compression rate u10 carries no
+    mass: it moves the contact point, not a body).
+
+    Parameters
+    ----------
+    M : ndarray (n, n)
+        Mass matrix of all speeds, symmetric positive semi-definite.
+    A : ndarray (m, n)
+        Constraint matrix (unchanged by the jump).
+    u_minus : ndarray (n,)
+        All speeds just before (satisfying the constraints with the old offset).
+    a0_plus : ndarray (m,)
+        Constraint offset just after.
+
+    Returns
+    -------
+    u_plus : ndarray (n,)
+    impulse : ndarray (m,)
+        ``L``. With ``a0_minus = -A u_minus`` the kinetic energy ``u M u / 2``
+        changes by ``-1/2 L . (a0_plus + a0_minus)``, the work of the impulse.
+    """
+    n, m = M.shape[0], A.shape[0]
+    kkt = np.block([[M, -A.T], [A, np.zeros((m, m))]])
+    sol = np.linalg.solve(kkt, np.concatenate([np.zeros(n), -(A @ u_minus + a0_plus)]))
+    return u_minus + sol[:n], sol[n:]

@@ -58,18 +58,25 @@ import numpy as np
 import sympy as sm
 
 __all__ = [
-    "N_FY_COEFFICIENTS", "N_MZ_COEFFICIENTS",
+    "N_FY_COEFFICIENTS", "N_MZ_COEFFICIENTS", "FY_OFFSET_INDICES", "MZ_OFFSET_INDICES",
     "lateral_force_factors", "aligning_moment_factors",
     "lateral_force_formula", "aligning_moment_formula",
-    "lateral_force_model", "aligning_moment_model", "cornering_stiffness_model",
+    "lateral_force_model", "aligning_moment_model", "cornering_stiffness_model", "lateral_secant_model",
+    "SECANT_SERIES_LIMIT",
     "lateral_force_numpy", "aligning_moment_numpy", "cornering_stiffness_numpy",
-    "lateral_force_factors_numpy",
+    "lateral_force_factors_numpy", "lateral_secant_numpy",
 ]
 
 #: Number of Pacejka 1989 lateral-force coefficients a0..a13.
 N_FY_COEFFICIENTS = 14
 #: Number of Pacejka 1989 aligning-moment coefficients c0..c17.
 N_MZ_COEFFICIENTS = 18
+
+#: Coefficients that shift the curves at zero slip and camber (the Sh and Sv
+#: terms not multiplied by camber): zeroing them gives a tyre with no
+#: zero-slip force or moment ("symmetric tyres").
+FY_OFFSET_INDICES = (9, 10, 12, 13)
+MZ_OFFSET_INDICES = (12, 13, 16, 17)
 
 _DEG_PER_RAD = sm.S(180) / sm.pi
 _N_PER_KN = sm.S(1000)
@@ -241,6 +248,53 @@ def cornering_stiffness_model(fz_n, a, friction_scale=1):
     return -sm.diff(force, slip).subs(slip, 0)
 
 
+#: |B x| (x = slip in deg) below which :func:`lateral_secant_model` uses its
+#: series: the next term is O((B x)^4), below 1e-16 there, while the direct
+#: quotient loses digits to cancellation (sin and atan of a tiny argument).
+SECANT_SERIES_LIMIT = 1e-4
+
+
+def lateral_secant_model(slip_rad, fz_n, a, friction_scale=1):
+    """Secant ratio of one coefficient set's pure-slip lateral-force curve, and its slope at zero slip.
+
+    With the curve taken at zero camber and without its zero-slip offsets
+    (Sh = Sv = 0), ``F_sym(slip) = D sin(C atan(B x - E (B x - atan(B x))))``
+    (x = slip in deg), the secant ratio is ``g = F_sym / (C0 x)`` with
+    ``C0 = B C D`` the slope at zero: 1 at zero slip, falling as the force
+    saturates, even in slip. It is independent of the peak factor D (so of
+    the load through D), and the friction scale k enters as B -> B/k. For
+    ``|B x| < SECANT_SERIES_LIMIT`` the series
+    ``1 - ((1 + E)/3 + C^2/6) (B x)^2`` replaces the 0/0 quotient.
+
+    Parameters
+    ----------
+    slip_rad : sympy.Expr or float
+        Slip angle [rad] (model convention; the ratio is even in it).
+    fz_n : sympy.Expr or float
+        Normal load [N], > 0 (callers floor it: the ratio is a shape only).
+    a : sequence of 14
+        Lateral-force coefficients a0..a13.
+    friction_scale : sympy.Expr or float
+        ``k`` as in :func:`lateral_force_model`.
+
+    Returns
+    -------
+    (slope, ratio) : tuple of sympy.Expr
+        ``slope`` = B C D [N/deg] (the weight of this set when sets are
+        blended: the blended ratio is sum(w slope g) / sum(w slope));
+        ``ratio`` = g [-].
+    """
+    a = _coefficients(a, N_FY_COEFFICIENTS, "lateral force")
+    alpha, _, fz_kn = _formula_inputs(slip_rad, 0, fz_n)
+    factors = _scale_friction(lateral_force_factors(0, fz_kn, a), friction_scale)
+    b, c, e = factors["B"], factors["C"], factors["E"]
+    y = b * alpha
+    direct = sm.sin(c * sm.atan(y - e * (y - sm.atan(y)))) / (c * y)
+    series = 1 - ((1 + e) / 3 + c**2 / 6) * y**2
+    ratio = sm.Piecewise((series, sm.Abs(y) < SECANT_SERIES_LIMIT), (direct, True))
+    return b * c * factors["D"], ratio
+
+
 # ---------------------------------------------------------------------------
 # NumPy evaluation, generated from the expressions above (built once, cached).
 
@@ -262,6 +316,9 @@ def _numpy_function(which):
     elif which == "stiffness":
         expr = cornering_stiffness_model(_FZ, _A, _SCALE)
         args = (_FZ, _SCALE, *_A)
+    elif which == "secant":
+        expr = list(lateral_secant_model(_SLIP, _FZ, _A, _SCALE))
+        args = (_SLIP, _FZ, _SCALE, *_A)
     elif which == "fy_factors":
         _, gamma_deg, fz_kn = _formula_inputs(0, _CAMBER, _FZ)
         factors = _scale_friction(lateral_force_factors(gamma_deg, fz_kn, _A), _SCALE)
@@ -303,6 +360,17 @@ def aligning_moment_numpy(slip, camber, fz, c, friction_scale=1.0):
 def cornering_stiffness_numpy(fz, a, friction_scale=1.0):
     """Vectorised :func:`cornering_stiffness_model`: N -> N/rad (positive)."""
     return _evaluate("stiffness", (fz,), friction_scale, a, N_FY_COEFFICIENTS)
+
+
+def lateral_secant_numpy(slip, fz, a, friction_scale=1.0):
+    """Vectorised :func:`lateral_secant_model`: (slope B C D [N/deg], secant ratio [-]) for rad, N (fz > 0)."""
+    coefficients = _coefficient_array(a, N_FY_COEFFICIENTS)
+    slip, fz = np.broadcast_arrays(np.asarray(slip, dtype=float), np.asarray(fz, dtype=float))
+    # numpy.select evaluates the quotient at zero slip too (0/0), then takes the series there.
+    with np.errstate(all="ignore"):
+        slope, ratio = _numpy_function("secant")(slip, fz, float(friction_scale), *coefficients)
+    return (np.broadcast_to(np.asarray(slope, dtype=float), fz.shape).copy(),
+            np.broadcast_to(np.asarray(ratio, dtype=float), fz.shape).copy())
 
 
 def lateral_force_factors_numpy(camber, fz, a, friction_scale=1.0):

@@ -20,6 +20,7 @@ import time
 
 import numpy as np
 
+from . import energy
 from .errors import InputError, check_range
 
 #: Kick-plate profiles the compiled model can represent (its ``kick_profile`` parameter).
@@ -69,16 +70,35 @@ _OUTPUT_COLUMNS = {
     "kinetic_energy": ("kinetic_energy", "J"), "potential_energy": ("potential_energy", "J"),
     "spring_energy": ("spring_energy", "J"), "sliding_power": ("sliding_power", "W"),
     "holonomic": ("holonomic_residual", "m"),
+    # The force and moment each tyre applies to the bicycle, in every transient form.
+    "fy_r": ("fy_rear", "N"), "fy_f": ("fy_front", "N"), "mz_r": ("mz_rear", "N m"), "mz_f": ("mz_front", "N m"),
+    "sigma_r": ("relaxation_length_rear", "m"), "sigma_f": ("relaxation_length_front", "m"),
 }
-# Relaxed tyre-force states (what acts on the bicycle).
-_TYRE_STATE_COLUMNS = {
-    "fyr": ("fy_rear", "N"), "fyf": ("fy_front", "N"), "mzr": ("mz_rear", "N m"), "mzf": ("mz_front", "N m"),
+# Contact-patch states (transient forms contact_patch and slip_lag only).
+_PATCH_STATE_COLUMNS = {
+    "slip_patch_r": ("slip_patch_rear", "rad"), "slip_patch_f": ("slip_patch_front", "rad"),
+    "camber_patch_r": ("camber_patch_rear", "rad"), "camber_patch_f": ("camber_patch_front", "rad"),
 }
+#: Energy balance residual column [J] (:func:`whipple_kick.energy.balance_residual`).
+BALANCE_COLUMN = "energy_balance_residual"
 #: Unit of every trajectory column.
 UNITS = {"time": "s", **{c: u for c, u in _COORDINATE_COLUMNS.values()},
          **{c: u for c, u in _SPEED_COLUMNS.values()},
-         **{c: u for c, u in _TYRE_STATE_COLUMNS.values()},
-         **{c: u for c, u in _OUTPUT_COLUMNS.values()}}
+         **{c: u for c, u in _PATCH_STATE_COLUMNS.values()},
+         **{c: u for c, u in _OUTPUT_COLUMNS.values()},
+         **{c: u for c, u in energy.COLUMNS.values()}, BALANCE_COLUMN: "J"}
+
+
+#: Tyre transient forms (:mod:`whipple_kick.transient`): the default and the others.
+TYRE_TRANSIENTS = ("contact_patch", "slip_lag", "force_lag")
+#: What happens to the speeds when the thesis' plate stops instantly (2 m/s to 0):
+#: ``impulse`` (the rear no-slip constraint's impulse, momentum-consistent) or
+#: ``resolve`` (only the dependent speeds re-solved, as before the impulse existed).
+PLATE_STOPS = ("impulse", "resolve")
+#: Heading at the kick start: ``fixed`` (heading N.x, perpendicular to the plate's
+#: motion, whatever the settle time; the settle is display only) or ``settled``
+#: (the steady motion starts at heading N.x at -settle, as before).
+KICK_HEADINGS = ("fixed", "settled")
 
 
 class SimulationError(RuntimeError):
@@ -165,8 +185,27 @@ class Scenario:
         |roll| [deg] that counts as a fall and ends the run.
     piecewise : bool
         Restart the integrator at the kick's start and end (default). False
-        integrates across them in one piece (for comparison only; not with
-        a table, whose every interval is its own parameter set).
+        integrates from -settle across the kick and the plate stop in one
+        LSODA run, without the plate stop's impulse (for comparison only;
+        not with a table, whose every interval is its own parameter set).
+    tyre_transient : {"contact_patch", "slip_lag", "force_lag"}
+        How the tyre forces build up (:mod:`whipple_kick.transient`):
+        lagged contact-patch slip and camber with a slip-dependent
+        relaxation length (default, passive and friction-limited); the same
+        with a constant relaxation length; or the thesis' lagged force.
+    plate_stop : {"impulse", "resolve"}
+        Speeds across the constant-acceleration profile's instant plate
+        stop: the rear no-slip constraint's impulse (default) or a re-solve
+        of the dependent speeds only (the earlier model, which removes
+        energy no force accounts for). The other profiles stop the plate
+        smoothly.
+    kick_heading : {"fixed", "settled"}
+        ``fixed`` (default): the post-kick run starts from the exact steady
+        motion with heading N.x (perpendicular to the plate's motion) and
+        the rear contact at the origin, whatever ``settle``; the settle is
+        integrated separately and is display only. ``settled``: the steady
+        motion starts so at -settle (the earlier model: with a steady turn
+        the heading at the kick then depends on ``settle``).
     """
 
     bicycle: str = "balanceassist_v1"
@@ -198,6 +237,9 @@ class Scenario:
     output_rate: float = 1000.0
     fall_angle_deg: float = 45.0
     piecewise: bool = True
+    tyre_transient: str = "contact_patch"
+    plate_stop: str = "impulse"
+    kick_heading: str = "fixed"
 
     @classmethod
     def thesis(cls, pressure_kpa=400.0, **changes):
@@ -205,11 +247,14 @@ class Scenario:
 
         Bicycle+rider preset ``balanceassist_635N``, Table 8.4 gains for
         635 N, T03 with the ``chapter8`` coefficients and the ``thesis``
-        friction mode, LSODA rtol 1e-12. ``changes`` override any field.
+        friction mode, the thesis' lagged-force tyre transient
+        (``tyre_transient="force_lag"``), LSODA rtol 1e-12. The plate stop
+        and the heading at the kick are the project's (impulse, fixed).
+        ``changes`` override any field.
         """
         base = dict(bicycle="balanceassist_635N", controller="thesis", thesis_load_n=635.0,
                     coefficient_set="chapter8", friction="thesis", rtol=1e-12,
-                    pressure_kpa=pressure_kpa)
+                    pressure_kpa=pressure_kpa, tyre_transient="force_lag")
         base.update(changes)
         return cls(**base)
 
@@ -308,6 +353,11 @@ class Scenario:
         check_range("gain scale", self.gain_scale, 0.0, 10.0, "(factor)")
         if self.controller not in CONTROLLERS:
             raise InputError(f"controller {self.controller!r} is unknown; choose one of {', '.join(CONTROLLERS)}")
+        for label, value, choices in (("tyre transient", self.tyre_transient, TYRE_TRANSIENTS),
+                                      ("plate stop", self.plate_stop, PLATE_STOPS),
+                                      ("kick heading", self.kick_heading, KICK_HEADINGS)):
+            if value not in choices:
+                raise InputError(f"{label} {value!r} is unknown; choose one of {', '.join(choices)}")
         if self.controller == "off" and self.gain_scale != 1.0:
             raise InputError(f"gain scale = {self.gain_scale:g} conflicts with controller off "
                              "(there are no gains to scale)")
@@ -514,6 +564,112 @@ class KickTable:
         return out
 
 
+def sample_times(scenario):
+    """The run's output times [s]: the multiples of 1/``output_rate`` on the kick's clock, plus -settle and duration.
+
+    On the kick's clock (t = 0 at the nominal kick start), so the samples
+    after the kick do not depend on ``settle``: k / rate for the integers k
+    with -settle <= k / rate <= duration, and the run's ends if they fall
+    between multiples.
+
+    Example
+    -------
+    >>> sample_times(Scenario(settle=0.002, duration=0.003, output_rate=1000.0)).tolist()
+    [-0.002, -0.001, 0.0, 0.001, 0.002, 0.003]
+    """
+    rate, t_start, t_end = scenario.output_rate, 0.0 - scenario.settle, scenario.duration   # no -0.0
+    tiny = 1e-9   # of a sample spacing: a product like 0.5 * 1000 is an integer to round-off
+    k = np.arange(math.ceil(t_start * rate - tiny), math.floor(t_end * rate + tiny) + 1)
+    times = k / rate
+    times = times[(times > t_start + tiny / rate) & (times < t_end - tiny / rate)]
+    return np.concatenate([[t_start], times, [t_end]])
+
+
+def _integrate_run(steady, scenario, kick_T, table, kick_start):
+    """Integrate one run: the display-only settle, then the kick from the exact steady state.
+
+    ``kick_heading="fixed"`` (piecewise): the post-kick run starts at the
+    kick start from ``steady.x`` (heading N.x, rear contact at the origin),
+    so nothing after the kick depends on ``settle``; the settle segment
+    starts from the steady motion moved back by ``settle``
+    (:func:`whipple_kick.slip.advance_steady`) and is integrated on its own.
+    ``piecewise=False`` integrates from -settle (from that moved-back state,
+    or from ``steady.x`` with ``kick_heading="settled"``) in one LSODA run.
+    The constant-acceleration profile's plate stop is a velocity jump
+    (:func:`whipple_kick.slip.velocity_jump`) in piecewise runs. The
+    quadratures are shifted to be 0 at the kick start.
+
+    Returns
+    -------
+    traj : integrate.Trajectory
+    rhs : slip.CompiledRHS or list of them
+    owner : ndarray of int or None
+        With a list of ``rhs``: which one produced each sample.
+    breakpoints : tuple of float
+    jumps : list of dict
+        One per velocity jump (:func:`whipple_kick.slip.velocity_jump`'s info).
+    """
+    from . import integrate, slip
+
+    fall_angle = math.radians(scenario.fall_angle_deg)
+    # piecewise=False is the comparison case: one LSODA run across the kick,
+    # not even restarted at the integrator's chunk boundaries.
+    chunk = integrate.DEFAULT_CHUNK if scenario.piecewise else math.inf
+    samples = sample_times(scenario)
+    t_start, t_end = float(samples[0]), scenario.duration
+    rhs = slip.CompiledRHS(steady.params)   # the plate at rest at the kick start (a table's first row)
+    fixed = scenario.kick_heading == "fixed"
+    x_start = slip.advance_steady(rhs, steady.x, t_start - kick_start, t=kick_start) if fixed else steady.x
+    jumps, jump_map = [], {}
+    if table is None:
+        breakpoints = (kick_start, kick_start + kick_T) if scenario.piecewise else ()
+        if scenario.piecewise and scenario.kick_profile == "constant":
+            def plate_stop(t, x):
+                x, info = slip.velocity_jump(rhs, t, x, impulse=scenario.plate_stop == "impulse")
+                jumps.append(info)
+                return x
+            jump_map = {kick_start + kick_T: plate_stop}
+    else:
+        breakpoints = tuple(float(t) for t in table.times if -scenario.settle < t < scenario.duration)
+
+    def run_from(x, a, rows):
+        if table is None:
+            return integrate.integrate(rhs, x, t_end, t_start=a, breakpoints=breakpoints, rtol=scenario.rtol,
+                                       fall_angle=fall_angle, chunk=chunk, samples=rows, jumps=jump_map), rhs, None
+        # The drive torque T6c found for the steady motion stays in every piece's parameters.
+        return _integrate_table(steady.params, x, table, scenario, chunk, t_start=a)
+
+    if not (fixed and scenario.piecewise) or kick_start <= t_start:
+        traj, rhs_out, owner = run_from(steady.x if kick_start <= t_start else x_start, t_start, samples)
+        return _from_kick_start(traj, kick_start), rhs_out, owner, breakpoints, jumps
+    settle = integrate.integrate(rhs, x_start, kick_start, t_start=t_start, rtol=scenario.rtol, fall_angle=fall_angle,
+                                 chunk=chunk, samples=samples[samples < kick_start])
+    post, rhs_out, owner = run_from(steady.x, kick_start, samples[samples >= kick_start])
+    quad = [slip.X[n] for n in slip.QUADRATURE_STATES]
+    settle_x = settle.x.copy()
+    settle_x[:, quad] -= settle.end_state[quad]   # cumulative from the kick start
+    traj = integrate.Trajectory(np.concatenate([settle.t, post.t]), np.concatenate([settle_x, post.x]),
+                                post.fell, post.fall_time, settle.nfev + post.nfev, post.message,
+                                end_state=post.end_state)
+    if owner is not None:
+        # The settle's samples belong to the model of the plate at rest before the table.
+        rhs_out = [rhs] + list(rhs_out)
+        owner = np.concatenate([np.zeros(settle.t.size, dtype=int), np.asarray(owner) + 1])
+    return traj, rhs_out, owner, breakpoints, jumps
+
+
+def _from_kick_start(traj, kick_start):
+    """``traj`` with the quadratures shifted to be 0 at the kick start (interpolated between samples)."""
+    from . import slip
+    if traj.t.size == 0:
+        return traj
+    x = traj.x.copy()
+    for name in slip.QUADRATURE_STATES:
+        j = slip.X[name]
+        x[:, j] -= np.interp(kick_start, traj.t, traj.x[:, j])
+    return replace(traj, x=x)
+
+
 def _segment_parameters(params, t0, coefficients):
     """``params`` with the plate following one cubic (everything else, e.g. T6c, kept)."""
     out = dict(params)
@@ -523,13 +679,14 @@ def _segment_parameters(params, t0, coefficients):
     return out
 
 
-def _integrate_table(params, x0, table, scenario, chunk):
+def _integrate_table(params, x0, table, scenario, chunk, t_start=None):
     """Integrate a tabulated kick piece by piece on the run's global output grid.
 
     Each piece (rest before, one spline segment per table interval, rest
     after) has its own parameter set and compiled right-hand side; each is
     one :func:`whipple_kick.integrate.integrate` call on the samples not yet
-    produced, starting from the previous piece's exact end state.
+    produced, starting from the previous piece's exact end state. The run
+    starts at ``t_start`` (default -settle) from ``x0``.
 
     Returns
     -------
@@ -541,8 +698,10 @@ def _integrate_table(params, x0, table, scenario, chunk):
     """
     from . import integrate, slip
 
-    t_start, t_end, rate = -scenario.settle, scenario.duration, scenario.output_rate
-    pending = np.linspace(t_start, t_end, int(round((t_end - t_start) * rate)) + 1)
+    t_end = scenario.duration
+    pending = sample_times(scenario)
+    t_start = pending[0] if t_start is None else t_start
+    pending = pending[pending >= t_start]
     fall_angle = math.radians(scenario.fall_angle_deg)
     ts, xs, owner, rhss, nfev = [], [], [], [], 0
     x = np.asarray(x0, dtype=float)
@@ -714,11 +873,13 @@ def preflight(scenario):
 
 # -------------------------------------------------------------------- running
 
-def _trajectory_frame(rhs, traj, owner=None):
+def _trajectory_frame(rhs, traj, owner=None, tyre_transient="contact_patch"):
     """DataFrame of states and named outputs at every sample.
 
     ``rhs`` is one compiled right-hand side, or (tabulated kick) a list of
-    them with ``owner[i]`` the one that produced sample ``i``.
+    them with ``owner[i]`` the one that produced sample ``i``. The patch
+    states are columns in the contact-patch forms only; the energy columns
+    and the balance residual (:mod:`whipple_kick.energy`) in every form.
     """
     import pandas as pd
     from . import slip
@@ -738,11 +899,20 @@ def _trajectory_frame(rhs, traj, owner=None):
         cols[name] = traj.x[:, slip.X[q]]
     for u, (name, _) in _SPEED_COLUMNS.items():
         cols[name] = outs[:, slip.OUT[u]]   # includes the dependent speeds u5 u6 u8
-    for s, (name, _) in _TYRE_STATE_COLUMNS.items():
-        cols[name] = traj.x[:, slip.X[s]]
+    applied = ("fy_r", "fy_f", "mz_r", "mz_f")
+    for o in applied:
+        cols[_OUTPUT_COLUMNS[o][0]] = outs[:, slip.OUT[o]]
+    if tyre_transient != "force_lag":
+        for state, (name, _) in _PATCH_STATE_COLUMNS.items():
+            cols[name] = traj.x[:, slip.X[state]]
     for o, (name, _) in _OUTPUT_COLUMNS.items():
-        cols[name] = outs[:, slip.OUT[o]]
-    return pd.DataFrame(cols)
+        if o not in applied:
+            cols[name] = outs[:, slip.OUT[o]]
+    for state, (name, _) in energy.COLUMNS.items():
+        cols[name] = traj.x[:, slip.X[state]]
+    frame = pd.DataFrame(cols)
+    frame[BALANCE_COLUMN] = energy.balance_residual(frame)
+    return frame
 
 
 def _recovery(df, baseline, first_peak, column="yaw_rate", label="yaw rate"):
@@ -876,7 +1046,7 @@ def run(scenario, *, tyres=None, gains=None):
         kick_start = float(table.times[0])
         kick = dict(profile=_SEGMENT_PROFILE, t0=kick_start, coefficients=(float(table.y[0]), 0.0, 0.0, 0.0))
     params = slip.model_parameters(moore, rear, front, gains=gains, symmetric=scenario.symmetric_tyres,
-                                   kick=kick)
+                                   kick=kick, tyre_transient=scenario.tyre_transient)
     try:
         steady = slip.steady_state(params, scenario.speed)
     except FloatingPointError as exc:
@@ -887,29 +1057,13 @@ def run(scenario, *, tyres=None, gains=None):
         raise InputError(f"a yaw-angle gain kq3 needs straight steady running, but the steady yaw rate is "
                          f"{steady_yaw_rate:.3g} rad/s (allowed |yaw rate| <= {_STRAIGHT_YAW_RATE:g} rad/s): "
                          f"use tyres without zero-slip offsets (symmetric_tyres=True)")
-    # piecewise=False is the comparison case: one LSODA run across the kick,
-    # not even restarted at the integrator's chunk boundaries.
-    if table is None:
-        breakpoints = (0.0, kick_T) if scenario.piecewise else ()
-    else:
-        breakpoints = tuple(float(t) for t in table.times if -scenario.settle < t < scenario.duration)
-    chunk = integrate.DEFAULT_CHUNK if scenario.piecewise else math.inf
     t_int = time.perf_counter()
-    owner = None
     try:
-        if table is None:
-            rhs = slip.CompiledRHS(steady.params)
-            traj = integrate.integrate(rhs, steady.x, scenario.duration, t_start=-scenario.settle,
-                                       breakpoints=breakpoints, rtol=scenario.rtol,
-                                       output_rate=scenario.output_rate,
-                                       fall_angle=math.radians(scenario.fall_angle_deg), chunk=chunk)
-        else:
-            # The drive torque T6c found for the steady motion stays in every piece's parameters.
-            traj, rhs, owner = _integrate_table(steady.params, steady.x, table, scenario, chunk)
+        traj, rhs, owner, breakpoints, jumps = _integrate_run(steady, scenario, kick_T, table, kick_start)
     except FloatingPointError as exc:
         raise SimulationError(f"integration failed: {exc}") from None
     integration_s = time.perf_counter() - t_int
-    df = _trajectory_frame(rhs, traj, owner)
+    df = _trajectory_frame(rhs, traj, owner, scenario.tyre_transient)
     if not np.all(np.isfinite(df.to_numpy())):
         raise SimulationError("non-finite values in the trajectory")
 
@@ -949,6 +1103,7 @@ def run(scenario, *, tyres=None, gains=None):
             "name": scenario.tyre if tyres is None else f"custom: rear {rear!r}, front {front!r}",
             "coefficient_set": scenario.coefficient_set,
             "friction": scenario.friction, "symmetric": scenario.symmetric_tyres,
+            "transient": scenario.tyre_transient,
             "pressure_rear_kpa": scenario.pressures[0] if tyres is None else None,
             "pressure_front_kpa": scenario.pressures[1] if tyres is None else None,
             "notes": notes,
@@ -976,12 +1131,13 @@ def run(scenario, *, tyres=None, gains=None):
             "pitch_rad": float(x0[slip.X["q5"]]), "yaw_rate_rad_s": baseline,
             "lateral_drift_m_s": float(x0[slip.X["u2"]]),
             "compression_rear_m": float(x0[slip.X["q9"]]), "compression_front_m": float(x0[slip.X["q10"]]),
-            "drive_torque_n_m": float(steady.params["T6c"]),
+            **_rear_wheel_torque(steady),
             "residual": float(steady.residual),
         },
         "peaks": {f"max_abs_{name}": float(np.max(np.abs(df[name].to_numpy()[after])))
                   for name in ("yaw_rate", "roll_rate", "steer_rate", "roll", "steer", "slip_rear",
                                "fy_rear", "fy_front", "steer_torque")},
+        "energy": _energy_summary(df, jumps, scenario),
         "recovery": {
             "criterion": f"|yaw rate - steady| <= {RECOVERY_FRACTION:.0%} of the first peak until the end",
             "first_peak_rad_s": first_peak,
@@ -992,16 +1148,58 @@ def run(scenario, *, tyres=None, gains=None):
         "metrics_unavailable": metrics["unavailable"],
         "numerics": {
             "method": "LSODA", "rtol": scenario.rtol, "piecewise": scenario.piecewise,
+            "plate_stop": scenario.plate_stop, "kick_heading": scenario.kick_heading,
             "breakpoints_s": list(breakpoints), "nfev": int(traj.nfev),
             "integration_wall_s": integration_s,
             "max_abs_holonomic_m": float(np.max(np.abs(df["holonomic_residual"]))),
             "model_hash": model_hash(),
         },
         "scenario": scenario.to_dict(),
-        "units": UNITS,
+        "units": {column: UNITS[column] for column in df.columns},
     }
     summary["numerics"]["wall_s"] = time.perf_counter() - wall0
     return Result(scenario=scenario, trajectory=df, summary=_clean(summary))
+
+
+def _rear_wheel_torque(steady):
+    """Summary entries of the steady rear-wheel torque T6c: value, sign convention, role, and what it balances."""
+    from . import slip
+
+    rhs = slip.CompiledRHS(steady.params)
+    dx, out = rhs.outputs(0.0, steady.x)
+    torque = float(steady.params["T6c"])
+    power = {name: float(dx[slip.X[state]]) for name, state in (
+        ("rear_wheel_torque", "W_wheel"), ("zero_slip_forces", "W_zero_slip"), ("aligning_moments", "W_moment"),
+        ("sliding", "D_slide"))}
+    power["sliding"] = -power["sliding"]   # dissipation enters the balance with a minus
+    role = "none" if torque == 0.0 else ("brake" if torque * out[slip.OUT["u6"]] < 0.0 else "drive")
+    return {
+        "rear_wheel_torque_n_m": torque,
+        "rear_wheel_torque_convention": ("on the rear wheel about the rear frame's C.y axis (pointing to the "
+                                         "rider's right); + opposes forward rolling (the wheel spins about -C.y)"),
+        "rear_wheel_torque_role": role,
+        "steady_power_w": power,
+    }
+
+
+def _energy_summary(df, jumps, scenario):
+    """Totals of the energy accounting after the kick, the balance residual and the velocity jumps."""
+    after = df["time"].to_numpy() >= 0.0
+    totals = {f"{column}_j": float(df[column].iloc[-1]) for column, _ in energy.COLUMNS.values()}
+    stored = sum(df[c].to_numpy() for c in energy.STORED)
+    dissipation = df["sliding_dissipation"].to_numpy() + df["damper_dissipation"].to_numpy()
+    residual = np.abs(df[BALANCE_COLUMN].to_numpy())
+    return {
+        "convention": ("works done ON the bicycle and dissipations, cumulative from the kick start (J); "
+                       "stored = kinetic + potential + tyre springs + carcasses; balance residual = "
+                       "change of stored - (works - dissipations)"),
+        **totals,
+        "stored_change_after_kick_j": float(stored[-1] - stored[after][0]) if after.any() else 0.0,
+        "balance_residual_max_abs_j": float(residual.max()),
+        "dissipation_largest_decrease_j": float(max(0.0, -np.diff(dissipation).min())) if len(df) > 1 else 0.0,
+        "plate_stop": scenario.plate_stop,
+        "velocity_jumps": jumps,
+    }
 
 
 def with_changes(scenario, **changes):

@@ -5,13 +5,20 @@ printed twice from the same expression lists: to C (with common
 subexpressions eliminated, compiled with the system C compiler and loaded
 with ctypes) and to NumPy (the test oracle and speed baseline). The C
 function does everything for one evaluation: the kick-plate profile, the
-constraint matrix and the dependent speeds, slip and camber angles, normal
-forces, Magic-Formula steady forces, tyre relaxation, the steer controller,
-Kane's equations and their reduction by pivoted LU.
+constraint matrix and the dependent speeds, slip and camber, normal forces,
+the tyre block of the active transient form (:mod:`whipple_kick.transient`,
+chosen by the ``tyre_transient`` parameter: only its branch runs), the steer
+controller, Kane's equations and their reduction by pivoted LU, and the
+rates of the energy quadratures (:mod:`whipple_kick.energy`). The
+Magic-Formula curves are C functions that skip a pressure-blend set of
+weight 0; the named outputs (:data:`OUTPUT_NAMES`) are computed only when
+asked for.
 
 State vector layout (by name, see :data:`STATE_NAMES`): q1..q10, the
-independent speeds u1 u2 u3 u4 u7 u9 u10, the tyre force states fyr fyf
-mzr mzf.
+independent speeds u1 u2 u3 u4 u7 u9 u10, four tyre states in fixed slots
+(:func:`tyre_state_names`: the contact patch's slip and camber angles, or
+the thesis' relaxed forces fyr fyf mzr mzf, which :data:`X` also names),
+and the quadratures of :data:`whipple_kick.energy.QUADRATURE_STATES`.
 """
 import ctypes
 import functools
@@ -23,7 +30,7 @@ import numpy as np
 import sympy as sm
 from sympy.printing.c import C99CodePrinter
 
-from . import cache, codegen, kane
+from . import cache, codegen, energy, kane, magic_formula, transient
 from . import symbols as S
 from .errors import InputError
 
@@ -31,58 +38,193 @@ COORDINATES = tuple(f"q{i}" for i in range(1, 11))
 SPEEDS = tuple(f"u{i}" for i in range(1, 11))
 DEPENDENT = ("u5", "u6", "u8")
 INDEPENDENT = tuple(n for n in SPEEDS if n not in DEPENDENT)
-TYRE_STATES = ("fyr", "fyf", "mzr", "mzf")
-STATE_NAMES = COORDINATES + INDEPENDENT + TYRE_STATES
-#: Per-evaluation outputs written by the C function when asked (by name).
+#: Tyre-state slot names of the thesis' form (kept as aliases in :data:`X`).
+TYRE_STATES = transient.STATES["force_lag"]
+#: Tyre-state slot names of the default form.
+PATCH_STATES = transient.STATES["contact_patch"]
+QUADRATURE_STATES = energy.QUADRATURE_STATES
+#: States integrated for the dynamics; the quadratures follow them.
+DYNAMIC_STATES = COORDINATES + INDEPENDENT + PATCH_STATES
+STATE_NAMES = DYNAMIC_STATES + QUADRATURE_STATES
+#: Per-evaluation outputs written by the C function when asked (by name):
+#: all speeds, plate motion, kinematic slip (atan(vsy/|vx|)) and wheel camber,
+#: rolling speeds, normal forces, the steady curves at that slip and camber,
+#: the steer torque, energies, the front contact height, the tyres' sliding
+#: power F vsy, the applied forces and moments, the relaxation lengths in use.
 OUTPUT_NAMES = SPEEDS + (
     "yp", "vp", "ap", "slip_r", "slip_f", "camber_r", "camber_f", "vx_r", "vx_f",
     "fz_r", "fz_f", "fy_ss_r", "fy_ss_f", "mz_ss_r", "mz_ss_f", "T7",
     "kinetic_energy", "potential_energy", "spring_energy", "holonomic", "sliding_power",
+    "fy_r", "fy_f", "mz_r", "mz_f", "sigma_r", "sigma_f",
 )
 PARAMETER_NAMES = S.SLIP_CONSTANTS
 X = {n: i for i, n in enumerate(STATE_NAMES)}
+X.update({n: X[m] for n, m in zip(TYRE_STATES, PATCH_STATES)})
 OUT = {n: i for i, n in enumerate(OUTPUT_NAMES)}
 P = {n: i for i, n in enumerate(PARAMETER_NAMES)}
 
-_SOURCES = ("symbols", "derivation", "codegen", "magic_formula", "slip")
+_SOURCES = ("symbols", "derivation", "codegen", "magic_formula", "transient", "energy", "slip")
 _PARTITION = kane.ConstraintPartition(SPEEDS, DEPENDENT)
+#: Tyre-block inputs computed with Kane's terms (plain symbols, registered in :mod:`symbols`).
+_KINEMATICS = ("vsy_r", "vsy_f", "vx_r", "vx_f", "camber_r", "camber_f", "fz_r", "fz_f",
+               "vplate_r", "wz_r", "wz_f", "T7")
+_APPLIED = ("Fy_r", "Fy_f", "Mz_r", "Mz_f")
+#: What each tyre block returns, in order (beyond the applied loads): the four
+#: state rates, then the form-dependent quadrature rates and relaxation lengths.
+_BLOCK_EXTRAS = ("W0", "D_slide", "P_carcass_r", "P_carcass_f", "sigma_r", "sigma_f")
+#: Output names the C code copies from the tyre block rather than computing.
+_BLOCK_OUTPUTS = {"fy_r": "Fy_r", "fy_f": "Fy_f", "mz_r": "Mz_r", "mz_f": "Mz_f",
+                  "sigma_r": "sigma_r", "sigma_f": "sigma_f"}
 
+
+def tyre_state_names(name=transient.DEFAULT_TRANSIENT):
+    """Names of the four tyre-state slots under the transient form ``name``."""
+    transient.check(name)
+    return transient.STATES[name]
+
+
+def state_names(name=transient.DEFAULT_TRANSIENT):
+    """All state names (:data:`STATE_NAMES` layout) with the tyre slots named for the form ``name``."""
+    return COORDINATES + INDEPENDENT + tyre_state_names(name) + QUADRATURE_STATES
+
+
+# ------------------------------------------------------------ tyre curves
+
+def _wheel_parameters(wheel, letter):
+    """(coefficient symbol lists of both sets, weight, friction scale, curve scale) of one wheel."""
+    sets = [list(S.syms([f"{letter}{wheel}{k}_{i}" for i in range(14 if letter == "a" else 18)])) for k in (1, 2)]
+    w, mu, lam = S.syms([f"w{wheel}", f"mu{wheel}", f"lam{wheel}"])
+    return sets, w, mu, lam
+
+
+def _set_curve(kind, wheel, k, slip, camber, fz):
+    """One coefficient set's raw steady curve (friction scale applied, no blend weight or curve scale)."""
+    mf = magic_formula
+    letter = "a" if kind == "fy" else "c"
+    sets, _, mu, _ = _wheel_parameters(wheel, letter)
+    builder = mf.lateral_force_model if kind == "fy" else mf.aligning_moment_model
+    return builder(slip, camber, fz, sets[k - 1], friction_scale=mu)
+
+
+def _set_secant(wheel, k, slip, fz):
+    """(slope, secant ratio) of one coefficient set (:func:`magic_formula.lateral_secant_model`)."""
+    sets, _, mu, _ = _wheel_parameters(wheel, "a")
+    return magic_formula.lateral_secant_model(slip, fz, sets[k - 1], friction_scale=mu)
+
+
+def _inline_curves():
+    """Curve builders giving full expressions (the NumPy oracle prints these)."""
+    def blend(kind):
+        def curve(wheel, slip, camber, fz):
+            _, w, _, lam = _wheel_parameters(wheel, "a")
+            return lam * ((1 - w) * _set_curve(kind, wheel, 1, slip, camber, fz)
+                          + w * _set_curve(kind, wheel, 2, slip, camber, fz))
+        return curve
+
+    def secant(wheel, slip, fz):
+        _, w, _, _ = _wheel_parameters(wheel, "a")
+        (c1, g1), (c2, g2) = _set_secant(wheel, 1, slip, fz), _set_secant(wheel, 2, slip, fz)
+        return ((1 - w) * c1 * g1 + w * c2 * g2) / ((1 - w) * c1 + w * c2)
+    return {"fy": blend("fy"), "mz": blend("mz"), "secant": secant}
+
+
+def _called_curves():
+    """Curve builders giving calls of the compiled curve functions (``wk_fy_r(...)``)."""
+    def call(kind):
+        return lambda wheel, *args: sm.Function(f"wk_{kind}_{wheel}")(*args)
+    return {"fy": call("fy"), "mz": call("mz"), "secant": call("sec")}
+
+
+# ---------------------------------------------------------------- expressions
 
 @functools.lru_cache(maxsize=None)
 def _expressions():
-    """The expression lists both printers use (plain symbols, plate profile substituted)."""
+    """Everything both printers need, as plain-symbol SymPy expressions.
+
+    Returns
+    -------
+    dict
+        ``stage1`` (constraint matrix and offset), ``stage2`` (mass matrix,
+        forcing without tyre loads ``f0``, its derivative ``G`` with respect
+        to the applied loads, acceleration remainder, tyre-block inputs),
+        ``blocks`` (per transient form and curve style), ``common`` (the
+        form-independent quadrature rates), ``outputs`` (named outputs by
+        name, the block's copies excluded), ``mass`` (the mass matrix alone)
+        and ``symbols``.
+    """
     from . import derivation
     eom = derivation.slip_equations()
-    tyre = S.dyns(TYRE_STATES)
-    dyn = list(eom.q) + list(eom.u) + list(tyre)
+    dyn = list(eom.q) + list(eom.u)
     t = sm.Symbol("t", real=True)
-    vp_s, ap_s = eom.inputs
+    vp_s, ap_s = eom.inputs[:2]
+    applied = sm.Matrix(eom.inputs[2:])
     ex = eom.extra
     profile = {vp_s: ex["vp"], ap_s: ex["ap"]}
 
     def plain(e):
         return codegen.plain(sm.sympify(e) if not isinstance(e, sm.MatrixBase) else e, dyn).xreplace(profile)
 
-    stage1 = {"A": plain(eom.constraint_matrix), "a0": plain(eom.constraint_offset)}
-    outputs = [
-        ex["yp"], ex["vp"], ex["ap"], ex["slip_r"], ex["slip_f"], ex["camber_r"], ex["camber_f"],
-        ex["vx_r"], ex["vx_f"], ex["fz_r"], ex["fz_f"], ex["fy_ss_r"], ex["fy_ss_f"],
-        ex["mz_ss_r"], ex["mz_ss_f"], ex["T7"], eom.kinetic_energy, eom.potential_energy,
-        ex["spring_energy"], eom.holonomic, ex["sliding_power"],
-    ]
-    stage2 = {
-        "M": plain(eom.mass_matrix), "f": plain(eom.forcing), "b": plain(eom.constraint_accel),
-        "tyre_rates": sm.Matrix([plain(ex[k]) for k in ("dfyr", "dfyf", "dmzr", "dmzf")]),
-        "outputs": sm.Matrix([plain(e) for e in outputs]),
+    forcing = plain(eom.forcing)
+    G = forcing.jacobian(applied)
+    if G.free_symbols & set(applied):
+        raise RuntimeError("Kane's forcing is not linear in the tyre loads")
+    f0 = forcing.xreplace({s: 0 for s in applied})
+    kin = {name: plain(ex[name]) for name in _KINEMATICS}
+    u = {f"u{i + 1}": codegen.plain_symbol(s) for i, s in enumerate(eom.u)}
+    sigma0 = {"r": S.sym("sigr"), "f": S.sym("sigf")}
+    blocks = {style: {name: transient.tyre_block(name, curves(), sigma0) for name in transient.TRANSIENTS}
+              for style, curves in (("inline", _inline_curves), ("called", _called_curves))}
+    common = {k: plain(v) for k, v in energy.common_rates(ex, u, S.sym("T6c")).items()}
+    k_sym = {name: S.sym(name) for name in _KINEMATICS + _APPLIED}
+    slip = {w: sm.atan2(k_sym[f"vsy_{w}"], sm.Abs(k_sym[f"vx_{w}"])) for w in "rf"}
+    outputs = {name: plain(ex[name]) for name in ("yp", "vp", "ap")}
+    for w in "rf":
+        outputs[f"slip_{w}"] = slip[w]
+    for name in ("camber_r", "camber_f", "vx_r", "vx_f", "fz_r", "fz_f"):
+        outputs[name] = k_sym[name]
+    for style in ("inline", "called"):
+        curves = (_inline_curves if style == "inline" else _called_curves)()
+        outputs[f"steady_{style}"] = {
+            f"{kind}_ss_{w}": curves[kind](w, slip[w], k_sym[f"camber_{w}"], k_sym[f"fz_{w}"])
+            for kind in ("fy", "mz") for w in "rf"}
+    outputs.update({
+        "T7": k_sym["T7"], "kinetic_energy": plain(eom.kinetic_energy),
+        "potential_energy": plain(eom.potential_energy), "spring_energy": plain(ex["spring_energy"]),
+        "holonomic": plain(eom.holonomic),
+        "sliding_power": k_sym["Fy_r"] * k_sym["vsy_r"] + k_sym["Fy_f"] * k_sym["vsy_f"],
+    })
+    return {
+        "stage1": {"A": plain(eom.constraint_matrix), "a0": plain(eom.constraint_offset)},
+        "stage2": {"M": plain(eom.mass_matrix), "f0": f0, "G": G, "b": plain(eom.constraint_accel),
+                   "kinematics": sm.Matrix([kin[n] for n in _KINEMATICS])},
+        "blocks": blocks, "common": common, "outputs": outputs,
+        "symbols": {
+            "t": t,
+            "q": [codegen.plain_symbol(s) for s in eom.q],
+            "u": [codegen.plain_symbol(s) for s in eom.u],
+            "s": {name: [sm.Symbol(n, real=True) for n in transient.STATES[name]] for name in transient.TRANSIENTS},
+            "p": list(S.syms(PARAMETER_NAMES)),
+            "kinematics": [k_sym[n] for n in _KINEMATICS],
+            "applied": [k_sym[n] for n in _APPLIED],
+        },
     }
-    symbols = {
-        "t": t,
-        "q": [codegen.plain_symbol(s) for s in eom.q],
-        "u": [codegen.plain_symbol(s) for s in eom.u],
-        "s": [codegen.plain_symbol(s) for s in tyre],
-        "p": list(S.syms(PARAMETER_NAMES)),
-    }
-    return stage1, stage2, symbols
+
+
+def _block_list(block):
+    """A tyre block's expressions in the fixed order: applied loads, 4 rates, :data:`_BLOCK_EXTRAS`."""
+    return [block[n] for n in _APPLIED] + list(block["rates"]) + [block[n] for n in _BLOCK_EXTRAS]
+
+
+def _output_list(ex, style):
+    """Output expressions in :data:`OUTPUT_NAMES` order after the speeds, block copies as their symbols."""
+    steady = ex["outputs"][f"steady_{style}"]
+    out = []
+    for name in OUTPUT_NAMES[len(SPEEDS):]:
+        if name in _BLOCK_OUTPUTS:
+            out.append(sm.Symbol(_BLOCK_OUTPUTS[name], real=True))
+        else:
+            out.append(steady[name] if name in steady else ex["outputs"][name])
+    return out
 
 
 # --------------------------------------------------------------------------- C
@@ -137,10 +279,17 @@ static int lu_solve(int n, double *A, int m, double *B)
 
 
 class _Printer(C99CodePrinter):
-    """C printer: plain symbols print as their names (declared as locals)."""
+    """C printer: plain symbols print as their names (declared as locals); the
+    compiled curve functions ``wk_*`` get the parameter pointer ``p``."""
 
     def _print_Symbol(self, expr):
         return expr.name
+
+    def _print_Function(self, expr):
+        name = expr.func.__name__
+        if name.startswith("wk_"):
+            return f"{name}({', '.join(self._print(a) for a in expr.args)}, p)"
+        return super()._print_Function(expr)
 
 
 def _c_block(exprs, targets, indent="    "):
@@ -152,26 +301,65 @@ def _c_block(exprs, targets, indent="    "):
     return "\n".join(lines)
 
 
+def _parameter_locals(exprs, indent="    "):
+    """``const double name = p[i];`` for the parameters ``exprs`` use."""
+    used = set().union(*(sm.sympify(e).free_symbols for e in exprs))
+    return [f"{indent}const double {s.name} = p[{P[s.name]}];" for s in S.syms(PARAMETER_NAMES) if s in used]
+
+
+def _c_curve_functions():
+    """Static C functions of the Magic-Formula curves, per wheel; a set of weight 0 is skipped."""
+    slip, camber, fz = sm.symbols("slip camber fz", real=True)
+    lines = []
+    for wheel in "rf":
+        for kind in ("fy", "mz"):
+            for k in (1, 2):
+                e = _set_curve(kind, wheel, k, slip, camber, fz)
+                lines += [f"static double wk_{kind}_{wheel}_{k}(double slip, double camber, double fz, const double *p)",
+                          "{", *_parameter_locals([e]), "    double v;", _c_block([e], ["v"]), "    return v;", "}"]
+            lines += [f"static double wk_{kind}_{wheel}(double slip, double camber, double fz, const double *p)", "{",
+                      f"    const double w = p[{P['w' + wheel]}];",
+                      f"    double v = (1.0 - w) * wk_{kind}_{wheel}_1(slip, camber, fz, p);",
+                      f"    if (w != 0.0) v += w * wk_{kind}_{wheel}_2(slip, camber, fz, p);",
+                      f"    return p[{P['lam' + wheel]}] * v;", "}"]
+        for k in (1, 2):
+            slope, ratio = _set_secant(wheel, k, slip, fz)
+            lines += [f"static void wk_sec_{wheel}_{k}(double slip, double fz, const double *p, double *c0, double *g)",
+                      "{", *_parameter_locals([slope, ratio]), _c_block([slope, ratio], ["*c0", "*g"]), "}"]
+        lines += [f"static double wk_sec_{wheel}(double slip, double fz, const double *p)", "{",
+                  f"    const double w = p[{P['w' + wheel]}];",
+                  "    double c1, g1, c2, g2;",
+                  f"    wk_sec_{wheel}_1(slip, fz, p, &c1, &g1);",
+                  "    if (w == 0.0) return g1;",
+                  f"    wk_sec_{wheel}_2(slip, fz, p, &c2, &g2);",
+                  "    return ((1.0 - w) * c1 * g1 + w * c2 * g2) / ((1.0 - w) * c1 + w * c2);", "}"]
+    return lines
+
+
 def c_source():
-    """Full C source of the slip model's right-hand side."""
-    stage1, stage2, sy = _expressions()
+    """Full C source of the slip model: right-hand side, outputs, Jacobian, impulse terms."""
+    ex = _expressions()
+    sy = ex["symbols"]
     n, m, k = len(SPEEDS), len(DEPENDENT), len(INDEPENDENT)
+    ns, nd, nq = len(STATE_NAMES), len(DYNAMIC_STATES), len(QUADRATURE_STATES)
+    nt = len(PATCH_STATES)
+    no = len(OUTPUT_NAMES) - n
     dep = [SPEEDS.index(x) for x in DEPENDENT]
     ind = [SPEEDS.index(x) for x in INDEPENDENT]
-    lines = [_C_HELPERS, "/* Generated by whipple_kick.slip; do not edit. */",
-             "int wk_slip_rhs(double t, const double *x, const double *p, double *dx, double *out)", "{"]
+    lines = [_C_HELPERS, "/* Generated by whipple_kick.slip; do not edit. */", *_c_curve_functions()]
+    lines += ["int wk_slip_rhs(double t, const double *x, const double *p, double *dx, double *out)", "{"]
     for i, s in enumerate(sy["p"]):
         lines.append(f"    const double {s.name} = p[{i}];")
     for i, s in enumerate(sy["q"]):
         lines.append(f"    const double {s.name} = x[{i}];")
-    for i, name in enumerate(TYRE_STATES):
-        lines.append(f"    const double {name} = x[{X[name]}];")
+    for name in transient.TRANSIENTS:
+        for slot, s in enumerate(sy["s"][name]):
+            if name != "slip_lag":   # slip_lag shares contact_patch's names
+                lines.append(f"    const double {s.name} = x[{len(COORDINATES) + k + slot}];")
     lines.append(f"    double A[{m * n}], a0[{m}];")
-    stage1_exprs = list(stage1["A"]) + list(stage1["a0"])
-    stage1_targets = [f"A[{i}]" for i in range(m * n)] + [f"a0[{i}]" for i in range(m)]
-    lines.append("    {")
-    lines.append(_c_block(stage1_exprs, stage1_targets, indent="        "))
-    lines.append("    }")
+    stage1 = ex["stage1"]
+    lines += ["    {", _c_block(list(stage1["A"]) + list(stage1["a0"]),
+                                 [f"A[{i}]" for i in range(m * n)] + [f"a0[{i}]" for i in range(m)], "        "), "    }"]
     # Dependent speeds: A_dep u_dep = -(A_ind u_ind + a0).
     lines.append(f"    double u[{n}];")
     for j, idx in enumerate(ind):
@@ -192,14 +380,25 @@ def c_source():
         lines.append(f"    u[{idx}] = rhs1[{jj} * {k + 1} + {k}];")
     for i, s in enumerate(sy["u"]):
         lines.append(f"    const double {s.name} = u[{i}];")
-    lines.append(f"    double M[{n * n}], f[{n}], b[{m}], rates[4], o[{len(OUTPUT_NAMES) - n}];")
-    stage2_exprs = list(stage2["M"]) + list(stage2["f"]) + list(stage2["b"]) + list(stage2["tyre_rates"]) + list(stage2["outputs"])
-    stage2_targets = ([f"M[{i}]" for i in range(n * n)] + [f"f[{i}]" for i in range(n)]
-                      + [f"b[{i}]" for i in range(m)] + [f"rates[{i}]" for i in range(4)]
-                      + [f"o[{i}]" for i in range(len(OUTPUT_NAMES) - n)])
-    lines.append("    {")
-    lines.append(_c_block(stage2_exprs, stage2_targets, indent="        "))
-    lines.append("    }")
+    # Kane's terms and the tyre block's inputs in one CSE'd block.
+    st2 = ex["stage2"]
+    kin = [s.name for s in sy["kinematics"]]
+    lines.append(f"    double M[{n * n}], f[{n}], G[{n * 4}], b[{m}], {', '.join(kin)};")
+    lines += ["    {", _c_block(list(st2["M"]) + list(st2["f0"]) + list(st2["G"]) + list(st2["b"]) + list(st2["kinematics"]),
+                                 [f"M[{i}]" for i in range(n * n)] + [f"f[{i}]" for i in range(n)]
+                                 + [f"G[{i}]" for i in range(n * 4)] + [f"b[{i}]" for i in range(m)] + kin,
+                                 "        "), "    }"]
+    # The active transient form's tyre block (only its branch runs).
+    block_targets = list(_APPLIED) + [f"trate[{i}]" for i in range(nt)] + list(_BLOCK_EXTRAS)
+    lines.append(f"    double {', '.join(_APPLIED)}, trate[{nt}], {', '.join(_BLOCK_EXTRAS)};")
+    lines.append(f"    const int mode = (int)tyre_transient;")
+    for code, name in enumerate(transient.TRANSIENTS):
+        head = "if" if code == 0 else "else if"
+        cond = f"(mode == {code})" if code < len(transient.TRANSIENTS) - 1 else "(1)"
+        lines += [f"    {head} {cond} {{", _c_block(_block_list(ex["blocks"]["called"][name]), block_targets, "        "),
+                  "    }"]
+    lines.append(f"    for (int i = 0; i < {n}; i++) f[i] += G[i * 4] * Fy_r + G[i * 4 + 1] * Fy_f"
+                 " + G[i * 4 + 2] * Mz_r + G[i * 4 + 3] * Mz_f;")
     # Kane's reduced equations: T = [I; C], C = -A_dep^-1 A_ind, t0 = [0; d], d = -A_dep^-1 b.
     lines.append(f"    double T[{n * k}], t0[{n}], d[{m}];")
     lines.append("    memset(T, 0, sizeof T); memset(t0, 0, sizeof t0);")
@@ -227,28 +426,67 @@ def c_source():
     lines.append("        r[i] = s;")
     lines.append("    }")
     lines.append(f"    if (lu_solve({k}, Mr, 1, r)) return 1;")
-    # Outputs.
     lines.append(f"    for (int i = 0; i < {n}; i++) dx[i] = u[i];")
     lines.append(f"    for (int i = 0; i < {k}; i++) dx[{n} + i] = r[i];")
-    lines.append(f"    for (int i = 0; i < 4; i++) dx[{n + k} + i] = rates[i];")
+    lines.append(f"    for (int i = 0; i < {nt}; i++) dx[{n + k} + i] = trate[i];")
+    # Quadrature rates: the form-independent ones, then the tyre block's.
+    q0 = nd
+    common = ex["common"]
+    lines += ["    {", _c_block([common[nm] for nm in ("W_plate", "W_steer", "W_wheel", "W_moment", "D_damper")],
+                                 [f"dx[{q0 + QUADRATURE_STATES.index(nm)}]"
+                                  for nm in ("W_plate", "W_steer", "W_wheel", "W_moment", "D_damper")], "        "),
+              "    }"]
+    for nm, local in (("W_zero_slip", "W0"), ("D_slide", "D_slide"), ("E_carcass_r", "P_carcass_r"),
+                      ("E_carcass_f", "P_carcass_f")):
+        lines.append(f"    dx[{q0 + QUADRATURE_STATES.index(nm)}] = {local};")
+    # Work of the rear no-slip constraint's force while the plate moves:
+    # u . (M du/dt - f) = -lambda . a0 (zero when a0 = 0, so skipped then).
+    lines.append(f"    if (a0[0] != 0.0 || a0[1] != 0.0 || a0[2] != 0.0) {{")
+    lines.append(f"        double ud[{n}], pc = 0.0;")
+    lines.append(f"        for (int i = 0; i < {n}; i++) {{ double s = t0[i]; for (int j = 0; j < {k}; j++) s += T[i * {k} + j] * r[j]; ud[i] = s; }}")
+    lines.append(f"        for (int i = 0; i < {n}; i++) {{ double s = -f[i]; for (int j = 0; j < {n}; j++) s += M[i * {n} + j] * ud[j]; pc += u[i] * s; }}")
+    lines.append(f"        dx[{q0 + QUADRATURE_STATES.index('W_plate')}] += pc;")
+    lines.append("    }")
     lines.append("    if (out) {")
     lines.append(f"        for (int i = 0; i < {n}; i++) out[i] = u[i];")
-    lines.append(f"        for (int i = 0; i < {len(OUTPUT_NAMES) - n}; i++) out[{n} + i] = o[i];")
+    lines += ["        {", _c_block(_output_list(ex, "called"), [f"out[{n + i}]" for i in range(no)], "            "),
+              "        }"]
     lines.append("    }")
-    lines.append("    for (int i = 0; i < %d; i++) if (!isfinite(dx[i])) return 2;" % len(STATE_NAMES))
+    lines.append(f"    for (int i = 0; i < {ns}; i++) if (!isfinite(dx[i])) return 2;")
     lines.append("    return 0;")
     lines.append("}")
     # Outputs at many samples in one call (post-processing a trajectory).
-    lines.append("int wk_slip_outputs(int n, const double *t, const double *x, const double *p, double *out)")
-    lines.append("{")
-    lines.append(f"    double dx[{len(STATE_NAMES)}];")
-    lines.append("    for (int i = 0; i < n; i++) {")
-    lines.append(f"        int status = wk_slip_rhs(t[i], x + (long)i * {len(STATE_NAMES)}, p, dx, out + (long)i * {len(OUTPUT_NAMES)});")
-    lines.append("        if (status) return status;")
-    lines.append("    }")
-    lines.append("    return 0;")
-    lines.append("}")
-    lines.append(f"int wk_slip_sizes(int *sizes) {{ sizes[0] = {len(STATE_NAMES)}; sizes[1] = {len(PARAMETER_NAMES)}; sizes[2] = {len(OUTPUT_NAMES)}; return 0; }}")
+    lines += ["int wk_slip_outputs(int n, const double *t, const double *x, const double *p, double *out)", "{",
+              f"    double dx[{ns}];",
+              "    for (int i = 0; i < n; i++) {",
+              f"        int status = wk_slip_rhs(t[i], x + (long)i * {ns}, p, dx, out + (long)i * {len(OUTPUT_NAMES)});",
+              "        if (status) return status;", "    }", "    return 0;", "}"]
+    # Jacobian by forward differences over the dynamic states (the
+    # quadratures feed nothing back: their columns are exactly zero).
+    lines += ["int wk_slip_jacobian(double t, const double *x, const double *p, const double *scale, double *J)", "{",
+              f"    double f0[{ns}], f1[{ns}], xp[{ns}];",
+              "    int status = wk_slip_rhs(t, x, p, f0, 0);", "    if (status) return status;",
+              "    memcpy(xp, x, sizeof xp);",
+              f"    for (int j = 0; j < {ns}; j++) {{",
+              f"        if (j >= {nd}) {{ for (int i = 0; i < {ns}; i++) J[i * {ns} + j] = 0.0; continue; }}",
+              "        volatile double moved = x[j] + 1.4901161193847656e-08 * fmax(fabs(x[j]), scale[j]);",
+              "        const double h = moved - x[j];",
+              "        xp[j] = moved;",
+              "        status = wk_slip_rhs(t, xp, p, f1, 0);", "        if (status) return status;",
+              f"        for (int i = 0; i < {ns}; i++) J[i * {ns} + j] = (f1[i] - f0[i]) / h;",
+              "        xp[j] = x[j];", "    }", "    return 0;", "}"]
+    # Mass matrix, constraint matrix and offset (the plate stop's impulse).
+    mass = list(st2["M"])
+    lines += ["int wk_slip_impulse_terms(double t, const double *x, const double *p, double *M, double *A, double *a0)",
+              "{", *_parameter_locals(list(stage1["A"]) + list(stage1["a0"]) + mass)]
+    for i, s in enumerate(sy["q"]):
+        lines.append(f"    const double {s.name} = x[{i}];")
+    lines += ["    {", _c_block(list(stage1["A"]) + list(stage1["a0"]),
+                                 [f"A[{i}]" for i in range(m * n)] + [f"a0[{i}]" for i in range(m)], "        "), "    }",
+              "    {", _c_block(mass, [f"M[{i}]" for i in range(n * n)], "        "), "    }",
+              "    return 0;", "}"]
+    lines.append(f"int wk_slip_sizes(int *sizes) {{ sizes[0] = {ns}; sizes[1] = {len(PARAMETER_NAMES)}; "
+                 f"sizes[2] = {len(OUTPUT_NAMES)}; sizes[3] = {nd}; return 0; }}")
     return "\n".join(lines) + "\n"
 
 
@@ -285,13 +523,18 @@ def library():
 
     lib_path = cache.build_once(f"slip_{key}.so", compile_to)
     lib = ctypes.CDLL(str(lib_path))
+    pointer = ctypes.c_void_p
     lib.wk_slip_rhs.restype = ctypes.c_int
-    lib.wk_slip_rhs.argtypes = [ctypes.c_double, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p]
+    lib.wk_slip_rhs.argtypes = [ctypes.c_double, pointer, pointer, pointer, pointer]
     lib.wk_slip_outputs.restype = ctypes.c_int
-    lib.wk_slip_outputs.argtypes = [ctypes.c_int, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p]
-    sizes = (ctypes.c_int * 3)()
+    lib.wk_slip_outputs.argtypes = [ctypes.c_int, pointer, pointer, pointer, pointer]
+    lib.wk_slip_jacobian.restype = ctypes.c_int
+    lib.wk_slip_jacobian.argtypes = [ctypes.c_double, pointer, pointer, pointer, pointer]
+    lib.wk_slip_impulse_terms.restype = ctypes.c_int
+    lib.wk_slip_impulse_terms.argtypes = [ctypes.c_double, pointer, pointer, pointer, pointer, pointer]
+    sizes = (ctypes.c_int * 4)()
     lib.wk_slip_sizes(sizes)
-    if tuple(sizes) != (len(STATE_NAMES), len(PARAMETER_NAMES), len(OUTPUT_NAMES)):
+    if tuple(sizes) != (len(STATE_NAMES), len(PARAMETER_NAMES), len(OUTPUT_NAMES), len(DYNAMIC_STATES)):
         raise RuntimeError(f"compiled slip model has sizes {tuple(sizes)}; rebuild the cache")
     return lib
 
@@ -300,17 +543,35 @@ def library():
 
 def numpy_source():
     """NumPy module source of the same expressions (oracle and baseline)."""
-    stage1, stage2, sy = _expressions()
+    ex = _expressions()
+    sy = ex["symbols"]
     t = [sy["t"]]
+    st2 = ex["stage2"]
     parts = [
         '"""Generated by whipple_kick.slip (NumPy oracle); do not edit."""',
         "import functools\nimport numpy",
         codegen.numpy_function("stage1", [("t", t), ("q", sy["q"]), ("p", sy["p"])],
-                               [stage1["A"], stage1["a0"]], doc="Constraint matrix and offset."),
-        codegen.numpy_function("stage2", [("t", t), ("q", sy["q"]), ("u", sy["u"]), ("s", sy["s"]), ("p", sy["p"])],
-                               [stage2["M"], stage2["f"], stage2["b"], stage2["tyre_rates"], stage2["outputs"]],
-                               doc="Mass matrix, forcing, constraint remainder, tyre rates, outputs."),
+                               [ex["stage1"]["A"], ex["stage1"]["a0"]], doc="Constraint matrix and offset."),
+        codegen.numpy_function("stage2", [("t", t), ("q", sy["q"]), ("u", sy["u"]), ("p", sy["p"])],
+                               [st2["M"], st2["f0"], st2["G"], st2["b"], st2["kinematics"]],
+                               doc="Mass matrix, forcing without tyre loads, its tyre-load derivative, "
+                                   "constraint remainder, tyre-block inputs."),
     ]
+    for name in transient.TRANSIENTS:
+        parts.append(codegen.numpy_function(
+            f"tyre_{name}", [("t", t), ("k", sy["kinematics"]), ("s", sy["s"][name]), ("p", sy["p"])],
+            [sm.Matrix(_block_list(ex["blocks"]["inline"][name]))], doc=f"Tyre block of {name}."))
+    common = ex["common"]
+    parts.append(codegen.numpy_function(
+        "common", [("t", t), ("q", sy["q"]), ("u", sy["u"]), ("k", sy["kinematics"]), ("a", sy["applied"]),
+                   ("p", sy["p"])],
+        [sm.Matrix([common[nm] for nm in ("W_plate", "W_steer", "W_wheel", "W_moment", "D_damper")])],
+        doc="Form-independent quadrature rates."))
+    block_symbols = [sm.Symbol(n, real=True) for n in _BLOCK_EXTRAS]
+    parts.append(codegen.numpy_function(
+        "outputs", [("t", t), ("q", sy["q"]), ("u", sy["u"]), ("k", sy["kinematics"]), ("a", sy["applied"]),
+                    ("e", block_symbols), ("p", sy["p"])],
+        [sm.Matrix(_output_list(ex, "inline"))], doc="Named outputs after the speeds."))
     return "\n\n".join(parts)
 
 
@@ -325,19 +586,35 @@ def numpy_module():
 def numpy_rhs(t, x, p, with_outputs=False):
     """Right-hand side evaluated with NumPy (slow; the oracle for the C code)."""
     mod = numpy_module()
-    q = x[:len(COORDINATES)]
-    u_ind = x[len(COORDINATES):len(COORDINATES) + len(INDEPENDENT)]
-    s = x[len(COORDINATES) + len(INDEPENDENT):]
+    nc, nk = len(COORDINATES), len(INDEPENDENT)
+    q = x[:nc]
+    u_ind = x[nc:nc + nk]
+    s = x[nc + nk:nc + nk + len(PATCH_STATES)]
+    name = transient.TRANSIENTS[int(p[P["tyre_transient"]])]
     # numpy.select evaluates every branch of a Piecewise, including the
     # unloaded-tyre branch's 0/0 that C never takes; the selected values are finite.
     with np.errstate(invalid="ignore", divide="ignore"):
         A, a0 = mod.stage1([t], q, p)
         u = _PARTITION.dependent_speeds(A, a0, u_ind)
-        M, f, b, rates, outputs = mod.stage2([t], q, u, s, p)
-    udot = _PARTITION.accelerations(M, f, A, b)
-    dx = np.concatenate([u, udot[_PARTITION.ind], rates])
-    if with_outputs:
-        return dx, np.concatenate([u, outputs])
+        M, f0, G, b, kin = mod.stage2([t], q, u, p)
+        block = getattr(mod, f"tyre_{name}")([t], kin, s, p)[0]
+        applied = block[:4]
+        f = f0 + G @ applied
+        udot = _PARTITION.accelerations(M, f, A, b)
+        rates = np.zeros(len(QUADRATURE_STATES))
+        common = mod.common([t], q, u, kin, applied, p)[0]
+        for value, nm in zip(common, ("W_plate", "W_steer", "W_wheel", "W_moment", "D_damper")):
+            rates[QUADRATURE_STATES.index(nm)] = value
+        extras = dict(zip(_BLOCK_EXTRAS, block[8:]))
+        for nm, local in (("W_zero_slip", "W0"), ("D_slide", "D_slide"), ("E_carcass_r", "P_carcass_r"),
+                          ("E_carcass_f", "P_carcass_f")):
+            rates[QUADRATURE_STATES.index(nm)] = extras[local]
+        if np.any(a0 != 0.0):
+            rates[QUADRATURE_STATES.index("W_plate")] += kane.constraint_power(M, f, u, udot)
+        dx = np.concatenate([u, udot[_PARTITION.ind], block[4:8], rates])
+        if with_outputs:
+            outputs = mod.outputs([t], q, u, kin, applied, block[8:], p)[0]
+            return dx, np.concatenate([u, outputs])
     return dx
 
 
@@ -368,6 +645,11 @@ class CompiledRHS:
     ----------
     params : mapping
         Every name in :data:`PARAMETER_NAMES`.
+
+    Example
+    -------
+    >>> rhs = CompiledRHS(steady.params)           # doctest: +SKIP
+    >>> dx = rhs(0.0, steady.x)                    # doctest: +SKIP
     """
 
     def __init__(self, params):
@@ -378,6 +660,11 @@ class CompiledRHS:
         self._dx_ptr = self._dx.ctypes.data
         self._out = np.empty(len(OUTPUT_NAMES))
         self._out_ptr = self._out.ctypes.data
+
+    @property
+    def transient(self):
+        """Name of the tyre transient form of these parameters."""
+        return transient.TRANSIENTS[int(self.p[P["tyre_transient"]])]
 
     def __call__(self, t, x):
         x = np.ascontiguousarray(x, dtype=float)
@@ -402,6 +689,37 @@ class CompiledRHS:
                 raise FloatingPointError(_STATUS.get(status, f"status {status}") + f" at t = {t:.6g} s")
             return dx.copy()
         return f
+
+    def jacobian_function(self, scale):
+        """``J(t, x)``: Jacobian d(dx/dt)/dx by forward differences in C (quadrature columns exactly 0).
+
+        Parameters
+        ----------
+        scale : array_like
+            Typical size of each state; the step is ``1.5e-8 max(|x_j|, scale_j)``.
+        """
+        scale = np.ascontiguousarray(scale, dtype=float)
+        n = len(STATE_NAMES)
+        fn, p_ptr, s_ptr = self.lib.wk_slip_jacobian, self._p_ptr, scale.ctypes.data
+
+        def jac(t, x):
+            x = np.ascontiguousarray(x, dtype=float)
+            J = np.empty((n, n))
+            status = fn(t, x.ctypes.data, p_ptr, s_ptr, J.ctypes.data)
+            if status:
+                raise FloatingPointError(_STATUS.get(status, f"status {status}") + f" at t = {t:.6g} s")
+            return J
+        jac.scale = scale   # keeps the array alive with the closure
+        return jac
+
+    def impulse_terms(self, t, x):
+        """Mass matrix M (10, 10), constraint matrix A (3, 10) and offset a0 (3,) at ``(t, x)``."""
+        x = np.ascontiguousarray(x, dtype=float)
+        n, m = len(SPEEDS), len(DEPENDENT)
+        M, A, a0 = np.empty((n, n)), np.empty((m, n)), np.empty(m)
+        self.lib.wk_slip_impulse_terms(t, x.ctypes.data, self._p_ptr, M.ctypes.data, A.ctypes.data,
+                                       a0.ctypes.data)
+        return M, A, a0
 
     def outputs_at(self, t, X):
         """Named outputs (:data:`OUTPUT_NAMES`) at many samples, in one C call.
@@ -446,8 +764,8 @@ _STATUS = {
 
 #: Magic-Formula coefficients that shift the curves at zero slip and camber
 #: (Sh and Sv terms not multiplied by camber). "Symmetric tyres" zero them.
-FY_OFFSET_INDICES = (9, 10, 12, 13)
-MZ_OFFSET_INDICES = (12, 13, 16, 17)
+FY_OFFSET_INDICES = magic_formula.FY_OFFSET_INDICES
+MZ_OFFSET_INDICES = magic_formula.MZ_OFFSET_INDICES
 GAIN_NAMES = ("kq3", "kq4", "kq7", "ku3", "ku4", "ku7")
 
 
@@ -489,7 +807,8 @@ def tyre_parameters(tyre, wheel, symmetric=False, lateral=True):
 
 
 def model_parameters(moore, rear_tyre, front_tyre, gains=None, kick=None,
-                     symmetric=False, lateral=True, drive_torque=0.0):
+                     symmetric=False, lateral=True, drive_torque=0.0,
+                     tyre_transient=transient.DEFAULT_TRANSIENT):
     """Assemble the slip model's parameters by name.
 
     Parameters
@@ -510,7 +829,10 @@ def model_parameters(moore, rear_tyre, front_tyre, gains=None, kick=None,
     symmetric, lateral : bool
         See :func:`tyre_parameters`.
     drive_torque : float
-        Constant rear-wheel torque [N m] (the steady-state solver sets it).
+        Constant rear-wheel torque T6c [N m] about the rear frame's C.y axis
+        (+ opposes forward rolling); the steady-state solver sets it.
+    tyre_transient : str
+        One of :data:`whipple_kick.transient.TRANSIENTS` (default ``contact_patch``).
     """
     params = {n: float(moore[n]) for n in S.CLASSIC_CONSTANTS}
     params.update(tyre_parameters(rear_tyre, "r", symmetric, lateral))
@@ -528,6 +850,7 @@ def model_parameters(moore, rear_tyre, front_tyre, gains=None, kick=None,
         "kick_profile": float(kick.get("profile", 0)),
         **{f"kick_c{i}": float(c) for i, c in enumerate(kick.get("coefficients", (0.0, 0.0, 0.0, 0.0)))},
         "T6c": float(drive_torque),
+        "tyre_transient": float(transient.check(tyre_transient)),
     })
     return params
 
@@ -550,9 +873,11 @@ def steady_state(params, speed, tol=1e-13):
     """Steady motion at ``speed`` [m/s] with the tyres' offsets balanced.
 
     Unknowns: roll q4, steer q7, pitch q5, tyre compressions q9, q10, lateral
-    drift velocity u2, yaw rate u3 and the drive torque T6c that holds the
-    speed against the sliding losses of the offset-balancing slip. The tyre
-    force states are at their steady values. Equations: front contact on
+    drift velocity u2, yaw rate u3 and the rear-wheel torque T6c that holds
+    the speed (the tyres' zero-slip offsets exchange energy with the rolling,
+    so T6c may brake or drive). The tyre states are at their steady values
+    (forces, or patch slip and camber equal to the kinematic ones); the
+    quadrature states are 0. Equations: front contact on
     the ground and every acceleration zero in the heading frame
     (du1/dt + u3 u2 = du2/dt - u3 u1 = du3/dt = du4/dt = du7/dt = du9/dt =
     du10/dt = 0), with q3 = 0 so the heading is N.x.
@@ -581,14 +906,17 @@ def steady_state(params, speed, tol=1e-13):
                    0.5 * weight / params["kzr"], 0.5 * weight / params["kzf"], 0.0, 0.0, 0.0])
     scale = np.array([1.0, 1.0, 1.0, 1e-3, 1e-3, 1.0, 1.0, 1.0])
 
+    steady_outputs = (("fy_ss_r", "fy_ss_f", "mz_ss_r", "mz_ss_f") if rhs.transient == "force_lag"
+                      else ("slip_r", "slip_f", "camber_r", "camber_f"))
+
     def state(z):
         xs = x.copy()
         for name, value in zip(names[:-1], z[:-1]):
             xs[X[name]] = value
         rhs.p[P["T6c"]] = z[-1]
         _, out = rhs.outputs(0.0, xs)
-        for state_name, out_name in zip(TYRE_STATES, ("fy_ss_r", "fy_ss_f", "mz_ss_r", "mz_ss_f")):
-            xs[X[state_name]] = out[OUT[out_name]]
+        for slot, out_name in zip(PATCH_STATES, steady_outputs):
+            xs[X[slot]] = out[OUT[out_name]]
         return xs
 
     def residual(zs):
@@ -613,17 +941,108 @@ def steady_state(params, speed, tol=1e-13):
     return SteadyState(xs, out_params, res, dict(zip(names, z)))
 
 
+def advance_steady(rhs, x, tau, t=0.0):
+    """The state of the steady motion through ``x``, ``tau`` seconds later (or earlier if < 0).
+
+    In a steady motion every state is constant except the heading, which
+    turns at the yaw rate u3, the rear contact, which moves on the circle
+    (or line) that the rotating velocity (u1, u2) traces, and the wheel
+    angles, which turn at u6 and u8. Used to start the display-only settle
+    so that it arrives at ``x`` at the kick. Quadratures are returned unchanged.
+
+    Parameters
+    ----------
+    rhs : CompiledRHS
+    x : array_like
+        A steady state (e.g. ``SteadyState.x``).
+    tau : float
+        Time shift [s].
+    t : float
+        Time at which ``x`` holds (the plate must be at rest then).
+
+    Returns
+    -------
+    ndarray
+    """
+    x = np.array(x, dtype=float)
+    _, out = rhs.outputs(t, x)
+    w = out[OUT["u3"]]
+    theta = w * tau
+    # int_0^tau of cos(w s) and sin(w s) ds, without dividing by a zero yaw rate.
+    c_int = tau * np.sinc(theta / np.pi)
+    s_int = tau * np.sin(theta / 2) * np.sinc(theta / (2 * np.pi))
+    u1, u2 = x[X["u1"]], x[X["u2"]]
+    c, s = np.cos(theta), np.sin(theta)
+    x[X["q1"]] += u1 * c_int - u2 * s_int
+    x[X["q2"]] += u1 * s_int + u2 * c_int
+    x[X["u1"]], x[X["u2"]] = c * u1 - s * u2, s * u1 + c * u2
+    x[X["q3"]] += theta
+    x[X["q6"]] += out[OUT["u6"]] * tau
+    x[X["q8"]] += out[OUT["u8"]] * tau
+    return x
+
+
+def velocity_jump(rhs, t, x, impulse=True):
+    """Carry the state across a jump of the plate velocity at ``t`` (the plate stop).
+
+    Parameters
+    ----------
+    rhs : CompiledRHS
+        Whose plate velocity jumps at ``t`` (``t`` itself belongs to after).
+    t : float
+        Time of the jump [s].
+    x : array_like
+        State arriving at ``t``.
+    impulse : bool
+        True: the rear no-slip constraint's impulse
+        (:func:`whipple_kick.kane.impulsive_projection`) sets all speeds and
+        its work is added to the plate's work W_plate. False: the
+        independent speeds are kept and only the dependent ones re-solved.
+
+    Returns
+    -------
+    x_after : ndarray
+    info : dict
+        ``time_s``, ``kinetic_energy_change_j`` (from the kinetic-energy
+        expression before and after), ``impulse_work_j`` (``-1/2 L.(a0+ + a0-)``,
+        the same change computed from the impulse: an independent check;
+        None without impulse) and ``constraint_impulse_n_s`` (``L``).
+    """
+    x = np.array(x, dtype=float)
+    before = np.nextafter(t, -np.inf)
+    M, A, a0_plus = rhs.impulse_terms(t, x)
+    _, _, a0_minus = rhs.impulse_terms(before, x)
+    ind = [X[n] for n in INDEPENDENT]
+    ke_before = rhs.outputs(before, x)[1][OUT["kinetic_energy"]]
+    work, impulse_value = None, None
+    if impulse:
+        u_minus = _PARTITION.dependent_speeds(A, a0_minus, x[ind])
+        u_plus, impulse_value = kane.impulsive_projection(M, A, u_minus, a0_plus)
+        x[ind] = u_plus[_PARTITION.ind]
+        work = float(-0.5 * impulse_value @ (a0_plus + a0_minus))
+        x[X["W_plate"]] += work
+    ke_after = rhs.outputs(t, x)[1][OUT["kinetic_energy"]]
+    return x, {"time_s": float(t), "kinetic_energy_change_j": float(ke_after - ke_before),
+               "impulse_work_j": work,
+               "constraint_impulse_n_s": None if impulse_value is None else [float(v) for v in impulse_value]}
+
+
 # ---------------------------------------------------------------- linearisation
 
-#: States of the linearisation in the heading frame: every state except the
-#: ignorable position q1, q2 and wheel angles q6, q8, the yaw angle q3 (the
-#: model is invariant to heading while the plate is at rest), the dependent
-#: pitch q5, with the rear-contact velocity [m/s] resolved in the heading
-#: frame: ``v_fwd`` along N.x and ``v_lat`` along N.y, both turned by the yaw
-#: angle q3 about N.z (N.z points down, so ``v_lat`` > 0 is a drift to the
-#: right). See :func:`linearize`.
-LINEAR_STATES = ("q4", "q7", "q9", "q10", "v_fwd", "v_lat", "u3", "u4", "u7", "u9", "u10",
-                 "fyr", "fyf", "mzr", "mzf")
+#: States of the linearisation in the heading frame: every dynamic state
+#: except the ignorable position q1, q2 and wheel angles q6, q8, the yaw angle
+#: q3 (the model is invariant to heading while the plate is at rest), the
+#: dependent pitch q5, with the rear-contact velocity [m/s] resolved in the
+#: heading frame: ``v_fwd`` along N.x and ``v_lat`` along N.y, both turned by
+#: the yaw angle q3 about N.z (N.z points down, so ``v_lat`` > 0 is a drift to
+#: the right). The last four are the tyre slots, named here for the default
+#: transient form (:func:`linear_states` names them for any). See :func:`linearize`.
+LINEAR_STATES = ("q4", "q7", "q9", "q10", "v_fwd", "v_lat", "u3", "u4", "u7", "u9", "u10") + PATCH_STATES
+
+
+def linear_states(name=transient.DEFAULT_TRANSIENT):
+    """:data:`LINEAR_STATES` with the tyre slots named for the transient form ``name``."""
+    return LINEAR_STATES[:-len(PATCH_STATES)] + tyre_state_names(name)
 
 
 def solve_pitch(rhs, x, tol=1e-14, max_iter=30):
@@ -699,8 +1118,10 @@ def linearize(rhs, x, step=1e-7, t=0.0):
     z0 = heading_state(x)
     x = solve_pitch(rhs, x)   # once for the reference; again only when a coordinate is perturbed
     J = np.empty((z0.size, z0.size))
+    # Tyre force states (force_lag) are ~100 N: a step 100 times larger.
+    force_scale = 1e2 if rhs.transient == "force_lag" else 1.0
     for j, name in enumerate(LINEAR_STATES):
-        h = step * max(1.0, abs(z0[j])) * (1e2 if name in TYRE_STATES else 1.0)
+        h = step * max(1.0, abs(z0[j])) * (force_scale if name in PATCH_STATES else 1.0)
         zp, zm = z0.copy(), z0.copy()
         zp[j] += h
         zm[j] -= h

@@ -98,6 +98,37 @@ def _entries():
         ("fyf", "front tyre lateral force on the wheel, along the front lateral axis", "N", s),
         ("mzr", "rear tyre self-aligning moment on the wheel about the downward normal", "N m", s),
         ("mzf", "front tyre self-aligning moment on the wheel about the downward normal", "N m", s),
+        # --- contact-patch tyre states (transients contact_patch and slip_lag) --
+        ("slip_patch_r", "rear tyre contact-patch (lagged) slip angle, + = patch sliding right", "rad", s),
+        ("slip_patch_f", "front tyre contact-patch (lagged) slip angle, + = patch sliding right", "rad", s),
+        ("camber_patch_r", "rear tyre contact-patch (lagged) camber angle, + = top leaning right", "rad", s),
+        ("camber_patch_f", "front tyre contact-patch (lagged) camber angle, + = top leaning right", "rad", s),
+        # --- cumulative work and dissipation (quadrature states, from 0 at the start) --
+        ("W_plate", "cumulative work of the kick plate on the bicycle (tyre force and rear no-slip constraint)", "J", s),
+        ("W_steer", "cumulative work of the steer torque T7 (T7 u7)", "J", s),
+        ("W_wheel", "cumulative work of the rear-wheel torque T6c (T6c u6)", "J", s),
+        ("W_zero_slip", "cumulative work of the tyres' zero-slip lateral forces F0 on the patch sliding velocity", "J", s),
+        ("W_moment", "cumulative work of the aligning moments (M_z times the wheel's rate about the ground normal)", "J", s),
+        ("D_slide", "cumulative sliding dissipation of the contact patches, -(F - F0) V'", "J", s),
+        ("D_damper", "cumulative dissipation of the vertical tyre dampers", "J", s),
+        ("E_carcass_r", "rear tyre carcass energy: integral of the power into the lateral carcass compliance", "J", s),
+        ("E_carcass_f", "front tyre carcass energy: integral of the power into the lateral carcass compliance", "J", s),
+        # --- tyre block: applied loads and its kinematic inputs (plain symbols) --
+        ("Fy_r", "lateral force the rear tyre applies to the wheel (along A.y), from the active transient form", "N", i),
+        ("Fy_f", "lateral force the front tyre applies to the wheel (along the front lateral axis)", "N", i),
+        ("Mz_r", "aligning moment the rear tyre applies to the wheel about the downward normal", "N m", i),
+        ("Mz_f", "aligning moment the front tyre applies to the wheel about the downward normal", "N m", i),
+        ("vsy_r", "lateral sliding velocity of the rear wheel's material contact point relative to the plate", "m/s", i),
+        ("vsy_f", "lateral sliding velocity of the front wheel's material contact point relative to the ground", "m/s", i),
+        ("vx_r", "rolling speed of the rear wheel centre relative to the plate, along the rear heading", "m/s", i),
+        ("vx_f", "rolling speed of the front wheel centre along the front heading", "m/s", i),
+        ("camber_r", "rear wheel camber angle, + = top leaning right", "rad", i),
+        ("camber_f", "front wheel camber angle, + = top leaning right", "rad", i),
+        ("fz_r", "rear tyre normal force (spring-damper, never pulling)", "N", i),
+        ("fz_f", "front tyre normal force (spring-damper, never pulling)", "N", i),
+        ("vplate_r", "kick-plate velocity along the rear lateral axis A.y", "m/s", i),
+        ("wz_r", "rear wheel angular velocity about the downward ground normal", "rad/s", i),
+        ("wz_f", "front wheel angular velocity about the downward ground normal", "rad/s", i),
     ]
     rows += [
         # --- slip model: tyre blending, friction, kick plate, controller -------
@@ -121,7 +152,9 @@ def _entries():
         ("ku3", "steer-torque feedback gain on yaw rate u3", "N m s/rad", c),
         ("ku4", "steer-torque feedback gain on roll rate u4", "N m s/rad", c),
         ("ku7", "steer-torque feedback gain on steer rate u7", "N m s/rad", c),
-        ("T6c", "constant rear-wheel drive torque holding the steady speed", "N m", c),
+        ("T6c", "constant rear-wheel torque holding the steady speed, about C.y (the rear frame's right-pointing "
+                "axis) on the wheel: + opposes forward rolling (a brake), - drives", "N m", c),
+        ("tyre_transient", "tyre transient form: 0 contact_patch (default), 1 slip_lag, 2 force_lag (thesis)", "-", c),
     ]
     fy_units = ["-", "N/kN^2", "N/kN", "N/deg", "kN", "1/deg", "1/kN", "-", "deg/deg", "deg/kN",
                 "deg", "N/(kN deg)", "N/kN", "N"]
@@ -156,7 +189,7 @@ SLIP_CONSTANTS = CLASSIC_CONSTANTS + (
     "rtr", "rtf", "kzr", "kzf", "czr", "czf", "sigr", "sigf",
     "wr", "wf", "mur", "muf", "lamr", "lamf",
     "kick_t0", "kick_T", "kick_D", "kick_profile", "kick_c0", "kick_c1", "kick_c2", "kick_c3",
-    "kq3", "kq4", "kq7", "ku3", "ku4", "ku7", "T6c",
+    "kq3", "kq4", "kq7", "ku3", "ku4", "ku7", "T6c", "tyre_transient",
 ) + tuple(f"{kind}{wheel}{k}_{i}" for wheel in "rf" for k in (1, 2)
           for kind, n in (("a", 14), ("c", 18)) for i in range(n))
 

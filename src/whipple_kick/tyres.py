@@ -16,6 +16,7 @@ OUTPUTS of the two bracketing measured coefficient sets linearly; see
 :attr:`Tyre.blend` for what a simulation must evaluate. docs/tyres.md has the
 data's provenance, the friction modes and the known limits of the fits.
 """
+import copy
 import math
 import pathlib
 import warnings
@@ -395,6 +396,26 @@ class Tyre:
                          f"(the thesis publishes M_z fits for T03 only); load it with "
                          f"missing_moment='zero' to use a zero aligning moment")
 
+    def without_offsets(self):
+        """A copy with the zero-slip offsets zeroed (as ``symmetric_tyres`` runs use it).
+
+        Example
+        -------
+        >>> import whipple_kick as wk
+        >>> float(wk.tyres.load("T03", 400).without_offsets().lateral_force(0.0, 0.0, 600.0))
+        0.0
+        """
+        twin = copy.copy(self)
+        twin._sets = []
+        for w, fy, mz in self._sets:
+            fy = fy.copy()
+            fy[list(mf.FY_OFFSET_INDICES)] = 0.0
+            if mz is not None:
+                mz = mz.copy()
+                mz[list(mf.MZ_OFFSET_INDICES)] = 0.0
+            twin._sets.append((w, fy, mz))
+        return twin
+
     # -- symbolic -------------------------------------------------------------
 
     def lateral_force_expression(self, slip, camber, fz):
@@ -447,6 +468,31 @@ class Tyre:
             w * mf.cornering_stiffness_numpy(fz, fy, self.friction_scale)
             for w, fy, _ in self._sets)
 
+    def secant_ratio(self, slip, fz):
+        """Secant ratio of the pure-slip lateral-force curve [-] (blended like the force).
+
+        ``g = F_sym(slip) / (C0 slip)`` with F_sym the curve at zero camber
+        without its zero-slip offsets and C0 its slope at zero: 1 at zero
+        slip, falling as the force saturates (:func:`magic_formula.lateral_secant_model`).
+        The contact-patch transient's relaxation length is the tyre's
+        ``relaxation_length`` times this (floored, :data:`whipple_kick.transient.G_MIN`).
+
+        Parameters
+        ----------
+        slip : array_like
+            Slip angle [rad].
+        fz : array_like
+            Normal load [N], > 0 (a shape: independent of the curve scale).
+        """
+        slip, _, fz = _finite_inputs(slip, 0.0, fz)
+        fz = _load(fz, "normal load fz", 0.0, low_open=True)
+        num = den = 0.0
+        for w, fy, _ in self._sets:
+            slope, ratio = mf.lateral_secant_numpy(slip, fz, fy, self.friction_scale)
+            num = num + w * slope * ratio
+            den = den + w * slope
+        return num / den
+
     def magic_formula_factors(self, fz, camber=0.0):
         """Magic Formula factors of F_y in the formula's units, at a measured pressure.
 
@@ -482,7 +528,11 @@ class LinearTyre:
     reaches, written as a Magic Formula with a huge peak factor so the slip
     model evaluates it unchanged. Made for checks against the no-slip
     (knife-edge) model: as the coefficient and the vertical stiffness grow
-    and the relaxation length shrinks, the slip model approaches it.
+    and the relaxation length shrinks, the slip model approaches it. It has
+    no friction limit: under large slip (the thesis kick's instant plate
+    stop) the contact-patch transient's force follows load spikes at once
+    and reaches tens of kN; use small kicks, or ``tyre_transient="force_lag"``,
+    for no-slip-limit checks.
 
     Attributes match those of :class:`Tyre` that the slip model reads.
     """
