@@ -12,7 +12,7 @@ __version__ = "0.1.0"
 _SUBMODULES = (
     "analysis", "benchmark", "bicycles", "cache", "classic", "cli", "codegen", "errors",
     "control", "derivation", "inputs", "integrate", "kane", "magic_formula", "parameters",
-    "plotting", "riders", "simulation", "slip", "sweep", "symbols", "tyres",
+    "plotting", "riders", "simulation", "slip", "steady", "sweep", "symbols", "tyres",
 )
 
 
