@@ -69,29 +69,30 @@ def envelope_cases():
 def envelope():
     print(f"slip model {simulation.model_hash()}\n")
     for rider, cases in envelope_cases():
-        counts = collections.Counter()
-        routes = collections.Counter()
-        unstable, slow, notes = 0, [], []
+        per_speed = collections.defaultdict(collections.Counter)
+        slow, notes = [], []
         for (v, p, fz), scenario in cases:
             status, summary, error, wall = outcome(scenario)
-            counts[status] += 1
+            row = per_speed[v]
+            row[status] += 1
             if summary is not None:
-                routes[summary["steady_state"]["found_by"].split(" (")[0].split(" started")[0]] += 1
-                unstable += not summary["linear_stability"]["stable"]
-                if status == "completed" and summary["recovery"]["time_s"] is None:
-                    counts["completed, not recovered in 6 s"] += 1
+                row["unstable"] += not summary["linear_stability"]["stable"]
+                row["turn"] += summary["steady_state"]["found_by"] != "direct"
+                row["recovered"] += summary["recovery"]["time_s"] is not None
             if status in ("failed", "no steady motion"):
                 notes.append(f"{v:g} m/s, {p:g} kPa, {fz:g} N: {error}")
             slow.append((wall, f"{v:g} m/s, {p:g} kPa, {fz:g} N ({status})"))
         slow.sort(reverse=True)
+        total = sum(per_speed.values(), collections.Counter())
         print(f"### {rider}: {len(cases)} cases\n")
-        print("| outcome | cases |\n|---|---|")
-        for key, n in sorted(counts.items()):
-            print(f"| {key} | {n} |")
-        print(f"| linearly unstable rider at the run's speed | {unstable} |")
-        for route, n in sorted(routes.items()):
-            print(f"| steady motion found: {route} | {n} |")
-        print(f"\nslowest runs: " + "; ".join(f"{w:.2f} s {label}" for w, label in slow[:3]))
+        print("| speed [m/s] | cases | completed (recovered in 6 s) | fell | failed | no steady motion | "
+              "steady motion not the direct solve | rider linearly unstable |\n|---|---|---|---|---|---|---|---|")
+        for v, row in sorted(per_speed.items()) + [("all", total)]:
+            n = sum(row[k] for k in ("completed", "fell", "failed", "no steady motion"))
+            label = v if v == "all" else f"{v:g}"
+            print(f"| {label} | {n} | {row['completed']} ({row['recovered']}) | {row['fell']} | {row['failed']} | "
+                  f"{row['no steady motion']} | {row['turn']} | {row['unstable']} |")
+        print("\nslowest runs: " + "; ".join(f"{w:.2f} s {label}" for w, label in slow[:3]))
         for note in notes:
             print(f"* {note}")
         print()
