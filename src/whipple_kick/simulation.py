@@ -837,7 +837,10 @@ def linear_stability(scenario, moore, gains, found, controller_type):
     classic = control.closed_loop_poles(moore, scenario.speed, gains)
     slip_poles = None
     if not gains.get("kq3", 0.0):
-        slip_poles = steady.lateral_poles(found.steady.params, found.steady.x)
+        try:
+            slip_poles = steady.lateral_poles(found.steady.params, found.steady.x)
+        except FloatingPointError:   # the linearisation's pitch solve failed: the classic model decides
+            slip_poles = None
     decisive, model = ((slip_poles, "slip model about the steady motion, constant speed")
                        if slip_poles is not None else (classic, "no-slip classic model"))
     slowest = decisive[0]

@@ -234,7 +234,20 @@ def lateral_poles(params, x):
     return poles[np.argsort(-poles.real, kind="stable")]
 
 
+def _poles_or_none(params, x, speed=None):
+    """:func:`lateral_poles` about ``x`` (or about the direct steady solve at ``speed``), None if that fails."""
+    try:
+        if x is None:
+            found = slip.steady_state(params, speed)
+            params, x = found.params, found.x
+        return lateral_poles(params, x)
+    except (FloatingPointError, InputError):
+        return None
+
+
 def _nearest_real_pole(poles):
+    if poles is None:
+        return None
     real = poles[np.abs(poles.imag) < 1e-9].real
     return float(real[np.argmin(np.abs(real))]) if real.size else None
 
@@ -246,27 +259,29 @@ def diagnosis(params, speed, last, fraction, advice=None, exhausted=False):
     offsets and ``fraction`` how far it got; ``exhausted`` that the search
     spent :data:`MAX_SOLVES`.
     """
-    symmetric = slip.steady_state(offset_scaled(params, 0.0), speed)
-    slowest = lateral_poles(symmetric.params, symmetric.x)[0]
-    stability = ("unstable" if slowest.real > 0 else "stable")
-    pole_text = f"{slowest.real:+.2f}" + (f" +- {abs(slowest.imag):.2f}j" if abs(slowest.imag) > 1e-9 else "")
     text = f"no steady motion at {speed:g} m/s: "
-    if last is None or fraction <= 0.0:
+    if (last is None or fraction <= 0.0) and exhausted:
+        text += f"the search stopped after {MAX_SOLVES} solves"
+    elif last is None or fraction <= 0.0:
         text += "not even with symmetric tyres"
     else:
         lean = math.degrees(last.unknowns["q4"])
-        near = _nearest_real_pole(lateral_poles(last.params, last.x))
+        near = _nearest_real_pole(_poles_or_none(last.params, last.x))
         text += (f"the closed loop cannot hold the steady turn the tyres' zero-slip offsets ask for "
                  f"(continued from symmetric tyres, the steady lean grows to {lean:+.1f} deg at "
                  f"{fraction:.0%} of the offsets")
         text += (f", where a real closed-loop pole has reached {near:+.3f} 1/s)" if near is not None else ")")
-    text += (f"; with symmetric tyres the rider's closed loop is {stability} at {speed:g} m/s "
-             f"(slowest pole {pole_text} 1/s)")
-    if TURN_LEANS_DEG:
+    poles = _poles_or_none(offset_scaled(params, 0.0), None, speed)
+    if poles is not None:
+        slowest = poles[0]
+        pole_text = f"{slowest.real:+.2f}" + (f" +- {abs(slowest.imag):.2f}j" if abs(slowest.imag) > 1e-9 else "")
+        text += (f"; with symmetric tyres the rider's closed loop is "
+                 f"{'unstable' if slowest.real > 0 else 'stable'} at {speed:g} m/s (slowest pole {pole_text} 1/s)")
+    if exhausted and last is not None and fraction > 0.0:
+        text += f"; the search stopped after {MAX_SOLVES} solves"
+    elif TURN_LEANS_DEG and not exhausted:
         text += (f"; nor from steady turns of {min(map(abs, TURN_LEANS_DEG)):g}-{max(TURN_LEANS_DEG):g} "
                  "deg of lean")
-    if exhausted:
-        text += f" (the search stopped after {MAX_SOLVES} solves)"
     if advice:
         text += f"; {advice}"
     return text
