@@ -73,12 +73,13 @@ class Budget:
     and ends as a failure. Deterministic (evaluations, not wall time).
 
     The defaults are set from measured runs (``scripts/envelope_study.py
-    budget``, docs/simulate.md "No run hangs"): no completed or falling run of the speed envelope, the kick,
-    tolerance and rider grids, a 151-row kick table or the thesis preset
-    spent more than 13 % of the limit at any point (the most: the thesis
-    preset falling at 1.92 m/s, rtol 1e-12, 42 779 evaluations in 2.95 s),
-    and none advanced less than 0.17 s in any 20 000 consecutive
-    evaluations, 170 times the stall threshold; the stalls found (a front
+    budget``, docs/simulate.md "No run hangs"): no completed or falling run
+    of the kick, tolerance and speed grids, a 151-row kick table or the
+    thesis preset spent more than 13 % of the limit at any point (the most:
+    the thesis preset falling at 1.92 m/s, rtol 1e-12, 42 779 evaluations in
+    2.95 s), and none advanced less than 0.17 s in any 20 000 consecutive
+    evaluations, 170 times the stall threshold; none of the 288 runs of the
+    speed envelope with the LQR riders tripped it. The stalls found (a front
     wheel unloading in a fall, steps of 1e-8 s) end after about 1-3 s of
     wall time.
 
