@@ -372,7 +372,7 @@ def _recommend(argv):
                     "steer rates all back within 5 %% of their first peaks) and says by how much the "
                     "best beats the second best, against the spread of the model itself.",
         epilog="Both tyres get the same pressure, as in the experiment. Every other setting is the "
-               "simulate default (LQR rider designed at 3 m/s, 3 m/s, 150 mm kick in 0.150 s, 6 s). "
+               "simulate default (3 m/s, LQR rider designed at that speed, 150 mm kick in 0.150 s, 6 s). "
                "See docs/sweeps.md.")
     p.add_argument("--fz", type=_number("N"), nargs="+", required=True, metavar="N",
                    help="static rear-tyre load(s) in N, e.g. --fz 570 635 701")
