@@ -156,7 +156,7 @@ def _continue(counter, solve_at, start, end, first_step):
 
 
 def find_steady_state(params, speed, *, advice=None):
-    """Steady motion at ``speed`` [m/s]: direct, then by continuation (see the module).
+    """Steady motion at ``speed`` [m/s]: the direct solve, then steady turns, then continuation (see the module).
 
     Parameters
     ----------
