@@ -46,7 +46,7 @@ def _figure(args, name, runs, title):
         result = run(scenario)
         s = result.summary
         outcome = f"fell at {s['fall_time_s']:.3f} s" if s["fell"] else "no fall"
-        print(f"  {name}: {label}: {outcome}; yaw-rate 5 % recovery "
+        print(f"  {name}: {label}: {outcome}; recovery (yaw, roll, steer rates within 5 %) "
               f"{s['recovery']['time_s']} s; {time.perf_counter() - t:.2f} s", file=sys.stderr)
         results.append((label, result))
     first = results[0][1].summary["kick"]

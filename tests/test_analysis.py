@@ -63,7 +63,7 @@ def test_damped_sine_peaks_times_and_values():
     assert np.all(np.sign(p.values[1:]) == -np.sign(p.values[:-1]))
     # indices point at the sample nearest each peak
     np.testing.assert_allclose(t[p.indices], times, atol=0.5e-3 + 1e-12)
-    assert an.recovery_time(p) == pytest.approx(times[-1] - 0.2, abs=1e-5)
+    assert an.last_peak_time(p) == pytest.approx(times[-1] - 0.2, abs=1e-5)
 
 
 @pytest.mark.parametrize("pair", an.PEAK_PAIRS)
@@ -172,13 +172,13 @@ def test_pre_kick_baseline_removes_a_bias():
 
 
 def test_no_oscillation_gives_one_peak_and_explicit_reasons():
-    # A single overdamped lobe: one peak, recovery time defined, no decrement.
+    # A single overdamped lobe: one peak, last-peak time defined, no decrement.
     t = np.arange(-0.2, 3.0, 1e-3)
     tau = np.clip(t, 0, None)
     x = tau * np.exp(-tau / 0.1)
     m = an.kick_metrics({"time": t, "yaw_rate": x})
     assert m["n_peaks"] == 1 and m["peak_stop_reason"] == "decayed"
-    assert m["recovery_time"] == pytest.approx(0.1, abs=1e-5)  # peak of tau exp(-tau/0.1)
+    assert m["last_peak_time"] == pytest.approx(0.1, abs=1e-5)  # peak of tau exp(-tau/0.1)
     for key in ("log_decrement_1_3", "damping_ratio_2_4", "period_3_5", "period"):
         assert m[key] is None
         assert "only 1 peaks" in m["unavailable"][key]
@@ -188,7 +188,7 @@ def test_flat_signal_reports_no_peaks_and_no_nan():
     t = np.linspace(0.0, 1.0, 101)
     m = an.kick_metrics({"time": t, "yaw_rate": np.zeros_like(t)})
     assert m["n_peaks"] == 0 and m["peak_stop_reason"] == "no_peaks"
-    assert m["recovery_time"] is None and "no yaw-rate peak" in m["unavailable"]["recovery_time"]
+    assert m["last_peak_time"] is None and "no yaw-rate peak" in m["unavailable"]["last_peak_time"]
     scalars = [v for k, v in m.items() if isinstance(v, float)]
     assert all(math.isfinite(v) for v in scalars)
 
@@ -211,12 +211,12 @@ def test_quiet_tail_shorter_than_a_period_is_not_trusted():
     assert len(p) == 3 and p.stop_reason == "end_of_record"
 
 
-def test_record_ending_mid_oscillation_has_no_recovery_time():
+def test_record_ending_mid_oscillation_has_no_last_peak_time():
     t = np.arange(0.0, 1.0, 1e-3)
     p = an.yaw_rate_peaks(t, np.sin(2 * math.pi * 5.3 * t))
     assert p.stop_reason == "end_of_record"
     with pytest.raises(an.MetricUnavailable, match="record ends"):
-        an.recovery_time(p)
+        an.last_peak_time(p)
 
 
 def test_log_decrement_and_damping_ratio_formulas():
@@ -363,3 +363,67 @@ def test_bad_series():
         an.yaw_rate_peaks(t[::-1], damped(t))
     with pytest.raises(InputError, match="'yaw_rate'"):
         an.kick_metrics({"time": t})
+
+
+# --------------------------------------------------------------- settling and recovery
+
+def _exact_settling(t_kick, fraction=0.05):
+    """Settling time of ``damped`` from the continuous signal: where the last lobe whose peak
+    exceeds ``fraction`` of the first falls through the band (Brent's method on the formula)."""
+    from scipy.optimize import brentq
+    times, values = exact_peaks(40, t_kick)
+    band = fraction * abs(values[0])
+    k = np.flatnonzero(np.abs(values) > band)[-1]
+    zero = t_kick + (k + 1) * math.pi / WD          # the zero crossing after peak k
+    return brentq(lambda s: abs(damped(np.array([s]), t_kick)[0]) - band, times[k], zero - 1e-12) - t_kick
+
+
+@pytest.mark.parametrize("t_kick", [0.0, 0.2137])
+def test_settling_time_of_a_damped_sine_against_the_continuous_signal(t_kick):
+    # Sampled at 1 kHz, the settling time is the first sample after the continuous crossing:
+    # within one sample interval (1 ms) after it.
+    t = np.arange(-0.3, 4.0, 1e-3)
+    s = an.settling_time(t, damped(t, t_kick), t_kick)
+    exact = _exact_settling(t_kick)
+    assert s.reason is None
+    assert s.first_peak == pytest.approx(abs(exact_peaks(1, t_kick)[1][0]), rel=1e-5)
+    assert 0.0 <= s.time - exact <= 1e-3 + 1e-9
+
+
+def test_settling_time_uses_the_baseline_and_the_first_large_peak():
+    # A small ripple (30 % of the main lobe) first: the first peak is the main lobe's
+    # (the first reaching half the largest), so the band is 5 % of 1.0, not of 0.3.
+    t, x, centres = lobes([0.3, -1.0, 0.5, -0.2, 0.04, -0.01])
+    s = an.settling_time(t, x + 2.0, baseline=2.0)
+    assert s.first_peak == pytest.approx(1.0, rel=1e-5)
+    # Lobe 4 (0.2) is the last above 0.05: it drops below the band 0.05 at
+    # sin(pi tau / 0.1) = 0.25 on its falling side.
+    lobe4_end = centres[3] + 0.05
+    expected = lobe4_end - math.asin(0.25) * 0.1 / math.pi
+    assert s.time == pytest.approx(expected, abs=1e-3)
+
+
+def test_signal_that_never_settles_or_never_moves():
+    t = np.arange(0.0, 2.25, 1e-3)      # ends at a trough of the undamped sine
+    s = an.settling_time(t, np.sin(2 * math.pi * t), label="roll rate")
+    assert s.time is None and "roll rate still outside 5% of its first peak at the end" in s.reason
+    flat = an.settling_time(t, np.zeros_like(t), label="steer rate")
+    assert flat.time is None and flat.first_peak is None and "no steer rate peak" in flat.reason
+
+
+def test_recovery_is_the_latest_of_yaw_roll_and_steer_settling():
+    t = np.arange(-0.2, 4.0, 1e-3)
+    yaw, roll = damped(t), 0.5 * damped(t)
+    steer = np.where(t > 0, np.exp(-8 * np.clip(t, 0, None)) * np.sin(30 * t), 0.0)   # settles first
+    rec = an.recovery({"time": t, "yaw_rate": yaw, "roll_rate": roll, "steer_rate": steer}, 0.0,
+                      {"yaw_rate": 0.0})
+    sig = rec["signals"]
+    assert sig["yaw_rate"]["time_s"] == sig["roll_rate"]["time_s"] == rec["time_s"]   # same shape, same time
+    assert sig["steer_rate"]["time_s"] < rec["time_s"] and rec["last_to_settle"] == "yaw_rate"
+    assert rec["time_s"] == pytest.approx(_exact_settling(0.0), abs=1e-3)
+    # A record that cannot show a recovery (a fall) keeps the peaks but no times.
+    fell = an.recovery({"time": t, "yaw_rate": yaw, "roll_rate": roll, "steer_rate": steer}, ended="fell")
+    assert fell["time_s"] is None and fell["reason"] == "fell"
+    assert all(v["time_s"] is None and v["first_peak_rad_s"] > 0 for v in fell["signals"].values())
+    with pytest.raises(InputError, match="'steer_rate'"):
+        an.recovery({"time": t, "yaw_rate": yaw, "roll_rate": roll})

@@ -96,3 +96,21 @@ def test_malformed_file_is_an_input_error_naming_file_and_key(tmp_path, edit, me
     with pytest.raises(InputError, match=message) as info:
         wk.bicycles.load(str(path))
     assert "broken.toml" in str(info.value) and "\n" not in str(info.value)
+
+
+def test_authors_presets_carry_the_load_they_are_labelled_with():
+    """Thesis Table 8.3's rider B and C loads select the Table 8.4 gains of the presets with rider."""
+    assert wk.bicycles.load("balanceassist_635N").thesis_rear_load_n == 635.0
+    assert wk.bicycles.load("balanceassist_701N").thesis_rear_load_n == 701.0
+    assert wk.bicycles.load("browser_with_rider").thesis_rear_load_n is None
+    assert wk.bicycles.load("balanceassist_v1").thesis_rear_load_n is None
+
+
+def test_a_load_label_needs_a_set_with_rider(tmp_path):
+    path = tmp_path / "labelled.toml"
+    text = GOOD.replace('includes_rider = true', 'includes_rider = false\nthesis_rear_load = { value = 635.0, '
+                        'unit = "N", source = "meijaard2007" }')
+    assert text != GOOD
+    path.write_text(text)
+    with pytest.raises(InputError, match="thesis_rear_load labels a set that includes its rider"):
+        wk.bicycles.load(str(path))

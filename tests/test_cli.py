@@ -6,6 +6,8 @@ import sys
 
 import pytest
 
+import whipple_kick as wk
+
 from whipple_kick.cli import simulate_main
 
 
@@ -126,6 +128,11 @@ BAD_INPUTS = {
     "front-without-rear": (["--pressure-front", "300"], ["--pressure-rear"]),
     "gain-scale-with-controller-off": (["--controller", "off", "--gain-scale", "0.5"], ["0.5", "off"]),
     "thesis-gains-unknown-load": (["--controller", "thesis", "--fz", "600"], ["600", "570, 635 and 701 N"]),
+    "thesis-load-unknown": (["--controller", "thesis", "--thesis-load", "600"], ["600", "570, 635 and 701 N"]),
+    "thesis-gains-preset-without-label": (["--bicycle", "browser_with_rider", "--controller", "thesis"],
+                                          ["570, 635 or 701 N", "--thesis-load"]),
+    "malformed-design-speed": (["--design-speed", "x"], ["--design-speed", "m/s"]),
+    "zero-design-speed": (["--design-speed", "0"], ["design speed = 0.0 m/s", "(0, 15] m/s"]),
     "preset-with-rider-and-load": (["--bicycle", "balanceassist_635N", "--fz", "635"], ["already includes"]),
     "unknown-profile": (["--kick-profile", "fast"], ["--kick-profile", "'fast'", "constant", "smooth", "table"]),
     "table-profile-without-file": (["--kick-profile", "table"], ["--kick-profile table", "--kick-table FILE"]),
@@ -279,3 +286,69 @@ def test_animate_without_an_encoder_writes_a_gif(tmp_path, capsys, monkeypatch):
     with Image.open(out / "animation.gif") as image:
         assert image.n_frames == 16 and image.size == (640, 360)
     assert "whipple_kick[video]" in stdout
+
+
+def test_rider_is_designed_at_the_run_speed_unless_told(tmp_path, capsys):
+    out = tmp_path / "adaptive"
+    status, stdout, err = _simulate(["--speed", "2.5", "--duration", "0.5", "--no-plot", "--out", str(out)], capsys)
+    assert status == 0 and err == ""
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["controller"]["design_speed_m_s"] == 2.5 and summary["linear_stability"]["stable"]
+    assert "designed at 2.5 m/s" in stdout
+
+
+def test_unstable_rider_is_one_printed_line(tmp_path, capsys):
+    """The thesis' 3 m/s design at 2 m/s: the run goes on, one warning line says the rider is
+    linearly unstable there, and summary.json says so too."""
+    out = tmp_path / "fixed"
+    status, stdout, err = _simulate(["--speed", "2", "--design-speed", "3", "--duration", "0.5", "--no-plot",
+                                     "--quiet", "--out", str(out)], capsys)
+    assert status == 0 and stdout == ""
+    assert err.count("\n") == 1 and err.startswith("simulate: warning: ")
+    assert "designed at 3 m/s is linearly unstable at 2 m/s" in err
+    summary = json.loads((out / "summary.json").read_text())
+    assert not summary["linear_stability"]["stable"]
+    assert summary["linear_stability"]["message"] in err
+
+
+@pytest.mark.parametrize("argv, row", [
+    (["--bicycle", "balanceassist_701N"], 701),                            # the preset's label
+    (["--bicycle", "balanceassist_701N", "--thesis-load", "635"], 635),    # the flag decides
+])
+def test_thesis_rider_from_the_command_line(argv, row, tmp_path, capsys):
+    out = tmp_path / "thesis"
+    status, _, err = _simulate(argv + ["--controller", "thesis", "--duration", "0.3", "--no-plot", "--quiet",
+                                       "--out", str(out)], capsys)
+    assert status == 0, err
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["controller"]["gains"] == wk.control.thesis_gains(row)
+    assert summary["controller"]["design_speed_m_s"] == 3.0
+
+
+def test_no_steady_motion_is_one_physical_line_and_status_2(tmp_path, capsys, monkeypatch):
+    """The issue's case (2.6 m/s with the rider designed at 3 m/s) when only the direct solve and the
+    continuation in the tyre offsets are tried: that branch folds, and the message says so in
+    physical terms, never with scipy's words."""
+    monkeypatch.setattr(wk.steady, "TURN_LEANS_DEG", ())
+    monkeypatch.setattr(wk.steady, "NEIGHBOUR_STEPS", ())
+    monkeypatch.chdir(tmp_path)
+    status, stdout, err = _simulate(["--speed", "2.6", "--design-speed", "3", "--quiet"], capsys)
+    assert status == 2 and stdout == ""
+    assert err.count("\n") == 1 and "Traceback" not in err
+    for fragment in ("no steady motion at 2.6 m/s", "zero-slip offsets", "real closed-loop pole",
+                     "designed at 3 m/s", "--design-speed"):
+        assert fragment in err, (fragment, err)
+    assert "progress" not in err and "iteration" not in err     # scipy's "not making good progress"
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_numerical_failure_keeps_the_partial_run(tmp_path, capsys, monkeypatch):
+    monkeypatch.setattr(wk.integrate, "DEFAULT_BUDGET", wk.integrate.Budget(allowance=1000, per_second=1000.0))
+    out = tmp_path / "stalled"
+    status, stdout, err = _simulate(["--duration", "2", "--no-plot", "--out", str(out)], capsys)
+    assert status == 1 and stdout == ""
+    assert err.count("\n") == 1 and err.startswith("simulate: numerical failure: ") and str(out) in err
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["outcome"] == "failed" and summary["end_time_s"] < 2.0
+    rows = (out / "trajectory.csv").read_text().splitlines()
+    assert len(rows) > 2

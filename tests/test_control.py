@@ -293,3 +293,29 @@ def test_heading_lqr_input_errors(combined):
         control.heading_lqr_gains(combined[635], DESIGN_SPEED, Q=np.eye(4))
     with pytest.raises(InputError, match="design speed"):
         control.heading_lqr_gains(combined[635], 0.0)
+
+
+def test_closed_loop_poles_by_name_agree_with_the_matrix_forms(combined):
+    """The rider's poles at any speed: the four-gain law is closed_loop_matrix; a yaw-rate gain folds
+    into it through the rolling kinematics; a yaw-angle gain adds the heading as a fifth state whose
+    pole, as that gain goes to 0, goes to 0 (the heading is then free) leaving the four-state poles."""
+    moore = combined[635]
+    gains = control.gains_dict(control.lqr_gains(moore, 3.0)[0])
+    K = [gains[name] for name in control.GAIN_ORDER]
+    for speed in (2.0, 3.0, 6.0):
+        poles = control.closed_loop_poles(moore, speed, gains)
+        expected = np.linalg.eigvals(control.closed_loop_matrix(moore, speed, K))
+        np.testing.assert_allclose(np.sort_complex(poles), np.sort_complex(expected), rtol=1e-12)
+        assert np.all(np.diff(poles.real) <= 0.0)
+    yaw = classic.yaw_rate_map(moore, 3.0)
+    with_ku3 = control.closed_loop_poles(moore, 3.0, {**gains, "ku3": 0.7})
+    folded = np.linalg.eigvals(control.closed_loop_matrix(moore, 3.0, np.array(K) + 0.7 * yaw))
+    np.testing.assert_allclose(np.sort_complex(with_ku3), np.sort_complex(folded), rtol=1e-12)
+    tiny = control.closed_loop_poles(moore, 3.0, {**gains, "kq3": -1e-9})
+    assert tiny.size == 5 and np.min(np.abs(tiny)) < 1e-8
+    np.testing.assert_allclose(np.sort_complex(tiny[np.abs(tiny) > 1e-8]),
+                               np.sort_complex(control.closed_loop_poles(moore, 3.0, gains)), rtol=1e-6)
+    # The heading-holding LQR's own design poles are what closed_loop_poles gives for its gains.
+    K5, design_poles = control.heading_lqr_gains(moore, 3.0)
+    heading = control.closed_loop_poles(moore, 3.0, dict(zip(control.HEADING_GAIN_ORDER, K5)))
+    np.testing.assert_allclose(np.sort_complex(heading), np.sort_complex(design_poles), rtol=1e-9)

@@ -11,8 +11,9 @@ __version__ = "0.1.0"
 
 _SUBMODULES = (
     "analysis", "animation", "benchmark", "bicycles", "cache", "classic", "cli", "codegen", "energy",
-    "errors", "control", "derivation", "geometry", "inputs", "integrate", "kane", "magic_formula",
-    "parameters", "plotting", "riders", "simulation", "slip", "sweep", "symbols", "transient", "tyres",
+    "errors", "control", "derivation", "geometry", "integrate", "kane", "magic_formula",
+    "parameters", "plotting", "riders", "simulation", "slip", "steady", "sweep", "symbols", "transient",
+    "tyres",
 )
 
 

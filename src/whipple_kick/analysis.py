@@ -9,7 +9,13 @@ reduced to numbers in exactly the same way. Definitions (see
   per half-wave ("lobe" between zero crossings). Peak #1 is the first one
   whose magnitude reaches ``threshold`` x the largest; detection stops at the
   first later peak whose magnitude is below that (8 % in the thesis).
-* **Recovery time.** Time of the last such peak *relative to the kick*.
+* **Last-peak time** (the thesis' "recovery time", Tables 8.6-8.8). Time of
+  the last such peak *relative to the kick*. Not a recovery time: the
+  signal may still be at half its first peak then.
+* **Settling time** (:func:`settling_time`). Time after the kick from which
+  |signal - steady| stays within 5 % of the signal's first peak; the
+  **recovery time** (:func:`recovery`) is when yaw, roll and steer rates
+  have all settled. The one definition of recovery in whipple_kick.
 * **Logarithmic decrement** (eq. 8.2) ``delta = (1/n) ln(|U0| / |Un|)``
   between same-sign peaks #k and #(k+2), which are one period apart, so
   ``n = 1``; **damping ratio** (eq. 8.3) ``zeta = delta / sqrt(4 pi^2 + delta^2)``.
@@ -53,7 +59,7 @@ METRIC_UNITS = {
     "peak_times": "s from kick",
     "peak_values": "rad/s",
     "peak_stop_reason": "-",
-    "recovery_time": "s from kick",
+    "last_peak_time": "s from kick",
     "log_decrement_1_3": "-", "damping_ratio_1_3": "-", "period_1_3": "s",
     "log_decrement_2_4": "-", "damping_ratio_2_4": "-", "period_2_4": "s",
     "log_decrement_3_5": "-", "damping_ratio_3_5": "-", "period_3_5": "s",
@@ -65,6 +71,14 @@ METRIC_UNITS = {
 
 #: Peak pairs of the thesis' Tables 8.6-8.8, as (first, second) peak numbers.
 PEAK_PAIRS = ((1, 3), (2, 4), (3, 5))
+
+#: Recovery: |signal - steady| stays within this fraction of the signal's first peak.
+SETTLING_FRACTION = 0.05
+#: A signal's first peak is the first extremum of |signal - steady| after the kick that reaches
+#: this fraction of the largest (a smaller lobe before it is a ripple, not the response).
+FIRST_PEAK_FRACTION = 0.5
+#: Signals that must all have settled for the bicycle to have recovered, with their units.
+RECOVERY_SIGNALS = {"yaw_rate": "rad/s", "roll_rate": "rad/s", "steer_rate": "rad/s"}
 
 #: Relative spread of sample intervals below which sampling counts as uniform.
 _UNIFORM_RTOL = 1e-3
@@ -316,8 +330,12 @@ def yaw_rate_peaks(t, signal, t_kick=0.0, threshold=0.08, *, hysteresis=None,
     return PeakSeries(tp, v, i.astype(int) + first, t_kick, largest, threshold, reason)
 
 
-def recovery_time(peaks):
+def last_peak_time(peaks):
     """Time of the last peak relative to the kick [s] (Tables 8.6-8.8, first row).
+
+    The thesis calls it the recovery time; it is the time of the last peak
+    above the stopping threshold (8 %), not a time from which the signal
+    stays small (that is :func:`settling_time`).
 
     Raises
     ------
@@ -385,6 +403,144 @@ def peak_pair_metrics(peaks, first, second):
     delta = log_decrement(peaks.values[first - 1], peaks.values[second - 1], n)
     return {"log_decrement": delta, "damping_ratio": damping_ratio(delta),
             "period": float(peaks.times[second - 1] - peaks.times[first - 1]) / n}
+
+
+# --------------------------------------------------------------------------
+# settling and recovery
+# --------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Settling:
+    """Result of :func:`settling_time`.
+
+    Attributes
+    ----------
+    time : float or None
+        Settling time [s from the kick], None when the signal does not settle in the record.
+    first_peak : float or None
+        |signal - baseline| at its first peak (signal units), None without a peak.
+    reason : str or None
+        Why ``time`` is None.
+    """
+
+    time: float | None
+    first_peak: float | None
+    reason: str | None
+
+
+def settling_time(t, signal, t_kick=0.0, baseline=0.0, *, fraction=SETTLING_FRACTION,
+                  first_peak_fraction=FIRST_PEAK_FRACTION, label="signal"):
+    """Time after the kick from which |signal - baseline| stays within ``fraction`` of its first peak.
+
+    The first peak is the first extremum of the deviation after the kick
+    (:func:`yaw_rate_peaks` with ``threshold=first_peak_fraction``) that
+    reaches ``first_peak_fraction`` of the largest. The settling time is the
+    first sample time after the last sample outside the band, minus
+    ``t_kick``; a signal still outside the band at the last sample has not
+    settled in the record.
+
+    Parameters
+    ----------
+    t, signal : array_like
+        Strictly increasing time [s] and the signal.
+    t_kick : float
+        Kick time [s].
+    baseline : float
+        Steady value of the signal (signal units).
+    fraction : float
+        Half-width of the band, as a fraction of the first peak (default 5 %).
+    first_peak_fraction : float
+        See above (default 0.5).
+    label : str
+        Name of the signal in the reasons.
+
+    Returns
+    -------
+    Settling
+
+    Example
+    -------
+    >>> import numpy as np
+    >>> t = np.arange(0.0, 6.0, 1e-3)
+    >>> x = np.exp(-t) * np.sin(2 * np.pi * t)      # first peak 0.79 at 0.23 s
+    >>> round(settling_time(t, x).time, 3)          # |x| <= 5 % of it from 2.877 s on
+    2.877
+    """
+    t, x = _as_series(t, signal, label)
+    fraction = check_range("settling band fraction", fraction, 0.0, 1.0, "(of the first peak)", low_open=True)
+    if t[-1] <= t_kick:
+        return Settling(None, None, f"the record ends before the kick (t = {t[-1]:.3f} s)")
+    peaks = yaw_rate_peaks(t, x, t_kick, threshold=first_peak_fraction, baseline=baseline)
+    if len(peaks) == 0:
+        return Settling(None, None, f"no {label} peak after the kick")
+    peak = float(abs(peaks.values[0]))
+    outside = np.flatnonzero((t >= t_kick) & (np.abs(x - baseline) > fraction * peak))
+    if outside.size and outside[-1] == t.size - 1:
+        return Settling(None, peak, f"{label} still outside {fraction:.0%} of its first peak at the end "
+                                    f"of the record ({t[-1] - t_kick:.3f} s after the kick)")
+    j = outside[-1] + 1 if outside.size else int(np.searchsorted(t, t_kick))
+    return Settling(float(t[j] - t_kick), peak, None)
+
+
+def recovery(data, t_kick=0.0, baselines=None, *, ended=None):
+    """Recovery after a kick: when yaw, roll and steer rates have all settled.
+
+    Each signal of :data:`RECOVERY_SIGNALS` is judged by :func:`settling_time`
+    (5 % of its own first peak); the recovery time is the latest of the
+    three. This is the one definition of recovery the simulation summary,
+    the sweep table, the pressure recommender and the command line use.
+
+    Parameters
+    ----------
+    data : pandas.DataFrame or dict of arrays
+        ``time`` and the :data:`RECOVERY_SIGNALS` columns (SI units).
+    t_kick : float
+        Kick time [s].
+    baselines : dict, optional
+        Steady value of each signal (default 0).
+    ended : str, optional
+        Why the record cannot show a recovery although it has peaks (e.g.
+        "fell 1.345 s after the kick", "integration failed"): every settling
+        time is then None with this reason.
+
+    Returns
+    -------
+    dict
+        ``definition``; ``time_s`` (latest settling time, or None) and
+        ``reason``; ``last_to_settle`` (signal name or None); ``signals``:
+        per signal ``first_peak_<unit>``, ``time_s``, ``reason``.
+
+    Example
+    -------
+    >>> import numpy as np
+    >>> t = np.arange(0.0, 6.0, 1e-3)
+    >>> x = np.exp(-t) * np.sin(2 * np.pi * t)
+    >>> rec = recovery({"time": t, "yaw_rate": x, "roll_rate": x, "steer_rate": 0.5 * x})
+    >>> round(rec["time_s"], 3), rec["signals"]["steer_rate"]["time_s"] == rec["time_s"]
+    (2.877, True)
+    """
+    baselines = dict(baselines or {})
+    signals = {}
+    for name, unit in RECOVERY_SIGNALS.items():
+        if name not in data:
+            raise InputError(f"column {name!r} ({unit}) is missing; recovery needs "
+                             f"{', '.join(RECOVERY_SIGNALS)}")
+        s = settling_time(np.asarray(data["time"], dtype=float), np.asarray(data[name], dtype=float),
+                          t_kick, float(baselines.get(name, 0.0)), label=name.replace("_", " "))
+        time, reason = (None, ended) if ended is not None else (s.time, s.reason)
+        signals[name] = {f"first_peak_{unit.replace('/', '_')}": s.first_peak, "time_s": time, "reason": reason}
+    unsettled = [name for name, v in signals.items() if v["time_s"] is None]
+    if unsettled:
+        time, last = None, None
+        reason = ended if ended is not None else "not settled within the run: " + "; ".join(
+            signals[name]["reason"] for name in unsettled)
+    else:
+        last = max(signals, key=lambda name: signals[name]["time_s"])
+        time, reason = signals[last]["time_s"], None
+    return {"definition": (f"time after the kick from which |signal - steady| stays within "
+                           f"{SETTLING_FRACTION:.0%} of the signal's first peak, for each of "
+                           f"{', '.join(RECOVERY_SIGNALS)}; recovered when all three have settled"),
+            "time_s": time, "reason": reason, "last_to_settle": last, "signals": signals}
 
 
 # --------------------------------------------------------------------------
@@ -544,7 +700,7 @@ def kick_metrics(data, t_kick=0.0, threshold=0.08, *, baseline=0.0, lowpass_hz=N
             return
         out.update(zip(keys, values))
 
-    attempt(["recovery_time"], lambda: [recovery_time(peaks)])
+    attempt(["last_peak_time"], lambda: [last_peak_time(peaks)])
     for a, b in PEAK_PAIRS:
         suffix = f"_{a}_{b}"
         attempt(["log_decrement" + suffix, "damping_ratio" + suffix, "period" + suffix],

@@ -58,7 +58,7 @@ SEATING_UNITS = {
 }
 
 _TOP_KEYS = {"format", "name", "parameterisation", "includes_rider", "description",
-             "sources", "parameters", "seating", "tyre_placeholders"}
+             "thesis_rear_load", "sources", "parameters", "seating", "tyre_placeholders"}
 
 
 class Bicycle(Mapping):
@@ -93,11 +93,15 @@ class Bicycle(Mapping):
     rider : Mapping or None
         For a bicycle built by :func:`whipple_kick.riders.seat`: the rider's
         name, mass [kg], height [m] and its own benchmark-form inertia.
+    thesis_rear_load_n : float or None
+        For the authors' presets with rider: the rear-tyre load [N] the set
+        is labelled with (thesis Table 8.3), which selects the Table 8.4
+        gains; None otherwise.
     """
 
     def __init__(self, *, name, benchmark=None, moore=None, parameterisation,
                  includes_rider, source, description="", uncertainties=None,
-                 geometry=None, tyre_placeholders=None, rider=None):
+                 geometry=None, tyre_placeholders=None, rider=None, thesis_rear_load_n=None):
         if (benchmark is None) == (moore is None):
             raise InputError(f"bicycle {name!r}: give exactly one of benchmark or moore parameters")
         if benchmark is not None:
@@ -119,6 +123,7 @@ class Bicycle(Mapping):
         self.geometry = None if geometry is None else types.MappingProxyType(dict(geometry))
         self.tyre_placeholders = types.MappingProxyType(dict(tyre_placeholders or {}))
         self.rider = None if rider is None else types.MappingProxyType(dict(rider))
+        self.thesis_rear_load_n = None if thesis_rear_load_n is None else float(thesis_rear_load_n)
 
     def __getitem__(self, key):
         return self._moore[key]
@@ -269,6 +274,14 @@ def _parse(path, data):
                                      complete=True)
         _positive(path, geometry, SEATING_UNITS, SEATING_UNITS)
         unc.update({f"seating.{k}": v for k, v in geo_unc.items()})
+    label = None
+    if "thesis_rear_load" in data:
+        if not data["includes_rider"]:
+            raise InputError(f"{path}: thesis_rear_load labels a set that includes its rider; "
+                             "this set has includes_rider = false")
+        label = _entries(path, "top level", {"thesis_rear_load": data["thesis_rear_load"]},
+                         {"thesis_rear_load": "N"}, sources, complete=True)[0]["thesis_rear_load"]
+        _positive(path, {"thesis_rear_load": label}, ("thesis_rear_load",), {"thesis_rear_load": "N"})
     tyres = None
     if "tyre_placeholders" in data:
         tyres, _ = _entries(path, "tyre_placeholders", data["tyre_placeholders"], None, sources,
@@ -296,4 +309,5 @@ def _parse(path, data):
         uncertainties=unc,
         geometry=geometry,
         tyre_placeholders=tyres,
+        thesis_rear_load_n=label,
     )

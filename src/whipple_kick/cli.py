@@ -81,7 +81,8 @@ def _simulate_parser():
                     "animation.mp4).",
         epilog="Time is measured from the kick start. Defaults are the thesis' settings: "
                "balanceassist_v1 + Yeadon rider for 635 N on the rear tyre, T03 at 400 kPa, 3 m/s, "
-               "LQR designed at 3 m/s, 150 mm kick in 0.150 s (13.3 m/s^2), 6 s. See docs/simulate.md.")
+               "LQR designed at the run's speed (the thesis: 3 m/s), 150 mm kick in 0.150 s (13.3 m/s^2), 6 s. "
+               "See docs/simulate.md.")
     g = p.add_argument_group("tyres")
     g.add_argument("--pressure", type=_number("kPa"), metavar="KPA",
                    help="inflation pressure of both tyres in kPa (default 400)")
@@ -119,8 +120,12 @@ def _simulate_parser():
     g.add_argument("--controller", choices=simulation.CONTROLLERS, default="lqr",
                    help="lqr: designed on the linearised classic model (default); thesis: Table 8.4 "
                         "gains (570, 635, 701 N only); off: no steer torque")
-    g.add_argument("--design-speed", type=_number("m/s"), default=3.0, metavar="M/S",
-                   help="LQR design speed in m/s (default 3)")
+    g.add_argument("--design-speed", type=_number("m/s"), metavar="M/S",
+                   help="LQR design speed in m/s (default: the run's --speed, as a real rider adapts; "
+                        "the thesis fixed it at 3)")
+    g.add_argument("--thesis-load", type=_number("N"), metavar="N",
+                   help="rear load in N whose Table 8.4 gains --controller thesis uses (570, 635 or 701; "
+                        "default --fz, or the load a preset with rider is labelled with)")
     g.add_argument("--gain-scale", type=_number("factor"), default=1.0, metavar="FACTOR",
                    help="multiply every controller gain (default 1; the thesis also ran 0.5)")
     g = p.add_argument_group("kick")
@@ -218,7 +223,8 @@ def _scenario_from_args(args):
         pressure_front_kpa=args.pressure_front, pressure_rear_kpa=args.pressure_rear,
         coefficient_set=args.coefficient_set, friction=args.friction,
         symmetric_tyres=args.symmetric_tyres, speed=args.speed, controller=args.controller,
-        design_speed=args.design_speed, gain_scale=args.gain_scale, low_inertia=args.low_inertia,
+        design_speed=args.design_speed, thesis_load_n=args.thesis_load, gain_scale=args.gain_scale,
+        low_inertia=args.low_inertia,
         kick_displacement=0.150 if args.kick_displacement is None else args.kick_displacement,
         kick_duration=args.kick_duration, kick_accel=args.kick_accel,
         kick_profile="constant" if profile is None else profile, kick_table=args.kick_table,
@@ -277,7 +283,8 @@ def _print_summary(result, out, files):
           f"rear/front ({sc['coefficient_set']}, friction {sc['friction']}, transient {sc['tyre_transient']}), "
           f"{bike['bicycle']}, rear load "
           f"{bike['static_load_rear_n']:.1f} N{rider}, {sc['speed']:g} m/s")
-    print(f"  controller {ctl['type']} x{ctl['gain_scale']:g}: {gains}")
+    design = f", designed at {ctl['design_speed_m_s']:g} m/s" if ctl["design_speed_m_s"] is not None else ""
+    print(f"  controller {ctl['type']} x{ctl['gain_scale']:g}{design}: {gains}")
     if "table" in kick:
         tab = kick["table"]
         print(f"  kick: table {tab['file']} ({tab['rows']} rows), net {kick['displacement_m'] * 1e3:+.0f} mm "
@@ -287,21 +294,22 @@ def _print_summary(result, out, files):
         print(f"  kick: {abs(kick['displacement_m']) * 1e3:.0f} mm {kick['direction']} in {kick['duration_s']:.3f} s "
               f"(peak {kick['peak_acceleration_m_s2']:.1f} m/s^2, {kick['profile']} profile) at t = 0 s")
     print(f"  steady state: roll {st['roll_rad'] * deg:.2f} deg, steer {st['steer_rad'] * deg:.2f} deg, "
-          f"yaw rate {st['yaw_rate_rad_s']:.4f} rad/s, rear-wheel torque {st['rear_wheel_torque_n_m']:+.4f} N m ({st['rear_wheel_torque_role']})")
+          f"yaw rate {st['yaw_rate_rad_s']:.4f} rad/s, rear-wheel torque {st['rear_wheel_torque_n_m']:+.4f} N m ({st['rear_wheel_torque_role']})"
+          + ("" if st["found_by"] == "direct" else f" (found by {st['found_by']})"))
     if s["fell"]:
         print(f"  result: FELL (|roll| reached {sc['fall_angle_deg']:g} deg) {s['fall_time_s']:.3f} s after the kick start")
     else:
         print(f"  result: no fall in {sc['duration']:g} s")
     m, rec = s["metrics"], s["recovery"]
     if m["peak_values"]:
-        print(f"  yaw rate: first peak {m['peak_values'][0]:+.3f} rad/s (from steady) at {m['peak_times'][0]:.3f} s; "
-              + (f"within 5 % of it from {rec['time_s']:.3f} s on" if rec["time_s"] is not None
-                 else f"not recovered to 5 % ({rec['reason']})"))
-    settled = [f"{label} {sig['time_s']:.2f} s" if sig["time_s"] is not None else f"{label} not within the run"
-               for label, sig in (("roll rate", rec["signals"]["roll_rate"]),
-                                  ("steer rate", rec["signals"]["steer_rate"]))]
+        print(f"  yaw rate: first peak {m['peak_values'][0]:+.3f} rad/s (from steady) at {m['peak_times'][0]:.3f} s")
     if not s["fell"]:
-        print("  within 5 % of their first peak from: " + ", ".join(settled))
+        settled = ", ".join(f"{name.replace('_', ' ')} {sig['time_s']:.2f} s" if sig["time_s"] is not None
+                            else f"{name.replace('_', ' ')} not within the run"
+                            for name, sig in rec["signals"].items())
+        print(f"  within 5 % of their first peaks from: {settled}")
+        print("  recovery time: " + (f"{rec['time_s']:.3f} s after the kick (all three settled)"
+                                     if rec["time_s"] is not None else "none within the run"))
     pk = s["peaks"]
     print(f"  peaks: |roll rate| {pk['max_abs_roll_rate']:.3f} rad/s, |steer rate| {pk['max_abs_steer_rate']:.3f} rad/s, "
           f"|Fy rear| {pk['max_abs_fy_rear']:.0f} N, |slip rear| {pk['max_abs_slip_rear'] * deg:.1f} deg")
@@ -341,8 +349,15 @@ def write_trajectory_csv(frame, path):
             fh.write("\n")
 
 
-def _simulate(argv):
+def _write_results(result, out):
+    """trajectory.csv and summary.json of ``result`` in ``out``; returns the file names."""
     import json
+    write_trajectory_csv(result.trajectory, out / "trajectory.csv")
+    (out / "summary.json").write_text(json.dumps(result.summary, indent=2, allow_nan=False) + "\n")
+    return ["trajectory.csv", "summary.json"]
+
+
+def _simulate(argv):
     import shutil
     from . import simulation
     args = _simulate_parser().parse_args(argv)
@@ -351,13 +366,23 @@ def _simulate(argv):
     out, created = _prepare_out(args.out if args.out else _default_out(scenario), args.force)
     try:
         result = simulation.run(scenario)
-    except (InputError, simulation.SimulationError):
+    except simulation.SimulationError as exc:
+        if exc.partial is not None:
+            # What ran before the failure is kept for the user to inspect.
+            _write_results(exc.partial, out)
+            raise simulation.SimulationError(
+                f"{exc}; the run up to t = {exc.partial.summary['end_time_s']:g} s is in {out}") from None
         if created and not any(out.iterdir()):
             shutil.rmtree(out, ignore_errors=True)
         raise
-    files = ["trajectory.csv", "summary.json"]
-    write_trajectory_csv(result.trajectory, out / "trajectory.csv")
-    (out / "summary.json").write_text(json.dumps(result.summary, indent=2, allow_nan=False) + "\n")
+    except InputError:
+        if created and not any(out.iterdir()):
+            shutil.rmtree(out, ignore_errors=True)
+        raise
+    files = _write_results(result, out)
+    if not result.summary["linear_stability"]["stable"]:
+        # A warning, not a failure: the run is valid (the bicycle may well fall).
+        print(f"simulate: warning: {result.summary['linear_stability']['message']}", file=sys.stderr)
     if not args.no_plot:
         from . import plotting
         k = result.summary["kick"]
@@ -399,12 +424,14 @@ def _recommend(argv):
     from . import sweep, tyres
     p = _OneLineParser(
         prog="recommend-pressure",
-        description="Recommend the tyre inflation pressure with the fastest yaw-rate recovery after "
-                    "a kick-plate kick (Dell'Orto 2025, Section 8.3 and Table 8.9): runs the kick at "
-                    "each pressure for each rear load and ranks the runs by the recovery time (time "
-                    "of the last yaw-rate peak above 8 %% of the largest).",
+        description="Recommend the tyre inflation pressure with the fastest recovery after a "
+                    "kick-plate kick (Dell'Orto 2025, Section 8.3 and Table 8.9): runs the kick at each "
+                    "pressure for each rear load, ranks the runs by the recovery time (yaw, roll and "
+                    "steer rates all back within 5 %% of their first peaks) and says by how much the "
+                    "best beats the second best, against the spread of the model itself.",
         epilog="Both tyres get the same pressure, as in the experiment. Every other setting is the "
-               "simulate default (LQR rider, 3 m/s, 150 mm kick in 0.150 s, 6 s). See docs/sweeps.md.")
+               "simulate default (3 m/s, LQR rider designed at that speed, 150 mm kick in 0.150 s, 6 s). "
+               "See docs/sweeps.md.")
     p.add_argument("--fz", type=_number("N"), nargs="+", required=True, metavar="N",
                    help="static rear-tyre load(s) in N, e.g. --fz 570 635 701")
     p.add_argument("--tyre", default="T03", metavar="NAME",
@@ -416,15 +443,18 @@ def _recommend(argv):
                    help="also try a grid of interpolated pressures between the measured ones")
     p.add_argument("--step", type=_number("kPa"), default=10.0, metavar="KPA",
                    help="step of the --fine grid in kPa (default 10)")
-    p.add_argument("--criterion", choices=tuple(sweep.CRITERIA), default="last_peak",
-                   help="last_peak: time of the last yaw-rate peak above 8 %% of the largest (thesis, "
-                        "default); settling: time from which the yaw rate stays within 5 %% of its first peak")
+    p.add_argument("--criterion", choices=tuple(k.replace("_", "-") for k in sweep.CRITERIA), default="settling",
+                   help="settling (default): time from which yaw, roll and steer rates all stay within 5 %% "
+                        "of their first peaks; last-peak: the thesis' rule, time of the last yaw-rate peak "
+                        "above 8 %% of the largest")
     p.add_argument("--duration", type=_number("s"), default=6.0, metavar="S",
                    help="simulated time after the kick in s (default 6)")
     p.add_argument("--workers", type=int, metavar="N",
                    help="worker processes (default: one per CPU core)")
     p.add_argument("--out", metavar="DIR",
                    help="sweep folder keeping every run (re-running with it resumes)")
+    p.add_argument("--extend", action="store_true",
+                   help="with --out: add these runs to a folder that holds another sweep")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     args = p.parse_args(argv)
     from .simulation import Scenario
@@ -432,7 +462,7 @@ def _recommend(argv):
     base.validate()
     recs = sweep.recommend_pressures(
         args.fz, tyre=args.tyre, pressures=args.pressures, fine=args.fine, step_kpa=args.step,
-        base=base, criterion=args.criterion, workers=args.workers, folder=args.out,
+        base=base, criterion=args.criterion, workers=args.workers, folder=args.out, extend=args.extend,
         progress=not args.no_progress and sys.stderr.isatty())
     for k, rec in enumerate(recs):
         if k:

@@ -241,3 +241,47 @@ def closed_loop_matrix(moore, speed, K):
     """``A - B_T7 K`` of the linearised classic model."""
     A, B = classic.linear_state_space(moore, speed)
     return A - B[:, [1]] @ np.atleast_2d(np.ravel(K))
+
+
+def closed_loop_poles(moore, speed, gains):
+    """Closed-loop poles [1/s] of the linearised classic (no-slip) model with gains by name.
+
+    The rider's law is ``T7 = -(kq3 q3 + kq4 q4 + kq7 q7 + ku3 u3 + ku4 u4 + ku7 u7)``
+    (missing gains 0). The yaw rate is a fixed combination of the four states
+    (:func:`classic.yaw_rate_map`), so ``ku3`` folds into the other gains; a
+    yaw-angle gain ``kq3`` adds the yaw angle as a fifth state
+    (:func:`heading_state_space`), otherwise the yaw angle is left out
+    (its pole is 0 whatever the rider does).
+
+    Parameters
+    ----------
+    moore : mapping
+        Moore parameters of the bicycle with rider (the plant of the run).
+    speed : float
+        Forward speed [m/s], > 0.
+    gains : mapping
+        Gains by name (N m/rad, N m s/rad).
+
+    Returns
+    -------
+    ndarray, complex
+        Sorted by decreasing real part.
+
+    Example
+    -------
+    >>> from whipple_kick import benchmark, control
+    >>> moore = benchmark.to_moore(benchmark.meijaard2007_parameters())
+    >>> poles = control.closed_loop_poles(moore, 5.0, {})     # no rider: the benchmark at 5 m/s
+    >>> bool(poles[0].real < 0)                                 # self-stable there
+    True
+    """
+    check_range("speed", speed, 0.0, None, "m/s", low_open=True)
+    g = {name: float(gains.get(name, 0.0)) for name in ("kq3", "kq4", "kq7", "ku3", "ku4", "ku7")}
+    yaw = classic.yaw_rate_map(moore, speed)
+    K4 = np.array([g["kq4"], g["kq7"], g["ku4"], g["ku7"]]) + g["ku3"] * yaw
+    if g["kq3"]:
+        A, b = heading_state_space(moore, speed)
+        poles = np.linalg.eigvals(A - b @ np.r_[g["kq3"], K4][None, :])
+    else:
+        poles = np.linalg.eigvals(closed_loop_matrix(moore, speed, K4))
+    return poles[np.argsort(-poles.real, kind="stable")]

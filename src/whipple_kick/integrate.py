@@ -8,13 +8,20 @@ through a jump map where the caller gives one (the plate stop's impulse).
 A fall (|roll| beyond a limit) ends the run as an event, not an error.
 LSODA's stiff steps use the compiled model's Jacobian (forward differences
 in C over the dynamic states; the energy quadratures feed nothing back).
+
+No integration runs for ever: a :class:`Budget` bounds the right-hand-side
+evaluations per simulated second. An integration that stalls (the step size
+collapsing, e.g. when a wheel unloads in a fall and the tyre forces switch
+faster than any step can follow) ends as a reported failure with the samples
+it produced so far, in bounded time.
 """
+import collections
 from dataclasses import dataclass
 
 import numpy as np
 import warnings
 
-from scipy.integrate import odeint, solve_ivp
+from scipy.integrate import LSODA, odeint
 
 from . import slip
 
@@ -29,7 +36,8 @@ class Trajectory:
     fall_time: float | None  # time of the fall event [s]
     nfev: int                # right-hand-side evaluations
     message: str
-    end_state: np.ndarray | None = None   # exact state at t_end (or at the fall)
+    end_state: np.ndarray | None = None   # exact state at t_end (or at the fall, or where it failed)
+    failed: bool = False     # the integration failed (stalled, non-finite derivative); samples end there
 
     def state(self, name):
         """Time history of one state by name."""
@@ -68,22 +76,132 @@ def default_atol(rtol, transient="contact_patch"):
     return atol
 
 
-def _careful_chunk(rhs, x, times, rtol, atol, fall, jac):
-    """Integrate one chunk with solve_ivp's LSODA and the fall event (exact event time)."""
-    sol = solve_ivp(rhs, (times[0], times[-1]), x, method="LSODA", t_eval=times, events=fall,
-                    rtol=rtol, atol=atol, jac=jac)
-    return sol
+@dataclass(frozen=True)
+class Budget:
+    """Most right-hand-side evaluations one :func:`integrate` call may spend.
+
+    ``allowance + per_second * (t - t_start)`` evaluations may have been
+    spent by the time the integration reaches ``t``, and the last
+    ``stall_window`` evaluations must have advanced the time by at least
+    ``stall_progress``; otherwise it has stalled (the step size collapsing)
+    and ends as a failure. Deterministic (evaluations, not wall time).
+
+    The defaults are set from measured runs (``scripts/envelope_study.py
+    budget``, docs/simulate.md "No run hangs"): no completed or falling run
+    of the kick, tolerance and speed grids, a 151-row kick table or the
+    thesis preset spent more than 13 % of the limit at any point (the most:
+    the thesis preset falling at 1.92 m/s, rtol 1e-12, 42 779 evaluations in
+    2.95 s), and none advanced less than 0.17 s in any 20 000 consecutive
+    evaluations, 170 times the stall threshold; none of the 288 runs of the
+    speed envelope with the LQR riders tripped it. The stalls found (a front
+    wheel unloading in a fall, steps of 1e-8 s) end after about 1-3 s of
+    wall time.
+
+    Attributes
+    ----------
+    allowance : int
+        Evaluations free of the rate (the start of a piece, a fall's last steps).
+    per_second : float
+        Evaluations per simulated second [1/s].
+    stall_window : int
+        Evaluations over which progress is judged.
+    stall_progress : float
+        Least simulated time [s] ``stall_window`` evaluations must advance.
+    """
+
+    allowance: int = 100_000
+    per_second: float = 100_000.0
+    stall_window: int = 20_000
+    stall_progress: float = 1e-3
+
+    def limit(self, simulated):
+        """Evaluations allowed after ``simulated`` seconds [s] of integration."""
+        return self.allowance + self.per_second * max(0.0, simulated)
+
+
+DEFAULT_BUDGET = Budget()
+
+
+def _careful_chunk(rhs, x, times, rtol, atol, fall, spent, budget, t_start, jac=None):
+    """Integrate one chunk with LSODA stepped from Python, the fall event and the budget.
+
+    The same solver, step by step, as ``solve_ivp(method="LSODA", t_eval=times,
+    events=fall)`` (samples from each step's dense output, the fall time by
+    Brent's method on it to 4 ulp), but a failure keeps the samples up to the
+    last accepted step, and the evaluation budget is checked after every step.
+
+    Returns
+    -------
+    times, states : ndarray
+        Samples produced (those of ``times`` up to the end, the fall or the failure).
+    end : (t, x)
+        Last time and exact state reached (the fall event's, if it fell).
+    status : {"completed", "fell", "failed"}
+    message : str or None
+        Why it failed.
+    nfev : int
+    """
+    from scipy.optimize import brentq
+
+    solver = LSODA(rhs, times[0], x, times[-1], rtol=rtol, atol=atol, jac=jac)
+    out_t, out_x = [times[:1]], [np.asarray(x, dtype=float)[None, :]]
+    nxt, g_old = 1, fall(times[0], x)
+    recent = collections.deque([(0, times[0])])   # (evaluations, time) after the steps of the last window
+    while True:
+        try:
+            trouble = solver.step()
+        except FloatingPointError as exc:
+            trouble = str(exc)
+            solver.status = "failed"
+        if solver.status == "failed":
+            return (np.concatenate(out_t), np.concatenate(out_x), (solver.t, solver.y), "failed",
+                    f"LSODA stopped at t = {solver.t:.6g} s: {trouble}", solver.nfev)
+        t_new, end, status = solver.t, (solver.t, solver.y), None
+        dense = None
+        g_new = fall(t_new, solver.y)
+        if g_old >= 0.0 >= g_new:   # |roll| rose through the limit (the event's direction)
+            dense = solver.dense_output()
+            t_fall = brentq(lambda t: fall(t, dense(t)), solver.t_old, t_new,
+                            xtol=4 * np.finfo(float).eps, rtol=4 * np.finfo(float).eps)
+            t_new, end, status = t_fall, (t_fall, dense(t_fall)), "fell"
+        g_old = g_new
+        upto = int(np.searchsorted(times, t_new, side="right"))
+        if upto > nxt:
+            dense = solver.dense_output() if dense is None else dense
+            out_t.append(times[nxt:upto])
+            out_x.append(dense(times[nxt:upto]).T)
+            nxt = upto
+        if status is None and solver.status == "finished":
+            status = "completed"
+        if status is not None:
+            return np.concatenate(out_t), np.concatenate(out_x), end, status, None, solver.nfev
+        recent.append((solver.nfev, t_new))
+        while len(recent) > 1 and recent[1][0] <= solver.nfev - budget.stall_window:
+            recent.popleft()
+        why = None
+        if spent + solver.nfev > budget.limit(t_new - t_start):
+            why = (f"{spent + solver.nfev} right-hand-side evaluations for {t_new - t_start:.4g} s simulated, "
+                   f"more than the budget {budget.allowance} + {budget.per_second:g}/s")
+        elif recent[0][0] <= solver.nfev - budget.stall_window and t_new - recent[0][1] < budget.stall_progress:
+            why = (f"{solver.nfev - recent[0][0]} right-hand-side evaluations advanced it only "
+                   f"{t_new - recent[0][1]:.2g} s (at least {budget.stall_progress:g} s per "
+                   f"{budget.stall_window} evaluations)")
+        if why is not None:
+            return (np.concatenate(out_t), np.concatenate(out_x), end, "failed",
+                    f"integration stalled at t = {t_new:.6g} s: {why}; last step {solver.step_size:.2g} s",
+                    solver.nfev)
 
 
 class _PastTheLimit(Exception):
     """Raised inside the fast path once the roll limit is passed."""
 
 
-def _fast_chunk(rhs, x, times, rtol, atol, roll_index, fall_angle, jac):
+def _fast_chunk(rhs, x, times, rtol, atol, roll_index, fall_angle, mxstep, jac=None):
     """Integrate one chunk with odeint's LSODA (the step loop stays in Fortran).
 
     Returns ``(states, nfev)``, or ``None`` if the roll limit was passed or
-    LSODA reported trouble (the caller then integrates the chunk carefully).
+    LSODA reported trouble, e.g. more than ``mxstep`` steps between two
+    samples (the caller then integrates the chunk carefully).
     """
     # Stop as soon as the bicycle is past the limit: odeint has no events,
     # and integrating a fallen bicycle onwards is wasted work.
@@ -98,7 +216,7 @@ def _fast_chunk(rhs, x, times, rtol, atol, roll_index, fall_angle, jac):
         warnings.simplefilter("ignore")
         try:
             y, info = odeint(guarded, x, times, Dfun=jac, rtol=rtol, atol=atol, tfirst=True, full_output=True,
-                             mxstep=100000)
+                             mxstep=mxstep)
         except (_PastTheLimit, FloatingPointError):
             return None
     if info["message"] != "Integration successful." or not np.all(np.isfinite(y)):
@@ -107,15 +225,21 @@ def _fast_chunk(rhs, x, times, rtol, atol, roll_index, fall_angle, jac):
 
 
 def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None,
-              output_rate=1000.0, fall_angle=np.deg2rad(45.0), chunk=None, samples=None, jumps=None):
+              output_rate=1000.0, fall_angle=np.deg2rad(45.0), chunk=None, samples=None,
+              budget=DEFAULT_BUDGET, jumps=None):
     """Integrate ``rhs`` from ``x0`` piecewise between breakpoints with LSODA.
 
     Each smooth piece is integrated in chunks of about ``chunk`` seconds
     with ODEPACK's LSODA through :func:`scipy.integrate.odeint`, whose step
     loop runs in Fortran. A chunk in which the roll limit is crossed (or in
     which LSODA reports trouble) is integrated again from its start with
-    :func:`scipy.integrate.solve_ivp` (the same LSODA, stepped from Python)
-    and a terminal event, which gives the exact fall time.
+    the same LSODA stepped from Python (:class:`scipy.integrate.LSODA`,
+    as ``solve_ivp`` does) and a fall event, which gives the exact fall
+    time. Numerical
+    trouble there (LSODA giving up, a non-finite derivative, or more
+    evaluations than ``budget`` allows) ends the integration as a failure:
+    the trajectory is returned with ``failed=True``, the samples up to the
+    last accepted step and a message saying where and why.
 
     Parameters
     ----------
@@ -145,6 +269,8 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
         returned. Default: ``output_rate`` from ``t_start``. A sample within
         a billionth of the sample spacing of a piece's edge is given the
         state at that edge rather than a sub-ulp integration of its own.
+    budget : Budget
+        Evaluation budget of this call (default :data:`DEFAULT_BUDGET`).
     jumps : mapping, optional
         ``{breakpoint: g(t, x) -> x}``: the state leaving the piece that
         ends at the breakpoint is mapped by ``g`` before the next piece
@@ -153,8 +279,19 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
     Returns
     -------
     Trajectory
-        With ``end_state`` the exact state at ``t_end`` (or at the fall),
-        whether or not ``t_end`` is a sample time.
+        With ``end_state`` the exact state at ``t_end`` (or at the fall, or
+        where it failed), whether or not that is a sample time.
+
+    Example
+    -------
+    >>> import numpy as np
+    >>> from whipple_kick import integrate
+    >>> def decay(t, x):            # any f(t, x) of the state layout's length
+    ...     return -x
+    >>> x0 = np.full(len(integrate.slip.STATE_NAMES), 1e-3)
+    >>> traj = integrate.integrate(decay, x0, 1.0, output_rate=10.0)
+    >>> round(float(traj.x[-1, 0] / 1e-3), 6), traj.failed
+    (0.367879, False)
     """
     transient = getattr(rhs, "transient", "contact_patch")
     atol = default_atol(rtol, transient) if atol is None else np.asarray(atol, dtype=float)
@@ -189,8 +326,13 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
             last_t = times[keep][-1]
 
     x = np.asarray(x0, dtype=float)
-    fell, fall_time, message = False, None, "completed"
+    fell, fall_time, message, failed = False, None, "completed", False
     done = False
+    # The fast path gives up (and the careful path takes over, with the budget) after more steps
+    # between two samples than a quarter of the stall window's evaluations (a step costs 1 to ~20
+    # evaluations, a stiff one with a finite-difference Jacobian the most), so a stall wastes about
+    # one window here; a legitimate interval needs far fewer steps (docs/simulate.md).
+    mxstep = max(1, budget.stall_window // 4)
     for a, b in zip(edges[:-1], edges[1:]):
         at_a = samples[np.abs(samples - a) <= eps]
         at_b = samples[(np.abs(samples - b) <= eps) & (samples > a + eps)]
@@ -208,29 +350,31 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
             times = grid[i0:i1 + 1]
             # A sample at the piece's end is emitted after the jump map (below).
             last = -1 if i1 == len(grid) - 1 else None
-            fast = _fast_chunk(rhs, x, times, rtol, atol, roll, fall_angle, jac)
-            if fast is not None:
+            fast = _fast_chunk(rhs, x, times, rtol, atol, roll, fall_angle, mxstep, jac)
+            if fast is not None and nfev + fast[1] <= budget.limit(times[-1] - t_start):
                 y, n = fast
                 nfev += n
                 emit(times[:last], y[:last])
                 x = y[-1]
                 continue
-            sol = _careful_chunk(rhs, x, times, rtol, atol, fall, jac)
-            nfev += sol.nfev
-            emit(sol.t[:last] if sol.status != 1 else sol.t, sol.y.T[:last] if sol.status != 1 else sol.y.T)
-            if sol.status == 1:
-                fell, fall_time = True, float(sol.t_events[0][0])
-                x = sol.y_events[0][0]
+            # A failed fast attempt is redone here, so only this attempt counts against the budget.
+            sample_t, sample_x, (t_reached, x), status, why, n = _careful_chunk(
+                rhs, x, times, rtol, atol, fall, nfev, budget, t_start, jac)
+            nfev += n
+            if status == "completed" and last is not None and sample_t.size and sample_t[-1] == times[-1]:
+                sample_t, sample_x = sample_t[:-1], sample_x[:-1]
+            emit(sample_t, sample_x)
+            if status == "fell":
+                fell, fall_time = True, float(t_reached)
                 if fall_time > last_t:
                     ts.append(np.array([fall_time]))
                     xs.append(x[None, :])
                 message = f"fell: |roll| reached {np.rad2deg(fall_angle):.0f} deg at t = {fall_time:.4f} s"
+            elif status == "failed":
+                failed, message = True, why
+            if status != "completed":
                 done = True
                 break
-            if sol.status < 0:
-                raise FloatingPointError(
-                    f"integration failed at t = {sol.t[-1] if sol.t.size else times[0]:.6g} s: {sol.message}")
-            x = sol.y[:, -1]
         if done:
             break
         if b in jumps:
@@ -240,4 +384,4 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
     X = np.concatenate(xs) if xs else np.empty((0, len(x)))
     if X.size and not np.all(np.isfinite(X)):
         raise FloatingPointError("non-finite state in the integration result")
-    return Trajectory(t, X, fell, fall_time, nfev, message, end_state=x)
+    return Trajectory(t, X, fell, fall_time, nfev, message, end_state=np.asarray(x, dtype=float), failed=failed)

@@ -187,7 +187,11 @@ def controller_text(summary):
         return "rider with custom steer-torque gains"
     if sc["controller"] == "off":
         return "no rider control (steer torque off)"
-    what = (f"LQR rider (designed at {sc['design_speed']:g} m/s)" if sc["controller"] == "lqr"
+    # The design speed actually used (the scenario's is None when the rider adapts to the run's speed).
+    design = summary.get("controller", {}).get("design_speed_m_s")
+    if design is None:
+        design = sc.get("design_speed") or sc["speed"]
+    what = (f"LQR rider (designed at {design:g} m/s)" if sc["controller"] == "lqr"
             else "thesis Table 8.4 rider gains")
     return f"{what}, gains scaled by {sc['gain_scale']:g}"
 

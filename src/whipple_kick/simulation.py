@@ -39,8 +39,8 @@ CONTROLLERS = ("lqr", "thesis", "off")
 DIRECTIONS = ("right", "left")
 #: Rear-frame entries halved by the "low inertia" variant (thesis Figure 8.9).
 LOW_INERTIA_KEYS = ("IBxx", "IByy", "IBzz", "IBxz", "zB")
-#: Recovery criterion of issue 6: |yaw rate - steady| within this fraction of the first peak.
-RECOVERY_FRACTION = 0.05
+#: Table 8.4's gains were designed at this speed [m/s] (thesis Section 8.3).
+THESIS_DESIGN_SPEED = 3.0
 #: |steady yaw rate| [rad/s] below which steady running counts as straight (a yaw-angle gain needs it).
 _STRAIGHT_YAW_RATE = 1e-9
 
@@ -102,7 +102,18 @@ KICK_HEADINGS = ("fixed", "settled")
 
 
 class SimulationError(RuntimeError):
-    """The integration failed numerically (not a user mistake)."""
+    """The integration failed numerically (not a user mistake).
+
+    Attributes
+    ----------
+    partial : Result or None
+        What was computed before the failure (trajectory up to it, summary
+        with ``status`` "failed"), when there is anything.
+    """
+
+    def __init__(self, message, partial=None):
+        super().__init__(message)
+        self.partial = partial
 
 
 @dataclass(frozen=True)
@@ -141,13 +152,17 @@ class Scenario:
     controller : {"lqr", "thesis", "off"}
         LQR designed on the linearised classic model at ``design_speed``;
         the thesis' Table 8.4 gains (for 570/635/701 N); or no steer torque.
-    design_speed : float
-        LQR design speed [m/s] (thesis: 3 m/s).
+    design_speed : float or None
+        LQR design speed [m/s]. Default None: the run's ``speed``, as a real
+        rider adapts to the speed. Give 3.0 to fix the rider as the thesis
+        did. Used by ``controller="lqr"`` only (Table 8.4's gains were
+        designed at 3 m/s).
     gain_scale : float
         Multiplies every controller gain (thesis Figure 8.7: 0.5).
     thesis_load_n : float or None
         Rear load [N] whose Table 8.4 gains ``controller="thesis"`` uses;
-        default ``fz_n`` (needed for presets that already include the rider).
+        default ``fz_n``, or for a preset that already includes the rider the
+        load it is labelled with (``balanceassist_635N``: 635 N).
     low_inertia : bool
         Halve the rear frame's IBxx, IByy, IBzz, IBxz and mass-centre height zB
         (thesis Figure 8.9). The LQR is still designed on the unmodified
@@ -221,7 +236,7 @@ class Scenario:
     symmetric_tyres: bool = False
     speed: float = 3.0
     controller: str = "lqr"
-    design_speed: float = 3.0
+    design_speed: float | None = None
     gain_scale: float = 1.0
     thesis_load_n: float | None = None
     low_inertia: bool = False
@@ -259,6 +274,11 @@ class Scenario:
         return cls(**base)
 
     # ------------------------------------------------------------ derived values
+
+    @property
+    def lqr_design_speed(self):
+        """Speed [m/s] the LQR rider is designed at: ``design_speed``, or the run's speed."""
+        return self.speed if self.design_speed is None else self.design_speed
 
     @property
     def pressures(self):
@@ -344,7 +364,8 @@ class Scenario:
     def validate(self):
         """Check every field; raise :class:`InputError` naming value, range and unit."""
         check_range("speed", self.speed, 0.0, 15.0, "m/s", low_open=True)
-        check_range("design speed", self.design_speed, 0.0, 15.0, "m/s", low_open=True)
+        if self.design_speed is not None:
+            check_range("design speed", self.design_speed, 0.0, 15.0, "m/s", low_open=True)
         check_range("duration", self.duration, 0.0, 120.0, "s", low_open=True)
         check_range("settle time", self.settle, 0.0, 60.0, "s")
         check_range("rtol", self.rtol, 1e-14, 1e-3, "(relative)")
@@ -710,7 +731,7 @@ def _integrate_table(params, x0, table, scenario, chunk, t_start=None):
         rhs = slip.CompiledRHS(_segment_parameters(params, t0, coefficients))
         rhss.append(rhs)
         traj = integrate.integrate(rhs, x, b, t_start=a, rtol=scenario.rtol, fall_angle=fall_angle,
-                                   chunk=chunk, samples=pending)
+                                   chunk=chunk, samples=pending, budget=integrate.DEFAULT_BUDGET)
         nfev += traj.nfev
         ts.append(traj.t)
         xs.append(traj.x)
@@ -718,10 +739,10 @@ def _integrate_table(params, x0, table, scenario, chunk, t_start=None):
         if traj.t.size:
             pending = pending[pending > traj.t[-1]]
         x = traj.end_state
-        if traj.fell:
+        if traj.fell or traj.failed:
             break
     trajectory = integrate.Trajectory(np.concatenate(ts), np.concatenate(xs), traj.fell, traj.fall_time,
-                                      nfev, traj.message, end_state=x)
+                                      nfev, traj.message, end_state=x, failed=traj.failed)
     return trajectory, rhss, np.concatenate(owner).astype(int)
 
 
@@ -805,28 +826,42 @@ def _lqr(design_items, speed):
 
 
 def controller_gains(scenario, design):
-    """Steer-torque gains by name and the closed-loop poles of the linear design (or None)."""
+    """Steer-torque gains by name, and the LQR design's closed-loop poles at its design speed (or None).
+
+    The LQR rider is designed at :attr:`Scenario.lqr_design_speed` (the run's
+    speed unless ``design_speed`` is given).
+    """
     from . import control
 
     if scenario.controller == "off":
         return {k: 0.0 for k in control.GAIN_ORDER}, None
     if scenario.controller == "thesis":
-        load = scenario.thesis_load_n if scenario.thesis_load_n is not None else scenario.fz_n
-        if load is None:
-            if scenario.rider_mass_kg is None and not _includes_rider(scenario):
-                load = 635.0
-            else:
-                raise InputError("controller thesis uses Table 8.4 gains for a rear load of 570, 635 or "
-                                 "701 N: give fz (N) (or thesis_load_n for a preset with rider)")
-        gains = control.thesis_gains(load)
+        gains = control.thesis_gains(thesis_load(scenario))
         return {k: scenario.gain_scale * v for k, v in gains.items()}, None
-    K, poles = _lqr(tuple(sorted(design.items())), float(scenario.design_speed))
+    K, poles = _lqr(tuple(sorted(design.items())), float(scenario.lqr_design_speed))
     return control.gains_dict(K, scenario.gain_scale), np.asarray(poles)
 
 
-def _includes_rider(scenario):
+def thesis_load(scenario):
+    """Rear load [N] whose Table 8.4 row ``controller="thesis"`` uses.
+
+    ``thesis_load_n`` if given, else ``fz_n``, else the load a preset with
+    rider is labelled with (``balanceassist_635N``: 635 N), else 635 N for a
+    bicycle whose rider is seated for the default load.
+    """
     from . import bicycles
-    return bicycles.load(scenario.bicycle).includes_rider
+
+    if scenario.thesis_load_n is not None:
+        return scenario.thesis_load_n
+    if scenario.fz_n is not None:
+        return scenario.fz_n
+    bike = bicycles.load(scenario.bicycle)
+    if bike.includes_rider and bike.thesis_rear_load_n is not None:
+        return bike.thesis_rear_load_n
+    if scenario.rider_mass_kg is None and not bike.includes_rider:
+        return 635.0
+    raise InputError("controller thesis uses Table 8.4 gains for a rear load of 570, 635 or 701 N: give fz (N), "
+                     "or thesis_load_n (--thesis-load N) for a rider given by mass or a preset with rider")
 
 
 def build_tyres(scenario):
@@ -858,9 +893,10 @@ def preflight(scenario):
     """Cheap checks of everything a user can get wrong, before any long work.
 
     Field ranges, tyre name and pressure range, bicycle name and rider
-    conflicts. Raises :class:`InputError`; returns ``scenario``.
+    conflicts, the Table 8.4 row of ``controller="thesis"``. Raises
+    :class:`InputError`; returns ``scenario``.
     """
-    from . import bicycles
+    from . import bicycles, control
 
     scenario.validate()
     build_tyres(scenario)
@@ -868,6 +904,8 @@ def preflight(scenario):
     if bike.includes_rider and (scenario.fz_n is not None or scenario.rider_mass_kg is not None):
         raise InputError(f"bicycle {bike.name!r} already includes its rider; "
                          "do not give a rear-tyre load fz or a rider mass with it")
+    if scenario.controller == "thesis":
+        control.thesis_gains(thesis_load(scenario))
     return scenario
 
 
@@ -915,33 +953,113 @@ def _trajectory_frame(rhs, traj, owner=None, tyre_transient="contact_patch"):
     return frame
 
 
-def _recovery(df, baseline, first_peak, column="yaw_rate", label="yaw rate"):
-    """Time after the kick from which |signal - baseline| stays within 5 % of its first peak.
+#: A closed-loop pole whose real part exceeds this [1/s] makes the rider linearly unstable
+#: (slower growth, by less than 1 % over a 10 s run, is not reported).
+UNSTABLE_REAL_PART = 1e-3
 
-    Returns (time or None, reason or None).
+
+def _who_rides(scenario, controller_type):
+    """How the summary and the messages name the rider in use."""
+    if controller_type == "lqr":
+        return f"the LQR rider designed at {scenario.lqr_design_speed:g} m/s"
+    if controller_type == "thesis":
+        return f"the thesis' Table 8.4 rider (designed at {THESIS_DESIGN_SPEED:g} m/s)"
+    if controller_type == "off":
+        return "the bicycle without steer control"
+    return "the rider with the given gains"
+
+
+def _steady_advice(scenario, controller_type):
+    """What a user can change when there is no steady motion (for the one-line error)."""
+    if controller_type == "lqr" and scenario.design_speed is not None:
+        return (f"the rider is designed at {scenario.design_speed:g} m/s: choose another design speed "
+                "(--design-speed; by default the run's speed) or another speed")
+    if controller_type == "thesis":
+        return (f"Table 8.4's rider was designed at {THESIS_DESIGN_SPEED:g} m/s: choose controller lqr "
+                "(designed at the run's speed) or another speed")
+    return "choose another speed, rider or tyre pressure, or symmetric tyres"
+
+
+def steady_motion(params, scenario, controller_type):
+    """The steady motion before the kick (:func:`whipple_kick.steady.find_steady_state`)."""
+    from . import steady
+    return steady.find_steady_state(params, scenario.speed, advice=_steady_advice(scenario, controller_type))
+
+
+def linear_stability(scenario, moore, gains, found, controller_type):
+    """Is the rider in use linearly stable at the run's speed?
+
+    Poles of the slip model linearised about the steady motion at constant
+    speed (:func:`whipple_kick.steady.lateral_poles`; decisive) and of the
+    no-slip classic model of the same bicycle with the same gains
+    (:func:`whipple_kick.control.closed_loop_poles`). A yaw-angle gain breaks
+    the slip linearisation's heading invariance: then the classic model decides.
+
+    Returns
+    -------
+    dict
+        ``stable``, ``message`` (one line, None when stable), ``slowest_pole_1_s``,
+        ``model`` (which linearisation decided), ``poles_slip_model_1_s``,
+        ``poles_no_slip_model_1_s`` (each as [real, imag] pairs), ``criterion``.
     """
-    t = df["time"].to_numpy()
-    dev = np.abs(df[column].to_numpy() - baseline)
-    after = t >= 0.0
-    if first_peak is None or first_peak <= 0.0:
-        return None, f"no {label} peak after the kick"
-    outside = np.flatnonzero(after & (dev > RECOVERY_FRACTION * first_peak))
-    if outside.size == 0:
-        return 0.0, None
-    j = outside[-1]
-    if j == t.size - 1:
-        return None, (f"{label} still outside {RECOVERY_FRACTION:.0%} of its first peak "
-                      f"at the end of the run (t = {t[-1]:.3f} s)")
-    return float(t[j + 1]), None
+    from . import control, steady
+
+    classic = control.closed_loop_poles(moore, scenario.speed, gains)
+    slip_poles = None
+    if not gains.get("kq3", 0.0):
+        try:
+            slip_poles = steady.lateral_poles(found.steady.params, found.steady.x)
+        except FloatingPointError:   # the linearisation's pitch solve failed: the classic model decides
+            slip_poles = None
+    decisive, model = ((slip_poles, "slip model about the steady motion, constant speed")
+                       if slip_poles is not None else (classic, "no-slip classic model"))
+    slowest = decisive[0]
+    stable = bool(slowest.real <= UNSTABLE_REAL_PART)
+    message = None
+    if not stable:
+        message = (f"{_who_rides(scenario, controller_type)} is linearly unstable at {scenario.speed:g} m/s: "
+                   f"slowest closed-loop pole {_pole_text(slowest)} 1/s ({model}; no-slip model "
+                   f"{_pole_text(classic[0])} 1/s)")
+    pairs = lambda poles: None if poles is None else [[float(p.real), float(p.imag)] for p in poles]
+    return {"stable": stable, "message": message, "slowest_pole_1_s": pairs([slowest])[0], "model": model,
+            "poles_slip_model_1_s": pairs(slip_poles), "poles_no_slip_model_1_s": pairs(classic),
+            "criterion": f"unstable when a closed-loop pole has real part > {UNSTABLE_REAL_PART:g} 1/s"}
 
 
-def _first_peak(df, column, baseline):
-    """First peak of |signal - baseline| after the kick reaching half the largest (``analysis.yaw_rate_peaks``)."""
-    from . import analysis
+def _pole_text(pole):
+    text = f"{pole.real:+.3f}"
+    return text + (f" +- {abs(pole.imag):.3f}j" if abs(pole.imag) > 1e-9 else "")
 
-    peaks = analysis.yaw_rate_peaks(df["time"].to_numpy(), df[column].to_numpy(), t_kick=0.0,
-                                    threshold=0.5, baseline=baseline)
-    return float(abs(peaks.values[0])) if peaks.values.size else None
+
+def _response_metrics(df, baseline, x0, scenario, traj):
+    """Section 8.3 metrics (``metrics``, ``unavailable``) and the recovery of a (possibly partial) run."""
+    from . import analysis, slip
+
+    fall_roll = math.radians(scenario.fall_angle_deg)
+    ended = None
+    if traj.fell:
+        ended = f"fell {traj.fall_time:.3f} s after the kick start"
+    elif traj.failed:
+        ended = "the integration failed before the end of the run"
+    try:
+        metrics = analysis.kick_metrics(df, t_kick=0.0, baseline=baseline, include_spectra=False,
+                                        fall_roll=fall_roll)
+        rec = analysis.recovery(df, 0.0, {name: float(x0[slip.X[state]]) for name, state in
+                                          (("yaw_rate", "u3"), ("roll_rate", "u4"), ("steer_rate", "u7"))},
+                                ended=ended)
+    except InputError as exc:   # a failure so early that too little of the response exists
+        metrics = {"unavailable": {"all": f"no response to analyse: {exc}"}}
+        rec = {"time_s": None, "reason": ended or str(exc), "signals": {}}
+    # The integrator's event is exact; kick_metrics sees |roll| only up to the limit.
+    metrics["fell"] = bool(traj.fell)
+    metrics["fall_time"] = traj.fall_time
+    unavailable = metrics.setdefault("unavailable", {})
+    if traj.fell:
+        unavailable.pop("fall_time", None)
+    if ended is not None and metrics.get("last_peak_time") is not None:
+        # The last peak above 8 % before a fall or a failure is not the end of the response.
+        metrics["last_peak_time"], unavailable["last_peak_time"] = None, ended
+    return metrics, rec
 
 
 def _custom_gains(gains):
@@ -1013,11 +1131,22 @@ def run(scenario, *, tyres=None, gains=None):
     Raises
     ------
     InputError
-        A field is out of range, unknown or conflicting.
+        A field is out of range, unknown or conflicting;
+        :class:`whipple_kick.steady.NoSteadyMotion` (an InputError) when
+        there is no steady motion to start from, with the physical reason.
     SimulationError
-        The integration failed numerically (never NaN in a result).
+        The integration failed numerically (never NaN in a result): e.g. it
+        stalled beyond :data:`whipple_kick.integrate.DEFAULT_BUDGET`. Its
+        ``partial`` holds the result up to the failure.
+
+    Example
+    -------
+    >>> from whipple_kick.simulation import Scenario, run
+    >>> result = run(Scenario(duration=1.0))                 # doctest: +SKIP
+    >>> result.summary["outcome"], result.summary["linear_stability"]["stable"]   # doctest: +SKIP
+    ('completed', True)
     """
-    from . import analysis, integrate, slip, symbols
+    from . import integrate, slip, symbols
 
     wall0 = time.perf_counter()
     scenario.validate()
@@ -1047,10 +1176,9 @@ def run(scenario, *, tyres=None, gains=None):
         kick = dict(profile=_SEGMENT_PROFILE, t0=kick_start, coefficients=(float(table.y[0]), 0.0, 0.0, 0.0))
     params = slip.model_parameters(moore, rear, front, gains=gains, symmetric=scenario.symmetric_tyres,
                                    kick=kick, tyre_transient=scenario.tyre_transient)
-    try:
-        steady = slip.steady_state(params, scenario.speed)
-    except FloatingPointError as exc:
-        raise SimulationError(f"no steady motion at {scenario.speed:g} m/s: {exc}") from None
+    found = steady_motion(params, scenario, controller_type)
+    steady = found.steady
+    stability = linear_stability(scenario, moore, gains, found, controller_type)
     steady_yaw_rate = float(steady.x[slip.X["u3"]])
     if gains.get("kq3", 0.0) and abs(steady_yaw_rate) > _STRAIGHT_YAW_RATE:
         # In a steady turn the yaw angle grows without bound, and so would kq3's torque.
@@ -1069,31 +1197,11 @@ def run(scenario, *, tyres=None, gains=None):
 
     x0 = steady.x
     baseline = float(x0[slip.X["u3"]])
-    metrics = analysis.kick_metrics(df, t_kick=0.0, baseline=baseline, include_spectra=False,
-                                    fall_roll=math.radians(scenario.fall_angle_deg))
-    # The integrator's event is exact; kick_metrics sees |roll| only up to the limit.
-    metrics["fell"] = bool(traj.fell)
-    metrics["fall_time"] = traj.fall_time
-    if traj.fell:
-        metrics["unavailable"].pop("fall_time", None)
+    metrics, recovery = _response_metrics(df, baseline, x0, scenario, traj)
     after = df["time"].to_numpy() >= 0.0
-    dev = np.abs(df["yaw_rate"].to_numpy()[after] - baseline)
-    # kick_metrics' peak values are already measured from the baseline.
-    first_peak = abs(metrics["peak_values"][0]) if metrics["peak_values"] else (
-        float(dev.max()) if dev.size else None)
-    rec, rec_reason = _recovery(df, baseline, first_peak)
-    if traj.fell:
-        rec, rec_reason = None, "fell"
-    # The thesis judges its model's return to steady state on the roll and
-    # steer rates (Section 8.4); report the same criterion for those too.
-    signals = {"yaw_rate": {"first_peak_rad_s": first_peak, "time_s": rec, "reason": rec_reason}}
-    for column, label, state in (("roll_rate", "roll rate", "u4"), ("steer_rate", "steer rate", "u7")):
-        steady_value = float(x0[slip.X[state]])
-        peak = _first_peak(df, column, steady_value)
-        t_rec, reason = (None, "fell") if traj.fell else _recovery(df, steady_value, peak, column, label)
-        signals[column] = {"first_peak_rad_s": peak, "time_s": t_rec, "reason": reason}
 
     summary = {
+        "outcome": "failed" if traj.failed else "fell" if traj.fell else "completed",
         "fell": bool(traj.fell),
         "fall_time_s": traj.fall_time,
         "end_time_s": float(df["time"].iloc[-1]),
@@ -1110,12 +1218,17 @@ def run(scenario, *, tyres=None, gains=None):
         },
         "controller": {
             "type": controller_type, "gain_scale": scenario.gain_scale if custom_gains is None else None,
-            "design_speed_m_s": scenario.design_speed if controller_type == "lqr" else None,
+            "design_speed_m_s": {"lqr": scenario.lqr_design_speed, "thesis": THESIS_DESIGN_SPEED}.get(
+                controller_type),
+            "rider": _who_rides(scenario, controller_type),
             "gains": gains,
             "gain_units": {name: symbols.info(name).unit for name in gains},
             "law": _control_law(gains),
-            "linear_closed_loop_poles": None if poles is None else [[p.real, p.imag] for p in poles],
+            # At the run's speed, for the gains used (the LQR design's own poles are at its design speed).
+            "linear_closed_loop_poles": stability["poles_no_slip_model_1_s"],
+            "design_poles": None if poles is None else [[p.real, p.imag] for p in poles],
         },
+        "linear_stability": stability,
         "kick": {"start_s": kick_start, "duration_s": kick_T, "displacement_m": kick_D,
                  "peak_acceleration_m_s2": kick_accel, "profile": scenario.kick_profile,
                  "direction": scenario.kick_direction,
@@ -1133,23 +1246,21 @@ def run(scenario, *, tyres=None, gains=None):
             "compression_rear_m": float(x0[slip.X["q9"]]), "compression_front_m": float(x0[slip.X["q10"]]),
             **_rear_wheel_torque(steady),
             "residual": float(steady.residual),
+            "found_by": found.route,
         },
-        "peaks": {f"max_abs_{name}": float(np.max(np.abs(df[name].to_numpy()[after])))
+        "peaks": {f"max_abs_{name}": float(np.max(np.abs(df[name].to_numpy()[after]), initial=0.0))
                   for name in ("yaw_rate", "roll_rate", "steer_rate", "roll", "steer", "slip_rear",
                                "fy_rear", "fy_front", "steer_torque")},
         "energy": _energy_summary(df, jumps, scenario),
-        "recovery": {
-            "criterion": f"|yaw rate - steady| <= {RECOVERY_FRACTION:.0%} of the first peak until the end",
-            "first_peak_rad_s": first_peak,
-            "time_s": rec, "reason": rec_reason,
-            "signals": signals,
-        },
+        "recovery": recovery,
         "metrics": {k: v for k, v in metrics.items() if k != "unavailable"},
         "metrics_unavailable": metrics["unavailable"],
         "numerics": {
             "method": "LSODA", "rtol": scenario.rtol, "piecewise": scenario.piecewise,
             "plate_stop": scenario.plate_stop, "kick_heading": scenario.kick_heading,
             "breakpoints_s": list(breakpoints), "nfev": int(traj.nfev),
+            "budget": {"allowance": integrate.DEFAULT_BUDGET.allowance,
+                       "per_simulated_second": integrate.DEFAULT_BUDGET.per_second},
             "integration_wall_s": integration_s,
             "max_abs_holonomic_m": float(np.max(np.abs(df["holonomic_residual"]))),
             "model_hash": model_hash(),
@@ -1158,7 +1269,10 @@ def run(scenario, *, tyres=None, gains=None):
         "units": {column: UNITS[column] for column in df.columns},
     }
     summary["numerics"]["wall_s"] = time.perf_counter() - wall0
-    return Result(scenario=scenario, trajectory=df, summary=_clean(summary))
+    result = Result(scenario=scenario, trajectory=df, summary=_clean(summary))
+    if traj.failed:
+        raise SimulationError(traj.message, partial=result)
+    return result
 
 
 def _rear_wheel_torque(steady):

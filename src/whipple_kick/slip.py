@@ -869,7 +869,7 @@ class SteadyState:
         return f"SteadyState({u}; residual {self.residual:.2g})"
 
 
-def steady_state(params, speed, tol=1e-13):
+def steady_state(params, speed, tol=1e-13, guess=None):
     """Steady motion at ``speed`` [m/s] with the tyres' offsets balanced.
 
     Unknowns: roll q4, steer q7, pitch q5, tyre compressions q9, q10, lateral
@@ -888,6 +888,10 @@ def steady_state(params, speed, tol=1e-13):
         From :func:`model_parameters`; ``T6c`` is replaced by the solution.
     speed : float
         Forward speed of the rear contact [m/s], > 0.
+    guess : mapping, optional
+        Starting values of the unknowns by name (e.g. ``SteadyState.unknowns``
+        of a neighbouring case); a name not given starts from upright
+        running. Continuation (:mod:`whipple_kick.steady`) passes it.
 
     Returns
     -------
@@ -904,6 +908,8 @@ def steady_state(params, speed, tol=1e-13):
     names = ("q4", "q7", "q5", "q9", "q10", "u2", "u3", "T6c")
     z0 = np.array([0.0, 0.0, steer_axis_tilt(params),
                    0.5 * weight / params["kzr"], 0.5 * weight / params["kzf"], 0.0, 0.0, 0.0])
+    if guess is not None:
+        z0 = np.array([float(guess.get(name, value)) for name, value in zip(names, z0)])
     scale = np.array([1.0, 1.0, 1.0, 1e-3, 1e-3, 1.0, 1.0, 1.0])
 
     steady_outputs = (("fy_ss_r", "fy_ss_f", "mz_ss_r", "mz_ss_f") if rhs.transient == "force_lag"

@@ -7,15 +7,17 @@ field, then the run's scalar results flattened from its summary. With a
 resumes where it stopped; docs/sweeps.md describes the folder and the rules.
 
 :func:`recommend_pressure` sweeps a tyre's pressures for one rear load and
-returns the pressure with the shortest yaw-rate recovery time (thesis
-Section 8.3 and Table 8.9).
+returns the pressure with the shortest recovery time (yaw, roll and steer
+rates settled; or the thesis' last-peak rule, Section 8.3 and Table 8.9),
+with the margin to the second best and whether that margin is clear of the
+model's own spread.
 
 Example
 -------
 >>> from whipple_kick import sweep
 >>> table = sweep.sweep({"pressure_kpa": [300, 400, 500], "fz_n": [570, 635, 701]},
 ...                     folder="thesis_grid")                    # doctest: +SKIP
->>> table.pivot(index="fz_n", columns="pressure_kpa", values="recovery_time")  # doctest: +SKIP
+>>> table.pivot(index="fz_n", columns="pressure_kpa", values="recovery.time_s")  # doctest: +SKIP
 """
 import atexit
 import concurrent.futures as cf
@@ -190,11 +192,12 @@ def flatten_summary(summary):
     """Scalar results of a :func:`simulation.run` summary as one flat dict.
 
     The Section 8.3 metrics (``summary["metrics"]``) keep their own names
-    (``recovery_time``, ``damping_ratio_1_3``, ``max_abs_roll``, ...); the
+    (``last_peak_time``, ``damping_ratio_1_3``, ``max_abs_roll``, ...); the
     yaw-rate peak times and values are JSON lists in ``peak_times`` and
     ``peak_values``, the reasons for unavailable metrics a JSON object in
     ``metrics_unavailable``. Every other scalar is named by its path, e.g.
-    ``recovery.time_s``, ``steady_state.roll_rad``, ``controller.gains.kq4``,
+    ``recovery.time_s`` (the recovery time), ``recovery.signals.roll_rate.time_s``,
+    ``linear_stability.stable``, ``steady_state.roll_rad``, ``controller.gains.kq4``,
     ``bicycle.rider_mass_kg``, ``numerics.nfev``. Lists elsewhere (the
     closed-loop poles, the tyre notes) are left out.
     """
@@ -273,7 +276,9 @@ def run_case(scenario, case_id, trajectory=None):
         ``case_id``, ``status`` ("ok" or "failed"), ``error`` (``"Type: message"``
         or None), ``results`` (flat, :func:`flatten_summary`), ``summary``
         (JSON text), ``trajectory`` ({column: array} or None) and ``run``
-        (start/end time stamps, wall time, worker host:pid).
+        (start/end time stamps, wall time, worker host:pid). A numerical
+        failure (:class:`~whipple_kick.simulation.SimulationError`) keeps the
+        results, summary and trajectory of the run up to the failure.
     """
     from threadpoolctl import threadpool_limits
 
@@ -291,13 +296,13 @@ def run_case(scenario, case_id, trajectory=None):
         # own process keeps its settings.
         with threadpool_limits(limits=1):
             result = simulation.run(scenario)
-        record["results"] = flatten_summary(result.summary)
-        record["summary"] = json.dumps(result.summary, allow_nan=False)
-        if trajectory is not None:
-            record["trajectory"] = _sampled(result.trajectory, trajectory)
+        _keep(record, result, trajectory)
     except Exception as exc:  # noqa: BLE001 - a failing case must not stop the sweep
         record.update(status="failed", error=f"{type(exc).__name__}: {exc}", results={},
                       summary=None, trajectory=None)
+        partial = getattr(exc, "partial", None)   # a numerical failure keeps what ran before it
+        if partial is not None:
+            _keep(record, partial, trajectory)
     record["run"] = {
         "started": datetime.datetime.fromtimestamp(started, datetime.timezone.utc).isoformat(),
         "finished": datetime.datetime.now(datetime.timezone.utc).isoformat(),
@@ -306,6 +311,14 @@ def run_case(scenario, case_id, trajectory=None):
         "worker": f"{socket.gethostname()}:{os.getpid()}",
     }
     return record
+
+
+def _keep(record, result, trajectory):
+    """Put a run's flat results, summary and (thinned) trajectory into its record."""
+    record["results"] = flatten_summary(result.summary)
+    record["summary"] = json.dumps(result.summary, allow_nan=False)
+    if trajectory is not None:
+        record["trajectory"] = _sampled(result.trajectory, trajectory)
 
 
 # ----------------------------------------------------------------------- the folder
@@ -429,7 +442,7 @@ class _Folder:
                     raise InputError(
                         f"sweep folder {str(self.path)!r} holds a different sweep ({len(old_ids)} cases, "
                         f"{len(set(old_ids) & set(ids))} shared with this one); use a new folder, "
-                        "or extend=True to add this sweep's cases to it")
+                        "or extend=True (recommend-pressure --extend) to add this sweep's cases to it")
                 # Keep the folder's cases first, then the new ones.
                 by_id = {cid: (ov, sc, cid) for ov, sc, cid in case_list}
                 old_cases = [(c["overrides"], simulation.Scenario(**c["scenario"]), c["case_id"])
@@ -680,14 +693,34 @@ def _collect(executor, todo, records, store, progress, total, spec, table_interv
 # --------------------------------------------------------------- the pressure recommender
 
 #: Recommender criteria: the table columns ranked, the first deciding, the
-#: second breaking ties. ``last_peak`` is the thesis' recovery time (time of
-#: the last yaw-rate peak above 8 % of the largest, Section 8.3, Table 8.9);
-#: ``settling`` the time from which |yaw rate - steady| stays within 5 % of
-#: its first peak (``summary["recovery"]``).
-CRITERIA = {"last_peak": ("recovery_time", "recovery.time_s"),
-            "settling": ("recovery.time_s", "recovery_time")}
-_CRITERION_TEXT = {"last_peak": "recovery time (last yaw-rate peak above 8 %)",
-                   "settling": "5 % settling time of the yaw rate"}
+#: second breaking ties. ``settling`` (default) is the recovery time of
+#: :func:`whipple_kick.analysis.recovery`: the time from which yaw, roll and
+#: steer rates all stay within 5 % of their first peaks (``recovery.time_s``).
+#: ``last_peak`` is the thesis' rule (time of the last yaw-rate peak above 8 %
+#: of the largest, Section 8.3, Table 8.9; ``last_peak_time``).
+CRITERIA = {"settling": ("recovery.time_s", "last_peak_time"),
+            "last_peak": ("last_peak_time", "recovery.time_s")}
+_CRITERION_TEXT = {"last_peak": "last-peak time (last yaw-rate peak above 8 % of the largest, thesis)",
+                   "settling": "recovery time (yaw, roll and steer rates within 5 % of their first peaks)"}
+#: Spread [s] of each criterion's value, below which a difference between pressures is not to be
+#: trusted: the largest change of the value over the nine thesis cases (300/400/500 kPa x
+#: 570/635/701 N) when the tyre coefficients change by 1 % (peak, stiffness, curvature, camber
+#: and M_z terms one group at a time, all at once, and eight random draws of every coefficient in
+#: [0.99, 1.01]) or rtol goes from 1e-10 to 1e-8 or 1e-12 (``scripts/recommender_spread.py``,
+#: docs/sweeps.md). Settling: 0.570 s (a random draw at 400 kPa, 570 N; a half-wave of the yaw
+#: rate crossing the 5 % band moves the settling time by about half a period); rtol moves
+#: neither by 1 ms. A margin between the best and the second-best pressure below the spread is
+#: "no clear optimum". Measured on the force-lag tyre transient; re-measure when the model changes.
+CRITERION_SPREAD_S = {"settling": 0.570, "last_peak": 0.011}
+
+
+def criterion_key(criterion):
+    """The :data:`CRITERIA` key of ``criterion`` (``"last-peak"`` as the CLI spells it is accepted)."""
+    key = str(criterion).replace("-", "_")
+    if key not in CRITERIA:
+        raise InputError(f"criterion = {criterion!r} is unknown; choose one of "
+                         f"{', '.join(k.replace('_', '-') for k in CRITERIA)}")
+    return key
 
 
 @dataclasses.dataclass
@@ -700,16 +733,26 @@ class Recommendation:
         Static rear-tyre load [N].
     tyre : str
     best_pressure_kpa : float or None
-        Pressure [kPa] with the shortest recovery time (None if no case recovered).
+        Pressure [kPa] ranked first (None if no case recovered or there is nothing to choose).
     best_measured_kpa : float or None
         The same among the measured pressures only.
     criterion : str
         Key of :data:`CRITERIA` the pressures were ranked by.
+    margin_s : float or None
+        Second-best minus best value of the criterion [s] (None with fewer
+        than two pressures that recovered).
+    spread_s : float
+        :data:`CRITERION_SPREAD_S` of the criterion [s].
+    verdict : str
+        ``"clear"`` (margin >= spread, or the only pressure that recovered),
+        ``"no clear optimum"`` (margin below the spread), ``"nothing to
+        choose"`` (one pressure) or ``"none recovered"``.
     table : pandas.DataFrame
-        One row per pressure: ``pressure_kpa``, ``measured``, ``recovery_time``
-        [s], ``recovery.time_s`` [s], ``n_peaks``, ``damping_ratio_1_3``,
-        ``period`` [s], ``max_abs_roll`` [rad], ``fell``, ``status``, ``error``,
-        ``rank``.
+        One row per pressure: ``pressure_kpa``, ``measured``,
+        ``recovery.time_s`` [s], ``last_peak_time`` [s], the yaw, roll and
+        steer rates' settling times [s], ``n_peaks``, ``damping_ratio_1_3``,
+        ``period`` [s], ``max_abs_roll`` [rad], ``fell``, ``status``,
+        ``error``, ``rank``.
     """
 
     fz_n: float
@@ -717,6 +760,9 @@ class Recommendation:
     best_pressure_kpa: float | None
     best_measured_kpa: float | None
     criterion: str
+    margin_s: float | None
+    spread_s: float
+    verdict: str
     table: "object"
 
 
@@ -763,23 +809,50 @@ def pressure_grid(tyre="T03", pressures=None, fine=False, step_kpa=10.0, coeffic
     return sorted(out), set(measured)
 
 
+def _did_not_recover(table):
+    """Rows that fell or failed (never ranked ahead of a run that did not)."""
+    fell = table["fell"].map(lambda v: v is True or _num(v) == 1.0)
+    return (fell | (table["status"] != "ok")).to_numpy()
+
+
 def _rank(table, criterion):
-    """Row order by the criterion's columns, rows without a value (fell, not recovered, failed) last."""
+    """Row order: runs that neither fell nor failed first, then by the criterion's columns (missing last)."""
     keys = [np.where(np.isfinite(v), v, np.inf)
-            for v in (table[col].astype(float).to_numpy() for col in CRITERIA[criterion])]
-    return np.lexsort(keys[::-1])
+            for v in (table[col].map(_num).to_numpy(dtype=float) for col in CRITERIA[criterion])]
+    return np.lexsort(keys[::-1] + [_did_not_recover(table)])
 
 
-def _best(rows, criterion):
-    """Pressure of the best-ranked row with a value of the criterion, or None."""
-    if rows.empty:
-        return None
-    top = rows.iloc[_rank(rows, criterion)[0]]
-    return float(top["pressure_kpa"]) if math.isfinite(_num(top[CRITERIA[criterion][0]])) else None
+def _ranked_values(rows, criterion):
+    """(pressures, values) of the rows with a value of the criterion, best first."""
+    order = _rank(rows, criterion)
+    values = rows[CRITERIA[criterion][0]].map(_num).to_numpy(dtype=float)[order]
+    ok = np.isfinite(values) & ~_did_not_recover(rows)[order]
+    return rows["pressure_kpa"].to_numpy(dtype=float)[order][ok], values[ok]
+
+
+def _verdict(rows, criterion):
+    """(best pressure, margin, verdict) of one load's rows (see :class:`Recommendation`)."""
+    if len(rows) == 1:
+        return None, None, "nothing to choose"
+    pressures, values = _ranked_values(rows, criterion)
+    if not pressures.size:
+        return None, None, "none recovered"
+    if pressures.size == 1:
+        return float(pressures[0]), None, "clear"   # the only pressure that recovered
+    margin = float(values[1] - values[0])
+    return float(pressures[0]), margin, ("clear" if margin >= CRITERION_SPREAD_S[criterion]
+                                         else "no clear optimum")
+
+
+#: Columns of :attr:`Recommendation.table`.
+_RECOMMENDATION_COLUMNS = (
+    "pressure_kpa", "measured", "recovery.time_s", "last_peak_time", "recovery.signals.yaw_rate.time_s",
+    "recovery.signals.roll_rate.time_s", "recovery.signals.steer_rate.time_s", "n_peaks",
+    "damping_ratio_1_3", "period", "max_abs_roll", "fell", "status", "error")
 
 
 def recommend_pressures(loads, tyre="T03", pressures=None, fine=False, step_kpa=10.0, base=None,
-                        criterion="last_peak", **sweep_options):
+                        criterion="settling", **sweep_options):
     """:func:`recommend_pressure` for several rear loads in one sweep.
 
     Returns
@@ -788,8 +861,7 @@ def recommend_pressures(loads, tyre="T03", pressures=None, fine=False, step_kpa=
         In the order of ``loads``.
     """
     base = simulation.Scenario() if base is None else base
-    if criterion not in CRITERIA:
-        raise InputError(f"criterion = {criterion!r} is unknown; choose one of {', '.join(CRITERIA)}")
+    criterion = criterion_key(criterion)
     loads = [check_range("rear-tyre load fz", f, 0.0, None, "N", low_open=True) for f in loads]
     if not loads:
         raise InputError("give at least one rear load fz (N)")
@@ -797,34 +869,38 @@ def recommend_pressures(loads, tyre="T03", pressures=None, fine=False, step_kpa=
     sweep_options.setdefault("progress", False)
     table = sweep({"fz_n": loads, "pressure_kpa": grid}, base=dataclasses.replace(base, tyre=tyre),
                   **sweep_options)
-    keep = ["pressure_kpa", "measured", "recovery_time", "recovery.time_s", "n_peaks",
-            "damping_ratio_1_3", "period", "max_abs_roll", "fell", "status", "error"]
     out = []
     for fz in loads:
         rows = table[table["fz_n"] == fz].copy()
         rows["measured"] = rows["pressure_kpa"].isin(measured)
-        for col in keep:
+        for col in _RECOMMENDATION_COLUMNS:
             if col not in rows:   # every case failed: no result columns at all
                 rows[col] = np.nan
-        rows = rows[keep].sort_values("pressure_kpa").reset_index(drop=True)
+        rows = rows[list(_RECOMMENDATION_COLUMNS)].sort_values("pressure_kpa").reset_index(drop=True)
         rows["rank"] = np.argsort(_rank(rows, criterion)) + 1
-        out.append(Recommendation(fz, tyre, _best(rows, criterion),
-                                  _best(rows[rows["measured"]].reset_index(drop=True), criterion),
-                                  criterion, rows))
+        best, margin, verdict = _verdict(rows, criterion)
+        best_measured = _verdict(rows[rows["measured"]].reset_index(drop=True), criterion)[0]
+        out.append(Recommendation(fz, tyre, best, best_measured, criterion, margin,
+                                  CRITERION_SPREAD_S[criterion], verdict, rows))
     return out
 
 
 def recommend_pressure(fz_n, tyre="T03", pressures=None, fine=False, step_kpa=10.0, base=None,
-                       criterion="last_peak", **sweep_options):
-    """The inflation pressure with the fastest yaw-rate recovery after a kick.
+                       criterion="settling", **sweep_options):
+    """The inflation pressure with the fastest recovery after a kick, and how sure that is.
 
     Runs ``base`` (default: the thesis' kick on the default bicycle with a
     rider for ``fz_n`` and the LQR rider) at each pressure and ranks the
-    cases by the thesis' recovery time (time of the last yaw-rate peak above
-    8 % of the largest; :func:`whipple_kick.analysis.recovery_time`), ties
-    broken by the 5 % settling time (``recovery.time_s``), or the other way
-    round with ``criterion="settling"``. Cases that fell or did not recover
-    rank last. docs/sweeps.md compares the result with thesis Table 8.9.
+    cases by the recovery time (:func:`whipple_kick.analysis.recovery`: yaw,
+    roll and steer rates all within 5 % of their first peaks), ties broken by
+    the thesis' last-peak time; ``criterion="last_peak"`` ranks by the
+    thesis' rule (last yaw-rate peak above 8 % of the largest, Table 8.9)
+    instead. A run that fell or failed never ranks ahead of one that did not.
+    The margin between the best and the second-best pressure is compared with
+    the spread a 1 % change of the tyre coefficients or of the integration
+    tolerance produces (:data:`CRITERION_SPREAD_S`): below it the verdict is
+    "no clear optimum"; with one pressure there is "nothing to choose".
+    docs/sweeps.md compares the result with thesis Table 8.9.
 
     Parameters
     ----------
@@ -843,15 +919,21 @@ def recommend_pressure(fz_n, tyre="T03", pressures=None, fine=False, step_kpa=10
     base : Scenario, optional
         Everything else about the run (``fz_n``, ``tyre`` and the pressure
         are set here).
-    criterion : {"last_peak", "settling"}
-        What "fastest recovery" means (:data:`CRITERIA`).
+    criterion : {"settling", "last_peak"}
+        What "fastest recovery" means (:data:`CRITERIA`; "last-peak" is accepted).
     **sweep_options
-        Passed to :func:`sweep` (``folder``, ``executor``, ``workers``,
-        ``progress``, ...).
+        Passed to :func:`sweep` (``folder``, ``extend``, ``executor``,
+        ``workers``, ``progress``, ...).
 
     Returns
     -------
     Recommendation
+
+    Example
+    -------
+    >>> from whipple_kick import sweep
+    >>> rec = sweep.recommend_pressure(635)                  # doctest: +SKIP
+    >>> rec.best_pressure_kpa, rec.margin_s, rec.verdict     # doctest: +SKIP
     """
     return recommend_pressures([fz_n], tyre, pressures, fine, step_kpa, base, criterion,
                                **sweep_options)[0]
@@ -871,33 +953,45 @@ def format_recommendation(rec):
         v = _num(value) * scale
         return fmt.format(v) if math.isfinite(v) else "-"
 
-    lines = [f"rear load {rec.fz_n:g} N, tyre {rec.tyre}: yaw-rate recovery after the kick, "
-             f"ranked by {_CRITERION_TEXT[rec.criterion]}",
-             f"{'p [kPa]':>8} {'meas.':>5} {'recovery [s]':>12} {'5% settle [s]':>13} {'peaks':>5} "
-             f"{'zeta 1-3':>8} {'period [s]':>10} {'max roll [deg]':>14} {'rank':>4}  note"]
+    column = CRITERIA[rec.criterion][0]
+    lines = [f"rear load {rec.fz_n:g} N, tyre {rec.tyre}: recovery after the kick, "
+             f"ranked by the {_CRITERION_TEXT[rec.criterion]}",
+             f"{'p [kPa]':>8} {'meas.':>5} {'recovery [s]':>12} {'yaw/roll/steer settle [s]':>25} "
+             f"{'last peak [s]':>13} {'zeta 1-3':>8} {'max roll [deg]':>14} {'rank':>4}  note"]
     for _, r in rec.table.iterrows():
         if r["status"] != "ok":
             note = f"failed: {r['error']}"
         elif r["fell"] is True or _num(r["fell"]) == 1.0:
             note = "fell"
-        elif not math.isfinite(_num(r[CRITERIA[rec.criterion][0]])):
+        elif not math.isfinite(_num(r[column])):
             note = "not recovered"
         else:
             note = "best" if r["pressure_kpa"] == rec.best_pressure_kpa else ""
+        settle = "/".join(cell(r[f"recovery.signals.{name}.time_s"], "{:.2f}")
+                          for name in ("yaw_rate", "roll_rate", "steer_rate"))
         lines.append(
             f"{r['pressure_kpa']:8g} {'yes' if r['measured'] else '':>5} "
-            f"{cell(r['recovery_time'], '{:.3f}'):>12} {cell(r['recovery.time_s'], '{:.3f}'):>13} "
-            f"{cell(r['n_peaks'], '{:.0f}'):>5} "
-            f"{cell(r['damping_ratio_1_3'], '{:.4f}'):>8} {cell(r['period'], '{:.4f}'):>10} "
+            f"{cell(r['recovery.time_s'], '{:.3f}'):>12} {settle:>25} "
+            f"{cell(r['last_peak_time'], '{:.3f}'):>13} {cell(r['damping_ratio_1_3'], '{:.4f}'):>8} "
             f"{cell(r['max_abs_roll'], '{:.2f}', 180.0 / math.pi):>14} {int(r['rank']):4d}  {note}")
-    if rec.best_pressure_kpa is None:
-        lines.append(f"recommendation for {rec.fz_n:g} N: none (no pressure recovered within the run)")
+    head = f"recommendation for {rec.fz_n:g} N: "
+    if rec.verdict == "nothing to choose":
+        only = float(rec.table["pressure_kpa"].iloc[0])
+        lines.append(head + f"nothing to choose: only {only:g} kPa was run"
+                     + (f" ({rec.tyre} was measured at one pressure)" if rec.table["measured"].all() else ""))
+    elif rec.verdict == "none recovered":
+        lines.append(head + "none (no pressure recovered within the run)")
     else:
         best = rec.table[rec.table["pressure_kpa"] == rec.best_pressure_kpa].iloc[0]
-        column = CRITERIA[rec.criterion][0]
-        text = (f"recommendation for {rec.fz_n:g} N: {rec.best_pressure_kpa:g} kPa "
-                f"({_CRITERION_TEXT[rec.criterion]} {_num(best[column]):.3f} s)")
+        text = f"{rec.best_pressure_kpa:g} kPa ({_num(best[column]):.3f} s)"
+        if rec.margin_s is None:
+            text += "; the only pressure that recovered"
+        else:
+            text += (f", {rec.margin_s:.3f} s ahead of the second best; "
+                     f"spread from a 1 % change of the tyre coefficients or of rtol: {rec.spread_s:.3f} s")
+            if rec.verdict == "no clear optimum":
+                text = f"no clear optimum: {text} (margin below the spread)"
         if rec.best_measured_kpa is not None and rec.best_measured_kpa != rec.best_pressure_kpa:
             text += f"; best measured pressure {rec.best_measured_kpa:g} kPa"
-        lines.append(text)
+        lines.append(head + text)
     return "\n".join(lines)
