@@ -66,7 +66,7 @@ def test_a_stalling_integration_ends_as_a_failure_with_its_samples():
     assert stall == pytest.approx(0.02, abs=2e-3)
     assert traj.t[-1] <= stall and traj.t.size == int(round(traj.t[-1] * 1000)) + 1
     assert np.all(np.isfinite(traj.x)) and traj.end_state is not None
-    assert traj.nfev <= budget.limit(stall) + 100
+    assert traj.evaluations == traj.nfev <= budget.limit(stall) + 100   # no Jacobian: LSODA differences itself
 
 
 def test_a_run_slower_than_the_budget_rate_fails_and_a_normal_run_does_not():
@@ -79,6 +79,96 @@ def test_a_run_slower_than_the_budget_rate_fails_and_a_normal_run_does_not():
     tight = integrate.Budget(allowance=200, per_second=100.0)
     traj = integrate.integrate(fast, _start(1e-3), 1.0, output_rate=100.0, budget=tight)
     assert traj.failed and "more than the budget 200 + 100/s" in traj.message
-    assert traj.nfev <= tight.limit(traj.t[-1]) + 100
+    assert traj.evaluations <= tight.limit(traj.t[-1]) + 100
     ok = integrate.integrate(fast, _start(1e-3), 0.05, output_rate=100.0)
     assert not ok.failed and ok.t[-1] == pytest.approx(0.05)
+
+
+# ------------------------------------------- the careful path across a jump map, and the Jacobian's cost
+
+def _every_chunk_careful():
+    """A budget whose fast path gives up after 2 steps between samples (mxstep = stall_window // 4), so
+    every chunk is integrated by the careful path; it never runs out and never judges a stall."""
+    return integrate.Budget(allowance=10**9, per_second=0.0, stall_window=8, stall_progress=0.0)
+
+
+@pytest.mark.parametrize("budget", [None, "careful"])
+def test_a_fall_right_after_a_jump_map_is_exact(budget):
+    """roll'' = roll; at t = 1 s a jump map sets the roll rate to 0.5 rad/s. From there roll =
+    r1 cosh(tau) + 0.5 sinh(tau) with r1 = 0.01 cosh(1), which reaches 45 deg at a closed-form time:
+    the fall is found exactly in the piece right after the jump (fast or careful path before it), the
+    sample at the jump holds the mapped state and the samples before it the unmapped one."""
+    budget = _every_chunk_careful() if budget == "careful" else None
+    fall_angle = math.radians(45.0)
+
+    def kick(t, x):
+        x = x.copy()
+        x[ROLL_RATE] = 0.5
+        return x
+    traj = integrate.integrate(capsize, _start(), 4.0, breakpoints=(1.0,), rtol=1e-11, output_rate=100.0,
+                               fall_angle=fall_angle, jumps={1.0: kick}, budget=budget)
+    assert traj.fell and not traj.failed
+    r1, w1 = 0.01 * math.cosh(1.0), 0.5
+    # r1 cosh(tau) + w1 sinh(tau) = R sinh(tau + phi) with R = sqrt(w1^2 - r1^2), tanh(phi) = r1 / w1.
+    tau = math.asinh(fall_angle / math.sqrt(w1**2 - r1**2)) - math.atanh(r1 / w1)
+    assert traj.fall_time == pytest.approx(1.0 + tau, abs=1e-8)
+    at = int(np.flatnonzero(traj.t == 1.0)[0])
+    assert traj.x[at, ROLL_RATE] == 0.5                                       # mapped
+    assert traj.x[at - 1, ROLL_RATE] == pytest.approx(0.01 * math.sinh(0.99), rel=1e-8)   # not mapped
+    assert traj.x[at, ROLL] == pytest.approx(r1, rel=1e-8)
+    if budget is not None:                  # every chunk on the careful path: it counted its work
+        assert traj.evaluations == traj.nfev > 0
+
+
+def test_a_stall_right_after_a_jump_map_keeps_the_samples_up_to_it():
+    """The piece after the jump slides on a switching line (x' = -sign(x) + 0.5) from 2 ms after it:
+    the careful path reports the stall there, with the mapped sample at the jump and every sample up
+    to the stall, within the budget."""
+    def after_one_second(t, x):
+        return chatter(t, x) if t >= 1.0 else np.zeros_like(x)
+
+    def move(t, x):
+        x = x.copy()
+        x[ROLL] = 0.001
+        return x
+    budget = integrate.Budget(allowance=5000, per_second=5000.0, stall_window=2000, stall_progress=1e-3)
+    traj = integrate.integrate(after_one_second, np.zeros(N), 2.0, breakpoints=(1.0,), output_rate=1000.0,
+                               rtol=1e-10, jumps={1.0: move}, budget=budget)
+    assert traj.failed and not traj.fell and traj.message.startswith("integration stalled at t = ")
+    stall = float(traj.message.split("t = ")[1].split(" s")[0])
+    assert stall == pytest.approx(1.002, abs=2e-3)
+    at = int(np.flatnonzero(traj.t == 1.0)[0])
+    assert traj.x[at, ROLL] == 0.001 and traj.x[at - 1, ROLL] == 0.0
+    assert traj.t[-1] <= stall and traj.t.size == int(round(traj.t[-1] * 1000)) + 1
+    assert traj.evaluations <= budget.limit(stall) + 100
+
+
+def test_the_budget_counts_the_evaluations_inside_the_jacobian():
+    """A stiff decay (rates 1e4 /s) makes LSODA take Jacobians. With a Jacobian that says it costs
+    1000 evaluations (as the compiled model's says it costs 22), the budget counts them: the same
+    run fits a budget when the Jacobian is free and fails it when it is not."""
+    def stiff(t, x):
+        return -1e4 * (x - 1e-3)
+
+    def make_jac(cost):
+        def jac(t, x):
+            return -1e4 * np.eye(N)
+        jac.evaluations = cost
+        return jac
+
+    class Model:
+        """An f(t, x) with a Jacobian, as slip.CompiledRHS offers one."""
+        def __init__(self, cost):
+            self.cost = cost
+
+        def __call__(self, t, x):
+            return stiff(t, x)
+
+        def jacobian_function(self, scale):
+            return make_jac(self.cost)
+    budget = integrate.Budget(allowance=2000, per_second=2000.0)
+    free = integrate.integrate(Model(0), _start(), 1.0, output_rate=100.0, budget=budget)
+    assert not free.failed and free.njev > 0 and free.evaluations == free.nfev
+    costly = integrate.integrate(Model(1000), _start(), 1.0, output_rate=100.0, budget=budget)
+    assert costly.failed and "more than the budget 2000 + 2000/s" in costly.message
+    assert costly.evaluations == costly.nfev + 1000 * costly.njev

@@ -319,7 +319,8 @@ def _print_summary(result, out, files):
     print(f"  energy after the kick: plate work {e['plate_work_j']:+.2f} J, sliding {e['sliding_dissipation_j']:.2f} J, "
           f"dampers {e['damper_dissipation_j']:.2f} J{jumps}; balance residual {e['balance_residual_max_abs_j']:.1e} J")
     n = s["numerics"]
-    print(f"  numerics: LSODA rtol {n['rtol']:g}, {n['nfev']} evaluations, integration {n['integration_wall_s']:.2f} s, "
+    print(f"  numerics: LSODA rtol {n['rtol']:g}, {n['evaluations']} evaluations ({n['njev']} Jacobians), "
+          f"integration {n['integration_wall_s']:.2f} s, "
           f"run {n['wall_s']:.2f} s")
     print(f"  wrote {', '.join(files)} in {out}")
 

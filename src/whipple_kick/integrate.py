@@ -10,7 +10,9 @@ LSODA's stiff steps use the compiled model's Jacobian (forward differences
 in C over the dynamic states; the energy quadratures feed nothing back).
 
 No integration runs for ever: a :class:`Budget` bounds the right-hand-side
-evaluations per simulated second. An integration that stalls (the step size
+evaluations per simulated second (those LSODA makes and those inside each
+Jacobian: a forward-difference Jacobian of the compiled model costs one
+evaluation per dynamic state and one more). An integration that stalls (the step size
 collapsing, e.g. when a wheel unloads in a fall and the tyre forces switch
 faster than any step can follow) ends as a reported failure with the samples
 it produced so far, in bounded time.
@@ -34,10 +36,12 @@ class Trajectory:
     x: np.ndarray            # states, shape (n, len(slip.STATE_NAMES))
     fell: bool               # the roll limit was reached
     fall_time: float | None  # time of the fall event [s]
-    nfev: int                # right-hand-side evaluations
+    nfev: int                # right-hand-side evaluations by LSODA (those inside Jacobians not counted)
     message: str
     end_state: np.ndarray | None = None   # exact state at t_end (or at the fall, or where it failed)
     failed: bool = False     # the integration failed (stalled, non-finite derivative); samples end there
+    njev: int = 0            # Jacobian evaluations
+    evaluations: int = 0     # all right-hand-side evaluations, the Jacobians' included (what the budget counts)
 
     def state(self, name):
         """Time history of one state by name."""
@@ -139,11 +143,16 @@ def _careful_chunk(rhs, x, times, rtol, atol, fall, spent, budget, t_start, jac=
     status : {"completed", "fell", "failed"}
     message : str or None
         Why it failed.
-    nfev : int
+    counts : (nfev, njev, evaluations)
+        LSODA's evaluations, its Jacobians, and all evaluations (the
+        Jacobians' included: :func:`_evaluations`), as the budget counts them.
     """
     from scipy.optimize import brentq
 
     solver = LSODA(rhs, times[0], x, times[-1], rtol=rtol, atol=atol, jac=jac)
+
+    def counts():
+        return solver.nfev, solver.njev, _evaluations(jac, solver.nfev, solver.njev)
     out_t, out_x = [times[:1]], [np.asarray(x, dtype=float)[None, :]]
     nxt, g_old = 1, fall(times[0], x)
     recent = collections.deque([(0, times[0])])   # (evaluations, time) after the steps of the last window
@@ -155,7 +164,7 @@ def _careful_chunk(rhs, x, times, rtol, atol, fall, spent, budget, t_start, jac=
             solver.status = "failed"
         if solver.status == "failed":
             return (np.concatenate(out_t), np.concatenate(out_x), (solver.t, solver.y), "failed",
-                    f"LSODA stopped at t = {solver.t:.6g} s: {trouble}", solver.nfev)
+                    f"LSODA stopped at t = {solver.t:.6g} s: {trouble}", counts())
         t_new, end, status = solver.t, (solver.t, solver.y), None
         dense = None
         g_new = fall(t_new, solver.y)
@@ -174,22 +183,34 @@ def _careful_chunk(rhs, x, times, rtol, atol, fall, spent, budget, t_start, jac=
         if status is None and solver.status == "finished":
             status = "completed"
         if status is not None:
-            return np.concatenate(out_t), np.concatenate(out_x), end, status, None, solver.nfev
-        recent.append((solver.nfev, t_new))
-        while len(recent) > 1 and recent[1][0] <= solver.nfev - budget.stall_window:
+            return np.concatenate(out_t), np.concatenate(out_x), end, status, None, counts()
+        used = counts()[2]
+        recent.append((used, t_new))
+        while len(recent) > 1 and recent[1][0] <= used - budget.stall_window:
             recent.popleft()
         why = None
-        if spent + solver.nfev > budget.limit(t_new - t_start):
-            why = (f"{spent + solver.nfev} right-hand-side evaluations for {t_new - t_start:.4g} s simulated, "
+        if spent + used > budget.limit(t_new - t_start):
+            why = (f"{spent + used} right-hand-side evaluations for {t_new - t_start:.4g} s simulated, "
                    f"more than the budget {budget.allowance} + {budget.per_second:g}/s")
-        elif recent[0][0] <= solver.nfev - budget.stall_window and t_new - recent[0][1] < budget.stall_progress:
-            why = (f"{solver.nfev - recent[0][0]} right-hand-side evaluations advanced it only "
+        elif recent[0][0] <= used - budget.stall_window and t_new - recent[0][1] < budget.stall_progress:
+            why = (f"{used - recent[0][0]} right-hand-side evaluations advanced it only "
                    f"{t_new - recent[0][1]:.2g} s (at least {budget.stall_progress:g} s per "
                    f"{budget.stall_window} evaluations)")
         if why is not None:
             return (np.concatenate(out_t), np.concatenate(out_x), end, "failed",
                     f"integration stalled at t = {t_new:.6g} s: {why}; last step {solver.step_size:.2g} s",
-                    solver.nfev)
+                    counts())
+
+
+def _evaluations(jac, nfev, njev):
+    """Right-hand-side evaluations LSODA's ``nfev`` calls and ``njev`` Jacobians cost.
+
+    A Jacobian with an ``evaluations`` attribute (the compiled model's
+    forward differences: one evaluation per dynamic state and one more) costs
+    that many; without a Jacobian LSODA differences itself and counts those
+    evaluations in ``nfev``.
+    """
+    return int(nfev) + int(njev) * int(getattr(jac, "evaluations", 0))
 
 
 class _PastTheLimit(Exception):
@@ -199,7 +220,7 @@ class _PastTheLimit(Exception):
 def _fast_chunk(rhs, x, times, rtol, atol, roll_index, fall_angle, mxstep, jac=None):
     """Integrate one chunk with odeint's LSODA (the step loop stays in Fortran).
 
-    Returns ``(states, nfev)``, or ``None`` if the roll limit was passed or
+    Returns ``(states, (nfev, njev, evaluations))``, or ``None`` if the roll limit was passed or
     LSODA reported trouble, e.g. more than ``mxstep`` steps between two
     samples (the caller then integrates the chunk carefully).
     """
@@ -221,12 +242,13 @@ def _fast_chunk(rhs, x, times, rtol, atol, roll_index, fall_angle, mxstep, jac=N
             return None
     if info["message"] != "Integration successful." or not np.all(np.isfinite(y)):
         return None
-    return y, int(info["nfe"][-1])
+    nfev, njev = int(info["nfe"][-1]), int(info["nje"][-1])
+    return y, (nfev, njev, _evaluations(jac, nfev, njev))
 
 
 def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None,
               output_rate=1000.0, fall_angle=np.deg2rad(45.0), chunk=None, samples=None,
-              budget=DEFAULT_BUDGET, jumps=None):
+              budget=None, jumps=None):
     """Integrate ``rhs`` from ``x0`` piecewise between breakpoints with LSODA.
 
     Each smooth piece is integrated in chunks of about ``chunk`` seconds
@@ -269,8 +291,9 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
         returned. Default: ``output_rate`` from ``t_start``. A sample within
         a billionth of the sample spacing of a piece's edge is given the
         state at that edge rather than a sub-ulp integration of its own.
-    budget : Budget
-        Evaluation budget of this call (default :data:`DEFAULT_BUDGET`).
+    budget : Budget, optional
+        Evaluation budget of this call (default: :data:`DEFAULT_BUDGET` as it
+        is when the call is made).
     jumps : mapping, optional
         ``{breakpoint: g(t, x) -> x}``: the state leaving the piece that
         ends at the breakpoint is mapped by ``g`` before the next piece
@@ -297,6 +320,7 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
     atol = default_atol(rtol, transient) if atol is None else np.asarray(atol, dtype=float)
     jac = rhs.jacobian_function(atol / rtol) if hasattr(rhs, "jacobian_function") else None
     jumps = dict(jumps or {})
+    budget = DEFAULT_BUDGET if budget is None else budget
     chunk = DEFAULT_CHUNK if chunk is None else chunk
     if samples is None:
         n_samples = int(round((t_end - t_start) * output_rate)) + 1
@@ -314,7 +338,8 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
     fall.terminal = True
     fall.direction = -1
 
-    ts, xs, nfev = [], [], 0
+    ts, xs = [], []
+    nfev = njev = spent = 0   # LSODA's evaluations, Jacobians, all evaluations (the budget's count)
     last_t = -np.inf   # time of the last emitted sample (chunks share end points)
 
     def emit(times, states):
@@ -351,16 +376,16 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
             # A sample at the piece's end is emitted after the jump map (below).
             last = -1 if i1 == len(grid) - 1 else None
             fast = _fast_chunk(rhs, x, times, rtol, atol, roll, fall_angle, mxstep, jac)
-            if fast is not None and nfev + fast[1] <= budget.limit(times[-1] - t_start):
-                y, n = fast
-                nfev += n
+            if fast is not None and spent + fast[1][2] <= budget.limit(times[-1] - t_start):
+                y, (n, nj, used) = fast
+                nfev, njev, spent = nfev + n, njev + nj, spent + used
                 emit(times[:last], y[:last])
                 x = y[-1]
                 continue
             # A failed fast attempt is redone here, so only this attempt counts against the budget.
-            sample_t, sample_x, (t_reached, x), status, why, n = _careful_chunk(
-                rhs, x, times, rtol, atol, fall, nfev, budget, t_start, jac)
-            nfev += n
+            sample_t, sample_x, (t_reached, x), status, why, (n, nj, used) = _careful_chunk(
+                rhs, x, times, rtol, atol, fall, spent, budget, t_start, jac)
+            nfev, njev, spent = nfev + n, njev + nj, spent + used
             if status == "completed" and last is not None and sample_t.size and sample_t[-1] == times[-1]:
                 sample_t, sample_x = sample_t[:-1], sample_x[:-1]
             emit(sample_t, sample_x)
@@ -384,4 +409,5 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
     X = np.concatenate(xs) if xs else np.empty((0, len(x)))
     if X.size and not np.all(np.isfinite(X)):
         raise FloatingPointError("non-finite state in the integration result")
-    return Trajectory(t, X, fell, fall_time, nfev, message, end_state=np.asarray(x, dtype=float), failed=failed)
+    return Trajectory(t, X, fell, fall_time, nfev, message, end_state=np.asarray(x, dtype=float), failed=failed,
+                      njev=njev, evaluations=spent)

@@ -665,13 +665,18 @@ def _integrate_run(steady, scenario, kick_T, table, kick_start):
         return _from_kick_start(traj, kick_start), rhs_out, owner, breakpoints, jumps
     settle = integrate.integrate(rhs, x_start, kick_start, t_start=t_start, rtol=scenario.rtol, fall_angle=fall_angle,
                                  chunk=chunk, samples=samples[samples < kick_start])
-    post, rhs_out, owner = run_from(steady.x, kick_start, samples[samples >= kick_start])
     quad = [slip.X[n] for n in slip.QUADRATURE_STATES]
     settle_x = settle.x.copy()
     settle_x[:, quad] -= settle.end_state[quad]   # cumulative from the kick start
+    if settle.fell or settle.failed:
+        # The steady motion did not last through the settle (it fell or the integration failed before
+        # the kick): that is the run's outcome, and there is no kick to integrate.
+        return replace(settle, x=settle_x), rhs, None, breakpoints, jumps
+    post, rhs_out, owner = run_from(steady.x, kick_start, samples[samples >= kick_start])
     traj = integrate.Trajectory(np.concatenate([settle.t, post.t]), np.concatenate([settle_x, post.x]),
                                 post.fell, post.fall_time, settle.nfev + post.nfev, post.message,
-                                end_state=post.end_state)
+                                end_state=post.end_state, failed=post.failed, njev=settle.njev + post.njev,
+                                evaluations=settle.evaluations + post.evaluations)
     if owner is not None:
         # The settle's samples belong to the model of the plate at rest before the table.
         rhs_out = [rhs] + list(rhs_out)
@@ -724,15 +729,16 @@ def _integrate_table(params, x0, table, scenario, chunk, t_start=None):
     t_start = pending[0] if t_start is None else t_start
     pending = pending[pending >= t_start]
     fall_angle = math.radians(scenario.fall_angle_deg)
-    ts, xs, owner, rhss, nfev = [], [], [], [], 0
+    ts, xs, owner, rhss = [], [], [], []
+    nfev = njev = evaluations = 0
     x = np.asarray(x0, dtype=float)
     traj = None
     for k, (a, b, t0, coefficients) in enumerate(table.pieces(t_start, t_end)):
         rhs = slip.CompiledRHS(_segment_parameters(params, t0, coefficients))
         rhss.append(rhs)
         traj = integrate.integrate(rhs, x, b, t_start=a, rtol=scenario.rtol, fall_angle=fall_angle,
-                                   chunk=chunk, samples=pending, budget=integrate.DEFAULT_BUDGET)
-        nfev += traj.nfev
+                                   chunk=chunk, samples=pending)
+        nfev, njev, evaluations = nfev + traj.nfev, njev + traj.njev, evaluations + traj.evaluations
         ts.append(traj.t)
         xs.append(traj.x)
         owner.append(np.full(traj.t.size, k))
@@ -742,7 +748,8 @@ def _integrate_table(params, x0, table, scenario, chunk, t_start=None):
         if traj.fell or traj.failed:
             break
     trajectory = integrate.Trajectory(np.concatenate(ts), np.concatenate(xs), traj.fell, traj.fall_time,
-                                      nfev, traj.message, end_state=x, failed=traj.failed)
+                                      nfev, traj.message, end_state=x, failed=traj.failed, njev=njev,
+                                      evaluations=evaluations)
     return trajectory, rhss, np.concatenate(owner).astype(int)
 
 
@@ -1258,7 +1265,9 @@ def run(scenario, *, tyres=None, gains=None):
         "numerics": {
             "method": "LSODA", "rtol": scenario.rtol, "piecewise": scenario.piecewise,
             "plate_stop": scenario.plate_stop, "kick_heading": scenario.kick_heading,
-            "breakpoints_s": list(breakpoints), "nfev": int(traj.nfev),
+            "breakpoints_s": list(breakpoints), "nfev": int(traj.nfev), "njev": int(traj.njev),
+            # What the budget counts: LSODA's evaluations and those inside its Jacobians.
+            "evaluations": int(traj.evaluations),
             "budget": {"allowance": integrate.DEFAULT_BUDGET.allowance,
                        "per_simulated_second": integrate.DEFAULT_BUDGET.per_second},
             "integration_wall_s": integration_s,

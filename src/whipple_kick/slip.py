@@ -697,6 +697,12 @@ class CompiledRHS:
         ----------
         scale : array_like
             Typical size of each state; the step is ``1.5e-8 max(|x_j|, scale_j)``.
+
+        Returns
+        -------
+        callable
+            ``jac(t, x)``; its ``evaluations`` attribute is the number of
+            right-hand-side evaluations one call makes (dynamic states + 1).
         """
         scale = np.ascontiguousarray(scale, dtype=float)
         n = len(STATE_NAMES)
@@ -710,6 +716,7 @@ class CompiledRHS:
                 raise FloatingPointError(_STATUS.get(status, f"status {status}") + f" at t = {t:.6g} s")
             return J
         jac.scale = scale   # keeps the array alive with the closure
+        jac.evaluations = len(DYNAMIC_STATES) + 1   # right-hand-side evaluations per call (the budget counts them)
         return jac
 
     def impulse_terms(self, t, x):
