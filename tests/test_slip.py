@@ -221,6 +221,36 @@ def test_tyre_physics_in_the_model(rider_bike, t03):
     assert np.all(np.isfinite(dx))
 
 
+@pytest.mark.parametrize("wheel", ["r", "f"])
+def test_a_lifted_wheel_closing_on_the_ground_carries_no_force(rider_bike, t03, wheel):
+    """A tyre off the ground (compression q < 0) carries no normal force, however fast it closes on
+    the ground: its damper acts only in contact. The case is the one seen with the controller off at
+    500 kPa (a front wheel 3.8 cm up closing at 5 m/s), where kz q + cz dq/dt > 0 pushed it with kN.
+    Its lateral force, moment and damper dissipation are zero too; C and the NumPy oracle agree."""
+    par = slip.model_parameters(rider_bike, t03, t03)
+    ss = slip.steady_state(par, 3.0)
+    rhs = slip.CompiledRHS(ss.params)
+    q, u = ("q9", "u9") if wheel == "r" else ("q10", "u10")
+    x = ss.x.copy()
+    x[slip.X[q]], x[slip.X[u]] = -0.038, 5.0
+    x[slip.X["u2"]] = 0.3                       # sliding sideways as well
+    x = slip.solve_pitch(rhs, x)
+    # The spring-damper alone would push: kz q + cz dq/dt = 5 kN at 400 kPa.
+    assert ss.params[f"kz{wheel}"] * x[slip.X[q]] + ss.params[f"cz{wheel}"] * x[slip.X[u]] > 4e3
+    dx, out = rhs.outputs(0.0, x)
+    for name in ("fz", "fy", "mz", "fy_ss", "mz_ss"):
+        assert out[slip.OUT[f"{name}_{wheel}"]] == 0.0, name
+    assert np.all(np.isfinite(dx))
+    assert dx[slip.X["D_damper"]] == pytest.approx(0.0, abs=1e-9)   # the other tyre is at rest vertically
+    oracle, oracle_out = slip.numpy_rhs(0.0, x, slip.parameter_vector(ss.params), with_outputs=True)
+    assert oracle_out[slip.OUT[f"fz_{wheel}"]] == 0.0
+    np.testing.assert_allclose(dx, oracle, rtol=0, atol=1e-10 * np.abs(dx).max())
+    # Touching the ground again (q > 0), the same rate pushes: the contact is back.
+    x[slip.X[q]] = 1e-4
+    x = slip.solve_pitch(rhs, x)
+    assert rhs.outputs(0.0, x)[1][slip.OUT[f"fz_{wheel}"]] > 0.0
+
+
 def test_mirror_symmetric_kicks(rider_bike, gains, t03):
     responses = []
     for sign in (1.0, -1.0):

@@ -321,6 +321,37 @@ def kick_plate_motion(t):
     return tuple(out)
 
 
+def normal_force(compression, compression_rate, stiffness, damping):
+    """Normal force of a tyre's vertical spring-damper: never pulling, zero off the ground.
+
+    ``max(0, kz q + cz dq/dt)`` while the tyre is compressed (q > 0); 0 when
+    it is not (q <= 0): a lifted wheel carries no force, however fast it
+    closes on the ground (the damper acts only in contact).
+
+    Parameters
+    ----------
+    compression, compression_rate : sympy.Expr
+        Tyre compression q [m] and its rate dq/dt [m/s].
+    stiffness, damping : sympy.Expr
+        Vertical stiffness kz [N/m] and damping cz [N s/m].
+
+    Returns
+    -------
+    sympy.Expr
+        The normal force [N].
+
+    Example
+    -------
+    >>> import sympy as sm
+    >>> q, dq = sm.symbols("q dq", real=True)
+    >>> fz = normal_force(q, dq, 1e5, 300.0)
+    >>> float(fz.subs({q: -0.01, dq: 5.0})), float(fz.subs({q: 0.004, dq: 0.0}))
+    (0.0, 400.0)
+    """
+    return sm.Piecewise((sm.Max(0, stiffness * compression + damping * compression_rate), compression > 0),
+                        (0, True))
+
+
 def slip_equations():
     """Derive the slip model: toroidal tyres, vertical compliance, lateral tyre loads as inputs.
 
@@ -356,11 +387,11 @@ def slip_equations():
     yp, vp, ap = kick_plate_motion(sm.Symbol("t", real=True))
     vp_s, ap_s = S.syms(["vp", "ap"])   # placeholders, replaced by the profile at code generation
 
-    # Normal forces: linear spring-damper on the compression, never pulling.
-    fz_r_raw = par["kzr"] * Q["q9"] + par["czr"] * U["u9"]
-    fz_f_raw = par["kzf"] * Q["q10"] + par["czf"] * U["u10"]
-    fz_r = sm.Max(0, fz_r_raw)
-    fz_f = sm.Max(0, fz_f_raw)
+    # Normal forces: linear spring-damper on the compression, never pulling,
+    # and only while the tyre touches the ground (q > 0): a lifted wheel
+    # closing on the ground must not be pushed by its damper before contact.
+    fz_r, fz_f = (normal_force(Q[q], U[u], par[kz], par[cz])
+                  for q, u, kz, cz in (("q9", "u9", "kzr", "czr"), ("q10", "u10", "kzf", "czf")))
 
     # Steer torque: full-state feedback, T7 = -K x (LQR convention).
     T7 = -(par["kq4"] * Q["q4"] + par["kq7"] * Q["q7"] + par["ku4"] * U["u4"]
@@ -391,8 +422,8 @@ def slip_equations():
     A_c, a0, b = constraint_terms(rows, kin, time_terms={vp_s: ap_s})
 
     # Spring energy counts only while the tyre is compressed; the damper
-    # dissipates Fz dq/dt - kz max(q, 0) dq/dt >= 0 in every branch of the
-    # never-pulling spring-damper (docs/validation.md).
+    # dissipates Fz dq/dt - kz max(q, 0) dq/dt >= 0 in every branch of
+    # normal_force (docs/validation.md).
     spring = (par["kzr"] * sm.Max(0, Q["q9"])**2 + par["kzf"] * sm.Max(0, Q["q10"])**2) / 2
     damper = (fz_r * U["u9"] - par["kzr"] * sm.Max(0, Q["q9"]) * U["u9"]
               + fz_f * U["u10"] - par["kzf"] * sm.Max(0, Q["q10"]) * U["u10"])
