@@ -130,6 +130,40 @@ def test_unloaded_tyre_is_exactly_zero_and_prints_a_ternary():
     assert moment[0] == 0.0 and moment[1] == 0.0 and np.isfinite(moment[2])
 
 
+@pytest.mark.parametrize("label, fy, mz", SETS, ids=[s[0] for s in SETS])
+def test_force_and_moment_vanish_with_the_load(label, fy, mz):
+    """A tyre whose load tends to zero carries a force and moment that tend to zero (no jump at
+    lift-off): below OFFSET_FADE_LOAD the fits' load-independent shifts a13 and c17 fade out, so
+    |F_y| and |M_z| are bounded by a constant times the load. Measured over +-90 deg of slip,
+    +-45 deg of camber and 1e-6..99 N: |F_y| <= 2.33 Fz, |M_z| <= 0.019 m x Fz; without the fade the
+    sets' a13 (up to 46 N) would stay as Fz -> 0."""
+    fz = np.geomspace(1e-6, 0.99 * mf.OFFSET_FADE_LOAD, 40)[None, None, :]
+    slip = np.radians(np.linspace(-90.0, 90.0, 91))[:, None, None]
+    camber = np.radians(np.linspace(-45.0, 45.0, 19))[None, :, None]
+    assert np.all(np.abs(mf.lateral_force_numpy(slip, camber, fz, fy)) <= 2.5 * fz)
+    if mz is not None:
+        assert np.all(np.abs(mf.aligning_moment_numpy(slip, camber, fz, mz)) <= 0.025 * fz)
+
+
+@pytest.mark.parametrize("label, fy, mz", MZ_SETS, ids=[s[0] for s in MZ_SETS])
+def test_the_fade_leaves_the_fitted_range_untouched(label, fy, mz):
+    """From OFFSET_FADE_LOAD up the model curves are the fitted formula exactly (the fits hold from
+    343 N, thesis Chapter 7); below it only the constant shifts a13 and c17 are weighted."""
+    deg = 180.0 / np.pi
+    for f in (mf.OFFSET_FADE_LOAD, 343.0, 635.0):
+        for s, c in ((0.05, 0.03), (-0.4, -0.2)):
+            # The same expression up to SymPy's order of evaluation (round-off).
+            assert float(mf.lateral_force_model(s, c, f, fy)) == pytest.approx(-float(
+                mf.lateral_force_formula(s * deg, -c * deg, f / 1000, fy)), rel=1e-12)
+            assert float(mf.aligning_moment_model(s, c, f, mz)) == pytest.approx(-float(
+                mf.aligning_moment_formula(s * deg, -c * deg, f / 1000, mz)), rel=1e-12)
+    half = 0.5 * mf.OFFSET_FADE_LOAD          # smoothstep weight 1/2
+    moved = np.array(fy, dtype=float)
+    moved[13] *= 0.5
+    assert float(mf.lateral_force_model(0.05, 0.03, half, fy)) == pytest.approx(
+        -float(mf.lateral_force_formula(0.05 * deg, -0.03 * deg, half / 1000, moved)), rel=1e-12)
+
+
 def test_numpy_matches_sympy():
     """The lambdified functions evaluate the same expression (rel 1e-12)."""
     _, fy, mz = next(s for s in MZ_SETS if s[0] == "T03-chapter8-500")
