@@ -2,6 +2,7 @@
 
 Usage:
     python scripts/regenerate_regression.py --reason "why the reference runs changed"
+    python scripts/regenerate_regression.py --thesis-form NAME [NAME ...] --reason "why"
 
 Writes ``tests/data/regression/<name>.npz`` for the cases in :func:`cases`
 (the project's default model) and appends a line (date, model hash, reason)
@@ -12,8 +13,11 @@ reruns each stored scenario and compares.
 thesis' tyre transient before the contact-patch form, the plate stop's
 impulse and the fixed heading at the kick existed; their stored scenarios
 name the options that reproduce them (``tyre_transient="force_lag"``,
-``plate_stop="resolve"``, ``kick_heading="settled"``). This script never
-rewrites them: they pin the thesis' form.
+``plate_stop="resolve"``, ``kick_heading="settled"``). They pin the thesis'
+form, so the default regeneration never rewrites them; ``--thesis-form``
+reruns the named ones with their own stored scenario, for a change of the
+physics that form shares (e.g. the normal force), and says why in the
+changelog.
 
 Each file holds float32 arrays at 200 Hz of the columns in :data:`COLUMNS`
 that the run has (time from the kick start, SI units), plus
@@ -34,6 +38,7 @@ import numpy as np
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 OUT = ROOT / "tests" / "data" / "regression"
+THESIS_FORM = OUT / "thesis_form"
 CHANGELOG = OUT / "CHANGELOG.md"
 #: Stored columns (those the run has): the thesis' response signals, both tyres' loads, slips and the
 #: energy accounting's main terms, so a swapped label or a changed tyre shows.
@@ -96,6 +101,24 @@ def write_case(name, scenario, path):
     return result
 
 
+def rewrite_thesis_form(name):
+    """Rerun the stored scenario of ``thesis_form/<name>.npz`` and rewrite it (its columns and scenario kept)."""
+    from whipple_kick import simulation
+    path = THESIS_FORM / f"{name}.npz"
+    if not path.exists():
+        raise SystemExit(f"no thesis-form reference {name!r} in {THESIS_FORM}")
+    with np.load(path) as data:
+        scenario = simulation.Scenario(**json.loads(str(data["scenario_json"])))
+        columns = [c for c in data.files if c not in ("name", "scenario_json", "model_hash", "generated")]
+    result = simulation.run(runnable(scenario, THESIS_FORM))
+    df = result.trajectory
+    arrays = {c: df[c].to_numpy(dtype=np.float32) for c in columns}
+    np.savez_compressed(path, **arrays, name=np.array(name),
+                        scenario_json=np.array(json.dumps(scenario.to_dict(), sort_keys=True)),
+                        model_hash=np.array(simulation.model_hash()), generated=np.array(_now()))
+    return result
+
+
 def _now():
     return datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
 
@@ -104,18 +127,27 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--reason", required=True,
                         help="why the references change (written to the changelog)")
+    parser.add_argument("--thesis-form", nargs="+", metavar="NAME",
+                        help="rewrite only these references of thesis_form/ (their stored scenarios)")
     args = parser.parse_args(argv)
     reason = " ".join(args.reason.split())
     if not reason:
         parser.error("--reason must not be empty")
     from whipple_kick import simulation
-    OUT.mkdir(parents=True, exist_ok=True)
-    _write_kick_table(OUT / KICK_TABLE)
-    for name, scenario in cases().items():
-        result = write_case(name, scenario, OUT / f"{name}.npz")
-        s = result.summary
-        end = f"fell at {s['fall_time_s']:.3f} s" if s["fell"] else f"{s['end_time_s']:g} s"
-        print(f"{name:22s} {end:18s} -> {name}.npz")
+    if args.thesis_form:
+        for name in args.thesis_form:
+            s = rewrite_thesis_form(name).summary
+            end = f"fell at {s['fall_time_s']:.3f} s" if s["fell"] else f"{s['end_time_s']:g} s"
+            print(f"{name:22s} {end:18s} -> thesis_form/{name}.npz")
+        reason = f"thesis_form/ {', '.join(args.thesis_form)} only: {reason}"
+    else:
+        OUT.mkdir(parents=True, exist_ok=True)
+        _write_kick_table(OUT / KICK_TABLE)
+        for name, scenario in cases().items():
+            result = write_case(name, scenario, OUT / f"{name}.npz")
+            s = result.summary
+            end = f"fell at {s['fall_time_s']:.3f} s" if s["fell"] else f"{s['end_time_s']:g} s"
+            print(f"{name:22s} {end:18s} -> {name}.npz")
     if not CHANGELOG.exists():
         CHANGELOG.write_text(
             "# Regression trajectories: changelog\n\n"
