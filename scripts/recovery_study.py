@@ -10,9 +10,11 @@ sets the recovery time, one factor at a time, and prints four Markdown tables:
    rider: settling times of yaw rate, roll rate and steer rate, the largest
    change of roll from its steady value, and the slowest pole of the slip
    model linearised (heading frame) about its steady motion with the
-   rider's gains; then the same cases' acceptance behaviour: the recovery
-   time with full gains, roll and steer settling with 50 % gains, the fall
-   time without control, and the thesis' last-peak time;
+   rider's gains; then the same cases' acceptance behaviour, with the
+   default tyre transient and with the thesis' force lag: the recovery
+   time with full gains, roll and steer settling with 50 % gains, the
+   outcome without control (fall time, or where the integration failed)
+   and when the fork turned past 90 deg, and the thesis' last-peak time;
 2. the slowest linear pole at 400 kPa, 635 N with one tyre property
    switched off at a time (aligning moment front/rear, camber force) and
    linear tyres from T03's cornering stiffness to near-rigid;
@@ -28,7 +30,7 @@ Recovery time of a signal: the time after the kick from which
 (``summary["recovery"]["signals"]`` of a simulation result).
 
 Usage: ``python scripts/recovery_study.py [--quick]`` (``--quick``: tables 2
-and 3 only). About 20 s.
+and 3 only). About 1 min.
 """
 import argparse
 import math
@@ -154,26 +156,47 @@ def nine_cases(duration):
     print()
 
 
-def nine_case_acceptance():
-    """The acceptance behaviour on the default 6 s run: full gains, 50 % gains, no control."""
+def _run_summary(scenario):
+    """The summary of ``scenario``'s run, and its trajectory, also when the integration failed."""
+    try:
+        result = simulation.run(scenario)
+    except simulation.SimulationError as exc:
+        result = exc.partial
+    return result.summary, result.trajectory
+
+
+def fork_over_time(trajectory):
+    """First time after the kick at which |steer| passes 90 deg (the front wheel turned backwards), or None."""
+    t = trajectory["time"].to_numpy()
+    over = np.flatnonzero((t >= 0.0) & (np.abs(trajectory["steer"].to_numpy()) > math.pi / 2))
+    return float(t[over[0]]) if over.size else None
+
+
+def nine_case_acceptance(transient):
+    """The acceptance behaviour on the default 6 s run in one tyre transient form: full gains, 50 % gains,
+    no control (outcome, and when the fork turned over)."""
     cell = lambda t: "-" if t is None else f"{t:.2f}"
-    print("Nine thesis cases, 6 s runs: recovery (yaw, roll and steer settled) with full gains; roll and "
-          "steer settling with 50 % gains (\"-\": not within the run); fall time without control; "
-          "the thesis' last-peak time with full gains\n")
+    print(f"Nine thesis cases, tyre transient {transient}, 6 s runs: recovery (yaw, roll and steer settled) "
+          "with full gains; roll and steer settling with 50 % gains (\"-\": not within the run); without "
+          "control: the outcome (fall time, or where the integration failed) and when |steer| first passed "
+          "90 deg; the thesis' last-peak time with full gains\n")
     print("| case | recovery, full gains [s] (yaw / roll / steer) | 50 % gains: roll / steer [s] | "
-          "controller off: fall [s] | last-peak time [s] |\n|---|---|---|---|---|")
+          "controller off: end [s] | controller off: steer past 90 deg [s] | last-peak time [s] |"
+          "\n|---|---|---|---|---|---|")
     for fz in (570.0, 635.0, 701.0):
         for pressure in (300.0, 400.0, 500.0):
-            full, half, off = (simulation.run(Scenario(pressure_kpa=pressure, fz_n=fz, **changes)).summary
-                               for changes in ({}, {"gain_scale": 0.5}, {"controller": "off"}))
+            (full, _), (half, _), (off, off_df) = (
+                _run_summary(Scenario(pressure_kpa=pressure, fz_n=fz, tyre_transient=transient, **changes))
+                for changes in ({}, {"gain_scale": 0.5}, {"controller": "off"}))
             sig = {name: full["recovery"]["signals"][name]["time_s"] for name in SIGNALS}
             half_sig = half["recovery"]["signals"]
             half_text = ("fell" if half["fell"] else
                          f"{cell(half_sig['roll_rate']['time_s'])} / {cell(half_sig['steer_rate']['time_s'])}")
+            off_text = {"fell": f"fell {cell(off['fall_time_s'])}",
+                        "failed": f"failed {cell(off['end_time_s'])}"}.get(off["outcome"], "no fall")
             print(f"| {pressure:.0f} kPa, {fz:.0f} N | {cell(full['recovery']['time_s'])} "
-                  f"({' / '.join(cell(sig[n]) for n in SIGNALS)}) | {half_text} | "
-                  f"{cell(off['fall_time_s']) if off['fell'] else 'no fall'} | "
-                  f"{cell(full['metrics']['last_peak_time'])} |")
+                  f"({' / '.join(cell(sig[n]) for n in SIGNALS)}) | {half_text} | {off_text} | "
+                  f"{cell(fork_over_time(off_df))} | {cell(full['metrics']['last_peak_time'])} |")
     print()
 
 
@@ -281,7 +304,8 @@ def main(argv=None):
     print(f"slip model {simulation.model_hash()}\n")
     if not args.quick:
         nine_cases(args.duration)
-        nine_case_acceptance()
+        for transient in ("contact_patch", "force_lag"):
+            nine_case_acceptance(transient)
     tyre_properties()
     one_at_a_time(args.duration)
     return 0

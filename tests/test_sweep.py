@@ -236,7 +236,7 @@ def test_recommend_pressure_function_fine_grid():
 
 
 def test_saved_trajectory_is_thinned_and_keeps_the_fall():
-    scenario = simulation.Scenario(duration=3.0, settle=0.1, controller="off", fz_n=635.0)   # falls at 2.15 s
+    scenario = simulation.Scenario(duration=3.0, settle=0.1, controller="off", fz_n=635.0)   # falls at 2.17 s
     spec = {"columns": ("time", "roll"), "dtype": "float64", "rate_hz": 100.0}
     record = sweep.run_case(scenario, "x", spec)
     t = record["trajectory"]["time"]
@@ -284,15 +284,26 @@ def test_recommendation_margin_and_no_clear_optimum_rule_on_the_nine_cases(nine_
             assert f"{cell:.3f}" in text
 
 
-def test_a_run_that_fell_is_never_ranked_ahead():
-    """The issue's case: at 2 m/s with a 35 m/s^2 kick the 400 kPa run falls; by either criterion
-    it ranks after the runs that did not fall, and is never the recommendation."""
-    base = simulation.Scenario(speed=2.0, design_speed=2.0, kick_accel=35.0, duration=4.0)
-    rec = sweep.recommend_pressure(701, base=base, criterion="last-peak")
-    fell = rec.table["fell"].astype(bool).to_numpy()
-    assert fell.any() and not fell.all()          # measured: 400 kPa falls, 300 and 500 do not
-    assert rec.table["rank"].to_numpy()[fell].min() > rec.table["rank"].to_numpy()[~fell].max()
-    assert rec.best_pressure_kpa not in set(rec.table["pressure_kpa"][fell])
+@pytest.mark.parametrize("fz, base", [
+    # The issue's case, which needs the thesis' force lag: 2 m/s, 35 m/s^2; 400 kPa falls, 300 and
+    # 500 kPa do not (measured). On the default tyre nothing falls there, nor at 2-3 m/s for any
+    # load and pressure of the nine cases with kicks of 30-100 m/s^2 over 150 mm.
+    (701, simulation.Scenario(speed=2.0, design_speed=2.0, kick_accel=35.0, duration=4.0,
+                              tyre_transient="force_lag")),
+    # On the default tyre a longer plate travel does it: 350 mm in 150 ms (31 m/s^2, within the
+    # plate peaks the thesis measured) at 701 N: 300 and 400 kPa fall (1.38 and 1.84 s), 500 kPa
+    # recovers (3.27 s, roll at most 16.6 deg).
+    (701, simulation.Scenario(kick_displacement=0.35, kick_duration=0.15)),
+], ids=["force_lag_issue_case", "default_350mm_kick"])
+def test_a_run_that_fell_is_never_ranked_ahead(fz, base):
+    """By either criterion a run that fell ranks after the runs that did not fall, and is never the
+    recommendation."""
+    for criterion in ("last-peak", "settling"):
+        rec = sweep.recommend_pressure(fz, base=base, criterion=criterion)
+        fell = rec.table["fell"].astype(bool).to_numpy()
+        assert fell.any() and not fell.all()
+        assert rec.table["rank"].to_numpy()[fell].min() > rec.table["rank"].to_numpy()[~fell].max()
+        assert rec.best_pressure_kpa is not None and rec.best_pressure_kpa not in set(rec.table["pressure_kpa"][fell])
 
 
 def _rows(**columns):
