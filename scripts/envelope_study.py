@@ -13,11 +13,13 @@ Two measurements, each printed as Markdown:
     failed or recovered, and the slowest cases.
 
 ``budget``
-    Right-hand-side evaluations of completed and falling runs across kicks
+    Right-hand-side evaluations (those inside the C Jacobians included) of
+    completed and falling runs across kicks
     (5-200 m/s^2), speeds (1.5-8 m/s), tolerances (rtol 1e-8..1e-12), riders,
     a 151-row kick table and the thesis preset, measured on every evaluation:
     the largest fraction of the default budget (``integrate.DEFAULT_BUDGET``)
-    any part of the run from its start spent, and the least time any window
+    any part of an integrate() call (the settle, the run after the kick, a
+    table's pieces: each has its own budget) from its start spent, and the least time any window
     of its ``stall_window`` consecutive evaluations advanced it, so the
     budget is set with a stated margin.
 
@@ -99,13 +101,19 @@ def envelope():
 
 
 class CallLog:
-    """Records the time of every right-hand-side evaluation of the compiled model."""
+    """Records the time of every right-hand-side evaluation of the compiled model.
+
+    A C Jacobian counts as the evaluations it makes (``jac.evaluations``), as
+    the budget counts it.
+    """
 
     def __init__(self):
         self.times = []
+        self.calls = []   # (first index into times, last index + 1, t_start) of each integrate() call
 
     def install(self):
         original_call, original_guarded = slip.CompiledRHS.__call__, slip.CompiledRHS.guarded
+        original_jacobian = slip.CompiledRHS.jacobian_function
         log = self.times
 
         def call(rhs, t, x):
@@ -120,7 +128,28 @@ class CallLog:
                 return fast(t, x)
             return f
 
+        def jacobian_function(rhs, scale):
+            jac = original_jacobian(rhs, scale)
+
+            def logged(t, x):
+                log.extend([t] * jac.evaluations)
+                return jac(t, x)
+            logged.evaluations = jac.evaluations
+            return logged
+
+        original_integrate = integrate.integrate
+        calls = self.calls
+
+        def integrate_logged(rhs, x0, t_end, t_start=0.0, *args, **kwargs):
+            first = len(log)
+            try:
+                return original_integrate(rhs, x0, t_end, t_start, *args, **kwargs)
+            finally:
+                calls.append((first, len(log), t_start))
+
         slip.CompiledRHS.__call__, slip.CompiledRHS.guarded = call, guarded
+        slip.CompiledRHS.jacobian_function = jacobian_function
+        integrate.integrate = integrate_logged
 
 
 def budget_used(times, t_start, budget):
@@ -167,16 +196,17 @@ def budget():
         rows = []
         for label, scenario in budget_cases(str(table)):
             log.times.clear()
+            log.calls.clear()
             status, summary, error, wall = outcome(scenario)
             if status not in ("completed", "fell"):
                 rows.append((math.inf, 0.0, label, status, 0, 0.0, error))
                 continue
             # The steady-state solve and the linearisation evaluate the model too: only the
-            # integration's evaluations (from the first one at t = -settle) count.
-            times = log.times[[i for i, x in enumerate(log.times) if x == -scenario.settle][0]:]
+            # integration's evaluations count, per integrate() call (each has its own budget).
+            per_call = [budget_used(log.times[a:b], t0, budget_) for a, b, t0 in log.calls if b > a]
             span = summary["end_time_s"] + scenario.settle
-            rows.append((*budget_used(times, -scenario.settle, budget_), label, status,
-                         summary["numerics"]["nfev"], span, None))
+            rows.append((max(u for u, _ in per_call), min(p for _, p in per_call), label, status,
+                         summary["numerics"]["evaluations"], span, None))
     rows.sort(key=lambda r: -r[0])
     print(f"Default budget: {budget_.allowance} evaluations + {budget_.per_second:g} per simulated second, "
           f"and at least {budget_.stall_progress:g} s per {budget_.stall_window} evaluations. Per run: the largest "

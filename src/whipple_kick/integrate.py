@@ -91,15 +91,16 @@ class Budget:
     and ends as a failure. Deterministic (evaluations, not wall time).
 
     The defaults are set from measured runs (``scripts/envelope_study.py
-    budget``, docs/simulate.md "No run hangs"): no completed or falling run
-    of the kick, tolerance and speed grids, a 151-row kick table or the
-    thesis preset spent more than 13 % of the limit at any point (the most:
-    the thesis preset falling at 1.92 m/s, rtol 1e-12, 42 779 evaluations in
-    2.95 s), and none advanced less than 0.17 s in any 20 000 consecutive
-    evaluations, 170 times the stall threshold; none of the 288 runs of the
-    speed envelope with the LQR riders tripped it. The stalls found (a front
-    wheel unloading in a fall, steps of 1e-8 s) end after about 1-3 s of
-    wall time.
+    budget``, docs/simulate.md "No run hangs"; evaluations counted as here,
+    the C Jacobian's included, per call): no completed or falling run of the
+    kick, tolerance and speed grids, a 151-row kick table or the thesis
+    preset spent more than 12.1 % of the limit at any point (the most: the
+    thesis preset falling at 1.92 m/s, 400 kPa, 35 153 evaluations in
+    2.83 s), and none advanced less than 1.03 s in any 20 000 consecutive
+    evaluations, 1030 times the stall threshold; none of the 288 runs of the
+    speed envelope with the LQR riders tripped it. The stalls found (the
+    thesis' set-up at 1.92-2 m/s and 500 kPa: a front wheel unloading in a
+    fall, steps of 1e-8 s) end after about 0.6-1.5 s of wall time.
 
     Attributes
     ----------
@@ -354,9 +355,9 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
     fell, fall_time, message, failed = False, None, "completed", False
     done = False
     # The fast path gives up (and the careful path takes over, with the budget) after more steps
-    # between two samples than a quarter of the stall window's evaluations (a step costs 1 to ~20
-    # evaluations, a stiff one with a finite-difference Jacobian the most), so a stall wastes about
-    # one window here; a legitimate interval needs far fewer steps (docs/simulate.md).
+    # between two samples than a quarter of the stall window's evaluations (a step costs 1 to ~25
+    # evaluations, a stiff one with a new Jacobian the most), so a stall wastes about one window
+    # here; a legitimate interval needs far fewer steps (docs/simulate.md).
     mxstep = max(1, budget.stall_window // 4)
     for a, b in zip(edges[:-1], edges[1:]):
         at_a = samples[np.abs(samples - a) <= eps]
