@@ -171,6 +171,20 @@ def test_a_stalled_integration_keeps_the_run_up_to_it(monkeypatch):
     _finite_partial(partial)
 
 
+def test_a_failure_in_the_settle_ends_the_run_before_the_kick(monkeypatch):
+    """The settle (display only, integrated on its own from the steady motion moved back) has its
+    own budget: if it fails, the run is reported as failed there, before the kick, and no kick is
+    integrated after it (measured with 50 + 50/s: stalled at t = -0.33 s)."""
+    monkeypatch.setattr(wk.integrate, "DEFAULT_BUDGET", wk.integrate.Budget(allowance=50, per_second=50.0))
+    with pytest.raises(SimulationError) as info:
+        run(Scenario(duration=1.0))
+    s = info.value.partial.summary
+    assert s["outcome"] == "failed" and not s["fell"] and "more than the budget 50 + 50/s" in s["message"]
+    assert -0.5 < s["end_time_s"] < 0.0
+    assert info.value.partial.trajectory["time"].iloc[-1] == s["end_time_s"]
+    _finite_partial(info.value.partial)
+
+
 def test_recovery_is_reported_for_yaw_roll_and_steer_rates(base):
     rec = base.summary["recovery"]
     signals = rec["signals"]
