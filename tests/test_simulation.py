@@ -1009,7 +1009,7 @@ def test_authors_code_preset_is_the_thesis_preset_with_their_assumptions():
 
 def test_upright_start_runs_from_upright_and_judges_stability_about_the_steady_motion():
     """Default tyres and rider, started upright: the run starts at the kick from roll 0 with no brake;
-    the rider's stability is still that of the steady motion (the same poles as a steady start)."""
+    the rider's stability and the recovery are still judged about the steady motion."""
     upright = run(Scenario(start="upright", settle=0.0, duration=0.3))
     steady = run(Scenario(duration=0.3))
     df, st = upright.trajectory, upright.summary["steady_state"]
@@ -1017,6 +1017,8 @@ def test_upright_start_runs_from_upright_and_judges_stability_about_the_steady_m
     assert st["rear_wheel_torque_n_m"] == 0.0 and "upright start" in st["found_by"]
     assert upright.summary["linear_stability"]["poles_slip_model_1_s"] == \
         steady.summary["linear_stability"]["poles_slip_model_1_s"]
+    # Yaw-rate peaks and recovery are measured from the steady motion, not from the upright start.
+    assert st["yaw_rate_baseline_rad_s"] == steady.summary["steady_state"]["yaw_rate_rad_s"] != 0.0
     assert np.max(np.abs(df[simulation.BALANCE_COLUMN])) < 1e-3
 
 
@@ -1030,3 +1032,21 @@ def test_kept_speeds_plate_stop_keeps_the_speeds_and_the_energy_balance():
     assert 0.01 < abs(jump["rear_slide_m_s"]) < 2.0
     assert np.max(np.abs(r.trajectory[simulation.BALANCE_COLUMN])) < 1e-3
     assert r.summary["numerics"]["plate_stop"] == "keep_speeds"
+
+
+def test_upright_start_without_a_steady_motion_is_judged_about_upright_running(monkeypatch):
+    """With no steady motion for these tyres (forced here), an upright start still runs; stability and
+    recovery are then judged about upright running with the offsets removed, and the summary says so."""
+    from whipple_kick import steady
+
+    def none(*args, **kwargs):
+        raise steady.NoSteadyMotion("no steady motion (forced by the test)")
+    monkeypatch.setattr(simulation, "steady_motion", none)
+    r = run(Scenario(start="upright", settle=0.0, duration=0.2))
+    stability, st = r.summary["linear_stability"], r.summary["steady_state"]
+    assert "upright running without the tyres' zero-slip offsets" in stability["model"]
+    assert stability["stable"]
+    assert "upright running (no steady motion with these tyres)" in st["found_by"]
+    assert st["yaw_rate_baseline_rad_s"] == 0.0
+    with pytest.raises(steady.NoSteadyMotion):
+        run(Scenario(duration=0.2))

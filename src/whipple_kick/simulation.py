@@ -1338,8 +1338,11 @@ def run(scenario, *, tyres=None, gains=None):
         raise SimulationError("non-finite values in the trajectory")
 
     x0 = steady.x
-    baseline = float(x0[slip.X["u3"]])
-    metrics, recovery = _response_metrics(df, baseline, x0, scenario, traj)
+    # Recovery is back to the steady motion, also after an upright start (which is not one);
+    # without a steady motion with these tyres, back to upright running.
+    reference = steady if found.route == _SYMMETRIC_ROUTE else found.steady
+    baseline = float(reference.x[slip.X["u3"]])
+    metrics, recovery = _response_metrics(df, baseline, reference.x, scenario, traj)
     after = df["time"].to_numpy() >= 0.0
 
     summary = {
@@ -1383,7 +1386,8 @@ def run(scenario, *, tyres=None, gains=None):
         "steady_state": {
             "speed_m_s": scenario.speed,
             "roll_rad": float(x0[slip.X["q4"]]), "steer_rad": float(x0[slip.X["q7"]]),
-            "pitch_rad": float(x0[slip.X["q5"]]), "yaw_rate_rad_s": baseline,
+            "pitch_rad": float(x0[slip.X["q5"]]), "yaw_rate_rad_s": float(x0[slip.X["u3"]]),
+            "yaw_rate_baseline_rad_s": baseline,
             "lateral_drift_m_s": float(x0[slip.X["u2"]]),
             "compression_rear_m": float(x0[slip.X["q9"]]), "compression_front_m": float(x0[slip.X["q10"]]),
             **_rear_wheel_torque(steady),
@@ -1391,7 +1395,9 @@ def run(scenario, *, tyres=None, gains=None):
             "found_by": found.route if scenario.start == "steady" else (
                 f"upright start (start 'upright'): not a steady motion, the tyres' zero-slip forces act from "
                 f"t = 0 (largest lateral acceleration there {steady.unknowns['largest_rate']:.3g} m/s^2 or "
-                f"rad/s^2)"),
+                f"rad/s^2); yaw-rate peaks and recovery are measured from "
+                + (f"the steady motion's yaw rate {baseline:.4g} rad/s" if reference is not steady
+                   else "upright running (no steady motion with these tyres)")),
         },
         "peaks": {f"max_abs_{name}": float(np.max(np.abs(df[name].to_numpy()[after]), initial=0.0))
                   for name in ("yaw_rate", "roll_rate", "steer_rate", "roll", "steer", "slip_rear",
