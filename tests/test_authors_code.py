@@ -69,14 +69,18 @@ def test_the_plate_stop_leaves_the_published_rear_slide(compat):
 
 
 def test_parameters_equal_the_authors_number_for_number(stored):
-    """Every value of their parameter array that their standard run uses equals ours (exactly)."""
+    """Every value of their parameter array that their standard run uses, their tyre's coefficients and its
+    friction factor equal ours (exactly)."""
     sc = Scenario.authors_code()
     moore, _, _ = simulation.build_bicycle(sc)
     rear, front, _ = simulation.build_tyres(sc)
     params = slip.model_parameters(moore, rear, front)
     for theirs, ours in authors_code.PARAMETER_NAMES.items():
         assert params[ours] == stored.parameters[theirs], (theirs, ours)
-    assert rear.curve_scale == front.curve_scale == 1.31917   # their Friction_coeff
+    assert rear.curve_scale == front.curve_scale == stored.tyre["Friction_coeff"]
+    for tyre in (rear, front):
+        (weight, fy, mz), = tyre.blend    # one measured pressure: their 500 kPa set
+        assert weight == 1.0 and fy.tolist() == stored.tyre["Fy_coef"] and mz.tolist() == stored.tyre["Mz_coef"]
     assert simulation.controller_gains(sc, moore)[0] == {"kq4": -19.5679, "kq7": 15.4934,
                                                           "ku4": -6.7665, "ku7": 1.5876}
 

@@ -65,6 +65,9 @@ class StoredRun:
         Their initial state by their state names.
     parameters : dict
         Their parameter array by their names.
+    tyre : dict
+        Their tyre: Magic-Formula coefficients ``Fy_coef`` (14), ``Mz_coef``
+        (18) and the factor ``Friction_coeff`` on the whole curves.
     """
 
     samples: "object"
@@ -72,6 +75,7 @@ class StoredRun:
     fall_time_s: float
     initial_state: dict
     parameters: dict
+    tyre: dict
 
 
 def load_run(folder):
@@ -100,7 +104,8 @@ def load_run(folder):
     samples = pd.read_csv(folder / SAMPLES_FILE).rename(columns=rename)
     whole = pd.read_csv(folder / WHOLE_RUN_FILE).rename(columns=rename)
     info = json.loads((folder / RUN_FILE).read_text())
-    return StoredRun(samples, whole, float(info["fall_time_s"]), info["initial_state"], info["parameters"])
+    return StoredRun(samples, whole, float(info["fall_time_s"]), info["initial_state"], info["parameters"],
+                     info["tyre"])
 
 
 def deviations(ours, theirs, window=(0.0, 1.0)):
