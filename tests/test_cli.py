@@ -99,6 +99,29 @@ def test_thesis_tyre_transient_and_earlier_options_reach_the_summary(tmp_path, c
     assert s["steady_state"]["rear_wheel_torque_role"] == "brake" and "brake" in stdout
 
 
+def test_compat_authors_code_and_flags_that_override_it(tmp_path, capsys):
+    """``--compat authors-code`` is ``Scenario.authors_code``; flags given with it change its fields."""
+    out = tmp_path / "compat"
+    status, stdout, err = _simulate(["--compat", "authors-code", "--duration", "0.3", "--no-plot",
+                                     "--out", str(out)], capsys)
+    assert status == 0, err
+    sc = json.loads((out / "summary.json").read_text())["scenario"]
+    preset = wk.simulation.Scenario.authors_code(duration=0.3).to_dict()
+    assert sc == preset
+    assert "camber sign reversed" in stdout and "start: upright" in stdout and "keep_speeds" in stdout
+    # The rider of their code is linearly unstable with their camber sign (docs/validation.md).
+    assert "linearly unstable" in err
+    out2 = tmp_path / "ours"
+    status, stdout, err = _simulate(["--compat", "authors-code", "--camber-sign", "physical", "--pressure", "400",
+                                     "--plate-stop", "impulse", "--duration", "0.3", "--no-plot", "--quiet",
+                                     "--out", str(out2)], capsys)
+    assert status == 0, err
+    sc = json.loads((out2 / "summary.json").read_text())["scenario"]
+    assert sc == wk.simulation.Scenario.authors_code(400.0, camber_sign="physical", plate_stop="impulse",
+                                                     duration=0.3).to_dict()
+    assert stdout == "" and err == ""
+
+
 # Every bad input: (argv, fragments the one-line message must contain).
 BAD_INPUTS = {
     "pressure-above-range": (["--pressure", "900"], ["900", "[300, 500]", "kPa"]),
@@ -151,6 +174,10 @@ BAD_INPUTS = {
                                                               "force_lag"]),
     "unknown-plate-stop": (["--plate-stop", "hold"], ["--plate-stop", "'hold'", "impulse", "resolve"]),
     "unknown-flag": (["--pressur", "400"], ["unrecognized", "--pressur"]),
+    "unknown-compat": (["--compat", "thesis"], ["--compat", "'thesis'", "authors-code"]),
+    "unknown-camber-sign": (["--camber-sign", "minus"], ["--camber-sign", "'minus'", "physical", "reversed"]),
+    "upright-start-with-settle": (["--start", "upright"], ["settle time = 0.5 s", "start 'upright'", "0 s"]),
+    "compat-with-settle": (["--compat", "authors-code", "--settle", "1"], ["settle time = 1 s", "0 s"]),
 }
 
 

@@ -95,3 +95,18 @@ def test_motion_limits_ignore_samples_after_half_the_fall_angle():
     assert (low, high) == pytest.approx((-0.056, 0.756))
     assert plotting.motion_limits(t, y, roll, math.radians(45.0), time_range=(0.0, 0.5)) == pytest.approx(
         (-0.04, 0.54))
+
+
+def test_upright_start_draws_the_steady_motion_as_the_baseline():
+    """After an upright start (not a steady motion) the yaw-rate baseline is still the steady turn's."""
+    result = simulation.run(simulation.Scenario(start="upright", settle=0.0, duration=0.3))
+    st = result.summary["steady_state"]
+    assert st["yaw_rate_rad_s"] == 0.0 and abs(st["yaw_rate_baseline_rad_s"]) > 0.01
+    fig = plotting.response_figure([("", result)], kick=(0.0, 0.15))
+    try:
+        assert any("steady motion (the run starts upright)" in t and f"{st['yaw_rate_baseline_rad_s']:.3f}" in t
+                   for t in _texts(fig))
+        line, = [line for line in fig.axes[0].lines if line.get_gid() == "baseline"]
+        assert line.get_ydata()[0] == st["yaw_rate_baseline_rad_s"]
+    finally:
+        plt.close(fig)

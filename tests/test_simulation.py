@@ -1038,3 +1038,69 @@ def test_bad_model_options_are_input_errors():
 
 def test_thesis_preset_uses_the_force_lag():
     assert Scenario.thesis().tyre_transient == "force_lag"
+
+
+# --------------------------------------------- the authors' published code (docs/validation.md)
+
+def test_authors_code_preset_is_the_thesis_preset_with_their_assumptions():
+    sc = Scenario.authors_code()
+    thesis = Scenario.thesis(500.0)
+    differ = {f: (getattr(thesis, f), getattr(sc, f)) for f in sc.to_dict() if getattr(sc, f) != getattr(thesis, f)}
+    assert differ == {"camber_sign": ("physical", "reversed"), "start": ("steady", "upright"),
+                      "settle": (0.5, 0.0), "plate_stop": ("impulse", "keep_speeds")}
+    assert sc.pressure_kpa == 500.0 and Scenario.authors_code(400.0, rtol=1e-10).pressure_kpa == 400.0
+    # Each assumption switches back alone; an upright start needs the kick to start the run.
+    assert Scenario.authors_code(plate_stop="impulse").validate().camber_sign == "reversed"
+    with pytest.raises(InputError, match=r"settle time = 0.5 s conflicts with start 'upright'.*allowed: 0 s"):
+        Scenario.authors_code(settle=0.5).validate()
+    with pytest.raises(InputError, match="camber sign 'negative' is unknown; choose one of physical, reversed"):
+        Scenario(camber_sign="negative").validate()
+    with pytest.raises(InputError, match="start 'level' is unknown; choose one of steady, upright"):
+        Scenario(start="level").validate()
+    with pytest.raises(InputError, match="keep_speeds' needs piecewise = True"):
+        Scenario(plate_stop="keep_speeds", piecewise=False).validate()
+
+
+def test_upright_start_runs_from_upright_and_judges_stability_about_the_steady_motion():
+    """Default tyres and rider, started upright: the run starts at the kick from roll 0 with no brake;
+    the rider's stability and the recovery are still judged about the steady motion."""
+    upright = run(Scenario(start="upright", settle=0.0, duration=0.3))
+    steady = run(Scenario(duration=0.3))
+    df, st = upright.trajectory, upright.summary["steady_state"]
+    assert df["time"].iloc[0] == 0.0 and df["roll"].iloc[0] == 0.0 and df["yaw_rate"].iloc[0] == 0.0
+    assert st["rear_wheel_torque_n_m"] == 0.0 and "upright start" in st["found_by"]
+    assert upright.summary["linear_stability"]["poles_slip_model_1_s"] == \
+        steady.summary["linear_stability"]["poles_slip_model_1_s"]
+    # Yaw-rate peaks and recovery are measured from the steady motion, not from the upright start.
+    assert st["yaw_rate_baseline_rad_s"] == steady.summary["steady_state"]["yaw_rate_rad_s"] != 0.0
+    assert np.max(np.abs(df[simulation.BALANCE_COLUMN])) < 1e-3
+
+
+def test_kept_speeds_plate_stop_keeps_the_speeds_and_the_energy_balance():
+    """No speed jumps at the stop (kinetic energy unchanged to 1e-9 J; the impulse changes it by -0.03 J),
+    the rear slide stays in the constraint and the balance closes (the rear constraint's work on the
+    slide is in plate_work)."""
+    r = run(Scenario(pressure_kpa=400.0, fz_n=635.0, duration=1.0, plate_stop="keep_speeds"))
+    jump, = r.summary["energy"]["velocity_jumps"]
+    assert abs(jump["kinetic_energy_change_j"]) < 1e-9 and jump["impulse_work_j"] is None
+    assert 0.01 < abs(jump["rear_slide_m_s"]) < 2.0
+    assert np.max(np.abs(r.trajectory[simulation.BALANCE_COLUMN])) < 1e-3
+    assert r.summary["numerics"]["plate_stop"] == "keep_speeds"
+
+
+def test_upright_start_without_a_steady_motion_is_judged_about_upright_running(monkeypatch):
+    """With no steady motion for these tyres (forced here), an upright start still runs; stability and
+    recovery are then judged about upright running with the offsets removed, and the summary says so."""
+    from whipple_kick import steady
+
+    def none(*args, **kwargs):
+        raise steady.NoSteadyMotion("no steady motion (forced by the test)")
+    monkeypatch.setattr(simulation, "steady_motion", none)
+    r = run(Scenario(start="upright", settle=0.0, duration=0.2))
+    stability, st = r.summary["linear_stability"], r.summary["steady_state"]
+    assert "upright running without the tyres' zero-slip offsets" in stability["model"]
+    assert stability["stable"]
+    assert "upright running (no steady motion with these tyres)" in st["found_by"]
+    assert st["yaw_rate_baseline_rad_s"] == 0.0
+    with pytest.raises(steady.NoSteadyMotion):
+        run(Scenario(duration=0.2))

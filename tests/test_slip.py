@@ -39,14 +39,16 @@ _TYRE_SPREAD = {"force_lag": (200.0, 200.0, 5.0, 5.0), "contact_patch": (0.6, 0.
 def test_c_agrees_with_numpy_oracle(rider_bike, gains, t03, transient):
     """100 random states, plate moving or not: C and the NumPy printing of the same expressions.
 
-    Every state derivative (quadrature rates included, with the plate's
-    constraint power while it moves) and every named output.
+    Every state derivative (quadrature rates included, with the rear
+    constraint's power while the plate moves or a rear slide is imposed)
+    and every named output.
     """
     par = slip.model_parameters(rider_bike, t03, wk.tyres.load("T03", pressure_kpa=350), gains=gains,
                                 kick=dict(t0=0.0, duration=0.15, displacement=0.15), tyre_transient=transient)
     ss = slip.steady_state(par, 3.0)
-    rhs = slip.CompiledRHS(ss.params)
-    p = slip.parameter_vector(ss.params)
+    params = dict(ss.params, vsx_r=-0.2)   # a rear slide as the authors' plate stop leaves, in both printings
+    rhs = slip.CompiledRHS(params)
+    p = slip.parameter_vector(params)
     rng = np.random.default_rng(1)
     worst = 0.0
     for _ in range(100):
@@ -472,3 +474,51 @@ def test_t03_curve_opposes_the_slip_at_every_camber_and_load(pressure):
     chapter8 = wk.tyres.load("T03", pressure_kpa=pressure, coefficient_set="chapter8")
     excess = chapter8.lateral_force(slips, cambers, loads) - chapter8.lateral_force(0.0 * slips, cambers, loads)
     assert np.any(excess * np.sign(slips) > 0.0)
+
+
+def test_upright_start_is_upright_and_balanced_vertically_but_not_steady(rider_bike, gains, t03):
+    """The authors' start: roll, steer, yaw, lateral speeds and T6c zero; front contact on the ground and
+    both tyres in vertical equilibrium (residual < 1e-8); the tyre states at their zero-slip values.
+    With T03's offsets the lateral accelerations are not zero (measured 0.3-2.5 m/s^2 or rad/s^2); with
+    symmetric tyres it is the steady motion (same pitch and compressions to 1e-12)."""
+    par = slip.model_parameters(rider_bike, t03, t03, gains=gains, tyre_transient="force_lag")
+    start = slip.upright_state(par, 3.0)
+    x = start.x
+    assert start.params["T6c"] == 0.0 and start.residual < 1e-8
+    for name in ("q3", "q4", "q7", "u2", "u3", "u4", "u7", "u9", "u10"):
+        assert x[slip.X[name]] == 0.0
+    rhs = slip.CompiledRHS(start.params)
+    dx, out = rhs.outputs(0.0, x)
+    assert abs(out[slip.OUT["holonomic"]]) < 1e-10
+    assert abs(dx[slip.X["u9"]]) < 1e-6 and abs(dx[slip.X["u10"]]) < 1e-6
+    for slot, name in zip(slip.TYRE_STATES, ("fy_ss_r", "fy_ss_f", "mz_ss_r", "mz_ss_f")):
+        assert x[slip.X[slot]] == out[slip.OUT[name]] != 0.0
+    assert start.unknowns["largest_rate"] > 0.05
+    symmetric = slip.model_parameters(rider_bike, t03, t03, gains=gains, symmetric=True)
+    up, steady = slip.upright_state(symmetric, 3.0), slip.steady_state(symmetric, 3.0)
+    for name in ("q5", "q9", "q10"):
+        assert up.x[slip.X[name]] == pytest.approx(steady.x[slip.X[name]], abs=1e-12)
+    assert up.unknowns["largest_rate"] < 1e-9
+
+
+def test_kept_speeds_leave_the_rear_sliding_at_the_plate_velocity_times_sin_yaw(rider_bike, gains, t03):
+    """The authors' plate stop: every speed continuous across it, and the rear constraint then imposes
+    the slide vp sin(yaw) (vp = 2 m/s before the stop), constant while the motion goes on."""
+    T, D = 0.15, 0.15
+    par = slip.model_parameters(rider_bike, t03, t03, gains=gains, kick=dict(t0=0.0, duration=T, displacement=D))
+    ss = slip.steady_state(par, 3.0)
+    rhs = slip.CompiledRHS(ss.params)
+    x_stop = integrate.integrate(rhs, ss.x, T, rtol=1e-12, output_rate=1000).end_state
+    slide = slip.kept_speeds_slide(rhs, T, x_stop)
+    assert slide == pytest.approx(2 * D / T * np.sin(x_stop[slip.X["q3"]]), rel=1e-9)
+    assert abs(slide) > 0.05
+    after = slip.CompiledRHS(dict(ss.params, vsx_r=slide))
+    before = rhs.outputs(np.nextafter(T, 0.0), x_stop)[1][:10]
+    np.testing.assert_allclose(after.outputs(T, x_stop)[1][:10], before, rtol=0, atol=1e-12)
+    tr = integrate.integrate(after, x_stop, T + 1.0, t_start=T, rtol=1e-12, output_rate=100)
+    for t, x in zip(tr.t, tr.x):
+        _, A, a0 = after.impulse_terms(t, x)
+        u = after.outputs(t, x)[1][:10]
+        residual_without_slide = A @ u + a0 + np.array([slide, 0.0, 0.0])
+        assert residual_without_slide[0] == pytest.approx(slide, abs=1e-9)
+    assert slip.kept_speeds_slide(after, T + 1.0, tr.end_state) == pytest.approx(slide, abs=1e-12)

@@ -104,6 +104,9 @@ def _simulate_parser():
                    help="how the tyre forces build up: contact_patch (default: lagged contact-patch slip and "
                         "camber, relaxation length shortening as the force saturates; passive, friction-limited), "
                         "slip_lag (the same with a constant relaxation length) or force_lag (the thesis' lagged force)")
+    g.add_argument("--camber-sign", choices=simulation.CAMBER_SIGNS, default="physical",
+                   help="physical (default: a leaning wheel is pushed toward the lean) or reversed (away from it, "
+                        "as the thesis authors' published code; not physical)")
     g = p.add_argument_group("bicycle and rider")
     g.add_argument("--bicycle", default="balanceassist_v1", metavar="NAME",
                    help="bicycle parameter set or .toml path (default balanceassist_v1; presets "
@@ -150,11 +153,22 @@ def _simulate_parser():
                    help="direction the plate moves (default right)")
     g.add_argument("--plate-stop", choices=simulation.PLATE_STOPS, default="impulse",
                    help="speeds across the constant profile's instant plate stop: impulse (default: the rear "
-                        "no-slip constraint's impulse) or resolve (dependent speeds only, the earlier model)")
+                        "no-slip constraint's impulse), resolve (dependent speeds only, the earlier model) or "
+                        "keep_speeds (no jump; the rear contact is left sliding along its heading, as the "
+                        "authors' published code)")
     g.add_argument("--kick-heading", choices=simulation.KICK_HEADINGS, default="fixed",
                    help="fixed (default): heading perpendicular to the plate at the kick start, whatever --settle; "
                         "settled: the steady motion starts so at -settle (the earlier model)")
     g = p.add_argument_group("run and output")
+    g.add_argument("--compat", choices=("authors-code",),
+                   help="authors-code: the thesis authors' published code (bicycle-kickplate-model) as it ran: "
+                        "balanceassist_635N, Table 8.4 rider, T03 chapter8 with the thesis friction, force lag, "
+                        "rtol 1e-12, camber sign reversed, upright start, kick at t = 0, speeds kept at the plate "
+                        "stop; --pressure defaults to 500; other flags given override its settings. For explaining "
+                        "that code's runs, not for predictions")
+    g.add_argument("--start", choices=simulation.STARTS, default="steady",
+                   help="steady (default: the solved steady motion) or upright (upright straight running, not an "
+                        "equilibrium with measured tyres, as the authors' code; needs --settle 0)")
     g.add_argument("--duration", type=_number("s"), default=6.0, metavar="S",
                    help="simulated time after the kick start in s (default 6)")
     g.add_argument("--settle", type=_number("s"), default=0.5, metavar="S",
@@ -199,7 +213,22 @@ def _animation_options(args):
     return options
 
 
-def _scenario_from_args(args):
+#: Scenario fields set by flags of another name (the rest by the flag of the field's own name).
+_FIELD_FLAGS = {"fz_n": ("fz",), "rider_mass_kg": ("rider_mass",), "pressure_kpa": ("pressure",),
+                "pressure_front_kpa": ("pressure_front",), "pressure_rear_kpa": ("pressure_rear",),
+                "thesis_load_n": ("thesis_load",), "kick_profile": ("kick_profile", "kick_table")}
+
+
+def _flags_given(argv):
+    """Destinations of the flags given on the command line (defaults not counted)."""
+    parser = _simulate_parser()
+    for action in parser._actions:
+        action.default = argparse.SUPPRESS
+    return set(vars(parser.parse_args(argv)))
+
+
+def _scenario_from_args(args, given=()):
+    """The scenario of the parsed flags; with ``--compat``, the preset with the ``given`` flags' fields changed."""
     from .simulation import Scenario
     fronts = (args.pressure_front, args.pressure_rear)
     if args.pressure is not None and any(v is not None for v in fronts):
@@ -217,7 +246,7 @@ def _scenario_from_args(args):
         profile = "table"
     elif profile == "table":
         raise InputError("--kick-profile table needs --kick-table FILE (CSV with columns time in s, y in m)")
-    return Scenario(
+    fields = dict(
         bicycle=args.bicycle, fz_n=args.fz, rider_mass_kg=args.rider_mass, tyre=args.tyre,
         pressure_kpa=400.0 if args.pressure is None else args.pressure,
         pressure_front_kpa=args.pressure_front, pressure_rear_kpa=args.pressure_rear,
@@ -230,7 +259,13 @@ def _scenario_from_args(args):
         kick_profile="constant" if profile is None else profile, kick_table=args.kick_table,
         kick_direction=args.kick_direction, settle=args.settle, duration=args.duration, rtol=args.rtol,
         tyre_transient=args.tyre_transient, plate_stop=args.plate_stop, kick_heading=args.kick_heading,
+        camber_sign=args.camber_sign, start=args.start,
     )
+    if args.compat is None:
+        return Scenario(**fields)
+    changes = {name: value for name, value in fields.items()
+               if any(flag in given for flag in _FIELD_FLAGS.get(name, (name,)))}
+    return Scenario.authors_code(**changes)
 
 
 _OUTPUT_FILES = ("trajectory.csv", "summary.json", "response.png")
@@ -293,9 +328,16 @@ def _print_summary(result, out, files):
     else:
         print(f"  kick: {abs(kick['displacement_m']) * 1e3:.0f} mm {kick['direction']} in {kick['duration_s']:.3f} s "
               f"(peak {kick['peak_acceleration_m_s2']:.1f} m/s^2, {kick['profile']} profile) at t = 0 s")
-    print(f"  steady state: roll {st['roll_rad'] * deg:.2f} deg, steer {st['steer_rad'] * deg:.2f} deg, "
-          f"yaw rate {st['yaw_rate_rad_s']:.4f} rad/s, rear-wheel torque {st['rear_wheel_torque_n_m']:+.4f} N m ({st['rear_wheel_torque_role']})"
-          + ("" if st["found_by"] == "direct" else f" (found by {st['found_by']})"))
+    if sc["start"] == "upright":
+        print("  start: upright straight running, no rear-wheel torque (not a steady motion: the tyres' "
+              "zero-slip forces act from t = 0)")
+    else:
+        print(f"  steady state: roll {st['roll_rad'] * deg:.2f} deg, steer {st['steer_rad'] * deg:.2f} deg, "
+              f"yaw rate {st['yaw_rate_rad_s']:.4f} rad/s, rear-wheel torque {st['rear_wheel_torque_n_m']:+.4f} N m "
+              f"({st['rear_wheel_torque_role']})" + ("" if st["found_by"] == "direct" else f" (found by {st['found_by']})"))
+    if sc["camber_sign"] == "reversed":
+        print("  camber sign reversed: camber thrust pushes a leaning wheel away from the lean (the authors' "
+              "published code; not physical)")
     if s["fell"]:
         print(f"  result: FELL (|roll| reached {sc['fall_angle_deg']:g} deg) {s['fall_time_s']:.3f} s after the kick start")
     else:
@@ -362,7 +404,8 @@ def _simulate(argv):
     import shutil
     from . import simulation
     args = _simulate_parser().parse_args(argv)
-    scenario = simulation.preflight(_scenario_from_args(args))
+    given = _flags_given(argv) if args.compat is not None else ()
+    scenario = simulation.preflight(_scenario_from_args(args, given))
     movie_options = _animation_options(args)
     out, created = _prepare_out(args.out if args.out else _default_out(scenario), args.force)
     try:

@@ -356,7 +356,8 @@ def slip_equations():
     """Derive the slip model: toroidal tyres, vertical compliance, lateral tyre loads as inputs.
 
     Constraints: rolling without longitudinal slip at both wheels (the rear
-    relative to the kick plate) and the front contact on the ground.
+    relative to the kick plate, less a constant imposed slide ``vsx_r``,
+    normally 0) and the front contact on the ground.
     Dependent speeds u5 (pitch rate), u6, u8 (wheel spin rates);
     independent u1, u2, u3, u4, u7, u9, u10. The lateral forces and aligning
     moments the tyres apply (``Fy_r Fy_f Mz_r Mz_f``) stay symbols here:
@@ -415,7 +416,9 @@ def slip_equations():
     v_r_slide = dn_mat.vel(N) - plate_vel
     v_f_slide = fn_mat.vel(N)
     rows = [
-        v_r_slide.dot(kin.rear_heading),
+        # vsx_r: an imposed constant longitudinal slide (0: rolling without
+        # slip); only the published code's plate stop makes it non-zero.
+        v_r_slide.dot(kin.rear_heading) - par["vsx_r"],
         fn_mat.vel(N).dot(kin.front_heading_scaled),
         kin.holonomic_rate,
     ]

@@ -59,6 +59,7 @@ import sympy as sm
 
 __all__ = [
     "N_FY_COEFFICIENTS", "N_MZ_COEFFICIENTS", "FY_OFFSET_INDICES", "MZ_OFFSET_INDICES",
+    "FY_CAMBER_ODD_INDICES", "MZ_CAMBER_ODD_INDICES", "camber_reversed",
     "lateral_force_factors", "aligning_moment_factors",
     "lateral_force_formula", "aligning_moment_formula",
     "lateral_force_model", "aligning_moment_model", "cornering_stiffness_model", "lateral_secant_model",
@@ -77,6 +78,12 @@ N_MZ_COEFFICIENTS = 18
 #: zero-slip force or moment ("symmetric tyres").
 FY_OFFSET_INDICES = (9, 10, 12, 13)
 MZ_OFFSET_INDICES = (12, 13, 16, 17)
+#: Coefficients of the terms odd in camber: a8 (Sh) and a11 (Sv) of F_y, c11
+#: (Sh) and c14, c15 (Sv) of M_z. Every other camber term is in |gamma|, so
+#: negating these five equals evaluating the curves at the opposite camber
+#: (:func:`camber_reversed`).
+FY_CAMBER_ODD_INDICES = (8, 11)
+MZ_CAMBER_ODD_INDICES = (11, 14, 15)
 
 _DEG_PER_RAD = sm.S(180) / sm.pi
 _N_PER_KN = sm.S(1000)
@@ -141,6 +148,42 @@ def aligning_moment_factors(gamma_deg, fz_kn, c):
         "Sh": c[11] * g + c[12] * fz + c[13],
         "Sv": (c[14] * fz**2 + c[15] * fz) * g + c[16] * fz + c[17],
     }
+
+
+def camber_reversed(coefficients, kind):
+    """Coefficients whose curve is the given one at the opposite camber.
+
+    ``F(slip, camber, Fz)`` with the returned coefficients equals
+    ``F(slip, -camber, Fz)`` with ``coefficients``, exactly: the terms odd in
+    camber change sign (:data:`FY_CAMBER_ODD_INDICES`,
+    :data:`MZ_CAMBER_ODD_INDICES`), the even ones (in |gamma|) do not. With
+    it the thesis authors' published code is reproduced, which feeds the
+    camber to the formula with the opposite sign to this module's mapping,
+    so that a leaning wheel's camber thrust pushes away from the lean.
+
+    Parameters
+    ----------
+    coefficients : sequence of 14 (``kind="fy"``) or 18 (``kind="mz"``)
+    kind : {"fy", "mz"}
+
+    Returns
+    -------
+    numpy.ndarray
+
+    Example
+    -------
+    >>> import numpy as np
+    >>> a = np.arange(14.0)
+    >>> camber_reversed(a, "fy")[[7, 8, 11]].tolist()
+    [7.0, -8.0, -11.0]
+    """
+    indices, count = {"fy": (FY_CAMBER_ODD_INDICES, N_FY_COEFFICIENTS),
+                      "mz": (MZ_CAMBER_ODD_INDICES, N_MZ_COEFFICIENTS)}[kind]
+    out = np.array(coefficients, dtype=float)
+    if out.shape != (count,):
+        raise ValueError(f"{kind} needs {count} coefficients, got shape {out.shape}")
+    out[list(indices)] *= -1.0
+    return out
 
 
 def _scale_friction(factors, friction_scale):

@@ -88,7 +88,9 @@ def _outcome(run):
     scenario = getattr(run, "scenario", None)
     fall_angle = math.radians(getattr(scenario, "fall_angle_deg", DEFAULT_FALL_ANGLE_DEG))
     fell = bool(summary.get("fell", False))
-    baseline = summary.get("steady_state", {}).get("yaw_rate_rad_s")
+    steady = summary.get("steady_state", {})
+    # The yaw-rate metrics' baseline: the steady turn, also after an upright start (which is not one).
+    baseline = steady.get("yaw_rate_baseline_rad_s", steady.get("yaw_rate_rad_s"))
     return fell, summary.get("fall_time_s") if fell else None, baseline, fall_angle
 
 
@@ -163,7 +165,9 @@ def response_figure(runs, path=None, title=None, kick=None, time_range=None, dpi
     if baselines:
         value = (f"{baselines[0]:.3f} rad/s" if np.ptp(baselines) < 5e-4 else
                  f"{min(baselines):.3f} to {max(baselines):.3f} rad/s")
-        axes[0].text(0.01, 0.03, f"dotted: steady turn before the kick, {value} (the yaw-rate baseline)",
+        upright = any(getattr(getattr(run, "scenario", None), "start", "steady") == "upright" for _, run in runs)
+        what = "steady motion (the run starts upright)" if upright else "steady turn before the kick"
+        axes[0].text(0.01, 0.03, f"dotted: {what}, {value} (the yaw-rate baseline)",
                      fontsize=7.5, color="0.25", transform=axes[0].transAxes, ha="left", va="bottom", gid="baseline")
     axes[-1].set_xlabel("time from kick start [s]")
     if time_range is not None:

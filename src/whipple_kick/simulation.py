@@ -92,13 +92,22 @@ UNITS = {"time": "s", **{c: u for c, u in _COORDINATE_COLUMNS.values()},
 #: Tyre transient forms (:mod:`whipple_kick.transient`): the default and the others.
 TYRE_TRANSIENTS = ("contact_patch", "slip_lag", "force_lag")
 #: What happens to the speeds when the thesis' plate stops instantly (2 m/s to 0):
-#: ``impulse`` (the rear no-slip constraint's impulse, momentum-consistent) or
-#: ``resolve`` (only the dependent speeds re-solved, as before the impulse existed).
-PLATE_STOPS = ("impulse", "resolve")
+#: ``impulse`` (the rear no-slip constraint's impulse, momentum-consistent),
+#: ``resolve`` (only the dependent speeds re-solved, as before the impulse existed)
+#: or ``keep_speeds`` (no speed jumps; the rear contact is left sliding along its
+#: heading at a constant velocity for the rest of the run: the authors' published code).
+PLATE_STOPS = ("impulse", "resolve", "keep_speeds")
 #: Heading at the kick start: ``fixed`` (heading N.x, perpendicular to the plate's
 #: motion, whatever the settle time; the settle is display only) or ``settled``
 #: (the steady motion starts at heading N.x at -settle, as before).
 KICK_HEADINGS = ("fixed", "settled")
+#: Sign of the camber the Magic Formula is fed: ``physical`` (a leaning wheel is
+#: pushed toward the lean) or ``reversed`` (away from it: the authors' published code).
+CAMBER_SIGNS = ("physical", "reversed")
+#: State at the start of the run: ``steady`` (the solved steady motion) or
+#: ``upright`` (upright straight running, not an equilibrium with measured tyres:
+#: the authors' published code).
+STARTS = ("steady", "upright")
 
 
 class SimulationError(RuntimeError):
@@ -221,6 +230,20 @@ class Scenario:
         integrated separately and is display only. ``settled``: the steady
         motion starts so at -settle (the earlier model: with a steady turn
         the heading at the kick then depends on ``settle``).
+    camber_sign : {"physical", "reversed"}
+        Sign of the camber fed to the Magic Formula. ``physical`` (default):
+        a leaning wheel is pushed toward the lean, as measured. ``reversed``:
+        away from it, as in the thesis authors' published code (the curves
+        evaluated at the opposite camber:
+        :func:`whipple_kick.magic_formula.camber_reversed`). Not physical;
+        it exists to explain that code's runs.
+    start : {"steady", "upright"}
+        ``steady`` (default): the run starts from the solved steady motion.
+        ``upright``: from upright straight running with the tyre states at
+        their zero-slip values and no rear-wheel torque
+        (:func:`whipple_kick.slip.upright_state`), as the authors' code
+        starts; with measured tyres this is not an equilibrium (their
+        offsets act from t = 0). Needs ``settle = 0`` (the kick starts the run).
     """
 
     bicycle: str = "balanceassist_v1"
@@ -255,6 +278,8 @@ class Scenario:
     tyre_transient: str = "contact_patch"
     plate_stop: str = "impulse"
     kick_heading: str = "fixed"
+    camber_sign: str = "physical"
+    start: str = "steady"
 
     @classmethod
     def thesis(cls, pressure_kpa=400.0, **changes):
@@ -272,6 +297,30 @@ class Scenario:
                     pressure_kpa=pressure_kpa, tyre_transient="force_lag")
         base.update(changes)
         return cls(**base)
+
+    @classmethod
+    def authors_code(cls, pressure_kpa=500.0, **changes):
+        """The thesis authors' published code (bicycle-kickplate-model, ``base_simulation.py``), reproduced.
+
+        For explaining that code's runs, not for predictions: it feeds the
+        camber to the Magic Formula with the opposite sign (camber thrust
+        away from the lean), starts from upright running that is not an
+        equilibrium, and leaves the rear contact sliding after the plate
+        stops. :meth:`thesis` with ``camber_sign="reversed"``,
+        ``start="upright"``, ``settle=0`` (the kick at t = 0) and
+        ``plate_stop="keep_speeds"``; their standard run is at 500 kPa.
+        Each of these can be switched back alone through ``changes``.
+        docs/validation.md ("The authors' published code") compares it with
+        that code's stored run.
+
+        Example
+        -------
+        >>> Scenario.authors_code().camber_sign, Scenario.authors_code(start="steady", settle=0.5).start
+        ('reversed', 'steady')
+        """
+        base = dict(camber_sign="reversed", start="upright", settle=0.0, plate_stop="keep_speeds")
+        base.update(changes)
+        return cls.thesis(pressure_kpa, **base)
 
     # ------------------------------------------------------------ derived values
 
@@ -376,9 +425,17 @@ class Scenario:
             raise InputError(f"controller {self.controller!r} is unknown; choose one of {', '.join(CONTROLLERS)}")
         for label, value, choices in (("tyre transient", self.tyre_transient, TYRE_TRANSIENTS),
                                       ("plate stop", self.plate_stop, PLATE_STOPS),
-                                      ("kick heading", self.kick_heading, KICK_HEADINGS)):
+                                      ("kick heading", self.kick_heading, KICK_HEADINGS),
+                                      ("camber sign", self.camber_sign, CAMBER_SIGNS),
+                                      ("start", self.start, STARTS)):
             if value not in choices:
                 raise InputError(f"{label} {value!r} is unknown; choose one of {', '.join(choices)}")
+        if self.start == "upright" and self.settle != 0.0:
+            raise InputError(f"settle time = {self.settle:g} s conflicts with start 'upright' (upright running is "
+                             "not a steady motion: the kick starts the run); allowed: 0 s")
+        if self.plate_stop == "keep_speeds" and not self.piecewise:
+            raise InputError("plate stop 'keep_speeds' needs piecewise = True (the single LSODA run re-solves "
+                             "the speeds at the plate stop)")
         if self.controller == "off" and self.gain_scale != 1.0:
             raise InputError(f"gain scale = {self.gain_scale:g} conflicts with controller off "
                              "(there are no gains to scale)")
@@ -639,21 +696,28 @@ def _integrate_run(steady, scenario, kick_T, table, kick_start):
     samples = sample_times(scenario)
     t_start, t_end = float(samples[0]), scenario.duration
     rhs = slip.CompiledRHS(steady.params)   # the plate at rest at the kick start (a table's first row)
-    fixed = scenario.kick_heading == "fixed"
+    # An upright start is no steady motion: nothing to move back along, it is where the run starts.
+    fixed = scenario.kick_heading == "fixed" and scenario.start == "steady"
     x_start = slip.advance_steady(rhs, steady.x, t_start - kick_start, t=kick_start) if fixed else steady.x
     jumps, jump_map = [], {}
+    stop = kick_start + kick_T
+    kept = table is None and scenario.piecewise and scenario.kick_profile == "constant" \
+        and scenario.plate_stop == "keep_speeds"
     if table is None:
-        breakpoints = (kick_start, kick_start + kick_T) if scenario.piecewise else ()
-        if scenario.piecewise and scenario.kick_profile == "constant":
+        breakpoints = (kick_start, stop) if scenario.piecewise else ()
+        if scenario.piecewise and scenario.kick_profile == "constant" and not kept:
             def plate_stop(t, x):
                 x, info = slip.velocity_jump(rhs, t, x, impulse=scenario.plate_stop == "impulse")
                 jumps.append(info)
                 return x
-            jump_map = {kick_start + kick_T: plate_stop}
+            jump_map = {stop: plate_stop}
     else:
         breakpoints = tuple(float(t) for t in table.times if -scenario.settle < t < scenario.duration)
 
     def run_from(x, a, rows):
+        if kept and a < stop:
+            return _integrate_kept_speeds(rhs, steady.params, x, (a, kick_start), rows, stop, scenario, chunk,
+                                          jumps)
         if table is None:
             return integrate.integrate(rhs, x, t_end, t_start=a, breakpoints=breakpoints, rtol=scenario.rtol,
                                        fall_angle=fall_angle, chunk=chunk, samples=rows, jumps=jump_map), rhs, None
@@ -682,6 +746,47 @@ def _integrate_run(steady, scenario, kick_T, table, kick_start):
         rhs_out = [rhs] + list(rhs_out)
         owner = np.concatenate([np.zeros(settle.t.size, dtype=int), np.asarray(owner) + 1])
     return traj, rhs_out, owner, breakpoints, jumps
+
+
+def _integrate_kept_speeds(rhs, params, x, span, rows, stop, scenario, chunk, jumps):
+    """Integrate across the plate stop keeping every speed (``plate_stop="keep_speeds"``).
+
+    Up to the stop with ``rhs``; from it with the rear constraint imposing
+    the slide that keeps the speeds continuous
+    (:func:`whipple_kick.slip.kept_speeds_slide`), as the authors' code's
+    acceleration-level constraint does. ``span`` is (start time, kick start)
+    [s]; the kick start is a breakpoint. Appends the stop's info to ``jumps``.
+
+    Returns
+    -------
+    traj : integrate.Trajectory
+    rhs : list of slip.CompiledRHS
+        Before and after the stop.
+    owner : ndarray of int
+        Which of them produced each sample.
+    """
+    from . import integrate, slip
+
+    fall_angle = math.radians(scenario.fall_angle_deg)
+    rows = np.asarray(rows, dtype=float)
+    t_start, kick_start = span
+    first = integrate.integrate(rhs, x, stop, t_start=t_start, breakpoints=(kick_start,), rtol=scenario.rtol,
+                                fall_angle=fall_angle, chunk=chunk, samples=rows[rows < stop])
+    if first.fell or first.failed:
+        return first, [rhs], np.zeros(first.t.size, dtype=int)
+    x_stop = first.end_state
+    slide = slip.kept_speeds_slide(rhs, stop, x_stop)
+    after = slip.CompiledRHS({**params, "vsx_r": slide})
+    ke = [r.outputs(t, x_stop)[1][slip.OUT["kinetic_energy"]]
+          for r, t in ((rhs, np.nextafter(stop, -np.inf)), (after, stop))]
+    jumps.append({"time_s": float(stop), "kinetic_energy_change_j": float(ke[1] - ke[0]), "impulse_work_j": None,
+                  "constraint_impulse_n_s": None, "rear_slide_m_s": slide})
+    second = integrate.integrate(after, x_stop, scenario.duration, t_start=stop, rtol=scenario.rtol,
+                                 fall_angle=fall_angle, chunk=chunk, samples=rows[rows >= stop])
+    traj = integrate.Trajectory(np.concatenate([first.t, second.t]), np.concatenate([first.x, second.x]),
+                                second.fell, second.fall_time, first.nfev + second.nfev, second.message,
+                                end_state=second.end_state, failed=second.failed)
+    return traj, [rhs, after], np.concatenate([np.zeros(first.t.size, dtype=int), np.ones(second.t.size, dtype=int)])
 
 
 def _from_kick_start(traj, kick_start):
@@ -993,6 +1098,42 @@ def steady_motion(params, scenario, controller_type):
     return steady.find_steady_state(params, scenario.speed, advice=_steady_advice(scenario, controller_type))
 
 
+#: What an upright start's stability is judged about when the tyres' offsets allow no steady motion.
+_SYMMETRIC_ABOUT = "upright running without the tyres' zero-slip offsets"
+_SYMMETRIC_ROUTE = f"{_SYMMETRIC_ABOUT} (no steady motion with them)"
+
+
+def start_state(params, scenario, controller_type):
+    """The steady motion the rider's stability is judged about, and the state the run starts from.
+
+    With ``start="steady"`` both are the steady motion. With
+    ``start="upright"`` the run starts from :func:`whipple_kick.slip.upright_state`;
+    stability is judged about the steady motion of the same model if there
+    is one, else about upright running with the tyres' offsets removed (an
+    exact equilibrium).
+
+    Returns
+    -------
+    found : whipple_kick.steady.Found
+    start : whipple_kick.slip.SteadyState
+    """
+    from . import slip, steady
+
+    if scenario.start == "steady":
+        found = steady_motion(params, scenario, controller_type)
+        return found, found.steady
+    try:
+        start = slip.upright_state(params, scenario.speed)
+    except FloatingPointError as exc:
+        raise SimulationError(str(exc)) from None
+    try:
+        found = steady_motion(params, scenario, controller_type)
+    except steady.NoSteadyMotion:
+        symmetric = slip.steady_state(steady.offset_scaled(params, 0.0), scenario.speed)
+        found = steady.Found(symmetric, _SYMMETRIC_ROUTE, 1)
+    return found, start
+
+
 def linear_stability(scenario, moore, gains, found, controller_type):
     """Is the rider in use linearly stable at the run's speed?
 
@@ -1018,7 +1159,8 @@ def linear_stability(scenario, moore, gains, found, controller_type):
             slip_poles = steady.lateral_poles(found.steady.params, found.steady.x)
         except FloatingPointError:   # the linearisation's pitch solve failed: the classic model decides
             slip_poles = None
-    decisive, model = ((slip_poles, "slip model about the steady motion, constant speed")
+    about = _SYMMETRIC_ABOUT if found.route == _SYMMETRIC_ROUTE else "the steady motion"
+    decisive, model = ((slip_poles, f"slip model about {about}, constant speed")
                        if slip_poles is not None else (classic, "no-slip classic model"))
     slowest = decisive[0]
     stable = bool(slowest.real <= UNSTABLE_REAL_PART)
@@ -1182,9 +1324,9 @@ def run(scenario, *, tyres=None, gains=None):
         kick_start = float(table.times[0])
         kick = dict(profile=_SEGMENT_PROFILE, t0=kick_start, coefficients=(float(table.y[0]), 0.0, 0.0, 0.0))
     params = slip.model_parameters(moore, rear, front, gains=gains, symmetric=scenario.symmetric_tyres,
-                                   kick=kick, tyre_transient=scenario.tyre_transient)
-    found = steady_motion(params, scenario, controller_type)
-    steady = found.steady
+                                   kick=kick, tyre_transient=scenario.tyre_transient,
+                                   reverse_camber=scenario.camber_sign == "reversed")
+    found, steady = start_state(params, scenario, controller_type)
     stability = linear_stability(scenario, moore, gains, found, controller_type)
     steady_yaw_rate = float(steady.x[slip.X["u3"]])
     if gains.get("kq3", 0.0) and abs(steady_yaw_rate) > _STRAIGHT_YAW_RATE:
@@ -1203,8 +1345,11 @@ def run(scenario, *, tyres=None, gains=None):
         raise SimulationError("non-finite values in the trajectory")
 
     x0 = steady.x
-    baseline = float(x0[slip.X["u3"]])
-    metrics, recovery = _response_metrics(df, baseline, x0, scenario, traj)
+    # Recovery is back to the steady motion, also after an upright start (which is not one);
+    # without a steady motion with these tyres, back to upright running.
+    reference = steady if found.route == _SYMMETRIC_ROUTE else found.steady
+    baseline = float(reference.x[slip.X["u3"]])
+    metrics, recovery = _response_metrics(df, baseline, reference.x, scenario, traj)
     after = df["time"].to_numpy() >= 0.0
 
     summary = {
@@ -1248,12 +1393,18 @@ def run(scenario, *, tyres=None, gains=None):
         "steady_state": {
             "speed_m_s": scenario.speed,
             "roll_rad": float(x0[slip.X["q4"]]), "steer_rad": float(x0[slip.X["q7"]]),
-            "pitch_rad": float(x0[slip.X["q5"]]), "yaw_rate_rad_s": baseline,
+            "pitch_rad": float(x0[slip.X["q5"]]), "yaw_rate_rad_s": float(x0[slip.X["u3"]]),
+            "yaw_rate_baseline_rad_s": baseline,
             "lateral_drift_m_s": float(x0[slip.X["u2"]]),
             "compression_rear_m": float(x0[slip.X["q9"]]), "compression_front_m": float(x0[slip.X["q10"]]),
             **_rear_wheel_torque(steady),
             "residual": float(steady.residual),
-            "found_by": found.route,
+            "found_by": found.route if scenario.start == "steady" else (
+                f"upright start (start 'upright'): not a steady motion, the tyres' zero-slip forces act from "
+                f"t = 0 (largest lateral acceleration there {steady.unknowns['largest_rate']:.3g} m/s^2 or "
+                f"rad/s^2); yaw-rate peaks and recovery are measured from "
+                + (f"the steady motion's yaw rate {baseline:.4g} rad/s" if reference is not steady
+                   else "upright running (no steady motion with these tyres)")),
         },
         "peaks": {f"max_abs_{name}": float(np.max(np.abs(df[name].to_numpy()[after]), initial=0.0))
                   for name in ("yaw_rate", "roll_rate", "steer_rate", "roll", "steer", "slip_rear",

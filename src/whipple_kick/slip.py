@@ -776,7 +776,7 @@ MZ_OFFSET_INDICES = magic_formula.MZ_OFFSET_INDICES
 GAIN_NAMES = ("kq3", "kq4", "kq7", "ku3", "ku4", "ku7")
 
 
-def tyre_parameters(tyre, wheel, symmetric=False, lateral=True):
+def tyre_parameters(tyre, wheel, symmetric=False, lateral=True, reverse_camber=False):
     """Slip-model parameters of one tyre, by name.
 
     Parameters
@@ -789,6 +789,11 @@ def tyre_parameters(tyre, wheel, symmetric=False, lateral=True):
         Zero the zero-slip offsets (:data:`FY_OFFSET_INDICES`, :data:`MZ_OFFSET_INDICES`).
     lateral : bool
         False switches the tyre's lateral force and moment off.
+    reverse_camber : bool
+        Evaluate the curves at the opposite camber
+        (:func:`whipple_kick.magic_formula.camber_reversed`): the thesis
+        authors' published code, whose camber thrust pushes a leaning wheel
+        away from the lean. Not physical; for comparisons only.
     """
     if wheel not in ("r", "f"):
         raise ValueError(f"wheel must be 'r' or 'f', got {wheel!r}")
@@ -808,6 +813,8 @@ def tyre_parameters(tyre, wheel, symmetric=False, lateral=True):
         if symmetric:
             fy[list(FY_OFFSET_INDICES)] = 0.0
             mz[list(MZ_OFFSET_INDICES)] = 0.0
+        if reverse_camber:
+            fy, mz = magic_formula.camber_reversed(fy, "fy"), magic_formula.camber_reversed(mz, "mz")
         out.update({f"a{wheel}{k}_{i}": v for i, v in enumerate(fy)})
         out.update({f"c{wheel}{k}_{i}": v for i, v in enumerate(mz)})
     return out
@@ -815,7 +822,7 @@ def tyre_parameters(tyre, wheel, symmetric=False, lateral=True):
 
 def model_parameters(moore, rear_tyre, front_tyre, gains=None, kick=None,
                      symmetric=False, lateral=True, drive_torque=0.0,
-                     tyre_transient=transient.DEFAULT_TRANSIENT):
+                     tyre_transient=transient.DEFAULT_TRANSIENT, reverse_camber=False):
     """Assemble the slip model's parameters by name.
 
     Parameters
@@ -833,7 +840,7 @@ def model_parameters(moore, rear_tyre, front_tyre, gains=None, kick=None,
         segment ``c0 + c1 tau + c2 tau^2 + c3 tau^3`` with ``tau = t - t0``,
         given as ``coefficients`` = (c0, c1, c2, c3) in m, m/s, m/s^2, m/s^3;
         see :func:`cubic_segments`). Default: no kick.
-    symmetric, lateral : bool
+    symmetric, lateral, reverse_camber : bool
         See :func:`tyre_parameters`.
     drive_torque : float
         Constant rear-wheel torque T6c [N m] about the rear frame's C.y axis
@@ -842,8 +849,8 @@ def model_parameters(moore, rear_tyre, front_tyre, gains=None, kick=None,
         One of :data:`whipple_kick.transient.TRANSIENTS` (default ``contact_patch``).
     """
     params = {n: float(moore[n]) for n in S.CLASSIC_CONSTANTS}
-    params.update(tyre_parameters(rear_tyre, "r", symmetric, lateral))
-    params.update(tyre_parameters(front_tyre, "f", symmetric, lateral))
+    params.update(tyre_parameters(rear_tyre, "r", symmetric, lateral, reverse_camber))
+    params.update(tyre_parameters(front_tyre, "f", symmetric, lateral, reverse_camber))
     gains = dict(gains or {})
     unknown = set(gains) - set(GAIN_NAMES)
     if unknown:
@@ -858,6 +865,7 @@ def model_parameters(moore, rear_tyre, front_tyre, gains=None, kick=None,
         **{f"kick_c{i}": float(c) for i, c in enumerate(kick.get("coefficients", (0.0, 0.0, 0.0, 0.0)))},
         "T6c": float(drive_torque),
         "tyre_transient": float(transient.check(tyre_transient)),
+        "vsx_r": 0.0,
     })
     return params
 
@@ -919,18 +927,12 @@ def steady_state(params, speed, tol=1e-13, guess=None):
         z0 = np.array([float(guess.get(name, value)) for name, value in zip(names, z0)])
     scale = np.array([1.0, 1.0, 1.0, 1e-3, 1e-3, 1.0, 1.0, 1.0])
 
-    steady_outputs = (("fy_ss_r", "fy_ss_f", "mz_ss_r", "mz_ss_f") if rhs.transient == "force_lag"
-                      else ("slip_r", "slip_f", "camber_r", "camber_f"))
-
     def state(z):
         xs = x.copy()
         for name, value in zip(names[:-1], z[:-1]):
             xs[X[name]] = value
         rhs.p[P["T6c"]] = z[-1]
-        _, out = rhs.outputs(0.0, xs)
-        for slot, out_name in zip(PATCH_STATES, steady_outputs):
-            xs[X[slot]] = out[OUT[out_name]]
-        return xs
+        return _steady_tyre_states(rhs, xs)
 
     def residual(zs):
         z = zs * scale
@@ -952,6 +954,87 @@ def steady_state(params, speed, tol=1e-13, guess=None):
     out_params = dict(params)
     out_params["T6c"] = float(z[-1])
     return SteadyState(xs, out_params, res, dict(zip(names, z)))
+
+
+def _steady_tyre_states(rhs, x):
+    """``x`` with the tyre slots at their steady values for its kinematics.
+
+    The relaxed forces and moments at the steady curves (``force_lag``), or
+    the patch slip and camber at the kinematic ones (contact forms), both at
+    the state's own slip, camber and load.
+    """
+    names = (("fy_ss_r", "fy_ss_f", "mz_ss_r", "mz_ss_f") if rhs.transient == "force_lag"
+             else ("slip_r", "slip_f", "camber_r", "camber_f"))
+    x = np.array(x, dtype=float)
+    _, out = rhs.outputs(0.0, x)
+    for slot, out_name in zip(PATCH_STATES, names):
+        x[X[slot]] = out[OUT[out_name]]
+    return x
+
+
+def upright_state(params, speed, tol=1e-13):
+    """Upright straight running at ``speed`` [m/s]: the start of the thesis authors' published code.
+
+    Roll, steer, yaw and every lateral speed are 0, the rear contact moves
+    along N.x at ``speed``, the rear-wheel torque ``T6c`` is 0; pitch and the
+    tyre compressions are solved so that the front contact is on the ground
+    and both tyres are in vertical equilibrium; the tyre states are at their
+    steady values (zero slip and camber: the fits' zero-slip offsets).
+    With measured tyres this is NOT a steady motion: the offsets push the
+    bicycle off it from the first instant (``unknowns["largest_rate"]`` says
+    how hard: the largest |acceleration| of the lateral speeds u2, u3, u4, u7
+    in SI units).
+
+    Parameters
+    ----------
+    params : mapping
+        From :func:`model_parameters` (``T6c`` is set to 0).
+    speed : float
+        Forward speed [m/s], > 0.
+
+    Returns
+    -------
+    SteadyState
+        ``residual`` is that of the solved equations (holonomic and the two
+        vertical accelerations), not of the motion.
+
+    Example
+    -------
+    >>> start = upright_state(params, 3.0)                        # doctest: +SKIP
+    >>> float(start.x[X["q4"]]), float(start.params["T6c"])       # doctest: +SKIP
+    (0.0, 0.0)
+    """
+    from scipy.optimize import root
+    from .benchmark import steer_axis_tilt
+
+    out_params = dict(params)
+    out_params["T6c"] = 0.0
+    rhs = CompiledRHS(out_params)
+    weight = params["g"] * (params["mc"] + params["md"] + params["me"] + params["mf"])
+    x = np.zeros(len(STATE_NAMES))
+    x[X["u1"]] = speed
+    names = ("q5", "q9", "q10")
+
+    def state(z):
+        xs = x.copy()
+        for name, value in zip(names, z):
+            xs[X[name]] = value
+        return _steady_tyre_states(rhs, xs)
+
+    def residual(z):
+        dx, out = rhs.outputs(0.0, state(z))
+        return np.array([out[OUT["holonomic"]] * 1e2, dx[X["u9"]] * 1e-2, dx[X["u10"]] * 1e-2])
+
+    z0 = np.array([steer_axis_tilt(params), 0.5 * weight / params["kzr"], 0.5 * weight / params["kzf"]])
+    sol = root(residual, z0, method="hybr", options={"xtol": tol})
+    res = float(np.max(np.abs(residual(sol.x))))
+    if not np.all(np.isfinite(sol.x)) or res > 1e-8:
+        raise FloatingPointError(f"upright start not found at {speed} m/s: {sol.message} (residual {res:.3g})")
+    xs = state(sol.x)
+    dx = rhs(0.0, xs)
+    unknowns = dict(zip(names, (float(v) for v in sol.x)))
+    unknowns["largest_rate"] = float(max(abs(dx[X[n]]) for n in ("u2", "u3", "u4", "u7")))
+    return SteadyState(xs, out_params, res, unknowns)
 
 
 def advance_steady(rhs, x, tau, t=0.0):
@@ -993,6 +1076,41 @@ def advance_steady(rhs, x, tau, t=0.0):
     x[X["q6"]] += out[OUT["u6"]] * tau
     x[X["q8"]] += out[OUT["u8"]] * tau
     return x
+
+
+def kept_speeds_slide(rhs, t, x):
+    """The rear slide ``vsx_r`` [m/s] that keeps every speed across a plate-velocity jump at ``t``.
+
+    The thesis authors' published code integrates all speeds as states and
+    enforces the rear no-slip condition only through its time derivative, so
+    when the plate stops instantly no speed jumps and the condition is left
+    violated by a constant: the rear contact keeps sliding along its heading,
+    relative to the stopped plate, at the plate's velocity before the stop
+    times sin(yaw) (0.204 m/s in their 500 kPa run). This returns that slide
+    (``rhs``'s own ``vsx_r`` included), to be imposed by the rear constraint
+    for the rest of the run.
+
+    Parameters
+    ----------
+    rhs : CompiledRHS
+        Whose plate velocity jumps at ``t`` (``t`` itself belongs to after).
+    t : float
+        Time of the jump [s].
+    x : array_like
+        State arriving at ``t``.
+
+    Returns
+    -------
+    float
+    """
+    x = np.asarray(x, dtype=float)
+    ind = [X[n] for n in INDEPENDENT]
+    _, A, a0_plus = rhs.impulse_terms(t, x)
+    _, _, a0_minus = rhs.impulse_terms(np.nextafter(t, -np.inf), x)
+    u = _PARTITION.dependent_speeds(A, a0_minus, x[ind])
+    residual = A @ u + a0_plus
+    # The rear row (vsx_r enters it as -vsx_r) is the only one the plate appears in.
+    return float(rhs.p[P["vsx_r"]] + residual[0])
 
 
 def velocity_jump(rhs, t, x, impulse=True):

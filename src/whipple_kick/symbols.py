@@ -152,6 +152,9 @@ def _entries():
         ("ku3", "steer-torque feedback gain on yaw rate u3", "N m s/rad", c),
         ("ku4", "steer-torque feedback gain on roll rate u4", "N m s/rad", c),
         ("ku7", "steer-torque feedback gain on steer rate u7", "N m s/rad", c),
+        ("vsx_r", "imposed longitudinal sliding velocity of the rear wheel's material contact point relative to "
+                  "the plate, along the rear heading (0: rolling without slip; the authors' plate stop leaves "
+                  "it non-zero)", "m/s", c),
         ("T6c", "constant rear-wheel torque holding the steady speed, about C.y (the rear frame's right-pointing "
                 "axis) on the wheel: + opposes forward rolling (a brake), - drives", "N m", c),
         ("tyre_transient", "tyre transient form: 0 contact_patch (default), 1 slip_lag, 2 force_lag (thesis)", "-", c),
@@ -189,7 +192,7 @@ SLIP_CONSTANTS = CLASSIC_CONSTANTS + (
     "rtr", "rtf", "kzr", "kzf", "czr", "czf", "sigr", "sigf",
     "wr", "wf", "mur", "muf", "lamr", "lamf",
     "kick_t0", "kick_T", "kick_D", "kick_profile", "kick_c0", "kick_c1", "kick_c2", "kick_c3",
-    "kq3", "kq4", "kq7", "ku3", "ku4", "ku7", "T6c", "tyre_transient",
+    "kq3", "kq4", "kq7", "ku3", "ku4", "ku7", "T6c", "tyre_transient", "vsx_r",
 ) + tuple(f"{kind}{wheel}{k}_{i}" for wheel in "rf" for k in (1, 2)
           for kind, n in (("a", 14), ("c", 18)) for i in range(n))
 
