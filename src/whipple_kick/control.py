@@ -13,6 +13,7 @@ solved. :func:`cached_lqr_gains` keeps each design in the per-user cache
 (:mod:`.cache`), keyed by everything the result depends on, so a repeated
 design (every ``simulate`` run after the first) never imports it.
 """
+import functools
 import hashlib
 import json
 import pathlib
@@ -142,6 +143,15 @@ def _solver_versions():
     return f"control {control_version}; slycot {slycot}; numpy {np.__version__}; scipy {scipy.__version__}"
 
 
+@functools.lru_cache(maxsize=1)
+def _sources_key():
+    """Hash of the sources and solver versions a design depends on, once per process.
+
+    (About 1.2 ms to compute: a sweep over 200 design speeds reads 200 entries.)
+    """
+    return cache.source_hash(_LQR_SOURCES, extra=_solver_versions())
+
+
 def lqr_cache_key(moore, speed=3.0, Q=None, R=1.0):
     """(entry name, key material) of the cached design of :func:`cached_lqr_gains`.
 
@@ -152,7 +162,7 @@ def lqr_cache_key(moore, speed=3.0, Q=None, R=1.0):
     """
     material = {
         "layout": _LQR_LAYOUT,
-        "sources": cache.source_hash(_LQR_SOURCES, extra=_solver_versions()),
+        "sources": _sources_key(),
         "parameters": {name: repr(float(moore[name])) for name in CLASSIC_CONSTANTS},
         "speed": repr(float(speed)),
         "Q": [[repr(float(v)) for v in row] for row in _weight(Q)],
