@@ -249,15 +249,21 @@ def _setup(scenario, tyres=None):
     return _Setup(scenario, moore, design, info, (rear, front), notes, scenario.controller)
 
 
-def _loop_params(setup, speed, loop):
+def _base_params(setup):
+    """Slip-model parameters of the scenario without steer control."""
+    sc = setup.scenario
+    return slip.model_parameters(setup.moore, *setup.tyres, symmetric=sc.symmetric_tyres,
+                                 tyre_transient=sc.tyre_transient)
+
+
+def _loop_params(setup, speed, loop, base=None):
     """Slip-model parameters at ``speed`` for ``loop`` (the rider's gains designed for that speed)."""
-    gains = None
+    params = dict(_base_params(setup) if base is None else base)
     if loop == "closed":
         gains, _ = simulation.controller_gains(simulation.with_changes(setup.scenario, speed=float(speed)),
                                                setup.design)
-    sc = setup.scenario
-    return slip.model_parameters(setup.moore, *setup.tyres, gains=gains, symmetric=sc.symmetric_tyres,
-                                 tyre_transient=sc.tyre_transient)
+        params.update(gains)
+    return params
 
 
 def _steady(params, speed, guess):
@@ -339,43 +345,46 @@ def mode_content(model, eigenvalue, vector, wheelbase):
     Parameters
     ----------
     model : LinearModel
-    eigenvalue : complex
-    vector : ndarray, complex
-        Right eigenvector of ``model.matrix``.
+    eigenvalue : complex or ndarray (k,)
+        One eigenvalue, or several.
+    vector : ndarray, complex, (n,) or (n, k)
+        Right eigenvector(s) of ``model.matrix``, as columns.
     wheelbase : float
         [m].
 
     Returns
     -------
-    shares : ndarray
+    shares : ndarray (6,) or (k, 6)
         Fraction of the squared amplitude in each of :data:`GROUPS` (sums to 1).
-    scaled : ndarray, complex
+    scaled : ndarray, complex, (10,) or (10, k)
         The angle-like amplitudes (for the eigenvector similarity of :func:`track`).
     """
+    single = np.ndim(eigenvalue) == 0
+    lam = np.atleast_1d(np.asarray(eigenvalue, dtype=complex))
+    vec = np.asarray(vector, dtype=complex).reshape(len(model.states), -1)
     idx = {n: i for i, n in enumerate(model.states)}
     M = model.matrix
     speed = model.speed
-    tau = 1.0 / max(abs(eigenvalue), speed / wheelbase)
-    tyre_slots = model.states[-4:]
+    tau = 1.0 / np.maximum(np.abs(lam), speed / wheelbase)
     lag = []
-    for name in tyre_slots:
+    for name in model.states[-4:]:   # tyre slots: rear, front, rear, front
         i = idx[name]
         gain = 1.0
         if name in slip.TYRE_STATES:   # force-lag forces and moments: per radian of slip
             gain = abs(M[i, idx["v_lat"]]) * speed / abs(M[i, i])
-        lag.append(eigenvalue * vector[i] / (-M[i, i]) / gain)
+        lag.append(lam * vec[i] / (-M[i, i]) / gain)
     scaled = np.array([
-        vector[idx["q4"]], vector[idx["q7"]],
-        vector[idx["u3"]] * tau, vector[idx["v_lat"]] * tau / wheelbase,
-        vector[idx["q9"]] / wheelbase, vector[idx["q10"]] / wheelbase,
+        vec[idx["q4"]], vec[idx["q7"]],
+        vec[idx["u3"]] * tau, vec[idx["v_lat"]] * tau / wheelbase,
+        vec[idx["q9"]] / wheelbase, vec[idx["q10"]] / wheelbase,
         *lag,
     ])
     power = np.abs(scaled) ** 2
-    # rear tyre: slip and camber (or force and moment) of the rear wheel; slots are r, f, r, f
     shares = np.array([power[0], power[1], power[2] + power[3], power[4] + power[5],
-                       power[6] + power[8], power[7] + power[9]])
-    total = shares.sum()
-    return shares / total if total > 0 else shares, scaled
+                       power[6] + power[8], power[7] + power[9]]).T
+    total = shares.sum(axis=1, keepdims=True)
+    shares = shares / np.where(total > 0, total, 1.0)
+    return (shares[0], scaled[:, 0]) if single else (shares, scaled)
 
 
 def name_mode(shares, real, frequency_hz):
@@ -542,23 +551,19 @@ class _Loop:
 
     def __init__(self, setup, loop, wheelbase):
         self.setup, self.loop, self.wheelbase = setup, loop, wheelbase
-        self.guess = None
+        self.base = _base_params(setup)
 
     def model(self, speed, guess=None):
         """LinearModel at ``speed`` (NoSteadyMotion if there is none)."""
-        params = _loop_params(self.setup, speed, self.loop)
+        params = _loop_params(self.setup, speed, self.loop, self.base)
         steady_state, found_by = _steady(params, speed, guess)
         return linearise(params, steady_state, self.loop, found_by)
 
     def eigen(self, model):
         """(eigenvalues, angle-like eigenvectors as columns, shares per eigenvalue)."""
         lam, vec = np.linalg.eig(model.matrix)
-        scaled, shares = [], []
-        for k in range(lam.size):
-            sh, sc = mode_content(model, lam[k], vec[:, k], self.wheelbase)
-            shares.append(sh)
-            scaled.append(sc)
-        return lam, np.array(scaled).T, np.array(shares)
+        shares, scaled = mode_content(model, lam, vec, self.wheelbase)
+        return lam, scaled, shares
 
 
 def _classic_eigen(canonical, speed, K=None):
@@ -1227,21 +1232,25 @@ SLOW_RANGE = (-10.0, 10.0)
 
 
 def _branch_lines(table):
-    """(mode, speeds, real parts, |imag| parts) per branch of each track, imaginary parts >= 0 only."""
-    lines = []
+    """Per mode: (speeds, real parts, |imag| parts), its branches joined with NaN gaps (Im >= 0 only).
+
+    One line per mode and part keeps the figure to a few dozen artists
+    (drawing some 600 separate lines cost 0.3 s of the command's 5 s).
+    """
+    speeds_all = np.unique(np.round(table["speed_m_s"].to_numpy(), 9))
+    lines = {}
     for (track_id, mode), g in table.groupby(["track", "mode"], sort=False):
         g = g.sort_values("speed_m_s")
         if (g["imag_1_s"] < 0).all():
             continue   # the conjugate of a drawn pair
-        k = np.round(g["speed_m_s"].to_numpy(), 9)
-        # break the line where the branch has a gap in speed
-        order = np.searchsorted(np.unique(np.round(table["speed_m_s"].to_numpy(), 9)), k)
-        breaks = np.nonzero(np.diff(order) > 1)[0] + 1
-        for part in np.split(np.arange(len(g)), breaks):
-            sub = g.iloc[part]
-            lines.append((mode, sub["speed_m_s"].to_numpy(), sub["real_1_s"].to_numpy(),
-                          np.abs(sub["imag_1_s"].to_numpy())))
-    return lines
+        order = np.searchsorted(speeds_all, np.round(g["speed_m_s"].to_numpy(), 9))
+        breaks = np.nonzero(np.diff(order) > 1)[0] + 1   # gaps in speed end a branch too
+        parts = lines.setdefault(mode, ([], [], []))
+        for piece in np.split(np.arange(len(g)), breaks):
+            sub = g.iloc[piece]
+            for store, values in zip(parts, (sub["speed_m_s"], sub["real_1_s"], np.abs(sub["imag_1_s"]))):
+                store += [*np.asarray(values, dtype=float), np.nan]
+    return {mode: tuple(np.array(v) for v in parts) for mode, parts in lines.items()}
 
 
 def _speed(value):
@@ -1289,30 +1298,29 @@ def figure(result, path, title=None):
     pathlib.Path
     """
     import pathlib
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
     from matplotlib.lines import Line2D
 
     df = result.eigenvalues
     loops = [loop for loop in LOOPS if loop in set(df["loop"])]
-    fig, axes = plt.subplots(len(loops), 2, figsize=(13, 4.6 * len(loops)), squeeze=False)
+    # A bare Figure (no pyplot): pyplot's redraw hooks on every artist cost 0.1 s here.
+    fig = Figure(figsize=(13, 4.6 * len(loops)))
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(len(loops), 2, squeeze=False)
     used = set()
     for row, loop in enumerate(loops):
-        slip_table = df[(df["model"] == "slip") & (df["loop"] == loop)]
-        classic_table = df[(df["model"] == "no-slip") & (df["loop"] == loop)]
+        slip_lines = _branch_lines(df[(df["model"] == "slip") & (df["loop"] == loop)])
+        classic_lines = _branch_lines(df[(df["model"] == "no-slip") & (df["loop"] == loop)])
         info = result.summary.get("slip", {}).get(loop, {})
         for col, ax in enumerate(axes[row]):
-            for _, v, re, im in _branch_lines(classic_table):
+            for v, re, im in classic_lines.values():
                 ax.plot(v, re, color="0.55", lw=1.0, alpha=0.45, zorder=1)
-                if np.any(im > 0):
-                    ax.plot(v, np.where(im > 0, im, np.nan), color="0.55", lw=1.0, ls="--", alpha=0.45, zorder=1)
-            for mode, v, re, im in _branch_lines(slip_table):
-                colour = MODE_COLOURS[mode]
+                ax.plot(v, np.where(im > 0, im, np.nan), color="0.55", lw=1.0, ls="--", alpha=0.45, zorder=1)
+            for mode, (v, re, im) in slip_lines.items():
                 used.add(mode)
-                ax.plot(v, re, color=colour, lw=1.6, zorder=3)
-                if np.any(im > 0):
-                    ax.plot(v, np.where(im > 0, im, np.nan), color=colour, lw=1.3, ls="--", zorder=3)
+                ax.plot(v, re, color=MODE_COLOURS[mode], lw=1.6, zorder=3)
+                ax.plot(v, np.where(im > 0, im, np.nan), color=MODE_COLOURS[mode], lw=1.3, ls="--", zorder=3)
             for rng in info.get("stable_speed_ranges", []):
                 ax.axvspan(rng["from_m_s"], rng["to_m_s"], color="tab:green", alpha=0.08, zorder=0)
             for key in ("weave_speed_m_s", "capsize_speed_m_s"):
@@ -1344,8 +1352,108 @@ def figure(result, path, title=None):
                         hspace=0.3, wspace=0.15)
     path = pathlib.Path(path)
     fig.savefig(path, dpi=110)
-    plt.close(fig)
     return path
+
+
+# ------------------------------------------------------------------ pressure and load
+
+#: The thesis' kick-plate grid: pressures [kPa] and static rear loads [N] (Chapter 8, Table 8.3).
+THESIS_PRESSURES_KPA = (300.0, 400.0, 500.0)
+THESIS_LOADS_N = (570.0, 635.0, 701.0)
+
+
+def _at(table, speed, mode):
+    """(eigenvalue with Im >= 0 named ``mode`` at ``speed`` with the largest real part, or None)."""
+    sel = table[np.isclose(table["speed_m_s"], speed) & (table["mode"] == mode) & (table["imag_1_s"] >= 0)]
+    if sel.empty:
+        return None
+    r = sel.loc[sel["real_1_s"].idxmax()]
+    return complex(r["real_1_s"], r["imag_1_s"])
+
+
+def _mode_columns(prefix, lam):
+    if lam is None:
+        return {f"{prefix}_real_1_s": None, f"{prefix}_frequency_hz": None, f"{prefix}_damping_ratio": None}
+    return {f"{prefix}_real_1_s": lam.real, f"{prefix}_frequency_hz": abs(lam.imag) / (2 * math.pi),
+            f"{prefix}_damping_ratio": -lam.real / abs(lam)}
+
+
+def case_row(result, at_speed=3.0):
+    """One row of :func:`pressure_load_table`: speeds, ranges and modes at ``at_speed`` of one analysis.
+
+    Columns: pressure and load; the slip and no-slip weave and capsize
+    speeds and the self-stable range (open loop); the stable speed range
+    with the rider (closed loop); at ``at_speed`` the weave (open and closed
+    loop) and the wobble (closed loop) as real part, frequency and damping
+    ratio, and the closed loop's slowest eigenvalue (what a disturbance
+    decays with); the wobble's least damping over the sweep.
+    """
+    sc, s, table = result.scenario, result.summary, result.eigenvalues
+    speed = float(result.speeds[np.argmin(np.abs(result.speeds - at_speed))])
+    rear, _ = sc.pressures
+    row = {"pressure_kpa": rear, "fz_n": sc.fz_n, "at_speed_m_s": speed}
+    first = lambda ranges: (ranges[0]["from_m_s"], ranges[0]["to_m_s"]) if ranges else (None, None)
+    for model, tag in (("slip", ""), ("no-slip", "noslip_")):
+        info = s[model]["open"]
+        row[f"{tag}weave_speed_m_s"] = info["weave_speed_m_s"]
+        row[f"{tag}capsize_speed_m_s"] = info["capsize_speed_m_s"]
+        row[f"{tag}self_stable_from_m_s"], row[f"{tag}self_stable_to_m_s"] = first(info["stable_speed_ranges"])
+    slip_table = table[table["model"] == "slip"]
+    open_t, closed_t = slip_table[slip_table["loop"] == "open"], slip_table[slip_table["loop"] == "closed"]
+    row.update(_mode_columns("open_weave", _at(open_t, speed, "weave")))
+    if "closed" in s["slip"]:
+        ranges = s["slip"]["closed"]["stable_speed_ranges"]
+        row["closed_stable_ranges"] = "; ".join(range_text(r) for r in ranges) or "none"
+        row.update(_mode_columns("closed_weave", _at(closed_t, speed, "weave")))
+        row.update(_mode_columns("closed_wobble", _at(closed_t, speed, "wobble")))
+        here = closed_t[np.isclose(closed_t["speed_m_s"], speed)]
+        slowest = here.loc[here["real_1_s"].idxmax()]
+        row["closed_slowest_real_1_s"] = float(slowest["real_1_s"])
+        row["closed_slowest_mode"] = slowest["mode"]
+    loop = "closed" if "closed" in s["slip"] else "open"
+    wob = s["slip"][loop]["wobble"]
+    row["wobble_least_damping_ratio"] = wob["least_damped"]["damping_ratio"] if wob["exists"] else None
+    row["wobble_least_damped_at_m_s"] = wob["least_damped"]["speed_m_s"] if wob["exists"] else None
+    return row
+
+
+def pressure_load_table(pressures=THESIS_PRESSURES_KPA, loads=THESIS_LOADS_N, *, base=None, speeds=None,
+                        at_speed=3.0):
+    """Weave, wobble and stable speed ranges over pressures x rear loads (:func:`case_row` per case).
+
+    Parameters
+    ----------
+    pressures : sequence of float
+        Inflation pressures of both tyres [kPa] (default the thesis' 300, 400, 500).
+    loads : sequence of float
+        Static rear-tyre loads [N] the rider is sized for (default 570, 635, 701).
+    base : whipple_kick.simulation.Scenario, optional
+        Everything else (default: offsets removed, the default rider designed at each speed).
+    speeds : array_like, optional
+        Sweep speeds [m/s] (default :data:`DEFAULT_SPEEDS`).
+    at_speed : float
+        Speed [m/s] of the weave and wobble columns (default 3, the kick-plate runs').
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per case, loads outer, pressures inner.
+
+    Example
+    -------
+    >>> table = pressure_load_table(pressures=(400.0,), loads=(635.0,))   # doctest: +SKIP
+    >>> table[["pressure_kpa", "weave_speed_m_s", "capsize_speed_m_s"]]   # doctest: +SKIP
+    """
+    import pandas as pd
+    base = simulation.Scenario(symmetric_tyres=True) if base is None else base
+    speeds = parse_speeds("{}:{}:{}".format(*DEFAULT_SPEEDS)) if speeds is None else check_speeds(speeds)
+    rows = []
+    for load in loads:
+        for pressure in pressures:
+            sc = simulation.with_changes(base, pressure_kpa=float(pressure), fz_n=float(load),
+                                         pressure_front_kpa=None, pressure_rear_kpa=None)
+            rows.append(case_row(analyse(sc, speeds), at_speed))
+    return pd.DataFrame(rows)
 
 
 # ------------------------------------------------------------------ outputs
@@ -1412,3 +1520,54 @@ def report_lines(summary):
             lines.append(f"    note: the steady motion is a turn with up to {math.degrees(lean):.1f} deg of lean "
                          "(the tyres' zero-slip offsets); these are the eigenvalues of that turn")
     return lines
+
+
+def pressure_load_figure(table, path):
+    """Figure of :func:`pressure_load_table`: against pressure, one line per rear load.
+
+    Panels: the open-loop weave and capsize speeds (the no-slip model's as
+    faint horizontal lines); the closed loop's weave damping ratio and
+    decay rate at the table's speed; the wobble's frequency and damping
+    ratio there.
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    import pathlib
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(14, 4.4))
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(1, 3)
+    rate_axis, wobble_damping_axis = axes[1].twinx(), axes[2].twinx()
+    colours = dict(zip(sorted(set(table["fz_n"])), ("tab:blue", "tab:orange", "tab:green", "tab:red")))
+    at = float(table["at_speed_m_s"].iloc[0])
+    for load, g in table.groupby("fz_n"):
+        c, p = colours[load], g["pressure_kpa"]
+        axes[0].plot(p, g["weave_speed_m_s"], "o-", color=c, label=f"{load:g} N: weave")
+        axes[0].plot(p, g["capsize_speed_m_s"], "s--", color=c, label=f"{load:g} N: capsize")
+        axes[0].axhline(g["noslip_weave_speed_m_s"].iloc[0], color=c, lw=0.8, alpha=0.4)
+        axes[0].axhline(g["noslip_capsize_speed_m_s"].iloc[0], color=c, lw=0.8, ls="--", alpha=0.4)
+        axes[1].plot(p, g["closed_weave_damping_ratio"], "o-", color=c)
+        rate_axis.plot(p, -g["closed_slowest_real_1_s"], "s:", color=c)
+        axes[2].plot(p, g["closed_wobble_frequency_hz"], "o-", color=c)
+        wobble_damping_axis.plot(p, g["closed_wobble_damping_ratio"], "s:", color=c)
+    axes[0].set_ylabel("speed [m/s]")
+    axes[0].set_title("open loop: weave (o-) and capsize (s--) speeds;\nfaint: no-slip model", fontsize=10)
+    axes[1].set_ylabel("weave damping ratio (o-)")
+    rate_axis.set_ylabel("slowest decay rate [1/s] (s:)")
+    axes[1].set_title(f"closed loop at {at:g} m/s: weave", fontsize=10)
+    axes[2].set_ylabel("wobble frequency [Hz] (o-)")
+    wobble_damping_axis.set_ylabel("wobble damping ratio (s:)")
+    axes[2].set_title(f"closed loop at {at:g} m/s: wobble", fontsize=10)
+    for ax in axes:
+        ax.set_xlabel("tyre pressure [kPa]")
+        ax.grid(alpha=0.3)
+        ax.set_xticks(sorted(set(table["pressure_kpa"])))
+    axes[0].legend(fontsize=7, ncol=1, loc="best")
+    fig.subplots_adjust(left=0.05, right=0.93, bottom=0.13, top=0.86, wspace=0.6)
+    path = pathlib.Path(path)
+    fig.savefig(path, dpi=110)
+    return path
