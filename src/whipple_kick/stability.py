@@ -67,8 +67,14 @@ MODE_DESCRIPTIONS = {
 #: front tyre's relaxation (at walking speed), not wobble: bicycle wobble is reported at
 #: 4-10 Hz (thesis Section 2.2.1; Meijaard et al. 2007 call the fast steer mode caster).
 WOBBLE_MIN_FREQUENCY_HZ = 2.0
+#: Fewest consecutive sweep speeds a mode name must hold along a track (shorter runs take a
+#: neighbour's name): no flicker where a content hovers near a rule's threshold.
+MIN_NAME_RUN = 3
 #: A share of at least this of an eigenvector's amplitude makes a group dominant.
 DOMINANT_SHARE = 0.5
+#: The front tyre takes part in a steer oscillation (wobble, or the slow caster pair) with at
+#: least this share; the weave's front-tyre lag is 0.01-0.04.
+TYRE_SHARE = 0.1
 #: Default speed sweep [m/s] of the ``stability`` command: start, stop, step.
 DEFAULT_SPEEDS = (0.5, 10.0, 0.05)
 #: A steady lean above this [deg] is reported: the eigenvalues are then those of a turn.
@@ -398,7 +404,8 @@ def name_mode(shares, real, frequency_hz):
        ``relaxation_rear`` or ``relaxation_front`` (the larger lag); else
        roll >= steer -> ``capsize``, steer > roll -> ``caster``;
     3. oscillatory, steer the largest mechanical share (roll, steer,
-       heading) and the front tyre's lag above the rear's and above roll:
+       heading) and the front tyre's lag above the rear's, above roll and
+       at least :data:`TYRE_SHARE`:
        ``wobble`` from :data:`WOBBLE_MIN_FREQUENCY_HZ` up, ``caster`` below
        it (at walking speed the caster mode and the front tyre's relaxation
        combine into a slow oscillation);
@@ -433,7 +440,7 @@ def name_mode(shares, real, frequency_hz):
         if rear + front >= DOMINANT_SHARE:
             return "relaxation_rear" if rear >= front else "relaxation_front"
         return "capsize" if roll >= steer else "caster"
-    if steer >= max(roll, heading) and front > max(rear, roll):
+    if steer >= max(roll, heading) and front > max(rear, roll, TYRE_SHARE):
         return "wobble" if frequency_hz >= WOBBLE_MIN_FREQUENCY_HZ else "caster"
     if rear + front >= DOMINANT_SHARE:
         return "lateral_rear" if rear >= front else "lateral_front"
@@ -509,38 +516,58 @@ def _segments(flags):
     return out
 
 
-def name_tracks(points):
-    """Name every point of every track by its branch.
+def _merge_short_runs(names, min_run):
+    """``names`` with every run shorter than ``min_run`` absorbed by its longer neighbour (shortest first)."""
+    names = list(names)
+    while True:
+        runs = _segments(names)
+        if len(runs) < 2:
+            return names
+        lengths = [stop - start for start, stop in runs]
+        k = int(np.argmin(lengths))
+        if lengths[k] >= min_run:
+            return names
+        left = lengths[k - 1] if k > 0 else -1
+        right = lengths[k + 1] if k + 1 < len(runs) else -1
+        donor = runs[k - 1] if left >= right else runs[k + 1]
+        start, stop = runs[k]
+        names[start:stop] = [names[donor[0]]] * (stop - start)
 
-    A branch is a maximal run of consecutive speeds along one track where
-    the eigenvalue stays real or stays complex (a pair that splits into two
-    real eigenvalues, or two that merge, changes character there and may
-    change name). Each branch gets one name, :func:`name_mode` of its
-    shares averaged over the branch, so names cannot flip where modes merely
-    cross in real part.
+
+def name_tracks(points, min_run=MIN_NAME_RUN):
+    """Name every point of every track from its own eigenvector content, without flicker.
+
+    Each point gets :func:`name_mode` of its own shares. Along a track, a
+    name can change only where the eigenvalue turns real or complex (a pair
+    splitting or two merging) or where the eigenvector's content changes
+    (two modes exchanging character where their eigenvalues veer); a run of
+    fewer than ``min_run`` speeds with another name is absorbed by its
+    longer neighbour, so a content hovering near a rule's threshold does not
+    flicker. Where two modes merely cross in real part nothing changes,
+    since tracking follows each eigenvector (:func:`track`).
 
     Parameters
     ----------
     points : list of dict
         Each with ``track``, ``speed_index``, ``real`` (bool), ``frequency_hz``
         and ``shares``; ``mode`` is set in place.
+    min_run : int
+        Fewest consecutive speeds a name must hold within a branch.
     """
     by_track = {}
     for p in points:
         by_track.setdefault(p["track"], []).append(p)
     for pts in by_track.values():
         pts.sort(key=lambda p: p["speed_index"])
-        # A gap in the speeds also ends a branch.
+        # A branch: consecutive speeds of one character (real or complex).
         keys = []
         for k, p in enumerate(pts):
             gap = k and p["speed_index"] != pts[k - 1]["speed_index"] + 1
             keys.append((keys[-1][0] + 1 if gap else (keys[-1][0] if keys else 0), p["real"]))
         for start, stop in _segments(keys):
             branch = pts[start:stop]
-            shares = np.mean([p["shares"] for p in branch], axis=0)
-            frequency = float(np.mean([p["frequency_hz"] for p in branch]))
-            name = name_mode(shares, branch[0]["real"], frequency)
-            for p in branch:
+            names = [name_mode(p["shares"], p["real"], p["frequency_hz"]) for p in branch]
+            for p, name in zip(branch, _merge_short_runs(names, min_run)):
                 p["mode"] = name
 
 
