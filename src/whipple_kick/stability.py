@@ -217,6 +217,11 @@ def linearise(params, steady_state, loop, found_by="direct", constant_speed=True
     Returns
     -------
     LinearModel
+
+    Example
+    -------
+    >>> params = slip.model_parameters(moore, rear, front)              # doctest: +SKIP
+    >>> model = linearise(params, slip.steady_state(params, 4.0), "open")   # doctest: +SKIP
     """
     rhs = slip.CompiledRHS(steady_state.params)
     J, B = slip.heading_linearisation(rhs, steady_state.x)
@@ -364,6 +369,11 @@ def mode_content(model, eigenvalue, vector, wheelbase):
         Fraction of the squared amplitude in each of :data:`GROUPS` (sums to 1).
     scaled : ndarray, complex, (10,) or (10, k)
         The angle-like amplitudes (for the eigenvector similarity of :func:`track`).
+
+    Example
+    -------
+    >>> lam, vec = np.linalg.eig(model.matrix)                          # doctest: +SKIP
+    >>> shares, scaled = mode_content(model, lam, vec, wheelbase=1.113)  # doctest: +SKIP
     """
     single = np.ndim(eigenvalue) == 0
     lam = np.atleast_1d(np.asarray(eigenvalue, dtype=complex))
@@ -463,6 +473,22 @@ def match_cost(lam_a, vec_a, lam_b, vec_b):
     eigenvalues, about 1 for unrelated ones) plus one minus the modal
     assurance criterion of the angle-like eigenvectors (0 for the same shape,
     1 for orthogonal ones).
+
+    Parameters
+    ----------
+    lam_a, lam_b : ndarray (n,), (m,)
+        Eigenvalues at two neighbouring speeds.
+    vec_a, vec_b : ndarray (p, n), (p, m)
+        Their angle-like eigenvectors (:func:`mode_content`) as columns.
+
+    Returns
+    -------
+    ndarray (n, m)
+
+    Example
+    -------
+    >>> match_cost(np.array([1j]), np.array([[1.0]]), np.array([1j]), np.array([[2.0]]))
+    array([[0.]])
     """
     la, lb = np.asarray(lam_a)[:, None], np.asarray(lam_b)[None, :]
     return np.abs(la - lb) / (np.abs(la) + np.abs(lb) + 1.0) + (1.0 - _mac(vec_a, vec_b))
@@ -486,6 +512,13 @@ def track(eigenvalues, vectors):
         optimal assignment (Hungarian method) of :func:`match_cost`, so two
         modes crossing in real part keep their identity when their
         eigenvalues or shapes differ.
+
+    Example
+    -------
+    >>> lams = [np.array([-1.0, -2.0]), np.array([-2.1, -0.9])]
+    >>> vecs = [np.eye(2), np.eye(2)[:, ::-1]]
+    >>> [ids.tolist() for ids in track(lams, vecs)]
+    [[0, 1], [1, 0]]
     """
     from scipy.optimize import linear_sum_assignment
     ids, next_id, prev = [], 0, None
@@ -553,6 +586,13 @@ def name_tracks(points, min_run=MIN_NAME_RUN):
         and ``shares``; ``mode`` is set in place.
     min_run : int
         Fewest consecutive speeds a name must hold within a branch.
+
+    Example
+    -------
+    >>> pts = [{"track": 0, "speed_index": k, "real": True, "frequency_hz": 0.0,
+    ...         "shares": [0.9, 0.1, 0, 0, 0, 0]} for k in range(4)]
+    >>> name_tracks(pts); [p["mode"] for p in pts]
+    ['capsize', 'capsize', 'capsize', 'capsize']
     """
     by_track = {}
     for p in points:
@@ -663,6 +703,20 @@ class Stability:
 def parse_speeds(text):
     """Speeds [m/s] from ``START:STOP:STEP`` (STOP included when on the grid) or ``V1,V2,...``.
 
+    Parameters
+    ----------
+    text : str
+
+    Returns
+    -------
+    ndarray
+        Strictly increasing speeds in (0, 15] m/s, at most :data:`MAX_SPEEDS`.
+
+    Raises
+    ------
+    InputError
+        One line naming the text, the rule and the unit.
+
     Example
     -------
     >>> parse_speeds("1:2:0.5")
@@ -689,7 +743,13 @@ def parse_speeds(text):
 
 
 def check_speeds(speeds):
-    """Speeds as a strictly increasing array, each in (0, 15] m/s; InputError otherwise."""
+    """Speeds as a strictly increasing array, each in (0, 15] m/s; InputError otherwise.
+
+    Example
+    -------
+    >>> check_speeds([1, 2.5])
+    array([1. , 2.5])
+    """
     speeds = np.atleast_1d(np.asarray(speeds, dtype=float))
     if speeds.size == 0 or speeds.size > MAX_SPEEDS:
         raise InputError(f"give 1 to {MAX_SPEEDS} speeds, got {speeds.size}")
@@ -730,48 +790,61 @@ def analyse(scenario, speeds, *, loops=None, tyres=None):
     >>> sorted(set(res.eigenvalues["mode"]))                                             # doctest: +SKIP
     """
     import pandas as pd
-    from .steady import NoSteadyMotion
 
     speeds = check_speeds(speeds)
+    loops = _check_loops(scenario, loops)
+    setup = _setup(scenario, tyres)
+    wheelbase = _wheelbase(setup.moore)
+    rows, steady_rows, models, contexts, raw = [], [], {}, {}, {}
+    for loop in loops:
+        contexts[loop] = _Loop(setup, loop, wheelbase)
+        lams, vecs, shares = _sweep_loop(contexts[loop], speeds, models, steady_rows)
+        rows += _named_rows("slip", loop, speeds, lams, vecs, shares, raw)
+    rows += _classic_rows(setup, speeds, loops, raw)
+    result = Stability(scenario, speeds, pd.DataFrame(rows), pd.DataFrame(steady_rows), models=models)
+    result.summary = {"title": describe(scenario, setup.info), "scenario": scenario.to_dict(),
+                      "bicycle": setup.info, "tyre_notes": setup.notes, "loops": list(loops),
+                      **_summarise(result, raw, _refiners(contexts, setup, result))}
+    return result
+
+
+def _check_loops(scenario, loops):
+    """The loops to analyse (default: open, and closed unless there is no rider); InputError if impossible."""
     if loops is None:
         loops = ("open",) if scenario.controller == "off" else LOOPS
     for loop in loops:
         _check_loop(loop)
     if "closed" in loops and scenario.controller == "off":
         raise InputError("the closed loop needs a rider: controller 'off' has none (choose lqr or thesis)")
-    setup = _setup(scenario, tyres)
-    wheelbase = _wheelbase(setup.moore)
-    rows, steady_rows, models, contexts, raw = [], [], {}, {}, {}
-    for loop in loops:
-        ctx = _Loop(setup, loop, wheelbase)
-        contexts[loop] = ctx
-        lams, vecs, shares_all, guess = [], [], [], None
-        for k, v in enumerate(speeds):
-            try:
-                model = ctx.model(float(v), guess)
-            except NoSteadyMotion as exc:
-                steady_rows.append({"loop": loop, "speed_m_s": float(v), "found_by": None, "message": str(exc)})
-                lams.append(None)
-                vecs.append(None)
-                shares_all.append(None)
-                guess = None
-                continue
-            guess = model.steady.unknowns
-            models[loop, k] = model
-            steady_rows.append(_steady_row(loop, v, model))
-            lam, vec, shares = ctx.eigen(model)
-            lams.append(lam)
-            vecs.append(vec)
-            shares_all.append(shares)
-        rows += _named_rows("slip", loop, speeds, lams, vecs, shares_all, raw)
-    rows += _classic_rows(setup, speeds, loops, raw)
-    eigen = pd.DataFrame(rows)
-    steady_table = pd.DataFrame(steady_rows)
-    result = Stability(scenario, speeds, eigen, steady_table, models=models)
-    result.summary = {"title": describe(scenario, setup.info), "scenario": scenario.to_dict(),
-                      "bicycle": setup.info, "tyre_notes": setup.notes, "loops": list(loops),
-                      **summarise(result, raw, _refiners(contexts, setup, result))}
-    return result
+    return tuple(loops)
+
+
+def _sweep_loop(ctx, speeds, models, steady_rows):
+    """Eigenvalues, angle-like eigenvectors and shares at each speed of one loop (None without steady motion).
+
+    The steady motion is continued from the previous speed's solution;
+    ``models`` and ``steady_rows`` receive each speed's model and steady motion.
+    """
+    from .steady import NoSteadyMotion
+    lams, vecs, shares, guess = [], [], [], None
+    for k, v in enumerate(speeds):
+        try:
+            model = ctx.model(float(v), guess)
+        except NoSteadyMotion as exc:
+            steady_rows.append({"loop": ctx.loop, "speed_m_s": float(v), "found_by": None, "message": str(exc)})
+            lams.append(None)
+            vecs.append(None)
+            shares.append(None)
+            guess = None
+            continue
+        guess = model.steady.unknowns
+        models[ctx.loop, k] = model
+        steady_rows.append(_steady_row(ctx.loop, v, model))
+        lam, vec, share = ctx.eigen(model)
+        lams.append(lam)
+        vecs.append(vec)
+        shares.append(share)
+    return lams, vecs, shares
 
 
 def _steady_row(loop, speed, model):
@@ -947,7 +1020,7 @@ def _unstable(values):
     return any(l.real > 0 for l, _ in values)
 
 
-def weave_speed(sweep):
+def _weave_speed(sweep):
     """Lowest speed [m/s] above which the weave is stable, and how it stabilises (or None, reason).
 
     A weave eigenvalue's real part crossing zero is located by Brent's
@@ -979,7 +1052,7 @@ def weave_speed(sweep):
     return None, "the weave is unstable up to the end of the sweep"
 
 
-def capsize_speed(sweep, above=None):
+def _capsize_speed(sweep, above=None):
     """Lowest speed [m/s] (from ``above`` up) where a capsize eigenvalue becomes unstable, and how (or None).
 
     Within a capsize branch the zero crossing is located by Brent's method;
@@ -1010,7 +1083,7 @@ def capsize_speed(sweep, above=None):
     return min(found)
 
 
-def stable_ranges(sweep):
+def _stable_ranges(sweep):
     """Speed intervals [m/s] where every eigenvalue has a negative real part.
 
     Boundaries between sweep speeds are located by Brent's method on the
@@ -1045,7 +1118,7 @@ def _mode_ranges(table):
     return {m: out[m] for m in MODES if m in out}
 
 
-def wobble_summary(table):
+def _wobble_summary(table):
     """The wobble of one loop: where it exists, its frequency and damping, the least damped point (or None)."""
     w = table[(table["mode"] == "wobble") & (table["imag_1_s"] > 0)]
     if w.empty:
@@ -1066,16 +1139,16 @@ def wobble_summary(table):
 
 
 def _loop_summary(table, sweep):
-    weave, weave_how = weave_speed(sweep)
-    capsize, capsize_how = capsize_speed(sweep, above=weave)
+    weave, weave_how = _weave_speed(sweep)
+    capsize, capsize_how = _capsize_speed(sweep, above=weave)
     return {"weave_speed_m_s": weave, "weave_speed_how": weave_how,
             "capsize_speed_m_s": capsize, "capsize_speed_how": capsize_how,
-            "stable_speed_ranges": stable_ranges(sweep),
-            "wobble": wobble_summary(table) if "share_front_tyre" in table else None,
+            "stable_speed_ranges": _stable_ranges(sweep),
+            "wobble": _wobble_summary(table) if "share_front_tyre" in table else None,
             "modes": _mode_ranges(table)}
 
 
-def summarise(result, raw, refiners):
+def _summarise(result, raw, refiners):
     """The summary of :class:`Stability` (JSON-ready): see :func:`analyse`."""
     df, speeds = result.eigenvalues, result.speeds
     out = {"speeds_m_s": {"from": float(speeds[0]), "to": float(speeds[-1]), "count": int(speeds.size)},
@@ -1122,6 +1195,11 @@ def perturbed_state(model, vector, amplitude):
     ndarray
         Full state (:data:`whipple_kick.slip.STATE_NAMES`), pitch re-solved
         so the front contact stays on the ground.
+
+    Example
+    -------
+    >>> lam, vec = np.linalg.eig(model.matrix)                    # doctest: +SKIP
+    >>> x0 = perturbed_state(model, vec[:, 0], 1e-4)              # doctest: +SKIP
     """
     idx = {n: i for i, n in enumerate(model.states)}
     # Rotate the eigenvector so its largest roll/steer entry is real and positive.
@@ -1155,6 +1233,15 @@ def free_response(model, vector, amplitude=1e-4, duration=2.0, rate=500.0, rtol=
         Times [s].
     deviation : ndarray (len(t), len(model.states))
         Heading-frame state minus its steady value.
+
+    Example
+    -------
+    >>> model = linear_model(Scenario(symmetric_tyres=True), 3.0, "closed")   # doctest: +SKIP
+    >>> lam, vec = np.linalg.eig(model.matrix)                                 # doctest: +SKIP
+    >>> k = int(np.argmax(lam.imag))                                           # doctest: +SKIP
+    >>> t, dev = free_response(model, vec[:, k], duration=1.0, rate=2000.0)    # doctest: +SKIP
+    >>> fit_eigenvalue(t, np.column_stack([modal_coordinate(model, k, dev).real,
+    ...                                    modal_coordinate(model, k, dev).imag]))  # doctest: +SKIP
     """
     from . import integrate
     rhs = slip.CompiledRHS(model.steady.params)
@@ -1186,6 +1273,10 @@ def modal_coordinate(model, index, deviation):
     Returns
     -------
     ndarray, complex (n_t,)
+
+    Example
+    -------
+    >>> eta = modal_coordinate(model, k, dev)     # see free_response    # doctest: +SKIP
     """
     _, V = np.linalg.eig(model.matrix)
     return deviation @ np.linalg.inv(V)[index]
@@ -1285,14 +1376,27 @@ def _speed(value):
 
 
 def range_text(interval):
-    """``"a-b m/s"`` of a stable speed range, saying where it is cut by the sweep's ends."""
+    """``"a-b"`` [m/s] of a stable speed range, saying where it is cut by the sweep's ends.
+
+    Example
+    -------
+    >>> range_text({"from_m_s": 0.5, "to_m_s": 4.33, "lower_open": True, "upper_open": False})
+    '0.50 (sweep start)-4.33'
+    """
     lo = f"{interval['from_m_s']:.2f}" + (" (sweep start)" if interval["lower_open"] else "")
     hi = f"{interval['to_m_s']:.2f}" + (" (sweep end)" if interval["upper_open"] else "")
     return f"{lo}-{hi}"
 
 
 def speeds_text(summary, loop):
-    """Weave and capsize speeds and stable ranges of one loop, slip and no-slip model, in a few lines."""
+    """Weave and capsize speeds and stable ranges of one loop, slip and no-slip model, one line each.
+
+    Example
+    -------
+    >>> print(speeds_text(result.summary, "open"))      # doctest: +SKIP
+    slip: weave 3.82 m/s, capsize 3.88 m/s; stable 3.82-3.88 m/s
+    no-slip: weave 3.97 m/s, capsize 5.93 m/s; stable 3.97-5.93 m/s
+    """
     lines = []
     for model in ("slip", "no-slip"):
         info = summary.get(model, {}).get(loop)
@@ -1323,6 +1427,10 @@ def figure(result, path, title=None):
     Returns
     -------
     pathlib.Path
+
+    Example
+    -------
+    >>> figure(analyse(Scenario(symmetric_tyres=True), [3.0, 4.0, 5.0]), "stability.png")   # doctest: +SKIP
     """
     import pathlib
     from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -1339,34 +1447,9 @@ def figure(result, path, title=None):
     for row, loop in enumerate(loops):
         slip_lines = _branch_lines(df[(df["model"] == "slip") & (df["loop"] == loop)])
         classic_lines = _branch_lines(df[(df["model"] == "no-slip") & (df["loop"] == loop)])
-        info = result.summary.get("slip", {}).get(loop, {})
+        used |= set(slip_lines)
         for col, ax in enumerate(axes[row]):
-            for v, re, im in classic_lines.values():
-                ax.plot(v, re, color="0.55", lw=1.0, alpha=0.45, zorder=1)
-                ax.plot(v, np.where(im > 0, im, np.nan), color="0.55", lw=1.0, ls="--", alpha=0.45, zorder=1)
-            for mode, (v, re, im) in slip_lines.items():
-                used.add(mode)
-                ax.plot(v, re, color=MODE_COLOURS[mode], lw=1.6, zorder=3)
-                ax.plot(v, np.where(im > 0, im, np.nan), color=MODE_COLOURS[mode], lw=1.3, ls="--", zorder=3)
-            for rng in info.get("stable_speed_ranges", []):
-                ax.axvspan(rng["from_m_s"], rng["to_m_s"], color="tab:green", alpha=0.08, zorder=0)
-            for key in ("weave_speed_m_s", "capsize_speed_m_s"):
-                if info.get(key) is not None:
-                    ax.axvline(info[key], color="k", lw=0.8, ls=":", zorder=2)
-            if col == 0:
-                ax.text(0.99, 0.98, speeds_text(result.summary, loop), transform=ax.transAxes, fontsize=8,
-                        va="top", ha="right", bbox={"facecolor": "white", "alpha": 0.85, "edgecolor": "0.8"})
-            ax.axhline(0.0, color="k", lw=0.6)
-            ax.set_xlim(result.speeds[0], result.speeds[-1])
-            ax.set_xlabel("speed [m/s]")
-            ax.grid(alpha=0.3)
-            if col == 0:
-                ax.set_ylim(*SLOW_RANGE)
-                ax.set_ylabel("eigenvalue [1/s]")
-                ax.set_title(f"{loop} loop: slow modes" + (" (no rider control)" if loop == "open"
-                                                           else " (with the rider)"), fontsize=10)
-            else:
-                ax.set_title(f"{loop} loop: all modes", fontsize=10)
+            _draw_panel(ax, slip_lines, classic_lines, result, loop, slow=col == 0)
     handles = [Line2D([], [], color=MODE_COLOURS[m], lw=2, label=m.replace("_", " ")) for m in MODES if m in used]
     handles += [Line2D([], [], color="k", lw=1.5, label="real part"),
                 Line2D([], [], color="k", lw=1.2, ls="--", label="imaginary part"),
@@ -1380,6 +1463,35 @@ def figure(result, path, title=None):
     path = pathlib.Path(path)
     fig.savefig(path, dpi=110)
     return path
+
+
+def _draw_panel(ax, slip_lines, classic_lines, result, loop, slow):
+    """One panel of :func:`figure`: the no-slip model faint, the slip model by mode, speeds and ranges marked."""
+    info = result.summary.get("slip", {}).get(loop, {})
+    for v, re, im in classic_lines.values():
+        ax.plot(v, re, color="0.55", lw=1.0, alpha=0.45, zorder=1)
+        ax.plot(v, np.where(im > 0, im, np.nan), color="0.55", lw=1.0, ls="--", alpha=0.45, zorder=1)
+    for mode, (v, re, im) in slip_lines.items():
+        ax.plot(v, re, color=MODE_COLOURS[mode], lw=1.6, zorder=3)
+        ax.plot(v, np.where(im > 0, im, np.nan), color=MODE_COLOURS[mode], lw=1.3, ls="--", zorder=3)
+    for rng in info.get("stable_speed_ranges", []):
+        ax.axvspan(rng["from_m_s"], rng["to_m_s"], color="tab:green", alpha=0.08, zorder=0)
+    for key in ("weave_speed_m_s", "capsize_speed_m_s"):
+        if info.get(key) is not None:
+            ax.axvline(info[key], color="k", lw=0.8, ls=":", zorder=2)
+    ax.axhline(0.0, color="k", lw=0.6)
+    ax.set_xlim(result.speeds[0], result.speeds[-1])
+    ax.set_xlabel("speed [m/s]")
+    ax.grid(alpha=0.3)
+    if slow:
+        ax.text(0.99, 0.98, speeds_text(result.summary, loop), transform=ax.transAxes, fontsize=8,
+                va="top", ha="right", bbox={"facecolor": "white", "alpha": 0.85, "edgecolor": "0.8"})
+        ax.set_ylim(*SLOW_RANGE)
+        ax.set_ylabel("eigenvalue [1/s]")
+        ax.set_title(f"{loop} loop: slow modes" + (" (no rider control)" if loop == "open" else " (with the rider)"),
+                     fontsize=10)
+    else:
+        ax.set_title(f"{loop} loop: all modes", fontsize=10)
 
 
 # ------------------------------------------------------------------ pressure and load
@@ -1414,6 +1526,10 @@ def case_row(result, at_speed=3.0):
     loop) and the wobble (closed loop) as real part, frequency and damping
     ratio, and the closed loop's slowest eigenvalue (what a disturbance
     decays with); the wobble's least damping over the sweep.
+
+    Example
+    -------
+    >>> case_row(analyse(Scenario(symmetric_tyres=True), parse_speeds("2:6:0.1")))["weave_speed_m_s"]   # doctest: +SKIP
     """
     sc, s, table = result.scenario, result.summary, result.eigenvalues
     speed = float(result.speeds[np.argmin(np.abs(result.speeds - at_speed))])
@@ -1486,7 +1602,14 @@ def pressure_load_table(pressures=THESIS_PRESSURES_KPA, loads=THESIS_LOADS_N, *,
 # ------------------------------------------------------------------ outputs
 
 def describe(scenario, info=None):
-    """One line naming the bicycle, rider, tyres, offsets and rider control of a stability analysis."""
+    """One line naming the bicycle, rider, tyres, offsets and rider control of a stability analysis.
+
+    Example
+    -------
+    >>> from whipple_kick.simulation import Scenario
+    >>> describe(Scenario(symmetric_tyres=True, controller="off"))
+    'T03 400 kPa (zero-slip offsets removed, contact_patch), balanceassist_v1; no rider control'
+    """
     rear, front = scenario.pressures
     p = f"{rear:g}" if rear == front else f"{rear:g}/{front:g} (rear/front)"
     load = f", rear load {info['static_load_rear_n']:.0f} N" if info else ""
@@ -1510,6 +1633,11 @@ def write(result, out, plot=True):
     -------
     list of str
         The file names written.
+
+    Example
+    -------
+    >>> write(analyse(Scenario(symmetric_tyres=True), [3.0, 4.0]), "out")   # doctest: +SKIP
+    ['eigenvalues.csv', 'summary.json', 'stability.png']
     """
     import json
     import pathlib
@@ -1525,7 +1653,12 @@ def write(result, out, plot=True):
 
 
 def report_lines(summary):
-    """The few lines the ``stability`` command prints: speeds and modes per loop."""
+    """The few lines the ``stability`` command prints: speeds and modes per loop.
+
+    Example
+    -------
+    >>> print("\\n".join(report_lines(result.summary)))     # doctest: +SKIP
+    """
     lines = []
     for loop in LOOPS:
         info = summary.get("slip", {}).get(loop)
@@ -1560,6 +1693,10 @@ def pressure_load_figure(table, path):
     Returns
     -------
     pathlib.Path
+
+    Example
+    -------
+    >>> pressure_load_figure(pressure_load_table(), "stability_pressure_load.png")   # doctest: +SKIP
     """
     import pathlib
     from matplotlib.backends.backend_agg import FigureCanvasAgg
