@@ -107,7 +107,7 @@ def _command(name):
 
 
 def bench_cli(repeats):
-    """The whole `stability` command in fresh processes (warm cache), beside `whipple-benchmark`."""
+    """The whole `stability` command in fresh processes (warm cache), beside a bare import of its libraries."""
     command = _command("stability") + ["--pressure", "400", "--fz", "635", "--quiet"]
     baseline = [sys.executable, "-c", "import numpy, scipy.optimize, pandas, matplotlib.pyplot"]
     times, base = [], []

@@ -143,13 +143,20 @@ def _solver_versions():
     return f"control {control_version}; slycot {slycot}; numpy {np.__version__}; scipy {scipy.__version__}"
 
 
-@functools.lru_cache(maxsize=1)
 def _sources_key():
-    """Hash of the sources and solver versions a design depends on, once per process.
+    """Hash of the package sources and solver versions a design depends on.
 
-    (About 1.2 ms to compute: a sweep over 200 design speeds reads 200 entries.)
+    Computed once per package folder and version reader (about 1.2 ms; a
+    sweep over 200 design speeds reads 200 entries), so pointing the cache
+    at another source tree or another reader still changes the key.
     """
-    return cache.source_hash(_LQR_SOURCES, extra=_solver_versions())
+    return _sources_key_for(cache._PACKAGE_DIR, _solver_versions)
+
+
+@functools.lru_cache(maxsize=8)
+def _sources_key_for(package_dir, versions):
+    # package_dir is the memo's key only: source_hash reads that same folder (cache._PACKAGE_DIR).
+    return cache.source_hash(_LQR_SOURCES, extra=versions())
 
 
 def lqr_cache_key(moore, speed=3.0, Q=None, R=1.0):
