@@ -67,6 +67,8 @@ MODE_DESCRIPTIONS = {
 #: front tyre's relaxation (at walking speed), not wobble: bicycle wobble is reported at
 #: 4-10 Hz (thesis Section 2.2.1; Meijaard et al. 2007 call the fast steer mode caster).
 WOBBLE_MIN_FREQUENCY_HZ = 2.0
+#: |steer torque| [N m] below which a steady motion of one loop is also the other loop's.
+ZERO_TORQUE_N_M = 1e-12
 #: Fewest consecutive sweep speeds a mode name must hold along a track (shorter runs take a
 #: neighbour's name): no flicker where a content hovers near a rule's threshold.
 MIN_NAME_RUN = 3
@@ -620,9 +622,21 @@ class _Loop:
         self.setup, self.loop, self.wheelbase = setup, loop, wheelbase
         self.base = _base_params(setup)
 
-    def model(self, speed, guess=None):
-        """LinearModel at ``speed`` (NoSteadyMotion if there is none)."""
+    def model(self, speed, guess=None, other=None):
+        """LinearModel at ``speed`` (NoSteadyMotion if there is none).
+
+        ``other``: the other loop's steady motion at this speed. Where the
+        rider's torque there is zero (upright straight running, symmetric
+        tyres: ``T7 = -K x`` with x = 0) it is this loop's steady motion too,
+        and no solve is needed.
+        """
         params = _loop_params(self.setup, speed, self.loop, self.base)
+        if other is not None:
+            shared = slip.SteadyState(other.x, {**params, "T6c": other.params["T6c"]}, other.residual,
+                                      other.unknowns)
+            rhs = slip.CompiledRHS(shared.params)
+            if abs(rhs.outputs(0.0, shared.x)[1][slip.OUT["T7"]]) < ZERO_TORQUE_N_M:
+                return linearise(params, shared, self.loop, "the other loop's (no steer torque)")
         steady_state, found_by = _steady(params, speed, guess)
         return linearise(params, steady_state, self.loop, found_by)
 
@@ -822,14 +836,16 @@ def _check_loops(scenario, loops):
 def _sweep_loop(ctx, speeds, models, steady_rows):
     """Eigenvalues, angle-like eigenvectors and shares at each speed of one loop (None without steady motion).
 
-    The steady motion is continued from the previous speed's solution;
+    The steady motion is continued from the previous speed's solution (or
+    taken from the other loop's where the steer torque is zero there);
     ``models`` and ``steady_rows`` receive each speed's model and steady motion.
     """
     from .steady import NoSteadyMotion
     lams, vecs, shares, guess = [], [], [], None
     for k, v in enumerate(speeds):
+        other = models.get(("open" if ctx.loop == "closed" else "closed", k))
         try:
-            model = ctx.model(float(v), guess)
+            model = ctx.model(float(v), guess, None if other is None else other.steady)
         except NoSteadyMotion as exc:
             steady_rows.append({"loop": ctx.loop, "speed_m_s": float(v), "found_by": None, "message": str(exc)})
             lams.append(None)
