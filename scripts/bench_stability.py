@@ -6,7 +6,7 @@ Usage:
     python scripts/bench_stability.py cli             # `stability --pressure 400 --fz 635`, fresh processes
     python scripts/bench_stability.py all
 
-Bounds (issue "stability"): one linearisation at most 50 right-hand-side
+Bounds: one linearisation at most 50 right-hand-side
 evaluations' worth of time; the default sweep of the command at most 5 s
 warm. Absolute times depend on the load of the machine (other jobs share
 its two cores): the ratios, measured interleaved in the same process, are
