@@ -12,7 +12,7 @@ __version__ = "0.1.0"
 _SUBMODULES = (
     "analysis", "animation", "benchmark", "bicycles", "cache", "classic", "cli", "codegen", "energy",
     "errors", "control", "derivation", "geometry", "integrate", "kane", "magic_formula",
-    "parameters", "plotting", "riders", "simulation", "slip", "steady", "sweep", "symbols", "transient",
+    "parameters", "plotting", "riders", "simulation", "slip", "stability", "steady", "sweep", "symbols", "transient",
     "tyres",
 )
 

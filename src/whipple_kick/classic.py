@@ -17,7 +17,6 @@ re-solution of the pitch angle from the holonomic constraint.
 import functools
 
 import numpy as np
-from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 from . import cache, codegen, kane
@@ -339,4 +338,5 @@ def simulate(moore, q0, u_ind0, t_end, steer_torque=None, rtol=1e-10, atol=1e-12
         return np.concatenate([u, udot[_PARTITION.ind]])
 
     x0 = np.concatenate([q0, u_ind0])
+    from scipy.integrate import solve_ivp   # 0.5-0.9 s to import; the linear analyses do not need it
     return solve_ivp(rhs, (0.0, t_end), x0, method="LSODA", rtol=rtol, atol=atol, t_eval=t_eval)

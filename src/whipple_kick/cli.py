@@ -70,19 +70,14 @@ def _number(unit):
     return parse
 
 
-def _simulate_parser():
+def _model_options(p, symmetric_flag=True, design_default="the run's --speed"):
+    """Add the tyre, bicycle-and-rider and controller options of ``simulate`` (shared with ``stability``).
+
+    ``symmetric_flag`` adds ``--symmetric-tyres``; ``design_default`` says
+    what the LQR design speed is by default. Returns the "riding and
+    control" group, for the caller's speed option.
+    """
     from . import simulation, tyres
-    p = _OneLineParser(
-        prog="simulate", allow_abbrev=False,
-        description="Kick-plate test on the nonlinear Carvallo-Whipple bicycle-rider model with "
-                    "Magic-Formula tyres (Dell'Orto 2025, Chapter 8): steady running, then the plate "
-                    "under the rear wheel jumps sideways; an LQR steer-torque rider recovers or the "
-                    "bicycle falls. Writes trajectory.csv, summary.json and response.png (and, with --animate, "
-                    "animation.mp4).",
-        epilog="Time is measured from the kick start. Defaults are the thesis' settings: "
-               "balanceassist_v1 + Yeadon rider for 635 N on the rear tyre, T03 at 400 kPa, 3 m/s, "
-               "LQR designed at the run's speed (the thesis: 3 m/s), 150 mm kick in 0.150 s (13.3 m/s^2), 6 s. "
-               "See docs/simulate.md.")
     g = p.add_argument_group("tyres")
     g.add_argument("--pressure", type=_number("kPa"), metavar="KPA",
                    help="inflation pressure of both tyres in kPa (default 400)")
@@ -98,8 +93,9 @@ def _simulate_parser():
     g.add_argument("--friction", choices=tyres.FRICTION_MODES, default="none",
                    help="friction correction rig -> plate: none (default), plate (peak x 1.30), "
                         "thesis (whole curves x 1.32, as the thesis' code)")
-    g.add_argument("--symmetric-tyres", action="store_true",
-                   help="zero the tyres' zero-slip offsets (exactly upright steady running)")
+    if symmetric_flag:
+        g.add_argument("--symmetric-tyres", action="store_true",
+                       help="zero the tyres' zero-slip offsets (exactly upright steady running)")
     g.add_argument("--tyre-transient", choices=simulation.TYRE_TRANSIENTS, default="contact_patch",
                    help="how the tyre forces build up: contact_patch (default: lagged contact-patch slip and "
                         "camber, relaxation length shortening as the force saturates; passive, friction-limited), "
@@ -118,19 +114,36 @@ def _simulate_parser():
     g.add_argument("--low-inertia", action="store_true",
                    help="halve the rear frame's inertias and mass-centre height (thesis Figure 8.9)")
     g = p.add_argument_group("riding and control")
-    g.add_argument("--speed", type=_number("m/s"), default=3.0, metavar="M/S",
-                   help="forward speed in m/s (default 3)")
     g.add_argument("--controller", choices=simulation.CONTROLLERS, default="lqr",
                    help="lqr: designed on the linearised classic model (default); thesis: Table 8.4 "
                         "gains (570, 635, 701 N only); off: no steer torque")
     g.add_argument("--design-speed", type=_number("m/s"), metavar="M/S",
-                   help="LQR design speed in m/s (default: the run's --speed, as a real rider adapts; "
+                   help=f"LQR design speed in m/s (default: {design_default}, as a real rider adapts; "
                         "the thesis fixed it at 3)")
     g.add_argument("--thesis-load", type=_number("N"), metavar="N",
                    help="rear load in N whose Table 8.4 gains --controller thesis uses (570, 635 or 701; "
                         "default --fz, or the load a preset with rider is labelled with)")
     g.add_argument("--gain-scale", type=_number("factor"), default=1.0, metavar="FACTOR",
                    help="multiply every controller gain (default 1; the thesis also ran 0.5)")
+    return g
+
+
+def _simulate_parser():
+    from . import simulation
+    p = _OneLineParser(
+        prog="simulate", allow_abbrev=False,
+        description="Kick-plate test on the nonlinear Carvallo-Whipple bicycle-rider model with "
+                    "Magic-Formula tyres (Dell'Orto 2025, Chapter 8): steady running, then the plate "
+                    "under the rear wheel jumps sideways; an LQR steer-torque rider recovers or the "
+                    "bicycle falls. Writes trajectory.csv, summary.json and response.png (and, with --animate, "
+                    "animation.mp4).",
+        epilog="Time is measured from the kick start. Defaults are the thesis' settings: "
+               "balanceassist_v1 + Yeadon rider for 635 N on the rear tyre, T03 at 400 kPa, 3 m/s, "
+               "LQR designed at the run's speed (the thesis: 3 m/s), 150 mm kick in 0.150 s (13.3 m/s^2), 6 s. "
+               "See docs/simulate.md.")
+    g = _model_options(p)
+    g.add_argument("--speed", type=_number("m/s"), default=3.0, metavar="M/S",
+                   help="forward speed in m/s (default 3)")
     g = p.add_argument_group("kick")
     how = g.add_mutually_exclusive_group()
     how.add_argument("--kick-accel", type=_number("m/s^2"), metavar="M/S2",
@@ -227,14 +240,27 @@ def _flags_given(argv):
     return set(vars(parser.parse_args(argv)))
 
 
-def _scenario_from_args(args, given=()):
-    """The scenario of the parsed flags; with ``--compat``, the preset with the ``given`` flags' fields changed."""
-    from .simulation import Scenario
+def _model_fields(args):
+    """Scenario fields of the options added by :func:`_model_options`."""
     fronts = (args.pressure_front, args.pressure_rear)
     if args.pressure is not None and any(v is not None for v in fronts):
         raise InputError("--pressure sets both tyres; do not combine it with --pressure-front/--pressure-rear")
     if (fronts[0] is None) != (fronts[1] is None):
         raise InputError("give both --pressure-front KPA and --pressure-rear KPA (or --pressure KPA for both)")
+    return dict(
+        bicycle=args.bicycle, fz_n=args.fz, rider_mass_kg=args.rider_mass, tyre=args.tyre,
+        pressure_kpa=400.0 if args.pressure is None else args.pressure,
+        pressure_front_kpa=args.pressure_front, pressure_rear_kpa=args.pressure_rear,
+        coefficient_set=args.coefficient_set, friction=args.friction, controller=args.controller,
+        design_speed=args.design_speed, thesis_load_n=args.thesis_load, gain_scale=args.gain_scale,
+        low_inertia=args.low_inertia, tyre_transient=args.tyre_transient, camber_sign=args.camber_sign,
+    )
+
+
+def _scenario_from_args(args, given=()):
+    """The scenario of the parsed flags; with ``--compat``, the preset with the ``given`` flags' fields changed."""
+    from .simulation import Scenario
+    fields = _model_fields(args)
     profile = args.kick_profile
     if args.kick_table is not None:
         if profile not in (None, "table"):
@@ -246,20 +272,13 @@ def _scenario_from_args(args, given=()):
         profile = "table"
     elif profile == "table":
         raise InputError("--kick-profile table needs --kick-table FILE (CSV with columns time in s, y in m)")
-    fields = dict(
-        bicycle=args.bicycle, fz_n=args.fz, rider_mass_kg=args.rider_mass, tyre=args.tyre,
-        pressure_kpa=400.0 if args.pressure is None else args.pressure,
-        pressure_front_kpa=args.pressure_front, pressure_rear_kpa=args.pressure_rear,
-        coefficient_set=args.coefficient_set, friction=args.friction,
-        symmetric_tyres=args.symmetric_tyres, speed=args.speed, controller=args.controller,
-        design_speed=args.design_speed, thesis_load_n=args.thesis_load, gain_scale=args.gain_scale,
-        low_inertia=args.low_inertia,
+    fields.update(
+        symmetric_tyres=args.symmetric_tyres, speed=args.speed,
         kick_displacement=0.150 if args.kick_displacement is None else args.kick_displacement,
         kick_duration=args.kick_duration, kick_accel=args.kick_accel,
         kick_profile="constant" if profile is None else profile, kick_table=args.kick_table,
         kick_direction=args.kick_direction, settle=args.settle, duration=args.duration, rtol=args.rtol,
-        tyre_transient=args.tyre_transient, plate_stop=args.plate_stop, kick_heading=args.kick_heading,
-        camber_sign=args.camber_sign, start=args.start,
+        plate_stop=args.plate_stop, kick_heading=args.kick_heading, start=args.start,
     )
     if args.compat is None:
         return Scenario(**fields)
@@ -271,7 +290,7 @@ def _scenario_from_args(args, given=()):
 _OUTPUT_FILES = ("trajectory.csv", "summary.json", "response.png")
 
 
-def _default_out(scenario):
+def _default_out(scenario, prefix="kick"):
     """A new folder name under the current directory (never an existing one)."""
     import datetime
     import pathlib
@@ -279,7 +298,7 @@ def _default_out(scenario):
     p = f"{rear:g}kPa" if rear == front else f"{rear:g}-{front:g}kPa"
     load = f"_{scenario.fz_n:g}N" if scenario.fz_n is not None else ""
     stamp = datetime.datetime.now().strftime("%Y%m%d-%H%M%S")
-    base = pathlib.Path.cwd() / f"kick_{scenario.tyre}_{p}{load}_{stamp}"
+    base = pathlib.Path.cwd() / f"{prefix}_{scenario.tyre}_{p}{load}_{stamp}"
     out, k = base, 1
     while out.exists():
         k += 1
@@ -524,4 +543,81 @@ def recommend_main(argv=None):
         # An unwritable --out folder is the user's to fix (2); lost worker processes are not (1).
         print(f"recommend-pressure: {exc}", file=sys.stderr)
         status = 2 if isinstance(exc, OSError) else 1
+    sys.exit(status)
+
+
+# ------------------------------------------------------------------ stability
+
+def _stability_parser():
+    from . import stability
+    start, stop, step = stability.DEFAULT_SPEEDS
+    p = _OneLineParser(
+        prog="stability", allow_abbrev=False,
+        description="Eigenvalues of the slip model (measured Magic-Formula tyres) linearised about its steady "
+                    "motion, against speed, without and with the rider's control, beside the no-slip "
+                    "(knife-edge) model of the same bicycle: weave, capsize, caster, wobble and the tyre modes, "
+                    "named from their eigenvectors and followed across speed. Writes eigenvalues.csv, "
+                    "stability.png and summary.json.",
+        epilog="Defaults: balanceassist_v1 + Yeadon rider for 635 N, T03 at 400 kPa with its zero-slip offsets "
+               "removed (straight running; --tyre-offsets measured linearises about the steady turns the "
+               "offsets cause), LQR rider designed at each speed. Speed is constant in the linear model "
+               "(the forward-speed mode is left out, as in the no-slip model). See docs/stability.md.")
+    g = _model_options(p, symmetric_flag=False, design_default="each speed of the sweep")
+    g.add_argument("--speeds", default=f"{start:g}:{stop:g}:{step:g}", metavar="START:STOP:STEP",
+                   help=f"forward speeds in m/s: START:STOP:STEP (STOP included) or V1,V2,... "
+                        f"(default {start:g}:{stop:g}:{step:g})")
+    g = p.add_argument_group("tyre offsets")
+    g.add_argument("--tyre-offsets", choices=("zero", "measured"), default="zero",
+                   help="zero (default): the fits' zero-slip offsets removed, as simulate --symmetric-tyres, so "
+                        "the steady motion is upright straight running; measured: about the steady motion with "
+                        "the offsets (a turn, large where a real eigenvalue is near zero)")
+    g = p.add_argument_group("output")
+    g.add_argument("--out", metavar="DIR",
+                   help="output folder (default: a new folder under the current directory)")
+    g.add_argument("--force", action="store_true",
+                   help="write into an existing non-empty output folder, overwriting the files written")
+    g.add_argument("--no-plot", action="store_true", help="do not write stability.png")
+    g.add_argument("--quiet", action="store_true", help="print nothing on success")
+    return p
+
+
+def _stability(argv):
+    import shutil
+    import time
+    from . import simulation, stability
+    args = _stability_parser().parse_args(argv)
+    started = time.perf_counter()
+    speeds = stability.parse_speeds(args.speeds)
+    scenario = simulation.Scenario(**_model_fields(args), symmetric_tyres=args.tyre_offsets == "zero",
+                                   speed=float(speeds[0]))
+    simulation.preflight(scenario)
+    out, created = _prepare_out(args.out if args.out else _default_out(scenario, "stability"), args.force)
+    try:
+        result = stability.analyse(scenario, speeds)
+    except InputError:
+        if created and not any(out.iterdir()):
+            shutil.rmtree(out, ignore_errors=True)
+        raise
+    result.summary["numerics"] = {"wall_s": time.perf_counter() - started}
+    files = stability.write(result, out, plot=not args.no_plot)
+    missing = {loop: m["speeds_without_steady_motion"] for loop, m in result.summary["steady_motion"].items()
+               if m["speeds_without_steady_motion"]}
+    for loop, count in missing.items():
+        print(f"stability: warning: {loop} loop: no steady motion at {count} of {speeds.size} speeds (left out): "
+              f"{result.summary['steady_motion'][loop]['first_reason']}", file=sys.stderr)
+    if not args.quiet:
+        print(f"stability: {result.summary['title']}; {speeds.size} speeds {speeds[0]:g}-{speeds[-1]:g} m/s")
+        for line in stability.report_lines(result.summary):
+            print(line)
+        print(f"  wrote {', '.join(files)} in {out} ({time.perf_counter() - started:.1f} s)")
+    return 0
+
+
+def stability_main(argv=None):
+    """Console script ``stability``: eigenvalues of the slip model against speed (see ``stability --help``)."""
+    try:
+        status = _run(_stability, argv)
+    except OSError as exc:
+        print(f"stability: cannot write the results: {exc}", file=sys.stderr)
+        status = 2
     sys.exit(status)

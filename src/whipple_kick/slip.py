@@ -1261,6 +1261,118 @@ def linearize(rhs, x, step=1e-7, t=0.0):
     return J
 
 
+#: Row of the constraint matrix A (:meth:`CompiledRHS.impulse_terms`) that is the
+#: holonomic constraint's rate: its entries are d(front contact height)/dq_i,
+#: since u_i = dq_i/dt (derivation.slip_equations: rear no-slip, front no-slip, holonomic).
+HOLONOMIC_ROW = 2
+
+
+@functools.lru_cache(maxsize=None)
+def _difference_scales(form):
+    """Typical size of each state for the C Jacobian's steps ``1.5e-8 max(|x_j|, scale_j)``.
+
+    Angles [rad] and speeds [m/s, rad/s] 1, compressions 1e-3 m, the
+    force-lag states 100 (N, N m). Steps about 1.5e-8 of these keep forward
+    differences at ~1e-7 relative (round-off ~eps/step times the terms'
+    size, truncation ~step/2 times the curvature), and the compression's
+    step stays far below a tyre's static compression even at 1e10 N/m
+    (6e-8 m), so the normal force's kink is never crossed. (The integrator's
+    scales, 100 to 1e4 times smaller, serve LSODA's Newton iteration but
+    leave 1e-5 round-off here.) Read-only.
+    """
+    scale = np.ones(len(STATE_NAMES))
+    for name in ("q9", "q10"):
+        scale[X[name]] = 1e-3
+    if form == "force_lag":
+        scale[[X[s] for s in TYRE_STATES]] = 1e2
+    scale.flags.writeable = False
+    return scale
+
+
+#: Full-state slot of each heading-frame state (v_fwd, v_lat are u1, u2 at zero yaw).
+_HEADING_SLOTS = np.array([X[{"v_fwd": "u1", "v_lat": "u2"}.get(n, n)] for n in LINEAR_STATES])
+#: Heading-frame coordinates the front contact height depends on (pitch q5 follows them).
+_PITCH_DRIVERS = [(LINEAR_STATES.index(n), SPEEDS.index("u" + n[1:])) for n in ("q4", "q7", "q9", "q10")]
+_I_FWD, _I_LAT, _I_U3 = (LINEAR_STATES.index(n) for n in ("v_fwd", "v_lat", "u3"))
+
+
+def heading_linearisation(rhs, x, t=0.0):
+    """The Jacobian of :func:`linearize` and the steer-torque column, from one C Jacobian.
+
+    The same heading-frame linear model as :func:`linearize` (states
+    :data:`LINEAR_STATES`), obtained by the chain rule instead of by
+    perturbing the heading-frame state: with ``x(z)`` the full state of a
+    heading-frame state ``z`` (yaw 0, ``u1 = v_fwd``, ``u2 = v_lat``, pitch
+    on the holonomic constraint), ``dz'/dz = S J E + R E``, where ``J`` is
+    the compiled model's own Jacobian (:meth:`CompiledRHS.jacobian_function`,
+    forward differences in C, steps :func:`_difference_scales`), ``E =
+    dx/dz`` embeds ``z`` (its pitch row ``-h_q / h_q5`` is the exact gradient
+    of the front contact height, :data:`HOLONOMIC_ROW`), ``S`` picks the rows
+    and ``R`` holds the rotating-frame terms of ``v_fwd' = u1' + u3 u2``,
+    ``v_lat' = u2' - u3 u1``. About 25 right-hand-side evaluations' worth of
+    time instead of about 110 (``scripts/bench_stability.py``); agrees with
+    :func:`linearize` to 1e-7 of each column's largest entry
+    (``tests/test_stability.py``).
+
+    The steer-torque column is exact: the model is affine in the steer
+    torque ``T7 = -(... + ku7 u7)`` and its coefficient depends on the
+    coordinates only, so two evaluations that differ only in ``ku7`` give it.
+
+    Parameters
+    ----------
+    rhs : CompiledRHS
+    x : array_like
+        Full state (e.g. ``SteadyState.x``); its q3 is ignored, u1 and u2 are
+        resolved along the heading. The plate must be at rest at ``t``.
+    t : float
+        Time [s].
+
+    Returns
+    -------
+    A : ndarray, shape (15, 15)
+        ``d(dz/dt)/dz`` of the model as parametrised (closed loop when
+        ``rhs`` carries the rider's gains).
+    B : ndarray, shape (15, 1)
+        Per unit steer torque T7 [N m].
+
+    Example
+    -------
+    >>> A, B = heading_linearisation(CompiledRHS(steady.params), steady.x)   # doctest: +SKIP
+    """
+    z = heading_state(x)
+    x0 = np.array(x, dtype=float)
+    x0[X["q3"]] = 0.0
+    x0[X["u1"]], x0[X["u2"]] = z[_I_FWD], z[_I_LAT]
+    if abs(rhs.outputs(t, x0)[1][OUT["holonomic"]]) > 1e-13:   # a steady state is on it already
+        x0 = solve_pitch(rhs, x0)
+    nd = len(DYNAMIC_STATES)
+    J = rhs.jacobian_function(_difference_scales(rhs.transient))(t, x0)[:nd, :nd]
+    h_q = rhs.impulse_terms(t, x0)[1][HOLONOMIC_ROW]
+    # A = S J E: the picked columns of J, plus the pitch column times dq5/dz.
+    A = J[np.ix_(_HEADING_SLOTS, _HEADING_SLOTS)]
+    pitch_column = J[_HEADING_SLOTS, X["q5"]]
+    for j, k in _PITCH_DRIVERS:
+        A[:, j] -= pitch_column * (h_q[k] / h_q[SPEEDS.index("u5")])
+    u1, u2, u3 = x0[X["u1"]], x0[X["u2"]], x0[X["u3"]]
+    A[_I_FWD, _I_U3] += u2
+    A[_I_FWD, _I_LAT] += u3
+    A[_I_LAT, _I_U3] -= u1
+    A[_I_LAT, _I_FWD] -= u3
+    # Steer-torque column: with u7 moved to u7 + 1 (any value != 0 would do), raising
+    # ku7 by 1 changes T7 by -(u7 + 1) and nothing else.
+    x0[X["u7"]] += 1.0
+    k = P["ku7"]
+    f_base = rhs(t, x0)
+    saved = rhs.p[k]
+    try:
+        rhs.p[k] = saved + 1.0
+        f_bumped = rhs(t, x0)
+    finally:
+        rhs.p[k] = saved
+    B = ((f_base - f_bumped)[_HEADING_SLOTS] / x0[X["u7"]]).reshape(-1, 1)
+    return A, B
+
+
 def linear_state_space(params, x, step=1e-7):
     """Open-loop ``A`` and steer-torque input ``B`` of the slip model about ``x``.
 
