@@ -120,8 +120,8 @@ class CallLog:
             log.append(t)
             return original_call(rhs, t, x)
 
-        def guarded(rhs, index, limit, exception):
-            fast = original_guarded(rhs, index, limit, exception)
+        def guarded(rhs, *limits):
+            fast = original_guarded(rhs, *limits)
 
             def f(t, x):
                 log.append(t)

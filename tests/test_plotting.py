@@ -11,7 +11,8 @@ from whipple_kick import plotting, simulation
 @pytest.fixture(scope="module")
 def fall():
     """Controller off, thesis force-lag tyre: the bicycle falls at 1.345 s, its steer rate reaching -67 rad/s at the end."""
-    result = simulation.run(simulation.Scenario(controller="off", duration=2.0, tyre_transient="force_lag"))
+    result = simulation.run(simulation.Scenario(controller="off", duration=2.0, tyre_transient="force_lag",
+                                                 steer_limit_deg=180.0))
     assert result.summary["fell"]
     return result
 

@@ -358,7 +358,9 @@ def _print_summary(result, out, files):
         print("  camber sign reversed: camber thrust pushes a leaning wheel away from the lean (the authors' "
               "published code; not physical)")
     if s["fell"]:
-        print(f"  result: FELL (|roll| reached {sc['fall_angle_deg']:g} deg) {s['fall_time_s']:.3f} s after the kick start")
+        why = (f"|steer| reached {sc['steer_limit_deg']:g} deg: the fork turned over" if s.get("fall_reason") == "steer"
+               else f"|roll| reached {sc['fall_angle_deg']:g} deg")
+        print(f"  result: FELL ({why}) {s['fall_time_s']:.3f} s after the kick start")
     else:
         print(f"  result: no fall in {sc['duration']:g} s")
     m, rec = s["metrics"], s["recovery"]

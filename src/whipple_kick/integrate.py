@@ -34,7 +34,7 @@ class Trajectory:
 
     t: np.ndarray            # times [s], shape (n,)
     x: np.ndarray            # states, shape (n, len(slip.STATE_NAMES))
-    fell: bool               # the roll limit was reached
+    fell: bool               # the roll limit (or the steer limit) was reached
     fall_time: float | None  # time of the fall event [s]
     nfev: int                # right-hand-side evaluations by LSODA (those inside Jacobians not counted)
     message: str
@@ -42,6 +42,7 @@ class Trajectory:
     failed: bool = False     # the integration failed (stalled, non-finite derivative); samples end there
     njev: int = 0            # Jacobian evaluations
     evaluations: int = 0     # all right-hand-side evaluations, the Jacobians' included (what the budget counts)
+    fall_reason: str | None = None   # "roll" or "steer": which limit ended the run
 
     def state(self, name):
         """Time history of one state by name."""
@@ -218,7 +219,8 @@ class _PastTheLimit(Exception):
     """Raised inside the fast path once the roll limit is passed."""
 
 
-def _fast_chunk(rhs, x, times, rtol, atol, roll_index, fall_angle, mxstep, jac=None):
+def _fast_chunk(rhs, x, times, rtol, atol, roll_index, fall_angle, mxstep, jac=None,
+                steer_index=0, steer_limit=np.inf):
     """Integrate one chunk with odeint's LSODA (the step loop stays in Fortran).
 
     Returns ``(states, (nfev, njev, evaluations))``, or ``None`` if the roll limit was passed or
@@ -228,10 +230,10 @@ def _fast_chunk(rhs, x, times, rtol, atol, roll_index, fall_angle, mxstep, jac=N
     # Stop as soon as the bicycle is past the limit: odeint has no events,
     # and integrating a fallen bicycle onwards is wasted work.
     if hasattr(rhs, "guarded"):
-        guarded = rhs.guarded(roll_index, fall_angle, _PastTheLimit)
+        guarded = rhs.guarded(roll_index, fall_angle, _PastTheLimit, steer_index, steer_limit)
     else:   # any f(t, x), e.g. the NumPy oracle
         def guarded(t, x):
-            if abs(x[roll_index]) > fall_angle:
+            if abs(x[roll_index]) > fall_angle or abs(x[steer_index]) > steer_limit:
                 raise _PastTheLimit
             return rhs(t, x)
     with warnings.catch_warnings():
@@ -249,7 +251,7 @@ def _fast_chunk(rhs, x, times, rtol, atol, roll_index, fall_angle, mxstep, jac=N
 
 def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None,
               output_rate=1000.0, fall_angle=np.deg2rad(45.0), chunk=None, samples=None,
-              budget=None, jumps=None):
+              budget=None, jumps=None, steer_limit=None):
     """Integrate ``rhs`` from ``x0`` piecewise between breakpoints with LSODA.
 
     Each smooth piece is integrated in chunks of about ``chunk`` seconds
@@ -284,6 +286,10 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
         Sample rate of the output [Hz] (when ``samples`` is not given).
     fall_angle : float
         |roll| limit [rad] ending the run.
+    steer_limit : float, optional
+        |steer| limit [rad] ending the run too (None: no limit). Past 90 deg
+        the front wheel rolls backwards, which the tyre model does not
+        describe, and no rider recovers from it.
     chunk : float, optional
         Length of the fast-path chunks [s] (default :data:`DEFAULT_CHUNK`;
         ``inf`` for one LSODA run per piece).
@@ -334,8 +340,12 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
     edges = [t_start] + sorted(b for b in set(breakpoints) if t_start < b < t_end) + [t_end]
     roll = slip.X["q4"]
 
+    steer = slip.X["q7"]
+    steer_limit = np.inf if steer_limit is None else float(steer_limit)
+
     def fall(t, x):
-        return fall_angle - abs(x[roll])
+        # The first of the two limits to be reached ends the run (the min of two margins).
+        return min(fall_angle - abs(x[roll]), steer_limit - abs(x[steer]))
     fall.terminal = True
     fall.direction = -1
 
@@ -352,7 +362,7 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
             last_t = times[keep][-1]
 
     x = np.asarray(x0, dtype=float)
-    fell, fall_time, message, failed = False, None, "completed", False
+    fell, fall_time, message, failed, fall_reason = False, None, "completed", False, None
     done = False
     # The fast path gives up (and the careful path takes over, with the budget) after more steps
     # between two samples than a quarter of the stall window's evaluations (a step costs 1 to ~25
@@ -376,7 +386,7 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
             times = grid[i0:i1 + 1]
             # A sample at the piece's end is emitted after the jump map (below).
             last = -1 if i1 == len(grid) - 1 else None
-            fast = _fast_chunk(rhs, x, times, rtol, atol, roll, fall_angle, mxstep, jac)
+            fast = _fast_chunk(rhs, x, times, rtol, atol, roll, fall_angle, mxstep, jac, steer, steer_limit)
             if fast is not None and spent + fast[1][2] <= budget.limit(times[-1] - t_start):
                 y, (n, nj, used) = fast
                 nfev, njev, spent = nfev + n, njev + nj, spent + used
@@ -395,7 +405,13 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
                 if fall_time > last_t:
                     ts.append(np.array([fall_time]))
                     xs.append(x[None, :])
-                message = f"fell: |roll| reached {np.rad2deg(fall_angle):.0f} deg at t = {fall_time:.4f} s"
+                if fall_angle - abs(x[roll]) <= steer_limit - abs(x[steer]):
+                    fall_reason = "roll"
+                    message = f"fell: |roll| reached {np.rad2deg(fall_angle):.0f} deg at t = {fall_time:.4f} s"
+                else:
+                    fall_reason = "steer"
+                    message = (f"lost: |steer| reached {np.rad2deg(steer_limit):.0f} deg (the front wheel turned "
+                               f"sideways) at t = {fall_time:.4f} s")
             elif status == "failed":
                 failed, message = True, why
             if status != "completed":
@@ -411,4 +427,4 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
     if X.size and not np.all(np.isfinite(X)):
         raise FloatingPointError("non-finite state in the integration result")
     return Trajectory(t, X, fell, fall_time, nfev, message, end_state=np.asarray(x, dtype=float), failed=failed,
-                      njev=njev, evaluations=spent)
+                      njev=njev, evaluations=spent, fall_reason=fall_reason)

@@ -207,6 +207,12 @@ class Scenario:
         Samples per second of the trajectory [Hz].
     fall_angle_deg : float
         |roll| [deg] that counts as a fall and ends the run.
+    steer_limit_deg : float
+        |steer| [deg] that also ends the run as lost (``fall_reason``
+        "steer"): past 90 deg the front wheel rolls backwards, which the tyre
+        model (forward rolling, pneumatic trail behind the contact) does not
+        describe, and no rider recovers from a fork turned over. Without
+        steer control the fork turns over before the roll reaches 45 deg.
     piecewise : bool
         Restart the integrator at the kick's start and end (default). False
         integrates from -settle across the kick and the plate stop in one
@@ -274,6 +280,7 @@ class Scenario:
     rtol: float = 1e-10
     output_rate: float = 1000.0
     fall_angle_deg: float = 45.0
+    steer_limit_deg: float = 90.0
     piecewise: bool = True
     tyre_transient: str = "contact_patch"
     plate_stop: str = "impulse"
@@ -420,6 +427,7 @@ class Scenario:
         check_range("rtol", self.rtol, 1e-14, 1e-3, "(relative)")
         check_range("output rate", self.output_rate, 1.0, 1e5, "Hz")
         check_range("fall angle", self.fall_angle_deg, 0.0, 90.0, "deg", low_open=True, high_open=True)
+        check_range("steer limit", self.steer_limit_deg, 0.0, 180.0, "deg", low_open=True)
         check_range("gain scale", self.gain_scale, 0.0, 10.0, "(factor)")
         if self.controller not in CONTROLLERS:
             raise InputError(f"controller {self.controller!r} is unknown; choose one of {', '.join(CONTROLLERS)}")
@@ -663,6 +671,12 @@ def sample_times(scenario):
     return np.concatenate([[t_start], times, [t_end]])
 
 
+def end_limits(scenario):
+    """The limits that end a run as lost (``integrate.integrate`` keywords): |roll| and |steer| [rad]."""
+    return {"fall_angle": math.radians(scenario.fall_angle_deg),
+            "steer_limit": math.radians(scenario.steer_limit_deg)}
+
+
 def _integrate_run(steady, scenario, kick_T, table, kick_start):
     """Integrate one run: the display-only settle, then the kick from the exact steady state.
 
@@ -689,7 +703,7 @@ def _integrate_run(steady, scenario, kick_T, table, kick_start):
     """
     from . import integrate, slip
 
-    fall_angle = math.radians(scenario.fall_angle_deg)
+    limits = end_limits(scenario)
     # piecewise=False is the comparison case: one LSODA run across the kick,
     # not even restarted at the integrator's chunk boundaries.
     chunk = integrate.DEFAULT_CHUNK if scenario.piecewise else math.inf
@@ -720,14 +734,14 @@ def _integrate_run(steady, scenario, kick_T, table, kick_start):
                                           jumps)
         if table is None:
             return integrate.integrate(rhs, x, t_end, t_start=a, breakpoints=breakpoints, rtol=scenario.rtol,
-                                       fall_angle=fall_angle, chunk=chunk, samples=rows, jumps=jump_map), rhs, None
+                                       **limits, chunk=chunk, samples=rows, jumps=jump_map), rhs, None
         # The drive torque T6c found for the steady motion stays in every piece's parameters.
         return _integrate_table(steady.params, x, table, scenario, chunk, t_start=a)
 
     if not (fixed and scenario.piecewise) or kick_start <= t_start:
         traj, rhs_out, owner = run_from(steady.x if kick_start <= t_start else x_start, t_start, samples)
         return _from_kick_start(traj, kick_start), rhs_out, owner, breakpoints, jumps
-    settle = integrate.integrate(rhs, x_start, kick_start, t_start=t_start, rtol=scenario.rtol, fall_angle=fall_angle,
+    settle = integrate.integrate(rhs, x_start, kick_start, t_start=t_start, rtol=scenario.rtol, **limits,
                                  chunk=chunk, samples=samples[samples < kick_start])
     quad = [slip.X[n] for n in slip.QUADRATURE_STATES]
     settle_x = settle.x.copy()
@@ -740,7 +754,7 @@ def _integrate_run(steady, scenario, kick_T, table, kick_start):
     traj = integrate.Trajectory(np.concatenate([settle.t, post.t]), np.concatenate([settle_x, post.x]),
                                 post.fell, post.fall_time, settle.nfev + post.nfev, post.message,
                                 end_state=post.end_state, failed=post.failed, njev=settle.njev + post.njev,
-                                evaluations=settle.evaluations + post.evaluations)
+                                evaluations=settle.evaluations + post.evaluations, fall_reason=post.fall_reason)
     if owner is not None:
         # The settle's samples belong to the model of the plate at rest before the table.
         rhs_out = [rhs] + list(rhs_out)
@@ -767,11 +781,11 @@ def _integrate_kept_speeds(rhs, params, x, span, rows, stop, scenario, chunk, ju
     """
     from . import integrate, slip
 
-    fall_angle = math.radians(scenario.fall_angle_deg)
+    limits = end_limits(scenario)
     rows = np.asarray(rows, dtype=float)
     t_start, kick_start = span
     first = integrate.integrate(rhs, x, stop, t_start=t_start, breakpoints=(kick_start,), rtol=scenario.rtol,
-                                fall_angle=fall_angle, chunk=chunk, samples=rows[rows < stop])
+                                **limits, chunk=chunk, samples=rows[rows < stop])
     if first.fell or first.failed:
         return first, [rhs], np.zeros(first.t.size, dtype=int)
     x_stop = first.end_state
@@ -782,10 +796,10 @@ def _integrate_kept_speeds(rhs, params, x, span, rows, stop, scenario, chunk, ju
     jumps.append({"time_s": float(stop), "kinetic_energy_change_j": float(ke[1] - ke[0]), "impulse_work_j": None,
                   "constraint_impulse_n_s": None, "rear_slide_m_s": slide})
     second = integrate.integrate(after, x_stop, scenario.duration, t_start=stop, rtol=scenario.rtol,
-                                 fall_angle=fall_angle, chunk=chunk, samples=rows[rows >= stop])
+                                 **limits, chunk=chunk, samples=rows[rows >= stop])
     traj = integrate.Trajectory(np.concatenate([first.t, second.t]), np.concatenate([first.x, second.x]),
                                 second.fell, second.fall_time, first.nfev + second.nfev, second.message,
-                                end_state=second.end_state, failed=second.failed)
+                                end_state=second.end_state, failed=second.failed, fall_reason=second.fall_reason)
     return traj, [rhs, after], np.concatenate([np.zeros(first.t.size, dtype=int), np.ones(second.t.size, dtype=int)])
 
 
@@ -833,7 +847,7 @@ def _integrate_table(params, x0, table, scenario, chunk, t_start=None):
     pending = sample_times(scenario)
     t_start = pending[0] if t_start is None else t_start
     pending = pending[pending >= t_start]
-    fall_angle = math.radians(scenario.fall_angle_deg)
+    limits = end_limits(scenario)
     ts, xs, owner, rhss = [], [], [], []
     nfev = njev = evaluations = 0
     x = np.asarray(x0, dtype=float)
@@ -841,7 +855,7 @@ def _integrate_table(params, x0, table, scenario, chunk, t_start=None):
     for k, (a, b, t0, coefficients) in enumerate(table.pieces(t_start, t_end)):
         rhs = slip.CompiledRHS(_segment_parameters(params, t0, coefficients))
         rhss.append(rhs)
-        traj = integrate.integrate(rhs, x, b, t_start=a, rtol=scenario.rtol, fall_angle=fall_angle,
+        traj = integrate.integrate(rhs, x, b, t_start=a, rtol=scenario.rtol, **limits,
                                    chunk=chunk, samples=pending)
         nfev, njev, evaluations = nfev + traj.nfev, njev + traj.njev, evaluations + traj.evaluations
         ts.append(traj.t)
@@ -854,7 +868,7 @@ def _integrate_table(params, x0, table, scenario, chunk, t_start=None):
             break
     trajectory = integrate.Trajectory(np.concatenate(ts), np.concatenate(xs), traj.fell, traj.fall_time,
                                       nfev, traj.message, end_state=x, failed=traj.failed, njev=njev,
-                                      evaluations=evaluations)
+                                      evaluations=evaluations, fall_reason=traj.fall_reason)
     return trajectory, rhss, np.concatenate(owner).astype(int)
 
 
@@ -1356,6 +1370,7 @@ def run(scenario, *, tyres=None, gains=None):
         "outcome": "failed" if traj.failed else "fell" if traj.fell else "completed",
         "fell": bool(traj.fell),
         "fall_time_s": traj.fall_time,
+        "fall_reason": traj.fall_reason,
         "end_time_s": float(df["time"].iloc[-1]),
         "message": traj.message,
         "bicycle": info,

@@ -22,6 +22,7 @@ and the quadratures of :data:`whipple_kick.energy.QUADRATURE_STATES`.
 """
 import ctypes
 import functools
+import math
 import os
 import shutil
 import subprocess
@@ -673,8 +674,8 @@ class CompiledRHS:
             raise FloatingPointError(_STATUS.get(status, f"status {status}") + f" at t = {t:.6g} s")
         return self._dx.copy()
 
-    def guarded(self, index, limit, exception):
-        """A fast ``f(t, x)`` that raises ``exception`` once ``|x[index]| > limit``.
+    def guarded(self, index, limit, exception, index2=0, limit2=math.inf):
+        """A fast ``f(t, x)`` that raises ``exception`` once ``|x[index]| > limit`` or ``|x[index2]| > limit2``.
 
         One Python frame per call with everything bound locally: the
         integrator's hot path (about 2e4 calls per run).
@@ -682,7 +683,7 @@ class CompiledRHS:
         fn, p_ptr, dx_ptr, dx = self.lib.wk_slip_rhs, self._p_ptr, self._dx_ptr, self._dx
 
         def f(t, x):
-            if abs(x[index]) > limit:
+            if abs(x[index]) > limit or abs(x[index2]) > limit2:
                 raise exception
             status = fn(t, x.ctypes.data, p_ptr, dx_ptr, None)
             if status:
