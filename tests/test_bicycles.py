@@ -77,18 +77,19 @@ GOOD = (wk.bicycles.BICYCLE_DIR / "benchmark.toml").read_text()
 
 
 @pytest.mark.parametrize("edit, message", [
-    (lambda t: t.replace('w    = { value = 1.02,', 'w    = { value = "x",'), r"parameters\.w\.value must be a number"),
-    (lambda t: t.replace('unit = "kg",     source = "meijaard2007" }\nIBxx', 'unit = "g",     source = "meijaard2007" }\nIBxx'), "parameters.mB unit must be 'kg'"),
+    (lambda t: t.replace('w    = { value = 1.02,', 'w    = { value = "x",'), r"parameters\.w\.value: must be a number"),
+    (lambda t: t.replace('unit = "kg",     source = "meijaard2007" }\nIBxx', 'unit = "g",     source = "meijaard2007" }\nIBxx'), "parameters.mB: unit must be 'kg'"),
     (lambda t: t.replace('source = "meijaard2007" }\nIRyy', 'source = "nowhere" }\nIRyy'), "source 'nowhere' is not a key"),
-    (lambda t: t.replace('IFyy = { value = 0.28,               unit = "kg m^2", source = "meijaard2007" }\n', ''), "missing IFyy"),
-    (lambda t: t + 'extra = { value = 1.0, unit = "m", source = "meijaard2007" }\n', "unknown keys extra"),
-    (lambda t: t.replace('mF   = { value = 3.0,', 'mF   = { value = -3.0,'), "mF = -3.0 kg must be > 0"),
-    (lambda t: t.replace('IBxz = { value = 2.4,', 'IBxz = { value = 6.0,'), "IBxz = 6.0 kg m\\^2 makes the B inertia tensor indefinite"),
-    (lambda t: t.replace('parameterisation = "benchmark"', 'parameterisation = "other"'), "parameterisation must be"),
+    (lambda t: t.replace('IFyy = { value = 0.28,               unit = "kg m^2", source = "meijaard2007" }\n', ''), "parameters: missing IFyy"),
+    (lambda t: t + 'extra = { value = 1.0, unit = "m", source = "meijaard2007" }\n', "parameters: unknown keys extra"),
+    (lambda t: t.replace('mF   = { value = 3.0,', 'mF   = { value = -3.0,'), "mF: value -3.0 kg must be > 0 kg"),
+    (lambda t: t.replace('IBxz = { value = 2.4,', 'IBxz = { value = 6.0,'), "IBxz: value 6.0 kg m\\^2 makes the B inertia tensor indefinite"),
+    (lambda t: t.replace('parameterisation = "benchmark"', 'parameterisation = "other"'), "parameterisation: must be"),
     (lambda t: t.replace('w    = { value = 1.02,', 'w    = { value = nan,'), "must be finite"),
     (lambda t: t.replace('[parameters]', '[parameters'), "not valid TOML"),
 ])
 def test_malformed_file_is_an_input_error_naming_file_and_key(tmp_path, edit, message):
+    """One line, ``<file>: <key>: <problem>`` (the one format of :mod:`whipple_kick.parameters`)."""
     path = tmp_path / "broken.toml"
     text = edit(GOOD)
     assert text != GOOD
@@ -112,5 +113,5 @@ def test_a_load_label_needs_a_set_with_rider(tmp_path):
                         'unit = "N", source = "meijaard2007" }')
     assert text != GOOD
     path.write_text(text)
-    with pytest.raises(InputError, match="thesis_rear_load labels a set that includes its rider"):
+    with pytest.raises(InputError, match="thesis_rear_load: labels a set that includes its rider"):
         wk.bicycles.load(str(path))

@@ -23,10 +23,10 @@ import types
 
 from . import benchmark as _benchmark
 from .errors import InputError
-from .parameters import PARAMETER_DIR, load_toml, require_finite
+from . import parameters
 
-#: Folder of the shipped bicycle files.
-BICYCLE_DIR = PARAMETER_DIR / "bicycles"
+#: Folder of the shipped bicycle files (package data, :func:`whipple_kick.parameters.shipped`).
+BICYCLE_DIR = parameters.shipped("bicycles")
 
 FORMAT = "whipple_kick bicycle, version 1"
 
@@ -147,7 +147,7 @@ def available():
     list of str
         Names accepted by :func:`load`.
     """
-    return sorted(p.stem for p in BICYCLE_DIR.glob("*.toml"))
+    return list(parameters.toml_files(BICYCLE_DIR))
 
 
 def load(name):
@@ -177,54 +177,7 @@ def load(name):
         if text not in names:
             raise InputError(f"unknown bicycle {text!r}; available: {', '.join(names)}")
         path = BICYCLE_DIR / f"{text}.toml"
-    return _parse(path, load_toml(path))
-
-
-def _entries(path, table_name, table, units, sources, *, complete):
-    """Validate a table of ``{value, unit, source[, uncertainty]}`` entries.
-
-    Returns ``(values, uncertainties)`` dicts. ``units`` maps each allowed key
-    to its required unit (None: any non-empty unit string).
-    """
-    if not isinstance(table, dict):
-        raise InputError(f"{path}: [{table_name}] must be a table")
-    if units is not None:
-        unknown = sorted(set(table) - set(units))
-        if unknown:
-            raise InputError(f"{path}: [{table_name}] has unknown keys {', '.join(unknown)}; "
-                             f"allowed: {', '.join(units)}")
-        if complete:
-            missing = [k for k in units if k not in table]
-            if missing:
-                raise InputError(f"{path}: [{table_name}] is missing {', '.join(missing)}")
-    values, uncertainties = {}, {}
-    for key, entry in table.items():
-        where = f"{table_name}.{key}"
-        if not isinstance(entry, dict) or "value" not in entry:
-            raise InputError(f"{path}: {where} must be a table {{value, unit, source}}")
-        extra = sorted(set(entry) - {"value", "unit", "source", "uncertainty"})
-        if extra:
-            raise InputError(f"{path}: {where} has unknown fields {', '.join(extra)}")
-        unit = entry.get("unit")
-        want = None if units is None else units[key]
-        if not isinstance(unit, str) or not unit or (want is not None and unit != want):
-            raise InputError(f"{path}: {where} unit must be {want or 'a unit string'!r}, got {unit!r}")
-        if entry.get("source") not in sources:
-            raise InputError(f"{path}: {where} source {entry.get('source')!r} is not a key of "
-                             f"[sources] ({', '.join(sources)})")
-        values[key] = require_finite(path, f"{where}.value", entry["value"])
-        if "uncertainty" in entry:
-            unc = require_finite(path, f"{where}.uncertainty", entry["uncertainty"])
-            if unc < 0:
-                raise InputError(f"{path}: {where}.uncertainty must be >= 0 {unit}, got {unc!r}")
-            uncertainties[key] = unc
-    return values, uncertainties
-
-
-def _positive(path, values, names, unit_of):
-    for key in names:
-        if not values[key] > 0:
-            raise InputError(f"{path}: {key} = {values[key]!r} {unit_of[key]} must be > 0")
+    return _parse(path, parameters.load_toml(path))
 
 
 def check_benchmark(path, bench):
@@ -234,69 +187,71 @@ def check_benchmark(path, bench):
     the steer-axis tilt must lie in (-pi/2, pi/2) rad; each planar inertia
     tensor [[Ixx, Ixz], [Ixz, Izz]] must be positive definite.
     """
-    _positive(path, bench, ("w", "g", "rR", "rF", "mR", "mB", "mH", "mF",
-                            "IRxx", "IRyy", "IFxx", "IFyy", "IBxx", "IByy", "IBzz",
-                            "IHxx", "IHyy", "IHzz"), BENCHMARK_UNITS)
+    parameters.positive(path, bench, ("w", "g", "rR", "rF", "mR", "mB", "mH", "mF",
+                                      "IRxx", "IRyy", "IFxx", "IFyy", "IBxx", "IByy", "IBzz",
+                                      "IHxx", "IHyy", "IHzz"), BENCHMARK_UNITS)
     if not abs(bench["lam"]) < math.pi / 2:
-        raise InputError(f"{path}: lam = {bench['lam']!r} rad is outside (-pi/2, pi/2) rad")
+        parameters.fail(path, "lam", f"value {bench['lam']!r} rad is outside (-pi/2, pi/2) rad")
     for body in ("B", "H"):
         ixx, izz, ixz = bench[f"I{body}xx"], bench[f"I{body}zz"], bench[f"I{body}xz"]
         if not ixx * izz > ixz * ixz:
-            raise InputError(f"{path}: I{body}xz = {ixz!r} kg m^2 makes the {body} inertia tensor "
-                             f"indefinite (need I{body}xz^2 < I{body}xx*I{body}zz = {ixx * izz:g} kg^2 m^4)")
+            parameters.fail(path, f"I{body}xz", f"value {ixz!r} kg m^2 makes the {body} inertia tensor indefinite "
+                            f"(need I{body}xz^2 < I{body}xx*I{body}zz = {ixx * izz:g} kg^2 m^4)")
 
 
 def _parse(path, data):
     """Build a :class:`Bicycle` from a parsed TOML file, validating everything."""
     unknown = sorted(set(data) - _TOP_KEYS)
     if unknown:
-        raise InputError(f"{path}: unknown top-level keys {', '.join(unknown)}")
+        parameters.fail(path, unknown[0], f"unknown top-level key; allowed: {', '.join(sorted(_TOP_KEYS))}")
     for key in ("format", "name", "parameterisation", "includes_rider", "sources", "parameters"):
         if key not in data:
-            raise InputError(f"{path}: missing top-level key {key!r}")
+            parameters.fail(path, key, "missing")
     if data["format"] != FORMAT:
-        raise InputError(f"{path}: format must be {FORMAT!r}, got {data['format']!r}")
+        parameters.fail(path, "format", f"must be {FORMAT!r}, got {data['format']!r}")
     form = data["parameterisation"]
     if form not in ("benchmark", "moore"):
-        raise InputError(f"{path}: parameterisation must be 'benchmark' or 'moore', got {form!r}")
+        parameters.fail(path, "parameterisation", f"must be 'benchmark' or 'moore', got {form!r}")
     if not isinstance(data["includes_rider"], bool):
-        raise InputError(f"{path}: includes_rider must be true or false, got {data['includes_rider']!r}")
+        parameters.fail(path, "includes_rider", f"must be true or false, got {data['includes_rider']!r}")
     sources = data["sources"]
     if not isinstance(sources, dict) or not sources or not all(
             isinstance(v, str) and v for v in sources.values()):
-        raise InputError(f"{path}: [sources] must map keys to non-empty citation strings")
+        parameters.fail(path, "sources", "must map keys to non-empty citation strings")
 
     units = BENCHMARK_UNITS if form == "benchmark" else MOORE_UNITS
-    values, unc = _entries(path, "parameters", data["parameters"], units, sources, complete=True)
+    values, unc = parameters.quantities(path, "parameters", data["parameters"], units, sources=sources,
+                                        uncertainty=True)
     geometry = None
     if "seating" in data:
-        geometry, geo_unc = _entries(path, "seating", data["seating"], SEATING_UNITS, sources,
-                                     complete=True)
-        _positive(path, geometry, SEATING_UNITS, SEATING_UNITS)
+        geometry, geo_unc = parameters.quantities(path, "seating", data["seating"], SEATING_UNITS,
+                                                  sources=sources, uncertainty=True)
+        parameters.positive(path, geometry, SEATING_UNITS, SEATING_UNITS)
         unc.update({f"seating.{k}": v for k, v in geo_unc.items()})
     label = None
     if "thesis_rear_load" in data:
         if not data["includes_rider"]:
-            raise InputError(f"{path}: thesis_rear_load labels a set that includes its rider; "
-                             "this set has includes_rider = false")
-        label = _entries(path, "top level", {"thesis_rear_load": data["thesis_rear_load"]},
-                         {"thesis_rear_load": "N"}, sources, complete=True)[0]["thesis_rear_load"]
-        _positive(path, {"thesis_rear_load": label}, ("thesis_rear_load",), {"thesis_rear_load": "N"})
+            parameters.fail(path, "thesis_rear_load", "labels a set that includes its rider; "
+                            "this set has includes_rider = false")
+        label = parameters.quantity(path, "thesis_rear_load", data["thesis_rear_load"], "N", sources=sources,
+                                    low=0.0, low_open=True)[0]
     tyres = None
     if "tyre_placeholders" in data:
-        tyres, _ = _entries(path, "tyre_placeholders", data["tyre_placeholders"], None, sources,
-                            complete=False)
+        tyres, _ = parameters.quantities(path, "tyre_placeholders", data["tyre_placeholders"], None,
+                                         sources=sources, complete=False, uncertainty=True)
 
     if form == "benchmark":
         bench = values
     else:
-        _positive(path, values, ("g", "rf", "rr", "mc", "md", "me", "mf", "id11", "id22",
-                                 "if11", "if22", "ic22", "ie22"), MOORE_UNITS)
+        parameters.positive(path, values, ("g", "rf", "rr", "mc", "md", "me", "mf", "id11", "id22",
+                                           "if11", "if22", "ic22", "ie22"), MOORE_UNITS)
         try:
             bench = _benchmark.from_moore(values)
         except ValueError:  # acos outside [-1, 1]: no upright pose with both wheels down
-            raise InputError(f"{path}: d1, d2, d3, rr, rf admit no upright configuration with "
-                             f"both wheels on the ground") from None
+            bench = None
+        if bench is None:
+            parameters.fail(path, "parameters", "d1, d2, d3, rr, rf admit no upright configuration with "
+                                                "both wheels on the ground")
     check_benchmark(path, bench)
     return Bicycle(
         name=data["name"],

@@ -39,10 +39,10 @@ from scipy.optimize import fsolve
 from . import benchmark as _benchmark
 from .bicycles import Bicycle
 from .errors import InputError, check_range
-from .parameters import PARAMETER_DIR, load_toml, require_finite
+from . import parameters
 
 #: Folder of the shipped rider files.
-RIDER_DIR = PARAMETER_DIR / "riders"
+RIDER_DIR = parameters.shipped("riders")
 
 FORMAT = "whipple_kick rider, version 1"
 
@@ -124,7 +124,7 @@ class YeadonRider:
 
 def available():
     """Names of the shipped rider files, sorted."""
-    return sorted(p.stem for p in RIDER_DIR.glob("*.toml"))
+    return list(parameters.toml_files(RIDER_DIR))
 
 
 def standing_height(measurements):
@@ -147,46 +147,41 @@ def _read_rider_file(name):
     if name not in names:
         raise InputError(f"unknown rider {name!r}; available: {', '.join(names)}")
     path = RIDER_DIR / f"{name}.toml"
-    data = load_toml(path)
+    data = parameters.load_toml(path)
     if data.get("format") != FORMAT:
-        raise InputError(f"{path}: format must be {FORMAT!r}, got {data.get('format')!r}")
+        parameters.fail(path, "format", f"must be {FORMAT!r}, got {data.get('format')!r}")
     if data.get("model") != "yeadon":
-        raise InputError(f"{path}: model must be 'yeadon', got {data.get('model')!r}")
+        parameters.fail(path, "model", f"must be 'yeadon', got {data.get('model')!r}")
     sources = data.get("sources")
     if not isinstance(sources, dict) or not sources:
-        raise InputError(f"{path}: [sources] must map keys to citation strings")
+        parameters.fail(path, "sources", "must map keys to citation strings")
     out = {}
     for table, unit, names_wanted in (("measurements", "m", yeadon.Human.measnames),
                                       ("configuration", "rad", yeadon.Human.CFGnames)):
-        tab = data.get(table)
-        if not isinstance(tab, dict) or not isinstance(tab.get("values"), dict):
-            raise InputError(f"{path}: [{table}] with a [{table}.values] table is required")
+        tab = parameters.table(path, table, data.get(table))
+        values = parameters.table(path, f"{table}.values", tab.get("values"))
         if tab.get("unit") != unit:
-            raise InputError(f"{path}: {table}.unit must be {unit!r}, got {tab.get('unit')!r}")
+            parameters.fail(path, f"{table}.unit", f"must be {unit!r}, got {tab.get('unit')!r}")
         if tab.get("source") not in sources:
-            raise InputError(f"{path}: {table}.source {tab.get('source')!r} is not a key of [sources]")
-        values = tab["values"]
+            parameters.fail(path, f"{table}.source", f"{tab.get('source')!r} is not a key of [sources]")
         unknown = sorted(set(values) - set(names_wanted))
         missing = [k for k in names_wanted if k not in values]
         if unknown or missing:
-            raise InputError(f"{path}: [{table}.values] unknown keys {unknown}, missing keys {missing}")
-        out[table] = {k: require_finite(path, f"{table}.values.{k}", values[k]) for k in names_wanted}
+            parameters.fail(path, f"{table}.values", f"unknown keys {unknown}, missing keys {missing}")
+        out[table] = {k: parameters.number(path, f"{table}.values.{k}", values[k]) for k in names_wanted}
     for key, value in out["measurements"].items():
-        if value <= 0:
-            raise InputError(f"{path}: measurements.values.{key} = {value!r} m must be > 0 m")
-    for key, (low, high) in zip(yeadon.Human.CFGnames, yeadon.Human.CFGbounds):
+        parameters.at_least(path, f"measurements.values.{key}", value, "m", 0.0, low_open=True)
+    for key, (low, high) in zip(yeadon.Human.CFGnames, yeadon.Human.CFGbounds, strict=True):
         value = out["configuration"][key]
         if not low <= value <= high:
-            raise InputError(f"{path}: configuration.values.{key} = {value!r} rad is outside "
-                             f"[{low:g}, {high:g}] rad")
+            parameters.fail(path, f"configuration.values.{key}", f"value {value!r} rad is outside "
+                                                                 f"[{low:g}, {high:g}] rad")
     for key in _MUST_BE_ZERO:
         if out["configuration"][key] != 0.0:
-            raise InputError(f"{path}: configuration.values.{key} must be 0 rad for seating on a "
-                             f"bicycle (the legs must move in the mid-plane), got {out['configuration'][key]!r}")
-    mass = data.get("mass")
-    if not isinstance(mass, dict) or mass.get("unit") != "kg" or mass.get("source") not in sources:
-        raise InputError(f"{path}: [mass] must have value, unit = 'kg' and a source key")
-    out["mass"] = require_finite(path, "mass.value", mass.get("value"))
+            parameters.fail(path, f"configuration.values.{key}", "must be 0 rad for seating on a bicycle (the "
+                            f"legs must move in the mid-plane), got {out['configuration'][key]!r}")
+    out["mass"] = parameters.quantity(path, "mass", data.get("mass"), "kg", sources=sources,
+                                      low=0.0, low_open=True)[0]
     out["source"] = "\n".join(f"{k}: {v}" for k, v in sources.items())
     return out
 

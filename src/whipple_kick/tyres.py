@@ -25,14 +25,15 @@ import numpy as np
 
 from . import magic_formula as mf
 from .errors import InputError, check_range
-from .parameters import PARAMETER_DIR, load_toml, require_finite
+from . import parameters
+from .parameters import fail as _fail, load_toml, table as _table, text as _text
 
 __all__ = ["Tyre", "TyreFile", "LinearTyre", "available", "linear_tyre", "load", "read_tyre_file",
            "DEFAULT_COEFFICIENT_SET", "FRICTION_MODES", "MISSING_MOMENT_MODES",
            "ZERO_MOMENT_COEFFICIENTS"]
 
-#: Folder of the shipped tyre files.
-TYRE_DIR = PARAMETER_DIR / "tyres"
+#: Folder of the shipped tyre files (package data, :func:`whipple_kick.parameters.shipped`).
+TYRE_DIR = parameters.shipped("tyres")
 #: Coefficient set used unless another is asked for (thesis Table 7.9 F_y).
 DEFAULT_COEFFICIENT_SET = "table7_9"
 #: ``none``: as measured on the rig; ``plate``: D scaled by mu_plate/mu_rig
@@ -94,39 +95,9 @@ class TyreFile:
         self.sets = sets
 
 
-def _fail(path, key, problem):
-    raise InputError(f"{path}: {key}: {problem}")
-
-
-def _table(path, key, value):
-    if not isinstance(value, dict):
-        _fail(path, key, f"must be a table, got {value!r}")
-    return value
-
-
-def _text(path, key, value):
-    if not isinstance(value, str) or not value.strip():
-        _fail(path, key, f"must be a non-empty string, got {value!r}")
-    return value
-
-
 def _quantity(path, key, entry, unit, low, low_open):
-    """Read ``{value, unit, source}``, checking unit, finiteness and range."""
-    entry = _table(path, key, entry)
-    extra = set(entry) - {"value", "unit", "source"}
-    if extra:
-        _fail(path, key, f"unknown field(s) {sorted(extra)}; allowed: value, unit, source")
-    for field in ("value", "unit", "source"):
-        if field not in entry:
-            _fail(path, key, f"missing field '{field}'")
-    if entry["unit"] != unit:
-        _fail(path, key, f"unit must be '{unit}', got {entry['unit']!r}")
-    _text(path, f"{key}.source", entry["source"])
-    value = require_finite(path, f"{key}.value", entry["value"])
-    if value < low or (low_open and value == low):
-        bound = ">" if low_open else ">="
-        _fail(path, key, f"value {value!r} {unit} must be {bound} {low:g} {unit}")
-    return value
+    """Read ``{value, unit, source}`` (the source is the citation), checking unit, finiteness and range."""
+    return parameters.quantity(path, key, entry, unit, low=low, low_open=low_open)[0]
 
 
 def _pressure_key(path, key, text):
@@ -145,7 +116,7 @@ def _coefficient_list(path, key, values, count):
         _fail(path, key, f"must be a list of {count} numbers, got {values!r}")
     if len(values) != count:
         _fail(path, key, f"must hold {count} coefficients, got {len(values)}")
-    return np.array([require_finite(path, f"{key}[{i}]", v) for i, v in enumerate(values)])
+    return np.array([parameters.number(path, f"{key}[{i}]", v) for i, v in enumerate(values)])
 
 
 def read_tyre_file(path):
@@ -246,8 +217,7 @@ def _read_sets(path, table, properties):
 
 
 def _tyre_files(directory=None):
-    directory = pathlib.Path(directory) if directory is not None else TYRE_DIR
-    return {p.stem: p for p in sorted(directory.glob("*.toml"))}
+    return parameters.toml_files(TYRE_DIR if directory is None else directory)
 
 
 def available(directory=None):
