@@ -37,7 +37,7 @@ def _base_case(rtol=1e-10):
 
 
 def bench_rhs(repeats):
-    from whipple_kick import slip
+    from whipple_kick import slip, slip_build
     ss = _base_case()
     rhs = slip.CompiledRHS(ss.params)
     p = slip.parameter_vector(ss.params)
@@ -45,7 +45,7 @@ def bench_rhs(repeats):
     x[slip.X["u4"]] = 0.1
     n_c, n_np = 20000, 200
     c_times, np_times = [], []
-    slip.numpy_rhs(0.05, x, p)  # import and warm up
+    slip_build.numpy_rhs(0.05, x, p)  # import and warm up
     for _ in range(repeats):
         t0 = time.perf_counter()
         for _ in range(n_c):
@@ -53,7 +53,7 @@ def bench_rhs(repeats):
         c_times.append((time.perf_counter() - t0) / n_c)
         t0 = time.perf_counter()
         for _ in range(n_np):
-            slip.numpy_rhs(0.05, x, p)
+            slip_build.numpy_rhs(0.05, x, p)
         np_times.append((time.perf_counter() - t0) / n_np)
     c, n = statistics.median(c_times), statistics.median(np_times)
     print(f"RHS call, compiled C (incl. ctypes + copy): median {c * 1e6:.2f} us  ({repeats} runs x {n_c} calls)")
@@ -83,7 +83,7 @@ def bench_build(repeats):
 
 
 def bench_run(repeats):
-    from whipple_kick import integrate, slip
+    from whipple_kick import integrate, slip, slip_build
     ss = _base_case()
     p = slip.parameter_vector(ss.params)
     for rtol in (1e-12, 1e-8):
@@ -97,7 +97,7 @@ def bench_run(repeats):
               f"({traj.nfev} RHS calls)  runs {[round(v, 3) for v in times]}")
         c_med = statistics.median(times)
         t0 = time.perf_counter()
-        integrate.integrate(lambda t, x: slip.numpy_rhs(t, x, p), ss.x, 6.0, t_start=0.0,
+        integrate.integrate(lambda t, x: slip_build.numpy_rhs(t, x, p), ss.x, 6.0, t_start=0.0,
                             breakpoints=(0.15,), rtol=rtol)
         n = time.perf_counter() - t0
         print(f"6 s base case, NumPy RHS, rtol {rtol:g}: {n:.2f} s (one run); C is {n / c_med:.0f}x faster")

@@ -89,20 +89,20 @@ def gmin():
 @contextlib.contextmanager
 def _secant_floor(value):
     """Compile and use the model with ``transient.G_MIN = value`` (its own cache entry)."""
-    from whipple_kick import cache, slip
+    from whipple_kick import cache, slip, slip_build
     original, hash_function = transient.G_MIN, cache.source_hash
 
     def keyed(sources, extra=""):
         return hash_function(sources, extra=f"{extra} G_MIN={value!r}")
     transient.G_MIN = value
     cache.source_hash = keyed
-    slip._expressions.cache_clear()
+    slip_build._expressions.cache_clear()
     slip.library.cache_clear()
     try:
         yield
     finally:
         transient.G_MIN, cache.source_hash = original, hash_function
-        slip._expressions.cache_clear()
+        slip_build._expressions.cache_clear()
         slip.library.cache_clear()
 
 

@@ -33,6 +33,9 @@ def test_cached_file_writable_by_others_is_not_loaded(tmp_path):
 
 
 def test_hash_changes_with_source_and_options():
+    """The key names the SymPy version the code is generated with, read without importing SymPy."""
+    import importlib.metadata
+    assert cache.sympy_version() == importlib.metadata.version("sympy")
     a = cache.source_hash(["derivation"], extra="x")
     assert a == cache.source_hash(["derivation"], extra="x")
     assert a != cache.source_hash(["derivation"], extra="y")
@@ -59,6 +62,9 @@ def test_concurrent_builds_share_one_library(tmp_path):
                               stderr=subprocess.PIPE, text=True) for _ in range(2)]
     outs = [p.communicate(timeout=600) for p in procs]
     assert all(p.returncode == 0 for p in procs), outs
+    # The builder says in one line what it does and how long it takes; the process that waits says nothing.
+    said = [line for _, err in outs for line in err.splitlines()]
+    assert len(said) == 1 and said[0].startswith("whipple_kick: building the slip model") and "20-30 s" in said[0]
     libraries = sorted(f.name for f in (tmp_path / "cache").iterdir() if f.suffix == ".so")
     assert len(libraries) == 1, libraries
     leftovers = [f.name for f in (tmp_path / "cache").iterdir() if f.name.endswith(".tmp")]

@@ -39,6 +39,34 @@ def test_main_job_writes_the_three_files(tmp_path, capsys):
     assert stderr == ""
 
 
+_WARM_PROBE = """
+import sys
+from whipple_kick.cli import simulate_main
+try:
+    simulate_main(["--pressure", "400", "--fz", "635", "--quiet", "--out", sys.argv[1]])
+except SystemExit as exc:
+    assert exc.code == 0, exc.code
+print(sorted(name for name in ("sympy", "control", "matplotlib.pyplot") if name in sys.modules))
+"""
+
+
+def test_warm_simulate_imports_neither_sympy_nor_python_control(tmp_path):
+    """The main job in a fresh process with the compiled model cached: no SymPy, no python-control, no pyplot.
+
+    SymPy belongs to the build (a cache miss), python-control to the
+    control-analysis API; the LQR design comes from SciPy's Riccati solver
+    and the figure is drawn without pyplot.
+    """
+    wk.slip.library_path()                                     # the compiled model, built if needed
+    out = tmp_path / "run"
+    done = subprocess.run([sys.executable, "-c", _WARM_PROBE, str(out)], capture_output=True, text=True,
+                          timeout=600, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip().splitlines()[-1] == "[]", done.stdout
+    assert done.stderr == ""                                   # a warm run builds nothing: not even its one line
+    assert sorted(p.name for p in out.iterdir()) == ["response.png", "summary.json", "trajectory.csv"]
+
+
 def test_default_output_folder_is_new(tmp_path, capsys, monkeypatch):
     monkeypatch.chdir(tmp_path)
     argv = ["--duration", "0.3", "--no-plot", "--quiet"]

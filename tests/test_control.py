@@ -199,6 +199,38 @@ def test_gains_dict_and_scale():
     assert control.gains_dict(_thesis_K(635)) == control.THESIS_GAINS[635]
 
 
+def test_gains_dict_refuses_a_vector_of_another_length():
+    """Five gains (a heading design) or three are not silently cut to the four names."""
+    for K in ([-12.0, 9.0, -4.0, 1.2, 0.5], [-12.0, 9.0, -4.0]):
+        with pytest.raises(InputError, match=f"exactly 4 gains \\(kq4, kq7, ku4, ku7\\), got {len(K)}"):
+            control.gains_dict(K)
+
+
+@pytest.mark.parametrize("weights", [{}, {"R": 10.0}, {"Q": np.diag([10.0, 1.0, 2.0, 0.5])}])
+@pytest.mark.parametrize("load", THESIS_LOADS)
+def test_scipy_riccati_design_equals_python_control(combined, load, weights):
+    """The run-time design (SciPy's Riccati solver) against python-control's lqr, the oracle.
+
+    Measured: identical to the last bit on this machine (python-control solves
+    the same equation with SciPy when slycot is absent); asserted to 1e-8 of
+    the largest gain, far below anything a run could see.
+    """
+    import control as ct
+
+    moore = combined[load]
+    K, poles = control.lqr_gains(moore, DESIGN_SPEED, **weights)
+    A, B = classic.linear_state_space(moore, DESIGN_SPEED)
+    Q = weights.get("Q", np.eye(4))
+    K_ct, _, poles_ct = ct.lqr(A, B[:, [1]], Q, np.atleast_2d(weights.get("R", 1.0)))
+    np.testing.assert_allclose(K, np.ravel(K_ct), rtol=0, atol=1e-8 * np.abs(K_ct).max())
+    np.testing.assert_allclose(np.sort_complex(poles), np.sort_complex(poles_ct), rtol=0,
+                               atol=1e-8 * np.abs(poles_ct).max())
+    K5, _ = control.heading_lqr_gains(moore, DESIGN_SPEED)
+    A5, b5 = control.heading_state_space(moore, DESIGN_SPEED)
+    K5_ct, _, _ = ct.lqr(A5, b5, np.eye(5), np.eye(1))
+    np.testing.assert_allclose(K5, np.ravel(K5_ct), rtol=0, atol=1e-8 * np.abs(K5_ct).max())
+
+
 def test_weights_are_configurable(combined):
     moore = combined[635]
     K1, _ = control.lqr_gains(moore, DESIGN_SPEED)
@@ -220,6 +252,8 @@ def test_lqr_input_errors(combined):
     for speed in (0.0, -3.0):
         with pytest.raises(InputError):
             control.lqr_gains(moore, speed)
+    with pytest.raises(InputError, match=r"R = 0.0 \(weight\) is outside the allowed range \(0, inf\]"):
+        control.lqr_gains(moore, DESIGN_SPEED, R=0.0)
 
 
 # --- (6) the heading-holding rider (yaw angle as a fifth state) --------------

@@ -1,7 +1,6 @@
 """Response figures that say what happened, tested through the figure objects (artists, texts), not pixels."""
 import math
 
-import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 
@@ -26,18 +25,32 @@ def _texts(fig):
     return [t.get_text() for ax in fig.axes for t in ax.texts] + [t.get_text() for t in fig.texts]
 
 
+def test_plotting_leaves_the_backend_and_pyplot_alone(tmp_path):
+    """A Figure on its own Agg canvas: no pyplot, no switch of the global backend (in a fresh process)."""
+    import subprocess
+    import sys
+    probe = ("import sys, matplotlib\n"
+             "matplotlib.use('pdf')\n"     # the user's choice, which plotting must keep
+             "from whipple_kick import plotting, simulation\n"
+             "r = simulation.run(simulation.Scenario(duration=0.3))\n"
+             "plotting.response_figure([('', r)], sys.argv[1], kick=(0.0, 0.15))\n"
+             "print(matplotlib.get_backend(), 'matplotlib.pyplot' in sys.modules)\n")
+    done = subprocess.run([sys.executable, "-c", probe, str(tmp_path / "r.png")], capture_output=True, text=True,
+                          timeout=600)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["pdf", "False"]
+    assert (tmp_path / "r.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
 def test_fall_is_marked(fall):
     """Acceptance: a vertical line at the fall time in every panel and "fell at 1.345 s"."""
     fall_time = fall.summary["fall_time_s"]
     fig = plotting.response_figure([("", fall)], kick=(0.0, 0.15))
-    try:
-        for ax in fig.axes:
-            marks = [line for line in ax.lines if line.get_gid() == "fall"]
-            assert len(marks) == 1
-            assert tuple(marks[0].get_xdata()) == (fall_time, fall_time)
-        assert f"fell at {fall_time:.3f} s" in _texts(fig)
-    finally:
-        plt.close(fig)
+    for ax in fig.axes:
+        marks = [line for line in ax.lines if line.get_gid() == "fall"]
+        assert len(marks) == 1
+        assert tuple(marks[0].get_xdata()) == (fall_time, fall_time)
+    assert f"fell at {fall_time:.3f} s" in _texts(fig)
 
 
 def test_axis_limits_come_from_the_motion_before_the_fall(fall):
@@ -48,17 +61,14 @@ def test_axis_limits_come_from_the_motion_before_the_fall(fall):
     +-1.65 rad/s, so the kick response fills the panel.
     """
     fig = plotting.response_figure([("", fall)], kick=(0.0, 0.15))
-    try:
-        panels = dict(zip((c for c, _ in plotting.RESPONSE_PANELS), fig.axes))
-        df = fall.trajectory
-        low, high = panels["steer_rate"].get_ylim()
-        assert df["steer_rate"].min() < -60.0           # the fall itself ...
-        assert -2.0 < low < -1.0 and 1.0 < high < 2.0   # ... is off the scale
-        before = np.abs(df["roll"].to_numpy()) < 0.5 * math.radians(45.0)
-        peak = np.max(np.abs(df["steer_rate"].to_numpy()[before]))
-        assert max(-low, high) == pytest.approx(peak * 1.16, rel=0.1)
-    finally:
-        plt.close(fig)
+    panels = dict(zip((c for c, _ in plotting.RESPONSE_PANELS), fig.axes))
+    df = fall.trajectory
+    low, high = panels["steer_rate"].get_ylim()
+    assert df["steer_rate"].min() < -60.0           # the fall itself ...
+    assert -2.0 < low < -1.0 and 1.0 < high < 2.0   # ... is off the scale
+    before = np.abs(df["roll"].to_numpy()) < 0.5 * math.radians(45.0)
+    peak = np.max(np.abs(df["steer_rate"].to_numpy()[before]))
+    assert max(-low, high) == pytest.approx(peak * 1.16, rel=0.1)
 
 
 def test_kick_baseline_and_gain_scale_are_said(recovers):
@@ -66,26 +76,20 @@ def test_kick_baseline_and_gain_scale_are_said(recovers):
     baseline = recovers.summary["steady_state"]["yaw_rate_rad_s"]
     title = plotting.result_title(recovers)
     fig = plotting.response_figure([("", recovers)], kick=(0.0, 0.15), title=title)
-    try:
-        texts = _texts(fig)
-        assert any(t.strip() == "kick (150 ms)" for t in texts)
-        assert any("steady turn before the kick" in t and f"{baseline:.3f} rad/s" in t for t in texts)
-        lines = [line for line in fig.axes[0].lines if line.get_gid() == "baseline"]
-        assert len(lines) == 1 and tuple(lines[0].get_ydata()) == (baseline, baseline)
-        assert not any(line.get_gid() == "fall" for ax in fig.axes for line in ax.lines)
-        assert "gains scaled by 1" in fig._suptitle.get_text()
-        assert " x1" not in fig._suptitle.get_text()
-    finally:
-        plt.close(fig)
+    texts = _texts(fig)
+    assert any(t.strip() == "kick (150 ms)" for t in texts)
+    assert any("steady turn before the kick" in t and f"{baseline:.3f} rad/s" in t for t in texts)
+    lines = [line for line in fig.axes[0].lines if line.get_gid() == "baseline"]
+    assert len(lines) == 1 and tuple(lines[0].get_ydata()) == (baseline, baseline)
+    assert not any(line.get_gid() == "fall" for ax in fig.axes for line in ax.lines)
+    assert "gains scaled by 1" in fig._suptitle.get_text()
+    assert " x1" not in fig._suptitle.get_text()
 
 
 def test_several_runs_name_their_fall_in_the_legend(fall, recovers):
     fig = plotting.response_figure([("off", fall), ("lqr", recovers)], kick=(0.0, 0.15))
-    try:
-        labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
-        assert labels == [f"off (fell at {fall.summary['fall_time_s']:.3f} s)", "lqr"]
-    finally:
-        plt.close(fig)
+    labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert labels == [f"off (fell at {fall.summary['fall_time_s']:.3f} s)", "lqr"]
 
 
 def test_motion_limits_ignore_samples_after_half_the_fall_angle():
@@ -104,10 +108,7 @@ def test_upright_start_draws_the_steady_motion_as_the_baseline():
     st = result.summary["steady_state"]
     assert st["yaw_rate_rad_s"] == 0.0 and abs(st["yaw_rate_baseline_rad_s"]) > 0.01
     fig = plotting.response_figure([("", result)], kick=(0.0, 0.15))
-    try:
-        assert any("steady motion (the run starts upright)" in t and f"{st['yaw_rate_baseline_rad_s']:.3f}" in t
-                   for t in _texts(fig))
-        line, = [line for line in fig.axes[0].lines if line.get_gid() == "baseline"]
-        assert line.get_ydata()[0] == st["yaw_rate_baseline_rad_s"]
-    finally:
-        plt.close(fig)
+    assert any("steady motion (the run starts upright)" in t and f"{st['yaw_rate_baseline_rad_s']:.3f}" in t
+               for t in _texts(fig))
+    line, = [line for line in fig.axes[0].lines if line.get_gid() == "baseline"]
+    assert line.get_ydata()[0] == st["yaw_rate_baseline_rad_s"]

@@ -6,17 +6,24 @@ folder created with private permissions (0700) and refused if another user
 can write to it. Several processes may build the same entry at once: a file
 lock serialises the builders and each entry is written to a temporary name
 and renamed into place, so a reader never sees a half-written file.
+
+Nothing here imports SymPy: the cache key names the SymPy version the entry
+was generated with through :mod:`importlib.metadata`, so a warm run finds
+its entries without loading the derivation's libraries.
 """
 import contextlib
 import fcntl
+import functools
 import hashlib
+import importlib.metadata
+import importlib.util
 import os
 import pathlib
 import platform
 import stat
 import sys
 
-import sympy
+from . import fileio
 
 _PACKAGE_DIR = pathlib.Path(__file__).resolve().parent
 
@@ -59,9 +66,18 @@ def source_hash(module_names, extra=""):
     for name in sorted(module_names):
         digest.update(name.encode())
         digest.update((_PACKAGE_DIR / f"{name}.py").read_bytes())
-    digest.update(f"sympy {sympy.__version__}; python {sys.version_info[:2]}; "
+    digest.update(f"sympy {sympy_version()}; python {sys.version_info[:2]}; "
                   f"{platform.machine()}; {extra}".encode())
     return digest.hexdigest()[:20]
+
+
+@functools.lru_cache(maxsize=None)
+def sympy_version():
+    """Version of the installed SymPy, read from its metadata (SymPy itself is not imported)."""
+    try:
+        return importlib.metadata.version("sympy")
+    except importlib.metadata.PackageNotFoundError:   # pragma: no cover - sympy is a dependency
+        return "not installed"
 
 
 @contextlib.contextmanager
@@ -75,17 +91,6 @@ def locked(path):
     finally:
         fcntl.flock(fd, fcntl.LOCK_UN)
         os.close(fd)
-
-
-def write_atomic(path, data):
-    """Write bytes or text to ``path`` via a temporary file and an atomic rename."""
-    path = pathlib.Path(path)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    mode = "wb" if isinstance(data, bytes) else "w"
-    with open(tmp, mode) as fh:
-        fh.write(data)
-    os.chmod(tmp, 0o600)
-    os.replace(tmp, path)
 
 
 def check_private_file(path):
@@ -107,13 +112,16 @@ def build_once(name, build):
     if not path.exists():
         with locked(path):
             if not path.exists():
-                tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-                try:
+                with fileio.atomic_path(path, private=True) as tmp:
                     build(tmp)
-                    os.chmod(tmp, 0o600)
-                    os.replace(tmp, path)
-                finally:
-                    if tmp.exists():
-                        tmp.unlink()
     check_private_file(path)
     return path
+
+
+def load_module(path, module_name):
+    """Import a generated Python module (a cache entry) from ``path``."""
+    spec = importlib.util.spec_from_file_location(module_name, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[module_name] = module
+    spec.loader.exec_module(module)
+    return module

@@ -19,7 +19,7 @@ import functools
 import numpy as np
 from scipy.optimize import brentq
 
-from . import cache, codegen, kane
+from . import cache, kane
 from .symbols import CLASSIC_CONSTANTS
 
 COORDINATES = tuple(f"q{i}" for i in range(1, 9))
@@ -38,8 +38,8 @@ _STEP = 1e-30  # complex step; any tiny value works, there is no cancellation
 
 
 def _generate_source():
-    """Derive the classic model and return the NumPy module source."""
-    from . import derivation
+    """Derive the classic model and return the NumPy module source (the build side: SymPy)."""
+    from . import codegen, derivation
     eom = derivation.classic_equations()
     dyn = list(eom.q) + list(eom.u)
     q = [codegen.plain_symbol(s) for s in eom.q]
@@ -74,7 +74,7 @@ def generated():
     """The generated NumPy module of the classic model (built once, then cached)."""
     key = cache.source_hash(_SOURCES, extra=_LAYOUT)
     path = cache.build_once(f"classic_{key}.py", lambda tmp: tmp.write_text(_generate_source()))
-    return codegen.load_module(path, f"whipple_kick_generated_classic_{key}")
+    return cache.load_module(path, f"whipple_kick_generated_classic_{key}")
 
 
 def parameter_array(moore):

@@ -1,12 +1,9 @@
-"""Turning the symbolic equations into code: NumPy source (and C, see :mod:`.ccode`).
+"""Turning the symbolic equations into code (the build side): NumPy source; C is printed by :mod:`.slip_build`.
 
 The generated NumPy functions accept complex arrays as well as real ones,
 which is what lets :mod:`.classic` linearise by complex-step differentiation
 (derivatives exact to round-off, no step-size trade-off).
 """
-import importlib.util
-import sys
-
 import sympy as sm
 from sympy.printing.numpy import NumPyPrinter
 
@@ -80,13 +77,4 @@ def numpy_function(name, arguments, outputs, doc=""):
     return "\n".join(lines) + "\n"
 
 
-def load_module(path, module_name):
-    """Import a generated Python module from ``path``."""
-    spec = importlib.util.spec_from_file_location(module_name, path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[module_name] = module
-    spec.loader.exec_module(module)
-    return module
-
-
-__all__ = ["plain", "plain_symbol", "numpy_function", "load_module"]
+__all__ = ["plain", "plain_symbol", "numpy_function"]

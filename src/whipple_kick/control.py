@@ -7,22 +7,18 @@ law without the minus sign; with the signs of its Table 8.4 gains (kq4 < 0,
 kq7 > 0) only ``-K x`` stabilises, which ``tests/test_control.py`` proves on
 the linear and the nonlinear model.
 
-python-control is the solver, but importing it costs more than a second
-(it pulls in scipy.signal), so it is imported only when a design is really
-solved. :func:`cached_lqr_gains` keeps each design in the per-user cache
-(:mod:`.cache`), keyed by everything the result depends on, so a repeated
-design (every ``simulate`` run after the first) never imports it.
+The design solves the continuous algebraic Riccati equation with SciPy
+(``scipy.linalg.solve_continuous_are``, about 1 ms for the 4-state model):
+python-control costs more than a second to import and is not needed at run
+time. It stays the library of the control-analysis API
+(:meth:`whipple_kick.stability.LinearModel.state_space` returns a
+``control.StateSpace``) and the tests' oracle: ``control.lqr`` gives the
+same gains (``tests/test_control.py``).
 """
-import functools
-import hashlib
-import json
-import pathlib
-
 import numpy as np
 
-from . import cache, classic
+from . import classic
 from .errors import InputError, check_range
-from .symbols import CLASSIC_CONSTANTS
 
 GAIN_ORDER = ("kq4", "kq7", "ku4", "ku7")
 #: Gains of :func:`heading_lqr_gains`, whose state adds the yaw angle q3.
@@ -65,11 +61,17 @@ def lqr_gains(moore, speed=3.0, Q=None, R=1.0):
 
 
 def _solve_lqr(A, b, Qm, R):
-    """python-control's LQR for one input: (K as a flat array, closed-loop poles)."""
-    import control as ct   # slow import: only here, where a design is solved
+    """LQR for one input: (K as a flat array, closed-loop poles).
 
-    K, _, poles = ct.lqr(A, b, Qm, np.atleast_2d(float(R)))
-    return np.asarray(K).ravel(), np.asarray(poles)
+    ``K = R^-1 b^T P`` with ``P`` the stabilising solution of the continuous
+    algebraic Riccati equation ``A^T P + P A - P b R^-1 b^T P + Q = 0``.
+    """
+    from scipy.linalg import solve_continuous_are
+
+    Rm = np.atleast_2d(check_range("R", R, 0.0, None, "(weight)", low_open=True))
+    P = solve_continuous_are(A, b, Qm, Rm)
+    K = np.linalg.solve(Rm, b.T @ P)
+    return K.ravel(), np.linalg.eigvals(A - b @ K)
 
 
 def heading_state_space(moore, speed):
@@ -121,128 +123,25 @@ def _weight(Q, size=4):
     return Qm
 
 
-# ------------------------------------------------------------ cached designs
-
-#: Package modules the design depends on: this one, the linearisation and
-#: the generated classic model it evaluates (classic.generated's sources).
-_LQR_SOURCES = ("control", "classic", "kane", "benchmark", *classic._SOURCES)
-_LQR_LAYOUT = "lqr-v1"   # bump when the entry's contents change
-
-
-def _solver_versions():
-    """Versions of the numerical libraries the solution comes from (without importing python-control)."""
-    import importlib.metadata
-    import importlib.util
-    import scipy
-
-    try:
-        control_version = importlib.metadata.version("control")
-    except importlib.metadata.PackageNotFoundError:
-        control_version = "unknown"
-    slycot = importlib.util.find_spec("slycot") is not None   # python-control's lqr prefers it
-    return f"control {control_version}; slycot {slycot}; numpy {np.__version__}; scipy {scipy.__version__}"
-
-
-def _sources_key():
-    """Hash of the package sources and solver versions a design depends on.
-
-    Computed once per package folder and version reader (about 1.2 ms; a
-    sweep over 200 design speeds reads 200 entries), so pointing the cache
-    at another source tree or another reader still changes the key.
-    """
-    return _sources_key_for(cache._PACKAGE_DIR, _solver_versions)
-
-
-@functools.lru_cache(maxsize=8)
-def _sources_key_for(package_dir, versions):
-    # package_dir is the memo's key only: source_hash reads that same folder (cache._PACKAGE_DIR).
-    return cache.source_hash(_LQR_SOURCES, extra=versions())
-
-
-def lqr_cache_key(moore, speed=3.0, Q=None, R=1.0):
-    """(entry name, key material) of the cached design of :func:`cached_lqr_gains`.
-
-    The material lists exactly what :func:`lqr_gains` reads: the classic
-    model's parameters by name (``repr``, full float precision), the speed,
-    ``Q`` and ``R``, plus a hash of the package sources and the solver
-    library versions, so that a code or library change misses the cache.
-    """
-    material = {
-        "layout": _LQR_LAYOUT,
-        "sources": _sources_key(),
-        "parameters": {name: repr(float(moore[name])) for name in CLASSIC_CONSTANTS},
-        "speed": repr(float(speed)),
-        "Q": [[repr(float(v)) for v in row] for row in _weight(Q)],
-        "R": repr(float(R)),
-    }
-    text = json.dumps(material, sort_keys=True)
-    return f"lqr_{hashlib.sha256(text.encode()).hexdigest()[:24]}.json", material
-
-
-def _read_entry(path, material):
-    """(K, poles) from a cache entry, or None if it is unreadable, corrupt or for other inputs."""
-    try:
-        cache.check_private_file(path)
-        data = json.loads(pathlib.Path(path).read_text())
-        if data["key"] != material:
-            return None
-        K = np.array([float(v) for v in data["gains"]])
-        poles = np.array([complex(float(re), float(im)) for re, im in data["poles"]])
-    except (OSError, ValueError, KeyError, TypeError):
-        return None
-    if K.shape != (4,) or poles.shape != (4,) or not (np.isfinite(K).all() and np.isfinite(poles).all()):
-        return None
-    return K, poles
-
-
-def _entry_text(material, K, poles):
-    # json writes floats with repr, which reads back bit for bit.
-    return json.dumps({"key": material, "gains": [float(k) for k in K],
-                       "poles": [[float(p.real), float(p.imag)] for p in np.asarray(poles, dtype=complex)]},
-                      indent=1, allow_nan=False) + "\n"
-
-
-def cached_lqr_gains(moore, speed=3.0, Q=None, R=1.0):
-    """:func:`lqr_gains`, kept in the per-user cache between processes.
-
-    The first call for a design solves it with python-control and stores
-    the gains and closed-loop poles (JSON, exact float round trip) under a
-    hash of :func:`lqr_cache_key`; later calls, in any process, read them
-    back without importing python-control. An entry that cannot be read,
-    is corrupt or is not private to this user is solved again and replaced.
-    """
-    check_range("design speed", speed, 0.0, None, "m/s", low_open=True)
-    missing = [n for n in CLASSIC_CONSTANTS if n not in moore]
-    if missing:
-        return lqr_gains(moore, speed, Q, R)   # raises the InputError naming them
-    name, material = lqr_cache_key(moore, speed, Q, R)
-    solved = []
-
-    def build(tmp):
-        solved.append(lqr_gains(moore, speed, Q, R))
-        tmp.write_text(_entry_text(material, *solved[0]))
-
-    path = cache.cache_dir() / name   # a folder another user can write to is refused, as for generated code
-    try:
-        cache.build_once(name, build)
-    except OSError:
-        pass   # e.g. an entry another user could have written (PermissionError): replaced below
-    if solved:
-        return solved[0]
-    entry = _read_entry(path, material)
-    if entry is None:
-        entry = lqr_gains(moore, speed, Q, R)
-        try:
-            with cache.locked(path):
-                cache.write_atomic(path, _entry_text(material, *entry))
-        except OSError:
-            pass   # the design is right; the next process solves it again
-    return entry
-
-
 def gains_dict(K, scale=1.0):
-    """Gains by name (``kq4 kq7 ku4 ku7``) from an array, scaled by ``scale``."""
-    return {name: float(scale * k) for name, k in zip(GAIN_ORDER, np.ravel(K))}
+    """Gains by name (``kq4 kq7 ku4 ku7``) from an array of exactly four, scaled by ``scale``.
+
+    Raises
+    ------
+    InputError
+        ``K`` does not hold exactly four gains (a 5-gain heading design is
+        :data:`HEADING_GAIN_ORDER`: name it with ``dict(zip(HEADING_GAIN_ORDER, K))``).
+
+    Example
+    -------
+    >>> gains_dict([-12.0, 9.0, -4.0, 1.0], scale=0.5)
+    {'kq4': -6.0, 'kq7': 4.5, 'ku4': -2.0, 'ku7': 0.5}
+    """
+    values = np.ravel(K)
+    if values.size != len(GAIN_ORDER):
+        raise InputError(f"gains_dict needs exactly {len(GAIN_ORDER)} gains ({', '.join(GAIN_ORDER)}), "
+                         f"got {values.size}")
+    return {name: float(scale * k) for name, k in zip(GAIN_ORDER, values, strict=True)}
 
 
 def thesis_gains(rear_load_n):

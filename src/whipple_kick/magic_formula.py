@@ -3,7 +3,9 @@
 Everything tyre-related in the project comes from the expressions built here:
 the compiled model prints them to C, :mod:`whipple_kick.tyres` evaluates them
 with NumPy through :func:`sympy.lambdify`. Nothing else re-implements the
-formula.
+formula. SymPy is imported by the functions that build expressions, not by
+the module: the runtime needs only the coefficient layout (counts, offset
+and camber-odd indices, :func:`camber_reversed`).
 
 Two conventions meet in this module:
 
@@ -55,7 +57,6 @@ by a term of second order in Sh (well below 1 % for the thesis data).
 import functools
 
 import numpy as np
-import sympy as sm
 
 __all__ = [
     "N_FY_COEFFICIENTS", "N_MZ_COEFFICIENTS", "FY_OFFSET_INDICES", "MZ_OFFSET_INDICES",
@@ -85,12 +86,14 @@ MZ_OFFSET_INDICES = (12, 13, 16, 17)
 FY_CAMBER_ODD_INDICES = (8, 11)
 MZ_CAMBER_ODD_INDICES = (11, 14, 15)
 
-_DEG_PER_RAD = sm.S(180) / sm.pi
-_N_PER_KN = sm.S(1000)
+#: Degrees per radian and newtons per kilonewton, exact (SymPy: 180/pi and 1000).
+_DEG_PER_RAD_TEXT, _N_PER_KN = "180/pi", 1000
 
 
 def _coefficients(values, count, name):
     """Return ``values`` as a list of sympified coefficients, checking the count."""
+    import sympy as sm
+
     values = list(values)
     if len(values) != count:
         raise ValueError(f"{name} needs {count} coefficients, got {len(values)}")
@@ -114,6 +117,8 @@ def lateral_force_factors(gamma_deg, fz_kn, a):
     dict
         ``B`` (1/deg), ``C``, ``D`` (N), ``E``, ``Sh`` (deg), ``Sv`` (N).
     """
+    import sympy as sm
+
     a = _coefficients(a, N_FY_COEFFICIENTS, "lateral force")
     g, fz = sm.sympify(gamma_deg), sm.sympify(fz_kn)
     c_factor = a[0]
@@ -135,6 +140,8 @@ def aligning_moment_factors(gamma_deg, fz_kn, c):
     Same units as :func:`lateral_force_factors` with D and Sv in N m;
     ``c`` holds the 18 coefficients c0..c17.
     """
+    import sympy as sm
+
     c = _coefficients(c, N_MZ_COEFFICIENTS, "aligning moment")
     g, fz = sm.sympify(gamma_deg), sm.sympify(fz_kn)
     c_factor = c[0]
@@ -188,6 +195,8 @@ def camber_reversed(coefficients, kind):
 
 def _scale_friction(factors, friction_scale):
     """Return factors with D -> k*D and B -> B/k (stiffness B*C*D kept)."""
+    import sympy as sm
+
     k = sm.sympify(friction_scale)
     scaled = dict(factors)
     scaled["D"] = k * factors["D"]
@@ -197,6 +206,8 @@ def _scale_friction(factors, friction_scale):
 
 def _curve(alpha_deg, factors):
     """The Magic Formula curve itself, y(alpha) for given factors."""
+    import sympy as sm
+
     b, c, d, e = factors["B"], factors["C"], factors["D"], factors["E"]
     bx = b * (sm.sympify(alpha_deg) + factors["Sh"])
     return d * sm.sin(c * sm.atan(bx - e * (bx - sm.atan(bx)))) + factors["Sv"]
@@ -217,14 +228,19 @@ def _formula_inputs(slip_rad, camber_rad, fz_n):
 
     This is the single place where the camber sign flips (see module notes).
     """
-    alpha_deg = sm.sympify(slip_rad) * _DEG_PER_RAD
-    gamma_deg = -sm.sympify(camber_rad) * _DEG_PER_RAD
-    fz_kn = sm.sympify(fz_n) / _N_PER_KN
+    import sympy as sm
+
+    deg_per_rad = sm.sympify(_DEG_PER_RAD_TEXT)
+    alpha_deg = sm.sympify(slip_rad) * deg_per_rad
+    gamma_deg = -sm.sympify(camber_rad) * deg_per_rad
+    fz_kn = sm.sympify(fz_n) / sm.Integer(_N_PER_KN)
     return alpha_deg, gamma_deg, fz_kn
 
 
 def _loaded_only(expr, fz_n):
     """``expr`` where the tyre is loaded (fz_n > 0), exactly 0 otherwise."""
+    import sympy as sm
+
     fz_n = sm.sympify(fz_n)
     if fz_n.is_number:
         # A number needs no Piecewise; and building the formula at Fz = 0
@@ -269,6 +285,8 @@ def offset_fade(fz_n):
     >>> float(offset_fade(0.0)), float(offset_fade(50.0)), float(offset_fade(635.0))
     (0.0, 0.5, 1.0)
     """
+    import sympy as sm
+
     fz_n = sm.sympify(fz_n)
     s = fz_n / sm.Float(OFFSET_FADE_LOAD)
     smooth = s**2 * (3 - 2 * s)
@@ -330,6 +348,8 @@ def cornering_stiffness_model(fz_n, a, friction_scale=1):
     7.2-7.7, there in N/deg): in the model convention the force opposes the
     slip, ``F_y ~ -C_alpha * slip``. Exactly 0 for ``fz_n <= 0``.
     """
+    import sympy as sm
+
     slip = sm.Dummy("slip")
     # Differentiate the model expression itself, so the sign mapping is not
     # restated here: C_alpha = -dF_y,model/dslip.
@@ -373,6 +393,8 @@ def lateral_secant_model(slip_rad, fz_n, a, friction_scale=1):
         blended: the blended ratio is sum(w slope g) / sum(w slope));
         ``ratio`` = g [-].
     """
+    import sympy as sm
+
     a = _coefficients(a, N_FY_COEFFICIENTS, "lateral force")
     alpha, _, fz_kn = _formula_inputs(slip_rad, 0, fz_n)
     factors = _scale_friction(lateral_force_factors(0, fz_kn, a), friction_scale)
@@ -387,32 +409,34 @@ def lateral_secant_model(slip_rad, fz_n, a, friction_scale=1):
 # ---------------------------------------------------------------------------
 # NumPy evaluation, generated from the expressions above (built once, cached).
 
-_SLIP, _CAMBER, _FZ, _SCALE = sm.symbols("slip camber fz friction_scale", real=True)
-_A = sm.symbols(f"a0:{N_FY_COEFFICIENTS}", real=True)
-_C = sm.symbols(f"c0:{N_MZ_COEFFICIENTS}", real=True)
 _FACTOR_NAMES = ("B", "C", "D", "E", "Sh", "Sv")
 
 
 @functools.lru_cache(maxsize=None)
 def _numpy_function(which):
     """Lambdify one of the model expressions (cached: built on first use)."""
+    import sympy as sm
+
+    slip, camber, fz, scale = sm.symbols("slip camber fz friction_scale", real=True)
+    a = sm.symbols(f"a0:{N_FY_COEFFICIENTS}", real=True)
+    c = sm.symbols(f"c0:{N_MZ_COEFFICIENTS}", real=True)
     if which == "fy":
-        expr = lateral_force_model(_SLIP, _CAMBER, _FZ, _A, _SCALE)
-        args = (_SLIP, _CAMBER, _FZ, _SCALE, *_A)
+        expr = lateral_force_model(slip, camber, fz, a, scale)
+        args = (slip, camber, fz, scale, *a)
     elif which == "mz":
-        expr = aligning_moment_model(_SLIP, _CAMBER, _FZ, _C, _SCALE)
-        args = (_SLIP, _CAMBER, _FZ, _SCALE, *_C)
+        expr = aligning_moment_model(slip, camber, fz, c, scale)
+        args = (slip, camber, fz, scale, *c)
     elif which == "stiffness":
-        expr = cornering_stiffness_model(_FZ, _A, _SCALE)
-        args = (_FZ, _SCALE, *_A)
+        expr = cornering_stiffness_model(fz, a, scale)
+        args = (fz, scale, *a)
     elif which == "secant":
-        expr = list(lateral_secant_model(_SLIP, _FZ, _A, _SCALE))
-        args = (_SLIP, _FZ, _SCALE, *_A)
+        expr = list(lateral_secant_model(slip, fz, a, scale))
+        args = (slip, fz, scale, *a)
     elif which == "fy_factors":
-        _, gamma_deg, fz_kn = _formula_inputs(0, _CAMBER, _FZ)
-        factors = _scale_friction(lateral_force_factors(gamma_deg, fz_kn, _A), _SCALE)
+        _, gamma_deg, fz_kn = _formula_inputs(0, camber, fz)
+        factors = _scale_friction(lateral_force_factors(gamma_deg, fz_kn, a), scale)
         expr = [factors[key] for key in _FACTOR_NAMES]
-        args = (_CAMBER, _FZ, _SCALE, *_A)
+        args = (camber, fz, scale, *a)
     else:  # pragma: no cover - internal misuse
         raise KeyError(which)
     return sm.lambdify(args, expr, modules="numpy")

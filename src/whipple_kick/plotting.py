@@ -8,17 +8,13 @@ band is labelled, a fall is marked by a vertical line and "fell at t s",
 the axis limits come from the motion before the fall (a falling bicycle's
 last few tenths of a second would otherwise stretch them 50-fold), and the
 yaw-rate baseline (the steady turn before the kick) is drawn and named.
-Matplotlib's non-interactive Agg backend is used, so plotting works without
-a display.
+Figures are :class:`matplotlib.figure.Figure` objects drawn on their own Agg
+canvas, without pyplot: plotting works without a display and leaves the
+global backend (and a user's interactive session) alone.
 """
 import math
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import matplotlib.transforms as mtransforms  # noqa: E402
-import numpy as np  # noqa: E402
+import numpy as np
 
 #: (column, axis label) of the four panels, top to bottom.
 RESPONSE_PANELS = (
@@ -104,7 +100,7 @@ def response_figure(runs, path=None, title=None, kick=None, time_range=None, dpi
         ``time`` [s] and ``roll`` [rad]. A Result's fall and steady turn are
         marked.
     path : str or pathlib.Path, optional
-        Write a PNG there (and close the figure).
+        Write a PNG there.
     title : str, optional
         Figure title.
     kick : (float, float), optional
@@ -127,7 +123,13 @@ def response_figure(runs, path=None, title=None, kick=None, time_range=None, dpi
     >>> [t.get_text() for t in fig.axes[0].texts if t.get_text().startswith("fell")]
     ['fell at 1.345 s']
     """
-    fig, axes = plt.subplots(len(RESPONSE_PANELS), 1, sharex=True, figsize=(8.0, 9.0))
+    import matplotlib.transforms as mtransforms
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(8.0, 9.0))
+    FigureCanvasAgg(fig)   # its own canvas: no pyplot, no global backend
+    axes = fig.subplots(len(RESPONSE_PANELS), 1, sharex=True)
     limits = {column: [] for column, _ in RESPONSE_PANELS}
     baselines = []
     for k, (label, run) in enumerate(runs):
@@ -180,7 +182,6 @@ def response_figure(runs, path=None, title=None, kick=None, time_range=None, dpi
     if path is None:
         return fig
     fig.savefig(path, dpi=dpi)
-    plt.close(fig)
     return None
 
 

@@ -945,9 +945,9 @@ def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia
 
 @functools.lru_cache(maxsize=256)
 def _lqr(design_items, speed):
-    # In front of the on-disk cache, which spares later processes python-control's import.
+    # A sweep over pressures or kicks designs the same rider once per process.
     from . import control
-    K, poles = control.cached_lqr_gains(dict(design_items), speed)
+    K, poles = control.lqr_gains(dict(design_items), speed)
     return tuple(np.ravel(K)), tuple(np.ravel(poles))
 
 
@@ -1266,7 +1266,7 @@ def _clean(value):
 def model_hash():
     """Content hash of the compiled slip model in use (from its library file name)."""
     from . import slip
-    return pathlib.Path(slip.library()._name).stem
+    return slip.library_path().stem
 
 
 def run(scenario, *, tyres=None, gains=None):

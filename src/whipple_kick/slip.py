@@ -1,18 +1,14 @@
-"""The slip model as compiled C: one call per right-hand-side evaluation.
+"""The slip model at run time: the compiled C right-hand side, its parameters, steady motion and linearisation.
 
-The symbolic equations of :func:`whipple_kick.derivation.slip_equations` are
-printed twice from the same expression lists: to C (with common
-subexpressions eliminated, compiled with the system C compiler and loaded
-with ctypes) and to NumPy (the test oracle and speed baseline). The C
-function does everything for one evaluation: the kick-plate profile, the
-constraint matrix and the dependent speeds, slip and camber, normal forces,
+The C library is built from the symbolic equations by :mod:`whipple_kick.slip_build`
+on a cache miss (once per version); this module only loads it (ctypes) with
+the plain-data metadata written beside it, so a warm run imports neither
+SymPy nor the derivation. One C call evaluates the right-hand side: the
+kick-plate profile, the dependent speeds, slip and camber, normal forces,
 the tyre block of the active transient form (:mod:`whipple_kick.transient`,
-chosen by the ``tyre_transient`` parameter: only its branch runs), the steer
-controller, Kane's equations and their reduction by pivoted LU, and the
-rates of the energy quadratures (:mod:`whipple_kick.energy`). The
-Magic-Formula curves are C functions that skip a pressure-blend set of
-weight 0; the named outputs (:data:`OUTPUT_NAMES`) are computed only when
-asked for.
+the ``tyre_transient`` parameter), the steer controller, Kane's equations
+and the rates of the energy quadratures (:mod:`whipple_kick.energy`); the
+named outputs (:data:`OUTPUTS`) only when asked for.
 
 State vector layout (by name, see :data:`STATE_NAMES`): q1..q10, the
 independent speeds u1 u2 u3 u4 u7 u9 u10, four tyre states in fixed slots
@@ -22,16 +18,14 @@ and the quadratures of :data:`whipple_kick.energy.QUADRATURE_STATES`.
 """
 import ctypes
 import functools
+import json
 import math
 import os
 import shutil
-import subprocess
 
 import numpy as np
-import sympy as sm
-from sympy.printing.c import C99CodePrinter
 
-from . import cache, codegen, energy, kane, magic_formula, transient
+from . import cache, energy, kane, magic_formula, transient
 from . import symbols as S
 from .errors import InputError
 
@@ -47,35 +41,47 @@ QUADRATURE_STATES = energy.QUADRATURE_STATES
 #: States integrated for the dynamics; the quadratures follow them.
 DYNAMIC_STATES = COORDINATES + INDEPENDENT + PATCH_STATES
 STATE_NAMES = DYNAMIC_STATES + QUADRATURE_STATES
-#: Per-evaluation outputs written by the C function when asked (by name):
-#: all speeds, plate motion, kinematic slip (atan(vsy/|vx|)) and wheel camber,
-#: rolling speeds, normal forces, the steady curves at that slip and camber,
-#: the steer torque, energies, the front contact height, the tyres' sliding
-#: power F vsy, the applied forces and moments, the relaxation lengths in use.
-OUTPUT_NAMES = SPEEDS + (
-    "yp", "vp", "ap", "slip_r", "slip_f", "camber_r", "camber_f", "vx_r", "vx_f",
-    "fz_r", "fz_f", "fy_ss_r", "fy_ss_f", "mz_ss_r", "mz_ss_f", "T7",
-    "kinetic_energy", "potential_energy", "spring_energy", "holonomic", "sliding_power",
-    "fy_r", "fy_f", "mz_r", "mz_f", "sigma_r", "sigma_f",
-)
+#: Named outputs the C function writes when asked, after all ten speeds: name -> (unit, what it is).
+OUTPUTS = {
+    "yp": ("m", "kick-plate lateral displacement along N.y"),
+    "vp": ("m/s", "kick-plate lateral velocity"),
+    "ap": ("m/s^2", "kick-plate lateral acceleration"),
+    "slip_r": ("rad", "rear kinematic slip angle atan(vsy/|vx|), + = contact sliding right"),
+    "slip_f": ("rad", "front kinematic slip angle atan(vsy/|vx|), + = contact sliding right"),
+    "camber_r": ("rad", "rear wheel camber, + = top leaning right"),
+    "camber_f": ("rad", "front wheel camber, + = top leaning right"),
+    "vx_r": ("m/s", "rear wheel rolling speed relative to the plate, along its heading"),
+    "vx_f": ("m/s", "front wheel rolling speed along its heading"),
+    "fz_r": ("N", "rear tyre normal force"),
+    "fz_f": ("N", "front tyre normal force"),
+    "fy_ss_r": ("N", "rear steady lateral force at the kinematic slip and camber"),
+    "fy_ss_f": ("N", "front steady lateral force at the kinematic slip and camber"),
+    "mz_ss_r": ("N m", "rear steady aligning moment at the kinematic slip and camber"),
+    "mz_ss_f": ("N m", "front steady aligning moment at the kinematic slip and camber"),
+    "T7": ("N m", "steer torque of the rider's control law"),
+    "kinetic_energy": ("J", "kinetic energy of the bicycle and rider"),
+    "potential_energy": ("J", "gravitational potential energy"),
+    "spring_energy": ("J", "energy stored in the vertical tyre springs"),
+    "holonomic": ("m", "front contact height above the ground (the holonomic constraint's residual)"),
+    "sliding_power": ("W", "power of the tyres' lateral forces on the contacts' sliding, F vsy"),
+    "fy_r": ("N", "lateral force the rear tyre applies to the bicycle"),
+    "fy_f": ("N", "lateral force the front tyre applies to the bicycle"),
+    "mz_r": ("N m", "aligning moment the rear tyre applies to the bicycle"),
+    "mz_f": ("N m", "aligning moment the front tyre applies to the bicycle"),
+    "sigma_r": ("m", "rear relaxation length in use"),
+    "sigma_f": ("m", "front relaxation length in use"),
+}
+#: Every output by position: the ten speeds (dependent ones included), then :data:`OUTPUTS`.
+OUTPUT_NAMES = SPEEDS + tuple(OUTPUTS)
 PARAMETER_NAMES = S.SLIP_CONSTANTS
 X = {n: i for i, n in enumerate(STATE_NAMES)}
-X.update({n: X[m] for n, m in zip(TYRE_STATES, PATCH_STATES)})
+X.update({n: X[m] for n, m in zip(TYRE_STATES, PATCH_STATES, strict=True)})
 OUT = {n: i for i, n in enumerate(OUTPUT_NAMES)}
 P = {n: i for i, n in enumerate(PARAMETER_NAMES)}
 
-_SOURCES = ("symbols", "derivation", "codegen", "magic_formula", "transient", "energy", "slip")
+#: Package modules the compiled library is generated from (its cache key hashes them).
+_SOURCES = ("symbols", "derivation", "codegen", "magic_formula", "transient", "energy", "slip", "slip_build")
 _PARTITION = kane.ConstraintPartition(SPEEDS, DEPENDENT)
-#: Tyre-block inputs computed with Kane's terms (plain symbols, registered in :mod:`symbols`).
-_KINEMATICS = ("vsy_r", "vsy_f", "vx_r", "vx_f", "camber_r", "camber_f", "fz_r", "fz_f",
-               "vplate_r", "wz_r", "wz_f", "T7")
-_APPLIED = ("Fy_r", "Fy_f", "Mz_r", "Mz_f")
-#: What each tyre block returns, in order (beyond the applied loads): the four
-#: state rates, then the form-dependent quadrature rates and relaxation lengths.
-_BLOCK_EXTRAS = ("W0", "D_slide", "P_carcass_r", "P_carcass_f", "sigma_r", "sigma_f")
-#: Output names the C code copies from the tyre block rather than computing.
-_BLOCK_OUTPUTS = {"fy_r": "Fy_r", "fy_f": "Fy_f", "mz_r": "Mz_r", "mz_f": "Mz_f",
-                  "sigma_r": "sigma_r", "sigma_f": "sigma_f"}
 
 
 def tyre_state_names(name=transient.DEFAULT_TRANSIENT):
@@ -87,408 +93,6 @@ def tyre_state_names(name=transient.DEFAULT_TRANSIENT):
 def state_names(name=transient.DEFAULT_TRANSIENT):
     """All state names (:data:`STATE_NAMES` layout) with the tyre slots named for the form ``name``."""
     return COORDINATES + INDEPENDENT + tyre_state_names(name) + QUADRATURE_STATES
-
-
-# ------------------------------------------------------------ tyre curves
-
-def _wheel_parameters(wheel, letter):
-    """(coefficient symbol lists of both sets, weight, friction scale, curve scale) of one wheel."""
-    sets = [list(S.syms([f"{letter}{wheel}{k}_{i}" for i in range(14 if letter == "a" else 18)])) for k in (1, 2)]
-    w, mu, lam = S.syms([f"w{wheel}", f"mu{wheel}", f"lam{wheel}"])
-    return sets, w, mu, lam
-
-
-def _set_curve(kind, wheel, k, slip, camber, fz):
-    """One coefficient set's raw steady curve (friction scale applied, no blend weight or curve scale)."""
-    mf = magic_formula
-    letter = "a" if kind == "fy" else "c"
-    sets, _, mu, _ = _wheel_parameters(wheel, letter)
-    builder = mf.lateral_force_model if kind == "fy" else mf.aligning_moment_model
-    return builder(slip, camber, fz, sets[k - 1], friction_scale=mu)
-
-
-def _set_secant(wheel, k, slip, fz):
-    """(slope, secant ratio) of one coefficient set (:func:`magic_formula.lateral_secant_model`)."""
-    sets, _, mu, _ = _wheel_parameters(wheel, "a")
-    return magic_formula.lateral_secant_model(slip, fz, sets[k - 1], friction_scale=mu)
-
-
-def _inline_curves():
-    """Curve builders giving full expressions (the NumPy oracle prints these)."""
-    def blend(kind):
-        def curve(wheel, slip, camber, fz):
-            _, w, _, lam = _wheel_parameters(wheel, "a")
-            return lam * ((1 - w) * _set_curve(kind, wheel, 1, slip, camber, fz)
-                          + w * _set_curve(kind, wheel, 2, slip, camber, fz))
-        return curve
-
-    def secant(wheel, slip, fz):
-        _, w, _, _ = _wheel_parameters(wheel, "a")
-        (c1, g1), (c2, g2) = _set_secant(wheel, 1, slip, fz), _set_secant(wheel, 2, slip, fz)
-        return ((1 - w) * c1 * g1 + w * c2 * g2) / ((1 - w) * c1 + w * c2)
-    return {"fy": blend("fy"), "mz": blend("mz"), "secant": secant}
-
-
-def _called_curves():
-    """Curve builders giving calls of the compiled curve functions (``wk_fy_r(...)``)."""
-    def call(kind):
-        return lambda wheel, *args: sm.Function(f"wk_{kind}_{wheel}")(*args)
-    return {"fy": call("fy"), "mz": call("mz"), "secant": call("sec")}
-
-
-# ---------------------------------------------------------------- expressions
-
-@functools.lru_cache(maxsize=None)
-def _expressions():
-    """Everything both printers need, as plain-symbol SymPy expressions.
-
-    Returns
-    -------
-    dict
-        ``stage1`` (constraint matrix and offset), ``stage2`` (mass matrix,
-        forcing without tyre loads ``f0``, its derivative ``G`` with respect
-        to the applied loads, acceleration remainder, tyre-block inputs),
-        ``blocks`` (per transient form and curve style), ``common`` (the
-        form-independent quadrature rates), ``outputs`` (named outputs by
-        name, the block's copies excluded), ``mass`` (the mass matrix alone)
-        and ``symbols``.
-    """
-    from . import derivation
-    eom = derivation.slip_equations()
-    dyn = list(eom.q) + list(eom.u)
-    t = sm.Symbol("t", real=True)
-    vp_s, ap_s = eom.inputs[:2]
-    applied = sm.Matrix(eom.inputs[2:])
-    ex = eom.extra
-    profile = {vp_s: ex["vp"], ap_s: ex["ap"]}
-
-    def plain(e):
-        return codegen.plain(sm.sympify(e) if not isinstance(e, sm.MatrixBase) else e, dyn).xreplace(profile)
-
-    forcing = plain(eom.forcing)
-    G = forcing.jacobian(applied)
-    if G.free_symbols & set(applied):
-        raise RuntimeError("Kane's forcing is not linear in the tyre loads")
-    f0 = forcing.xreplace({s: 0 for s in applied})
-    kin = {name: plain(ex[name]) for name in _KINEMATICS}
-    u = {f"u{i + 1}": codegen.plain_symbol(s) for i, s in enumerate(eom.u)}
-    sigma0 = {"r": S.sym("sigr"), "f": S.sym("sigf")}
-    blocks = {style: {name: transient.tyre_block(name, curves(), sigma0) for name in transient.TRANSIENTS}
-              for style, curves in (("inline", _inline_curves), ("called", _called_curves))}
-    common = {k: plain(v) for k, v in energy.common_rates(ex, u, S.sym("T6c")).items()}
-    k_sym = {name: S.sym(name) for name in _KINEMATICS + _APPLIED}
-    slip = {w: sm.atan2(k_sym[f"vsy_{w}"], sm.Abs(k_sym[f"vx_{w}"])) for w in "rf"}
-    outputs = {name: plain(ex[name]) for name in ("yp", "vp", "ap")}
-    for w in "rf":
-        outputs[f"slip_{w}"] = slip[w]
-    for name in ("camber_r", "camber_f", "vx_r", "vx_f", "fz_r", "fz_f"):
-        outputs[name] = k_sym[name]
-    for style in ("inline", "called"):
-        curves = (_inline_curves if style == "inline" else _called_curves)()
-        outputs[f"steady_{style}"] = {
-            f"{kind}_ss_{w}": curves[kind](w, slip[w], k_sym[f"camber_{w}"], k_sym[f"fz_{w}"])
-            for kind in ("fy", "mz") for w in "rf"}
-    outputs.update({
-        "T7": k_sym["T7"], "kinetic_energy": plain(eom.kinetic_energy),
-        "potential_energy": plain(eom.potential_energy), "spring_energy": plain(ex["spring_energy"]),
-        "holonomic": plain(eom.holonomic),
-        "sliding_power": k_sym["Fy_r"] * k_sym["vsy_r"] + k_sym["Fy_f"] * k_sym["vsy_f"],
-    })
-    return {
-        "stage1": {"A": plain(eom.constraint_matrix), "a0": plain(eom.constraint_offset)},
-        "stage2": {"M": plain(eom.mass_matrix), "f0": f0, "G": G, "b": plain(eom.constraint_accel),
-                   "kinematics": sm.Matrix([kin[n] for n in _KINEMATICS])},
-        "blocks": blocks, "common": common, "outputs": outputs,
-        "symbols": {
-            "t": t,
-            "q": [codegen.plain_symbol(s) for s in eom.q],
-            "u": [codegen.plain_symbol(s) for s in eom.u],
-            "s": {name: [sm.Symbol(n, real=True) for n in transient.STATES[name]] for name in transient.TRANSIENTS},
-            "p": list(S.syms(PARAMETER_NAMES)),
-            "kinematics": [k_sym[n] for n in _KINEMATICS],
-            "applied": [k_sym[n] for n in _APPLIED],
-        },
-    }
-
-
-def _block_list(block):
-    """A tyre block's expressions in the fixed order: applied loads, 4 rates, :data:`_BLOCK_EXTRAS`."""
-    return [block[n] for n in _APPLIED] + list(block["rates"]) + [block[n] for n in _BLOCK_EXTRAS]
-
-
-def _output_list(ex, style):
-    """Output expressions in :data:`OUTPUT_NAMES` order after the speeds, block copies as their symbols."""
-    steady = ex["outputs"][f"steady_{style}"]
-    out = []
-    for name in OUTPUT_NAMES[len(SPEEDS):]:
-        if name in _BLOCK_OUTPUTS:
-            out.append(sm.Symbol(_BLOCK_OUTPUTS[name], real=True))
-        else:
-            out.append(steady[name] if name in steady else ex["outputs"][name])
-    return out
-
-
-# --------------------------------------------------------------------------- C
-
-_C_HELPERS = r"""
-#include <math.h>
-#include <string.h>
-/* Not defined by strict C99 <math.h>; SymPy's printer uses them. */
-#ifndef M_PI
-#define M_PI 3.14159265358979323846
-#endif
-#ifndef M_1_PI
-#define M_1_PI 0.31830988618379067154
-#endif
-#ifndef M_PI_2
-#define M_PI_2 1.57079632679489661923
-#endif
-
-/* Solve A X = B in place by LU with partial pivoting. A is n x n, B is
-   n x m, both row-major. Returns 0 on success, 1 if A is singular. */
-static int lu_solve(int n, double *A, int m, double *B)
-{
-    for (int k = 0; k < n; k++) {
-        int piv = k;
-        double big = fabs(A[k * n + k]);
-        for (int i = k + 1; i < n; i++) {
-            double v = fabs(A[i * n + k]);
-            if (v > big) { big = v; piv = i; }
-        }
-        if (!(big > 0.0)) return 1;
-        if (piv != k) {
-            for (int j = 0; j < n; j++) { double tmp = A[k * n + j]; A[k * n + j] = A[piv * n + j]; A[piv * n + j] = tmp; }
-            for (int j = 0; j < m; j++) { double tmp = B[k * m + j]; B[k * m + j] = B[piv * m + j]; B[piv * m + j] = tmp; }
-        }
-        for (int i = k + 1; i < n; i++) {
-            double l = A[i * n + k] / A[k * n + k];
-            A[i * n + k] = l;
-            for (int j = k + 1; j < n; j++) A[i * n + j] -= l * A[k * n + j];
-            for (int j = 0; j < m; j++) B[i * m + j] -= l * B[k * m + j];
-        }
-    }
-    for (int i = n - 1; i >= 0; i--) {
-        for (int j = 0; j < m; j++) {
-            double s = B[i * m + j];
-            for (int k = i + 1; k < n; k++) s -= A[i * n + k] * B[k * m + j];
-            B[i * m + j] = s / A[i * n + i];
-        }
-    }
-    return 0;
-}
-"""
-
-
-class _Printer(C99CodePrinter):
-    """C printer: plain symbols print as their names (declared as locals); the
-    compiled curve functions ``wk_*`` get the parameter pointer ``p``."""
-
-    def _print_Symbol(self, expr):
-        return expr.name
-
-    def _print_Function(self, expr):
-        name = expr.func.__name__
-        if name.startswith("wk_"):
-            return f"{name}({', '.join(self._print(a) for a in expr.args)}, p)"
-        return super()._print_Function(expr)
-
-
-def _c_block(exprs, targets, indent="    "):
-    """C statements computing ``exprs`` (CSE'd) into the C lvalues ``targets``."""
-    printer = _Printer()
-    replacements, reduced = sm.cse(list(exprs), symbols=sm.numbered_symbols("x_"), order="none")
-    lines = [f"{indent}const double {lhs} = {printer.doprint(rhs)};" for lhs, rhs in replacements]
-    lines += [f"{indent}{target} = {printer.doprint(e)};" for target, e in zip(targets, reduced)]
-    return "\n".join(lines)
-
-
-def _parameter_locals(exprs, indent="    "):
-    """``const double name = p[i];`` for the parameters ``exprs`` use."""
-    used = set().union(*(sm.sympify(e).free_symbols for e in exprs))
-    return [f"{indent}const double {s.name} = p[{P[s.name]}];" for s in S.syms(PARAMETER_NAMES) if s in used]
-
-
-def _c_curve_functions():
-    """Static C functions of the Magic-Formula curves, per wheel; a set of weight 0 is skipped."""
-    slip, camber, fz = sm.symbols("slip camber fz", real=True)
-    lines = []
-    for wheel in "rf":
-        for kind in ("fy", "mz"):
-            for k in (1, 2):
-                e = _set_curve(kind, wheel, k, slip, camber, fz)
-                lines += [f"static double wk_{kind}_{wheel}_{k}(double slip, double camber, double fz, const double *p)",
-                          "{", *_parameter_locals([e]), "    double v;", _c_block([e], ["v"]), "    return v;", "}"]
-            lines += [f"static double wk_{kind}_{wheel}(double slip, double camber, double fz, const double *p)", "{",
-                      f"    const double w = p[{P['w' + wheel]}];",
-                      f"    double v = (1.0 - w) * wk_{kind}_{wheel}_1(slip, camber, fz, p);",
-                      f"    if (w != 0.0) v += w * wk_{kind}_{wheel}_2(slip, camber, fz, p);",
-                      f"    return p[{P['lam' + wheel]}] * v;", "}"]
-        for k in (1, 2):
-            slope, ratio = _set_secant(wheel, k, slip, fz)
-            lines += [f"static void wk_sec_{wheel}_{k}(double slip, double fz, const double *p, double *c0, double *g)",
-                      "{", *_parameter_locals([slope, ratio]), _c_block([slope, ratio], ["*c0", "*g"]), "}"]
-        lines += [f"static double wk_sec_{wheel}(double slip, double fz, const double *p)", "{",
-                  f"    const double w = p[{P['w' + wheel]}];",
-                  "    double c1, g1, c2, g2;",
-                  f"    wk_sec_{wheel}_1(slip, fz, p, &c1, &g1);",
-                  "    if (w == 0.0) return g1;",
-                  f"    wk_sec_{wheel}_2(slip, fz, p, &c2, &g2);",
-                  "    return ((1.0 - w) * c1 * g1 + w * c2 * g2) / ((1.0 - w) * c1 + w * c2);", "}"]
-    return lines
-
-
-def c_source():
-    """Full C source of the slip model: right-hand side, outputs, Jacobian, impulse terms."""
-    ex = _expressions()
-    sy = ex["symbols"]
-    n, m, k = len(SPEEDS), len(DEPENDENT), len(INDEPENDENT)
-    ns, nd, nq = len(STATE_NAMES), len(DYNAMIC_STATES), len(QUADRATURE_STATES)
-    nt = len(PATCH_STATES)
-    no = len(OUTPUT_NAMES) - n
-    dep = [SPEEDS.index(x) for x in DEPENDENT]
-    ind = [SPEEDS.index(x) for x in INDEPENDENT]
-    lines = [_C_HELPERS, "/* Generated by whipple_kick.slip; do not edit. */", *_c_curve_functions()]
-    lines += ["int wk_slip_rhs(double t, const double *x, const double *p, double *dx, double *out)", "{"]
-    for i, s in enumerate(sy["p"]):
-        lines.append(f"    const double {s.name} = p[{i}];")
-    for i, s in enumerate(sy["q"]):
-        lines.append(f"    const double {s.name} = x[{i}];")
-    for name in transient.TRANSIENTS:
-        for slot, s in enumerate(sy["s"][name]):
-            if name != "slip_lag":   # slip_lag shares contact_patch's names
-                lines.append(f"    const double {s.name} = x[{len(COORDINATES) + k + slot}];")
-    lines.append(f"    double A[{m * n}], a0[{m}];")
-    stage1 = ex["stage1"]
-    lines += ["    {", _c_block(list(stage1["A"]) + list(stage1["a0"]),
-                                 [f"A[{i}]" for i in range(m * n)] + [f"a0[{i}]" for i in range(m)], "        "), "    }"]
-    # Dependent speeds: A_dep u_dep = -(A_ind u_ind + a0).
-    lines.append(f"    double u[{n}];")
-    for j, idx in enumerate(ind):
-        lines.append(f"    u[{idx}] = x[{len(COORDINATES) + j}];")
-    lines.append(f"    double Adep[{m * m}], rhs1[{m * (k + 1)}];")
-    lines.append(f"    for (int i = 0; i < {m}; i++) {{")
-    lines.append("        double s = a0[i];")
-    for jj, idx in enumerate(dep):
-        lines.append(f"        Adep[i * {m} + {jj}] = A[i * {n} + {idx}];")
-    for jj, idx in enumerate(ind):
-        lines.append(f"        s += A[i * {n} + {idx}] * u[{idx}];")
-        lines.append(f"        rhs1[i * {k + 1} + {jj}] = A[i * {n} + {idx}];")
-    lines.append(f"        rhs1[i * {k + 1} + {k}] = -s;")
-    lines.append("    }")
-    # One LU of A_dep serves both the speeds (last column) and T (the rest).
-    lines.append(f"    if (lu_solve({m}, Adep, {k + 1}, rhs1)) return 1;")
-    for jj, idx in enumerate(dep):
-        lines.append(f"    u[{idx}] = rhs1[{jj} * {k + 1} + {k}];")
-    for i, s in enumerate(sy["u"]):
-        lines.append(f"    const double {s.name} = u[{i}];")
-    # Kane's terms and the tyre block's inputs in one CSE'd block.
-    st2 = ex["stage2"]
-    kin = [s.name for s in sy["kinematics"]]
-    lines.append(f"    double M[{n * n}], f[{n}], G[{n * 4}], b[{m}], {', '.join(kin)};")
-    lines += ["    {", _c_block(list(st2["M"]) + list(st2["f0"]) + list(st2["G"]) + list(st2["b"]) + list(st2["kinematics"]),
-                                 [f"M[{i}]" for i in range(n * n)] + [f"f[{i}]" for i in range(n)]
-                                 + [f"G[{i}]" for i in range(n * 4)] + [f"b[{i}]" for i in range(m)] + kin,
-                                 "        "), "    }"]
-    # The active transient form's tyre block (only its branch runs).
-    block_targets = list(_APPLIED) + [f"trate[{i}]" for i in range(nt)] + list(_BLOCK_EXTRAS)
-    lines.append(f"    double {', '.join(_APPLIED)}, trate[{nt}], {', '.join(_BLOCK_EXTRAS)};")
-    lines.append(f"    const int mode = (int)tyre_transient;")
-    for code, name in enumerate(transient.TRANSIENTS):
-        head = "if" if code == 0 else "else if"
-        cond = f"(mode == {code})" if code < len(transient.TRANSIENTS) - 1 else "(1)"
-        lines += [f"    {head} {cond} {{", _c_block(_block_list(ex["blocks"]["called"][name]), block_targets, "        "),
-                  "    }"]
-    lines.append(f"    for (int i = 0; i < {n}; i++) f[i] += G[i * 4] * Fy_r + G[i * 4 + 1] * Fy_f"
-                 " + G[i * 4 + 2] * Mz_r + G[i * 4 + 3] * Mz_f;")
-    # Kane's reduced equations: T = [I; C], C = -A_dep^-1 A_ind, t0 = [0; d], d = -A_dep^-1 b.
-    lines.append(f"    double T[{n * k}], t0[{n}], d[{m}];")
-    lines.append("    memset(T, 0, sizeof T); memset(t0, 0, sizeof t0);")
-    for jj, idx in enumerate(ind):
-        lines.append(f"    T[{idx} * {k} + {jj}] = 1.0;")
-    lines.append(f"    double Adep2[{m * m}], rhs2[{m}];")
-    lines.append(f"    for (int i = 0; i < {m}; i++) {{")
-    for jj, idx in enumerate(dep):
-        lines.append(f"        Adep2[i * {m} + {jj}] = A[i * {n} + {idx}];")
-    lines.append("        rhs2[i] = b[i];")
-    lines.append("    }")
-    lines.append(f"    if (lu_solve({m}, Adep2, 1, rhs2)) return 1;")
-    lines.append(f"    for (int i = 0; i < {m}; i++) d[i] = -rhs2[i];")
-    # rhs1 now holds A_dep^-1 A_ind in its first k columns.
-    for ii, idx in enumerate(dep):
-        lines.append(f"    for (int j = 0; j < {k}; j++) T[{idx} * {k} + j] = -rhs1[{ii} * {k + 1} + j];")
-        lines.append(f"    t0[{idx}] = d[{ii}];")
-    lines.append(f"    double MT[{n * k}], Mr[{k * k}], r[{k}];")
-    lines.append(f"    for (int i = 0; i < {n}; i++) for (int j = 0; j < {k}; j++) {{")
-    lines.append(f"        double s = 0.0; for (int l = 0; l < {n}; l++) s += M[i * {n} + l] * T[l * {k} + j]; MT[i * {k} + j] = s; }}")
-    lines.append(f"    for (int i = 0; i < {k}; i++) {{")
-    lines.append(f"        for (int j = 0; j < {k}; j++) {{ double s = 0.0; for (int l = 0; l < {n}; l++) s += T[l * {k} + i] * MT[l * {k} + j]; Mr[i * {k} + j] = s; }}")
-    lines.append("        double s = 0.0;")
-    lines.append(f"        for (int l = 0; l < {n}; l++) {{ double g = f[l]; for (int c = 0; c < {n}; c++) g -= M[l * {n} + c] * t0[c]; s += T[l * {k} + i] * g; }}")
-    lines.append("        r[i] = s;")
-    lines.append("    }")
-    lines.append(f"    if (lu_solve({k}, Mr, 1, r)) return 1;")
-    lines.append(f"    for (int i = 0; i < {n}; i++) dx[i] = u[i];")
-    lines.append(f"    for (int i = 0; i < {k}; i++) dx[{n} + i] = r[i];")
-    lines.append(f"    for (int i = 0; i < {nt}; i++) dx[{n + k} + i] = trate[i];")
-    # Quadrature rates: the form-independent ones, then the tyre block's.
-    q0 = nd
-    common = ex["common"]
-    lines += ["    {", _c_block([common[nm] for nm in ("W_plate", "W_steer", "W_wheel", "W_moment", "D_damper")],
-                                 [f"dx[{q0 + QUADRATURE_STATES.index(nm)}]"
-                                  for nm in ("W_plate", "W_steer", "W_wheel", "W_moment", "D_damper")], "        "),
-              "    }"]
-    for nm, local in (("W_zero_slip", "W0"), ("D_slide", "D_slide"), ("E_carcass_r", "P_carcass_r"),
-                      ("E_carcass_f", "P_carcass_f")):
-        lines.append(f"    dx[{q0 + QUADRATURE_STATES.index(nm)}] = {local};")
-    # Work of the rear no-slip constraint's force while the plate moves:
-    # u . (M du/dt - f) = -lambda . a0 (zero when a0 = 0, so skipped then).
-    lines.append(f"    if (a0[0] != 0.0 || a0[1] != 0.0 || a0[2] != 0.0) {{")
-    lines.append(f"        double ud[{n}], pc = 0.0;")
-    lines.append(f"        for (int i = 0; i < {n}; i++) {{ double s = t0[i]; for (int j = 0; j < {k}; j++) s += T[i * {k} + j] * r[j]; ud[i] = s; }}")
-    lines.append(f"        for (int i = 0; i < {n}; i++) {{ double s = -f[i]; for (int j = 0; j < {n}; j++) s += M[i * {n} + j] * ud[j]; pc += u[i] * s; }}")
-    lines.append(f"        dx[{q0 + QUADRATURE_STATES.index('W_plate')}] += pc;")
-    lines.append("    }")
-    lines.append("    if (out) {")
-    lines.append(f"        for (int i = 0; i < {n}; i++) out[i] = u[i];")
-    lines += ["        {", _c_block(_output_list(ex, "called"), [f"out[{n + i}]" for i in range(no)], "            "),
-              "        }"]
-    lines.append("    }")
-    lines.append(f"    for (int i = 0; i < {ns}; i++) if (!isfinite(dx[i])) return 2;")
-    lines.append("    return 0;")
-    lines.append("}")
-    # Outputs at many samples in one call (post-processing a trajectory).
-    lines += ["int wk_slip_outputs(int n, const double *t, const double *x, const double *p, double *out)", "{",
-              f"    double dx[{ns}];",
-              "    for (int i = 0; i < n; i++) {",
-              f"        int status = wk_slip_rhs(t[i], x + (long)i * {ns}, p, dx, out + (long)i * {len(OUTPUT_NAMES)});",
-              "        if (status) return status;", "    }", "    return 0;", "}"]
-    # Jacobian by forward differences over the dynamic states (the
-    # quadratures feed nothing back: their columns are exactly zero).
-    lines += ["int wk_slip_jacobian(double t, const double *x, const double *p, const double *scale, double *J)", "{",
-              f"    double f0[{ns}], f1[{ns}], xp[{ns}];",
-              "    int status = wk_slip_rhs(t, x, p, f0, 0);", "    if (status) return status;",
-              "    memcpy(xp, x, sizeof xp);",
-              f"    for (int j = 0; j < {ns}; j++) {{",
-              f"        if (j >= {nd}) {{ for (int i = 0; i < {ns}; i++) J[i * {ns} + j] = 0.0; continue; }}",
-              "        volatile double moved = x[j] + 1.4901161193847656e-08 * fmax(fabs(x[j]), scale[j]);",
-              "        const double h = moved - x[j];",
-              "        xp[j] = moved;",
-              "        status = wk_slip_rhs(t, xp, p, f1, 0);", "        if (status) return status;",
-              f"        for (int i = 0; i < {ns}; i++) J[i * {ns} + j] = (f1[i] - f0[i]) / h;",
-              "        xp[j] = x[j];", "    }", "    return 0;", "}"]
-    # Mass matrix, constraint matrix and offset (the plate stop's impulse).
-    mass = list(st2["M"])
-    lines += ["int wk_slip_impulse_terms(double t, const double *x, const double *p, double *M, double *A, double *a0)",
-              "{", *_parameter_locals(list(stage1["A"]) + list(stage1["a0"]) + mass)]
-    for i, s in enumerate(sy["q"]):
-        lines.append(f"    const double {s.name} = x[{i}];")
-    lines += ["    {", _c_block(list(stage1["A"]) + list(stage1["a0"]),
-                                 [f"A[{i}]" for i in range(m * n)] + [f"a0[{i}]" for i in range(m)], "        "), "    }",
-              "    {", _c_block(mass, [f"M[{i}]" for i in range(n * n)], "        "), "    }",
-              "    return 0;", "}"]
-    lines.append(f"int wk_slip_sizes(int *sizes) {{ sizes[0] = {ns}; sizes[1] = {len(PARAMETER_NAMES)}; "
-                 f"sizes[2] = {len(OUTPUT_NAMES)}; sizes[3] = {nd}; return 0; }}")
-    return "\n".join(lines) + "\n"
 
 
 def _compiler():
@@ -508,22 +112,53 @@ def _compiler():
 _CFLAGS = ("-O2", "-fPIC", "-shared", "-std=c99")
 
 
-@functools.lru_cache(maxsize=None)
-def library():
-    """Load (building and caching if needed) the compiled slip model."""
+def layout():
+    """The layouts the running code expects of the compiled library (as its metadata records them)."""
+    return {"states": list(STATE_NAMES), "parameters": list(PARAMETER_NAMES), "outputs": list(OUTPUT_NAMES),
+            "dynamic_states": len(DYNAMIC_STATES)}
+
+
+def _metadata_matches(path):
+    """Whether the metadata file at ``path`` exists, is private and records the running code's layouts."""
+    try:
+        cache.check_private_file(path)
+        return json.loads(path.read_text()).get("layout") == layout()
+    except (OSError, ValueError, AttributeError):
+        return False
+
+
+def library_path():
+    """Path of the compiled slip model in the cache, built first on a cache miss.
+
+    The cache entry is ``slip_<key>.so`` with its C source and plain-data
+    metadata (``slip_<key>.json``) beside it, the key hashing the package
+    sources it is generated from, the SymPy version, the compiler and its
+    flags. A miss runs :func:`whipple_kick.slip_build.build_library` (SymPy,
+    20-30 s, one line on stderr). An entry whose metadata is missing or
+    records other layouts (states, parameters, outputs) is built again.
+    """
     cc = _compiler()
     key = cache.source_hash(_SOURCES, extra=f"{os.path.basename(cc)} {' '.join(_CFLAGS)}")
+    name = f"slip_{key}.so"
 
-    def compile_to(tmp):
-        src_path = cache.cache_dir() / f"slip_{key}.c"
-        cache.write_atomic(src_path, c_source())   # kept next to the library for inspection
-        proc = subprocess.run([cc, *_CFLAGS, "-o", str(tmp), str(src_path), "-lm"],
-                              capture_output=True, text=True)
-        if proc.returncode != 0:
-            raise RuntimeError(f"compiling the slip model failed ({cc}):\n{proc.stderr[-4000:]}")
+    def build(tmp):
+        from . import slip_build   # SymPy and the derivation: only on a cache miss
+        slip_build.build_library(tmp, key, cc, _CFLAGS)
 
-    lib_path = cache.build_once(f"slip_{key}.so", compile_to)
-    lib = ctypes.CDLL(str(lib_path))
+    lib_path = cache.build_once(name, build)
+    if not _metadata_matches(lib_path.with_suffix(".json")):
+        with cache.locked(lib_path):
+            lib_path.unlink(missing_ok=True)
+        lib_path = cache.build_once(name, build)
+        if not _metadata_matches(lib_path.with_suffix(".json")):
+            raise RuntimeError(f"the compiled slip model {lib_path} has no matching metadata; remove the cache folder")
+    return lib_path
+
+
+@functools.lru_cache(maxsize=None)
+def library():
+    """The compiled slip model (ctypes library of :func:`library_path`), loaded once per process."""
+    lib = ctypes.CDLL(str(library_path()))
     pointer = ctypes.c_void_p
     lib.wk_slip_rhs.restype = ctypes.c_int
     lib.wk_slip_rhs.argtypes = [ctypes.c_double, pointer, pointer, pointer, pointer]
@@ -538,85 +173,6 @@ def library():
     if tuple(sizes) != (len(STATE_NAMES), len(PARAMETER_NAMES), len(OUTPUT_NAMES), len(DYNAMIC_STATES)):
         raise RuntimeError(f"compiled slip model has sizes {tuple(sizes)}; rebuild the cache")
     return lib
-
-
-# ----------------------------------------------------------------------- NumPy
-
-def numpy_source():
-    """NumPy module source of the same expressions (oracle and baseline)."""
-    ex = _expressions()
-    sy = ex["symbols"]
-    t = [sy["t"]]
-    st2 = ex["stage2"]
-    parts = [
-        '"""Generated by whipple_kick.slip (NumPy oracle); do not edit."""',
-        "import functools\nimport numpy",
-        codegen.numpy_function("stage1", [("t", t), ("q", sy["q"]), ("p", sy["p"])],
-                               [ex["stage1"]["A"], ex["stage1"]["a0"]], doc="Constraint matrix and offset."),
-        codegen.numpy_function("stage2", [("t", t), ("q", sy["q"]), ("u", sy["u"]), ("p", sy["p"])],
-                               [st2["M"], st2["f0"], st2["G"], st2["b"], st2["kinematics"]],
-                               doc="Mass matrix, forcing without tyre loads, its tyre-load derivative, "
-                                   "constraint remainder, tyre-block inputs."),
-    ]
-    for name in transient.TRANSIENTS:
-        parts.append(codegen.numpy_function(
-            f"tyre_{name}", [("t", t), ("k", sy["kinematics"]), ("s", sy["s"][name]), ("p", sy["p"])],
-            [sm.Matrix(_block_list(ex["blocks"]["inline"][name]))], doc=f"Tyre block of {name}."))
-    common = ex["common"]
-    parts.append(codegen.numpy_function(
-        "common", [("t", t), ("q", sy["q"]), ("u", sy["u"]), ("k", sy["kinematics"]), ("a", sy["applied"]),
-                   ("p", sy["p"])],
-        [sm.Matrix([common[nm] for nm in ("W_plate", "W_steer", "W_wheel", "W_moment", "D_damper")])],
-        doc="Form-independent quadrature rates."))
-    block_symbols = [sm.Symbol(n, real=True) for n in _BLOCK_EXTRAS]
-    parts.append(codegen.numpy_function(
-        "outputs", [("t", t), ("q", sy["q"]), ("u", sy["u"]), ("k", sy["kinematics"]), ("a", sy["applied"]),
-                    ("e", block_symbols), ("p", sy["p"])],
-        [sm.Matrix(_output_list(ex, "inline"))], doc="Named outputs after the speeds."))
-    return "\n\n".join(parts)
-
-
-@functools.lru_cache(maxsize=None)
-def numpy_module():
-    """The generated NumPy oracle module (cached like the C library)."""
-    key = cache.source_hash(_SOURCES, extra="numpy")
-    path = cache.build_once(f"slip_numpy_{key}.py", lambda tmp: tmp.write_text(numpy_source()))
-    return codegen.load_module(path, f"whipple_kick_generated_slip_{key}")
-
-
-def numpy_rhs(t, x, p, with_outputs=False):
-    """Right-hand side evaluated with NumPy (slow; the oracle for the C code)."""
-    mod = numpy_module()
-    nc, nk = len(COORDINATES), len(INDEPENDENT)
-    q = x[:nc]
-    u_ind = x[nc:nc + nk]
-    s = x[nc + nk:nc + nk + len(PATCH_STATES)]
-    name = transient.TRANSIENTS[int(p[P["tyre_transient"]])]
-    # numpy.select evaluates every branch of a Piecewise, including the
-    # unloaded-tyre branch's 0/0 that C never takes; the selected values are finite.
-    with np.errstate(invalid="ignore", divide="ignore"):
-        A, a0 = mod.stage1([t], q, p)
-        u = _PARTITION.dependent_speeds(A, a0, u_ind)
-        M, f0, G, b, kin = mod.stage2([t], q, u, p)
-        block = getattr(mod, f"tyre_{name}")([t], kin, s, p)[0]
-        applied = block[:4]
-        f = f0 + G @ applied
-        udot = _PARTITION.accelerations(M, f, A, b)
-        rates = np.zeros(len(QUADRATURE_STATES))
-        common = mod.common([t], q, u, kin, applied, p)[0]
-        for value, nm in zip(common, ("W_plate", "W_steer", "W_wheel", "W_moment", "D_damper")):
-            rates[QUADRATURE_STATES.index(nm)] = value
-        extras = dict(zip(_BLOCK_EXTRAS, block[8:]))
-        for nm, local in (("W_zero_slip", "W0"), ("D_slide", "D_slide"), ("E_carcass_r", "P_carcass_r"),
-                          ("E_carcass_f", "P_carcass_f")):
-            rates[QUADRATURE_STATES.index(nm)] = extras[local]
-        if np.any(a0 != 0.0):
-            rates[QUADRATURE_STATES.index("W_plate")] += kane.constraint_power(M, f, u, udot)
-        dx = np.concatenate([u, udot[_PARTITION.ind], block[4:8], rates])
-        if with_outputs:
-            outputs = mod.outputs([t], q, u, kin, applied, block[8:], p)[0]
-            return dx, np.concatenate([u, outputs])
-    return dx
 
 
 # ------------------------------------------------------------------- interface

@@ -40,7 +40,7 @@ import math
 
 import numpy as np
 
-from . import simulation, slip
+from . import fileio, simulation, slip
 from .errors import InputError, check_range
 
 #: Loops analysed: without rider control, and with the scenario's rider.
@@ -1659,9 +1659,9 @@ def write(result, out, plot=True):
     import json
     import pathlib
     out = pathlib.Path(out)
-    result.eigenvalues.to_csv(out / "eigenvalues.csv", index=False, lineterminator="\n")
+    fileio.write_csv(result.eigenvalues, out / "eigenvalues.csv")
     summary = simulation._clean(result.summary)
-    (out / "summary.json").write_text(json.dumps(summary, indent=2, allow_nan=False) + "\n")
+    fileio.write_atomic(out / "summary.json", json.dumps(summary, indent=2, allow_nan=False) + "\n")
     files = ["eigenvalues.csv", "summary.json"]
     if plot:
         figure(result, out / "stability.png", title=result.summary.get("title"))

@@ -35,7 +35,7 @@ import time
 
 import numpy as np
 
-from . import simulation
+from . import fileio, simulation
 from .errors import InputError, check_range
 
 #: Files of a sweep folder.
@@ -334,12 +334,6 @@ def _versions():
     return out
 
 
-def _write_atomic(path, text):
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    tmp.write_text(text)
-    os.replace(tmp, path)
-
-
 def read_log(folder):
     """Records of a sweep folder by case id (the last record of a case wins).
 
@@ -382,12 +376,11 @@ def load_trajectory(folder, case_id):
 
 
 def _save_trajectory(folder, record):
-    path = trajectory_path(folder, record["case_id"])
-    tmp = path.with_name(f".{path.stem}.{os.getpid()}.tmp.npz")
     traj = record["trajectory"]
-    np.savez_compressed(tmp, columns=np.array(list(traj)), summary_json=np.array(record["summary"]),
-                        **traj)
-    os.replace(tmp, path)   # a file under its final name is always complete
+    # A file under its final name is always complete; savez wants a name ending in .npz.
+    with fileio.atomic_path(trajectory_path(folder, record["case_id"])) as tmp:
+        with open(tmp, "wb") as fh:
+            np.savez_compressed(fh, columns=np.array(list(traj)), summary_json=np.array(record["summary"]), **traj)
 
 
 def _table(case_list, records):
@@ -466,7 +459,7 @@ class _Folder:
 
     def write_manifest(self, status, **counts):
         self.manifest.update(status=status, updated=_now(), **counts)
-        _write_atomic(self.path / MANIFEST_FILE, json.dumps(self.manifest, indent=1, allow_nan=False) + "\n")
+        fileio.write_atomic(self.path / MANIFEST_FILE, json.dumps(self.manifest, indent=1, allow_nan=False) + "\n")
 
     def add(self, record):
         """Save one finished case: trajectory first, then its log line."""
@@ -486,9 +479,8 @@ class _Folder:
         if not force and start < self._next_table:
             return
         table = _table(self.case_list, self.records)
-        tmp = self.path / f".{TABLE_FILE}.{os.getpid()}.tmp"
-        table.to_csv(tmp, index=False, float_format="%.12g")
-        os.replace(tmp, self.path / TABLE_FILE)
+        with fileio.atomic_path(self.path / TABLE_FILE) as tmp:
+            table.to_csv(tmp, index=False, float_format="%.12g")
         end = time.monotonic()
         self._next_table = end + max(interval, 20.0 * (end - start))
 

@@ -5,14 +5,16 @@ speeds, inputs, tyre states) is declared here exactly once, and created
 through :func:`sym` / :func:`dyn`, which refuse names that are not
 registered. Numeric values are always passed and looked up by these names.
 
+The registry is plain data: importing this module does not import SymPy, so
+the runtime (which only needs names, units and descriptions) never pays for
+it; :func:`sym` and :func:`dyn` import SymPy when the build side first
+creates a symbol.
+
 Frames and points follow Moore (2012): N ground (x, y horizontal, z down),
 A yaw frame, B roll frame, C rear frame (pitched so C.z is the steer axis),
 D rear wheel, E front frame, F front wheel.
 """
 from dataclasses import dataclass
-
-import sympy as sm
-import sympy.physics.mechanics as me
 
 
 @dataclass(frozen=True)
@@ -207,6 +209,8 @@ def info(name):
 
 def sym(name):
     """Return the (real) SymPy symbol for a registered constant or input."""
+    import sympy as sm   # the build side only: the registry itself is plain data
+
     entry = info(name)
     if entry.kind in ("coordinate", "speed", "state"):
         raise KeyError(f"{name!r} is a {entry.kind}; use dyn()")
@@ -215,6 +219,8 @@ def sym(name):
 
 def dyn(name):
     """Return the dynamicsymbol (function of time) for a registered coordinate, speed or state."""
+    import sympy.physics.mechanics as me   # the build side only
+
     entry = info(name)
     if entry.kind not in ("coordinate", "speed", "state"):
         raise KeyError(f"{name!r} is a {entry.kind}; use sym()")

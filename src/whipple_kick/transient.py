@@ -39,8 +39,6 @@ tyre's lateral force on the bicycle (plate part excluded) splits as
 ``P_carcass = F (V' - vsy)``. docs/validation.md gives the argument and the
 measured sizes.
 """
-import sympy as sm
-
 from . import symbols as S
 
 #: Transient forms, by name; the compiled model's ``tyre_transient`` parameter is the index.
@@ -98,6 +96,8 @@ def tyre_block(name, curves, sigma0):
         ``P_carcass_f`` (power into each carcass), ``sigma_r``, ``sigma_f``
         (relaxation lengths in use [m]).
     """
+    import sympy as sm
+
     states = [sm.Symbol(n, real=True) for n in STATES[name]]
     out, rates = {}, [None] * 4
     w0 = slide = 0

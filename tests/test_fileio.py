@@ -1,0 +1,105 @@
+"""File I/O: atomic writes, CSV written as pandas writes it (exact floats), CSV read through pandas."""
+import io
+import os
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from whipple_kick import fileio
+from whipple_kick.errors import InputError
+
+
+def _bits(frame):
+    return frame.to_numpy(dtype=np.float64).view(np.int64)
+
+
+def _awkward_frame():
+    rng = np.random.default_rng(0)
+    raw = rng.integers(0, 2**63 - 1, size=2000, dtype=np.int64).view(np.float64)
+    raw = raw[np.isfinite(raw)]
+    special = np.array([0.0, -0.0, 5e-324, -5e-324, 2.2250738585072014e-308, 1.7976931348623157e308,
+                        -1.7976931348623157e308, 0.1 + 0.2, np.nextafter(1.0, 2.0), 1e16, 123456789012345678.0,
+                        1 / 3, -2.5, 1.0])
+    n = len(special)
+    return raw, pd.DataFrame({
+        "time": np.arange(n) * 1e-3,
+        "random": raw[:n],
+        "special": special,
+        "zeros": np.zeros(n),                                  # must stay a float column
+        "negative zeros": np.full(n, -0.0),
+        "whole": np.arange(n, dtype=float),
+    })
+
+
+def test_csv_is_pandas_own_text_and_reads_back_bit_for_bit(tmp_path):
+    """write_csv writes exactly DataFrame.to_csv(index=False)'s bytes, and read_csv returns every bit."""
+    raw, frame = _awkward_frame()
+    path = tmp_path / "t.csv"
+    fileio.write_csv(frame, path)
+    reference = io.StringIO()
+    frame.to_csv(reference, index=False, lineterminator="\n")
+    assert path.read_text() == reference.getvalue()
+    back = pd.read_csv(path)
+    assert list(back.columns) == list(frame.columns) and (back.dtypes == np.float64).all()
+    assert np.array_equal(_bits(back), _bits(frame))
+    # Longer than one write chunk (2000 rows), every random bit pattern; one column alone.
+    pairs = raw[: len(raw) // 2 * 2].reshape(-1, 2)
+    many = pd.concat([pd.DataFrame({"a": pairs[:, 0], "b": pairs[:, 1]})] * 3, ignore_index=True)
+    assert len(many) > 2000
+    fileio.write_csv(many, path)
+    assert np.array_equal(_bits(pd.read_csv(path)), _bits(many))
+    assert path.read_text() == many.to_csv(index=False, lineterminator="\n")
+    fileio.write_csv(many[["a"]], path)
+    assert path.read_text() == many[["a"]].to_csv(index=False, lineterminator="\n")
+
+
+def test_csv_of_other_tables_goes_through_to_csv(tmp_path):
+    frame = pd.DataFrame({"time": [0.0, 0.1], "x": [np.nan, 1.5], "n": [1, 2], "mode": ["weave", "capsize"]})
+    path = tmp_path / "t.csv"
+    fileio.write_csv(frame, path)
+    assert path.read_text() == frame.to_csv(index=False, lineterminator="\n")
+    empty = pd.DataFrame({"a": np.zeros(0)})
+    fileio.write_csv(empty, path)
+    assert path.read_text() == "a\n"
+
+
+def test_atomic_write_leaves_the_old_file_when_the_writer_fails(tmp_path):
+    path = tmp_path / "summary.json"
+    fileio.write_atomic(path, "old\n")
+    with pytest.raises(RuntimeError), fileio.atomic_path(path) as tmp:
+        tmp.write_text("half of the new")
+        raise RuntimeError("interrupted")
+    assert path.read_text() == "old\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["summary.json"]   # no temporary left
+
+
+def test_atomic_write_private_and_bytes(tmp_path):
+    path = tmp_path / "entry.bin"
+    fileio.write_atomic(path, b"\x00\x01", private=True)
+    assert path.read_bytes() == b"\x00\x01" and path.stat().st_mode & 0o777 == 0o600
+    assert fileio.temporary_name(path).name == f".entry.bin.{os.getpid()}.tmp"
+
+
+@pytest.mark.parametrize("content, message", [
+    (None, r"kick table '.*missing\.csv' does not exist"),
+    (b"\xff\xfe\x00 not utf-8", r"is not a UTF-8 text file"),
+    (b"", r"has no rows"),
+    (b'a,b\n1,2\n3,"4\n', r"is not a delimited table"),
+])
+def test_read_csv_problems_are_one_line_input_errors(tmp_path, content, message):
+    path = tmp_path / "missing.csv"
+    if content is not None:
+        path.write_bytes(content)
+    with pytest.raises(InputError, match=message) as info:
+        fileio.read_csv(path, "kick table")
+    assert "\n" not in str(info.value)
+    with pytest.raises(InputError, match="is not a file"):
+        fileio.read_csv(tmp_path, "kick table")
+
+
+def test_read_csv_reads_through_pandas(tmp_path):
+    path = tmp_path / "m.csv"
+    path.write_text("\ufefftime,y\n# a comment\n0.0,1.5\n0.1,2.5\n")
+    frame = fileio.read_csv(path, "table", comment="#")
+    assert list(frame.columns) == ["time", "y"] and frame["y"].tolist() == [1.5, 2.5]
