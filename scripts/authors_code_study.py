@@ -32,7 +32,8 @@ import tempfile
 
 import numpy as np
 
-from whipple_kick import authors_code, bicycles, simulation, slip, steady
+import whipple_kick as wk
+from whipple_kick import authors_code, bicycles, slip, steady
 from whipple_kick.simulation import Scenario, run
 
 DATA = pathlib.Path(__file__).resolve().parent.parent / "tests" / "data" / "authors_model"
@@ -113,7 +114,7 @@ def geometry():
     """Their contact positions in this model: wheel radius + 2 r_t and crown radius 2 r_t (parameters only)."""
     stored = _stored()
     sc = Scenario.authors_code()
-    rear, front, _ = simulation.build_tyres(sc)
+    rear, front, _ = wk.assembly.build_tyres(sc)
     bike = bicycles.load(sc.bicycle)
     r_t = {"rr": rear.crown_radius, "rf": front.crown_radius}
     text = (bicycles.BICYCLE_DIR / f"{sc.bicycle}.toml").read_text()
@@ -147,9 +148,9 @@ def geometry():
 
 
 def _parameters(scenario):
-    moore, design, _ = simulation.build_bicycle(scenario)
-    rear, front, _ = simulation.build_tyres(scenario)
-    gains, _ = simulation.controller_gains(scenario, design)
+    moore, design, _ = wk.assembly.build_bicycle(scenario)
+    rear, front, _ = wk.assembly.build_tyres(scenario)
+    gains, _ = wk.assembly.controller_gains(scenario, design)
     return slip.model_parameters(moore, rear, front, gains=gains, tyre_transient=scenario.tyre_transient,
                                  reverse_camber=scenario.camber_sign == "reversed")
 
@@ -184,11 +185,11 @@ def energy():
           f"{theirs[-1]:.3f} m/s at the fall")
     columns = ("kinetic_energy", "potential_energy", "spring_energy", "plate_work", "steer_work",
                "rear_wheel_torque_work", "zero_slip_force_work", "aligning_moment_work", "sliding_dissipation",
-               "damper_dissipation", simulation.BALANCE_COLUMN)
+               "damper_dissipation", wk.results.BALANCE_COLUMN)
     print("\n| from the kick to | " + " | ".join(f"{c} [J]" for c in columns) + " |")
     print("|---|" + "---|" * len(columns))
     for label, i in ((f"the largest speed ({df['time'].iloc[k]:.2f} s)", k), ("the fall", len(df) - 1)):
-        print(f"| {label} | " + " | ".join(f"{df[c].iloc[i] - df[c].iloc[0]:+.2f}" if c != simulation.BALANCE_COLUMN
+        print(f"| {label} | " + " | ".join(f"{df[c].iloc[i] - df[c].iloc[0]:+.2f}" if c != wk.results.BALANCE_COLUMN
                                           else f"{df[c].iloc[i]:.1e}" for c in columns) + " |")
 
 

@@ -83,7 +83,7 @@ def bench_build(repeats):
 
 
 def bench_run(repeats):
-    from whipple_kick import integrate, slip, slip_build
+    from whipple_kick import lsoda, slip, slip_build
     ss = _base_case()
     p = slip.parameter_vector(ss.params)
     for rtol in (1e-12, 1e-8):
@@ -91,13 +91,13 @@ def bench_run(repeats):
         for _ in range(repeats):
             rhs = slip.CompiledRHS(ss.params)
             t0 = time.perf_counter()
-            traj = integrate.integrate(rhs, ss.x, 6.0, t_start=0.0, breakpoints=(0.15,), rtol=rtol)
+            traj = lsoda.integrate(rhs, ss.x, 6.0, t_start=0.0, breakpoints=(0.15,), rtol=rtol)
             times.append(time.perf_counter() - t0)
         print(f"6 s base case, C RHS, rtol {rtol:g}: median {statistics.median(times):.3f} s  "
               f"({traj.nfev} RHS calls)  runs {[round(v, 3) for v in times]}")
         c_med = statistics.median(times)
         t0 = time.perf_counter()
-        integrate.integrate(lambda t, x: slip_build.numpy_rhs(t, x, p), ss.x, 6.0, t_start=0.0,
+        lsoda.integrate(lambda t, x: slip_build.numpy_rhs(t, x, p), ss.x, 6.0, t_start=0.0,
                             breakpoints=(0.15,), rtol=rtol)
         n = time.perf_counter() - t0
         print(f"6 s base case, NumPy RHS, rtol {rtol:g}: {n:.2f} s (one run); C is {n / c_med:.0f}x faster")

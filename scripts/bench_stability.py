@@ -26,11 +26,12 @@ import numpy as np
 
 
 def _steady(symmetric, speed=4.0):
+    import whipple_kick as wk
     from whipple_kick import simulation, slip, steady
     sc = simulation.Scenario(symmetric_tyres=symmetric, speed=speed)
-    moore, design, _ = simulation.build_bicycle(sc)
-    rear, front, _ = simulation.build_tyres(sc)
-    gains, _ = simulation.controller_gains(sc, design)
+    moore, design, _ = wk.assembly.build_bicycle(sc)
+    rear, front, _ = wk.assembly.build_tyres(sc)
+    gains, _ = wk.assembly.controller_gains(sc, design)
     params = slip.model_parameters(moore, rear, front, gains=gains, symmetric=symmetric)
     return steady.find_steady_state(params, speed).steady
 

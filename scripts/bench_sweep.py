@@ -51,14 +51,15 @@ def _warm_up():
 
 
 def bench_nine(repeats, duration):
-    from whipple_kick import simulation, sweep
+    import whipple_kick as wk
+    from whipple_kick import simulation
     base = simulation.Scenario(duration=duration)
     times = {}
     for workers in (1, 2):
         runs = []
         for _ in range(repeats):
             t0 = time.perf_counter()
-            table = sweep.sweep(_thesis_grid(), base=base, workers=workers, progress=False)
+            table = wk.sweep(_thesis_grid(), base=base, workers=workers, progress=False)
             runs.append(time.perf_counter() - t0)
             assert (table["status"] == "ok").all(), table["error"].dropna().tolist()
         times[workers] = runs
@@ -77,7 +78,8 @@ def bench_nine(repeats, duration):
 
 def bench_many(n, duration, workers, folder):
     import numpy as np
-    from whipple_kick import simulation, sweep
+    import whipple_kick as wk
+    from whipple_kick import simulation
     # A pressure x load grid of about n cases (interpolated tyres between the measured pressures).
     n_p = max(1, int(round(np.sqrt(n / 1.6))))
     n_f = max(1, int(round(n / n_p)))
@@ -88,7 +90,7 @@ def bench_many(n, duration, workers, folder):
     with tempfile.TemporaryDirectory() as tmp:
         target = folder or os.path.join(tmp, "sweep")
         t0 = time.perf_counter()
-        table = sweep.sweep(grid, base=base, workers=workers, folder=target, progress=sys.stderr.isatty())
+        table = wk.sweep(grid, base=base, workers=workers, folder=target, progress=sys.stderr.isatty())
         wall = time.perf_counter() - t0
         size = sum(os.path.getsize(os.path.join(d, f)) for d, _, fs in os.walk(target) for f in fs)
     n_cases = len(table)

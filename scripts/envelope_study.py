@@ -17,7 +17,7 @@ Two measurements, each printed as Markdown:
     completed and falling runs across kicks
     (5-200 m/s^2), speeds (1.5-8 m/s), tolerances (rtol 1e-8..1e-12), riders,
     a 151-row kick table and the thesis preset, measured on every evaluation:
-    the largest fraction of the default budget (``integrate.DEFAULT_BUDGET``)
+    the largest fraction of the default budget (``lsoda.DEFAULT_BUDGET``)
     any part of an integrate() call (the settle, the run after the kick, a
     table's pieces: each has its own budget) from its start spent, and the least time any window
     of its ``stall_window`` consecutive evaluations advanced it, so the
@@ -34,7 +34,8 @@ import time
 
 import numpy as np
 
-from whipple_kick import integrate, simulation, slip, steady
+import whipple_kick as wk
+from whipple_kick import lsoda, simulation, slip, steady
 from whipple_kick.simulation import Scenario
 
 SPEEDS = (1.5, 1.92, 2.0, 2.2, 2.4, 2.5, 2.6, 2.7, 3.0, 4.0, 6.0, 8.0)
@@ -69,7 +70,7 @@ def envelope_cases():
 
 
 def envelope():
-    print(f"slip model {simulation.model_hash()}\n")
+    print(f"slip model {wk.slip.model_hash()}\n")
     for rider, cases in envelope_cases():
         per_speed = collections.defaultdict(collections.Counter)
         slow, notes = [], []
@@ -137,7 +138,7 @@ class CallLog:
             logged.evaluations = jac.evaluations
             return logged
 
-        original_integrate = integrate.integrate
+        original_integrate = lsoda.integrate
         calls = self.calls
 
         def integrate_logged(rhs, x0, t_end, t_start=0.0, *args, **kwargs):
@@ -149,7 +150,7 @@ class CallLog:
 
         slip.CompiledRHS.__call__, slip.CompiledRHS.guarded = call, guarded
         slip.CompiledRHS.jacobian_function = jacobian_function
-        integrate.integrate = integrate_logged
+        lsoda.integrate = integrate_logged
 
 
 def budget_used(times, t_start, budget):
@@ -184,7 +185,7 @@ def budget_cases(table_path):
 def budget():
     import pathlib
     import tempfile
-    budget_ = integrate.DEFAULT_BUDGET
+    budget_ = lsoda.DEFAULT_BUDGET
     with tempfile.TemporaryDirectory() as folder:
         table = pathlib.Path(folder) / "smooth.csv"
         t = np.arange(151) / 1000.0

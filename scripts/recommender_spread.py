@@ -2,7 +2,7 @@
 
 On the nine thesis cases (T03 at 300/400/500 kPa x rear loads 570/635/701 N,
 default scenario) this script measures, for each ranking criterion of
-``sweep.CRITERIA`` (the recovery time, i.e. yaw, roll and steer rates settled,
+``wk.recommend.CRITERIA`` (the recovery time, i.e. yaw, roll and steer rates settled,
 and the thesis' last-peak time):
 
 * the value per case at the default settings (rtol 1e-10), the margin between
@@ -15,7 +15,7 @@ and the thesis' last-peak time):
   draws of every coefficient scaled by an independent random factor in
   [0.99, 1.01] (front and rear alike);
 * the spread: the largest such change over the nine cases, per criterion.
-  That is ``sweep.CRITERION_SPREAD_S``: a margin below it is "no clear optimum".
+  That is ``wk.recommend.CRITERION_SPREAD_S``: a margin below it is "no clear optimum".
 
 Usage: ``python scripts/recommender_spread.py`` (about 2 minutes on one core).
 """
@@ -24,7 +24,8 @@ import sys
 
 import numpy as np
 
-from whipple_kick import simulation, sweep
+import whipple_kick as wk
+from whipple_kick import simulation
 from whipple_kick.simulation import Scenario
 
 PRESSURES = (300.0, 400.0, 500.0)
@@ -93,7 +94,7 @@ def value(s, criterion):
 
 
 def main():
-    print(f"slip model {simulation.model_hash()}\n")
+    print(f"slip model {wk.slip.model_hash()}\n")
     base = {(p, fz): summary(Scenario(pressure_kpa=p, fz_n=fz)) for fz in LOADS for p in PRESSURES}
     variants = {f"rtol {rtol:g}": {} for rtol in (1e-8, 1e-12)}
     for (p, fz) in base:
@@ -103,13 +104,13 @@ def main():
         variants[label] = {}
         for (p, fz) in base:
             scenario = Scenario(pressure_kpa=p, fz_n=fz)
-            rear, front, _ = simulation.build_tyres(scenario)
+            rear, front, _ = wk.assembly.build_tyres(scenario)
             pair = (PerturbedTyre(rear, fy, mz, label), PerturbedTyre(front, fy, mz, label))
             variants[label][(p, fz)] = summary(scenario, tyres=pair)
 
     spread = {}
     for criterion in VALUES:
-        print(f"## {criterion}: {sweep._CRITERION_TEXT[criterion]}\n")
+        print(f"## {criterion}: {wk.recommend._CRITERION_TEXT[criterion]}\n")
         print("| rear load | " + " | ".join(f"{p:g} kPa [s]" for p in PRESSURES) + " | best | margin [s] |")
         print("|---|" + "---|" * (len(PRESSURES) + 2))
         margins = {}
@@ -134,7 +135,7 @@ def main():
         spread[criterion] = worst_all
         print(f"\nspread ({criterion}): {worst_all:.3f} s; loads whose margin is below it: "
               + (", ".join(f"{fz:g} N" for fz, m in margins.items() if not m >= worst_all) or "none") + "\n")
-    print("sweep.CRITERION_SPREAD_S = {" + ", ".join(f'"{k}": {v:.3f}' for k, v in spread.items()) + "}")
+    print("wk.recommend.CRITERION_SPREAD_S = {" + ", ".join(f'"{k}": {v:.3f}' for k, v in spread.items()) + "}")
     return 0
 
 

@@ -40,6 +40,7 @@ import numpy as np
 import scipy.linalg as sl
 import scipy.optimize as so
 
+import whipple_kick as wk
 from whipple_kick import control, simulation, slip, tyres
 from whipple_kick.simulation import Scenario
 
@@ -54,10 +55,10 @@ def recovery_times(result):
 
 def linear_model(scenario, gains=None, tyre_pair=None):
     """Open-loop A, B, the rider's K on :data:`slip.LINEAR_STATES`, about the steady motion."""
-    rear, front, _ = simulation.build_tyres(scenario) if tyre_pair is None else (*tyre_pair, [])
-    moore, design, _ = simulation.build_bicycle(scenario)
+    rear, front, _ = wk.assembly.build_tyres(scenario) if tyre_pair is None else (*tyre_pair, [])
+    moore, design, _ = wk.assembly.build_bicycle(scenario)
     if gains is None:
-        gains, _ = simulation.controller_gains(scenario, design)
+        gains, _ = wk.assembly.controller_gains(scenario, design)
     params = slip.model_parameters(moore, rear, front, gains=gains, symmetric=scenario.symmetric_tyres)
     steady = slip.steady_state(params, scenario.speed)
     return slip.linear_state_space(steady.params, steady.x)
@@ -207,32 +208,32 @@ def one_at_a_time(duration):
     gains0 = np.array([K[0, slip.LINEAR_STATES.index(n)] for n in RIDER_STATES])
     k_slip, j_slip, j_classic = output_feedback_lqr(A, B, gains0)
     slip_gains = control.gains_dict(k_slip)
-    thesis = simulation.with_changes(base, controller="thesis")
+    thesis = base.with_changes(controller="thesis")
     no_moment = measured_pair(base, moment=False)
 
     print("400 kPa, 635 N: one change at a time\n")
     print(HEADER)
     rows = [
         ("T03 as measured (default)", base, {}, None),
-        ("T03 without its offsets (symmetric)", simulation.with_changes(base, symmetric_tyres=True), {}, None),
+        ("T03 without its offsets (symmetric)", base.with_changes(symmetric_tyres=True), {}, None),
         # The no-slip limit with the thesis' force lag: the linear tyre has no friction limit, and under
         # the contact-patch form the instant plate stop's load spike throws the rear wheel off (it falls).
         ("near-rigid linear tyre (no-slip limit: 100/rad, 0.01 m, 1e7 N/m; force lag)",
-         simulation.with_changes(base, symmetric_tyres=True, tyre_transient="force_lag"), {"tyres": (rigid, rigid)},
+         base.with_changes(symmetric_tyres=True, tyre_transient="force_lag"), {"tyres": (rigid, rigid)},
          (rigid, rigid)),
         ("small kick: 0.005 m in 0.15 s (linear regime)",
-         simulation.with_changes(base, kick_displacement=0.005, kick_duration=0.15), {}, None),
+         base.with_changes(kick_displacement=0.005, kick_duration=0.15), {}, None),
         ("Table 8.4 gains", thesis, {}, None),
-        ("Table 8.4 gains, small kick", simulation.with_changes(thesis, kick_displacement=0.005, kick_duration=0.15),
+        ("Table 8.4 gains, small kick", thesis.with_changes(kick_displacement=0.005, kick_duration=0.15),
          {}, None),
         ("Table 8.4 gains, near-rigid linear tyre (force lag)",
-         simulation.with_changes(thesis, symmetric_tyres=True, tyre_transient="force_lag"),
+         thesis.with_changes(symmetric_tyres=True, tyre_transient="force_lag"),
          {"tyres": (rigid, rigid)}, (rigid, rigid)),
         ("gains designed on the slip model", base, {"gains": slip_gains}, None),
         ("LQR with Q = 10 I (a 10x more demanding rider)", base, {"gains": lqr_gains(base, 10.0)}, None),
         ("LQR with Q = 100 I", base, {"gains": lqr_gains(base, 100.0)}, None),
         ("heading-holding LQR (yaw angle as 5th state, Q = I), symmetric T03",
-         simulation.with_changes(base, symmetric_tyres=True), {"gains": heading_gains(base)}, None),
+         base.with_changes(symmetric_tyres=True), {"gains": heading_gains(base)}, None),
         ("T03 without aligning moment M_z", base, {"tyres": no_moment}, no_moment),
     ]
     for label, scenario, overrides, pair in rows:
@@ -250,28 +251,28 @@ def one_at_a_time(duration):
 
 def lqr_gains(scenario, weight):
     """Our LQR rider with Q = weight * I, R = 1, by name."""
-    design = simulation.build_bicycle(scenario)[1]
+    design = wk.assembly.build_bicycle(scenario)[1]
     return control.gains_dict(control.lqr_gains(design, scenario.lqr_design_speed, Q=weight * np.eye(4))[0])
 
 
 def heading_gains(scenario):
     """The heading-holding LQR rider (Q = I, R = 1), by name."""
-    design = simulation.build_bicycle(scenario)[1]
+    design = wk.assembly.build_bicycle(scenario)[1]
     K, _ = control.heading_lqr_gains(design, scenario.lqr_design_speed)
     return dict(zip(control.HEADING_GAIN_ORDER, K))
 
 
 def measured_pair(scenario, **switches):
-    rear, front, _ = simulation.build_tyres(scenario)
+    rear, front, _ = wk.assembly.build_tyres(scenario)
     return ToggledTyre(rear, **switches), ToggledTyre(front, **switches)
 
 
 def tyre_properties():
     """Slowest closed-loop pole (our LQR rider, 400 kPa, 635 N) with one tyre property at a time."""
     base = Scenario(pressure_kpa=400.0, fz_n=635.0)
-    symmetric = simulation.with_changes(base, symmetric_tyres=True)
-    rear, front, _ = simulation.build_tyres(base)
-    moore, _, info = simulation.build_bicycle(base)
+    symmetric = base.with_changes(symmetric_tyres=True)
+    rear, front, _ = wk.assembly.build_tyres(base)
+    moore, _, info = wk.assembly.build_bicycle(base)
     loads = (info["static_load_rear_n"], info["static_load_front_n"])
     coefficient = [t.cornering_stiffness(fz) / fz for t, fz in zip((rear, front), loads)]
 
@@ -301,7 +302,7 @@ def main(argv=None):
     parser.add_argument("--quick", action="store_true", help="leave out the nine-case table")
     parser.add_argument("--duration", type=float, default=8.0, help="simulated time after the kick [s]")
     args = parser.parse_args(argv)
-    print(f"slip model {simulation.model_hash()}\n")
+    print(f"slip model {wk.slip.model_hash()}\n")
     if not args.quick:
         nine_cases(args.duration)
         for transient in ("contact_patch", "force_lag"):

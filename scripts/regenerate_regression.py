@@ -36,6 +36,8 @@ import sys
 
 import numpy as np
 
+import whipple_kick as wk
+
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 OUT = ROOT / "tests" / "data" / "regression"
 THESIS_FORM = OUT / "thesis_form"
@@ -96,7 +98,7 @@ def write_case(name, scenario, path):
     arrays = {c: df[c].to_numpy(dtype=np.float32) for c in COLUMNS if c in df.columns}
     np.savez_compressed(path, **arrays, name=np.array(name),
                         scenario_json=np.array(json.dumps(scenario.to_dict(), sort_keys=True)),
-                        model_hash=np.array(simulation.model_hash()),
+                        model_hash=np.array(wk.slip.model_hash()),
                         generated=np.array(_now()))
     return result
 
@@ -115,7 +117,7 @@ def rewrite_thesis_form(name):
     arrays = {c: df[c].to_numpy(dtype=np.float32) for c in columns}
     np.savez_compressed(path, **arrays, name=np.array(name),
                         scenario_json=np.array(json.dumps(scenario.to_dict(), sort_keys=True)),
-                        model_hash=np.array(simulation.model_hash()), generated=np.array(_now()))
+                        model_hash=np.array(wk.slip.model_hash()), generated=np.array(_now()))
     return result
 
 
@@ -133,7 +135,6 @@ def main(argv=None):
     reason = " ".join(args.reason.split())
     if not reason:
         parser.error("--reason must not be empty")
-    from whipple_kick import simulation
     if args.thesis_form:
         for name in args.thesis_form:
             s = rewrite_thesis_form(name).summary
@@ -154,7 +155,7 @@ def main(argv=None):
             "One line per regeneration (`scripts/regenerate_regression.py --reason ...`): "
             "date (UTC), compiled model hash, reason.\n\n")
     with CHANGELOG.open("a") as fh:
-        fh.write(f"- {_now()} | {simulation.model_hash()} | {reason}\n")
+        fh.write(f"- {_now()} | {wk.slip.model_hash()} | {reason}\n")
     print(f"appended to {CHANGELOG.relative_to(ROOT)}")
     return 0
 

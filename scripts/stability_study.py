@@ -32,6 +32,7 @@ import pathlib
 
 import numpy as np
 
+import whipple_kick as wk
 from whipple_kick import simulation, stability, tyres
 from whipple_kick.simulation import Scenario
 
@@ -93,7 +94,7 @@ class ModifiedTyre:
 
 
 def _loads(scenario):
-    _, _, info = simulation.build_bicycle(scenario)
+    _, _, info = wk.assembly.build_bicycle(scenario)
     return info["static_load_rear_n"], info["static_load_front_n"]
 
 
@@ -145,7 +146,7 @@ def coefficients():
     print("|---|---|---|---|---|---|---|")
     loads = _loads(BASE)
     for p in stability.THESIS_PRESSURES_KPA:
-        rear, front, _ = simulation.build_tyres(simulation.with_changes(BASE, pressure_kpa=p))
+        rear, front, _ = wk.assembly.build_tyres(BASE.with_changes(pressure_kpa=p))
         for wheel, t, fz in (("rear", rear, loads[0]), ("front", front, loads[1])):
             ca, cg, trail, mg = small_slip_coefficients(t, fz)
             print(f"| {p:g} | {wheel} | {fz:.0f} | {ca:.2f} | {cg:.3f} | {trail * 1e3:.1f} | {mg:+.2f} |")
@@ -167,8 +168,8 @@ def _open_loop_row(label, pair, scenario=BASE, speeds=STUDY_SPEEDS):
 
 
 def properties(pressure=400.0):
-    scenario = simulation.with_changes(BASE, pressure_kpa=pressure)
-    rear, front, _ = simulation.build_tyres(scenario)
+    scenario = BASE.with_changes(pressure_kpa=pressure)
+    rear, front, _ = wk.assembly.build_tyres(scenario)
     loads = _loads(scenario)
     unit_camber = [1.0 / small_slip_coefficients(t, fz)[1] for t, fz in ((rear, loads[0]), (front, loads[1]))]
     both = lambda **kw: (ModifiedTyre(rear, **kw), ModifiedTyre(front, **kw))
@@ -210,7 +211,7 @@ def properties(pressure=400.0):
 
 def sensitivity():
     """The relaxation length (not measured for T03), the transient form and the offsets, at 400 kPa, 635 N."""
-    rear, front, _ = simulation.build_tyres(BASE)
+    rear, front, _ = wk.assembly.build_tyres(BASE)
     print("Sensitivity of the default case (400 kPa, 635 N) to modelling choices nothing validated\n")
     print("| choice | weave speed [m/s] | capsize speed [m/s] | self-stable [m/s] | with rider: stable [m/s] | "
           "closed-loop weave at 3 m/s (real, f, damping) | wobble at 3 m/s (f, damping) |")
@@ -226,7 +227,7 @@ def sensitivity():
              ("crown radius x2 (20 mm)", BASE,
               (ModifiedTyre(rear, crown_radius=2 * rear.crown_radius),
                ModifiedTyre(front, crown_radius=2 * front.crown_radius))),
-             ("force_lag (the thesis' transient)", simulation.with_changes(BASE, tyre_transient="force_lag"), None),
+             ("force_lag (the thesis' transient)", BASE.with_changes(tyre_transient="force_lag"), None),
              ("measured zero-slip offsets (about the steady turn)", Scenario(), None)]
     for label, sc, pair in cases:
         res = stability.analyse(sc, stability.parse_speeds("0.5:10:0.05"), tyres=pair)
@@ -251,7 +252,7 @@ def consistency():
     print("|---|---|---|---|---|---|")
     cases = [(BASE, 3.6, "open", "weave", 4.0), (BASE, 6.0, "open", "capsize", 3.0),
              (BASE, 3.0, "closed", "weave", 4.0)]
-    cases += [(simulation.with_changes(BASE, pressure_kpa=p), 3.0, "closed", "wobble", 1.0)
+    cases += [(BASE.with_changes(pressure_kpa=p), 3.0, "closed", "wobble", 1.0)
               for p in stability.THESIS_PRESSURES_KPA]
     cases += [(BASE, 1.0, "open", "wobble", 1.0), (BASE, 3.0, "open", "lateral_rear", 1.0)]
     for sc, v, loop, mode, duration in cases:
@@ -274,7 +275,7 @@ def consistency():
 
 def _named_index(model, lam, vec, mode):
     """Index of the eigenvalue (Im >= 0) named ``mode`` with the largest real part."""
-    wheelbase = stability._wheelbase(simulation.build_bicycle(BASE)[0])
+    wheelbase = stability._wheelbase(wk.assembly.build_bicycle(BASE)[0])
     best = None
     for k in range(lam.size):
         if lam[k].imag < 0:

@@ -31,7 +31,8 @@ import numpy as np
 
 import whipple_kick as wk
 from whipple_kick import transient
-from whipple_kick.simulation import Scenario, build_tyres, run
+from whipple_kick.assembly import build_tyres
+from whipple_kick.simulation import Scenario, run
 
 BASE = Scenario(pressure_kpa=400.0, fz_n=635.0)
 
@@ -179,14 +180,14 @@ def steady():
     print(f"T6c = {st['rear_wheel_torque_n_m']:+.5f} N m ({st['rear_wheel_torque_role']}); steady powers [W]: "
           + ", ".join(f"{k} {v:+.4f}" for k, v in st["steady_power_w"].items()))
     # What positive T6c does: integrate the steady state with T6c = 0 for 20 s (no kick).
-    from whipple_kick import integrate, slip
-    moore, design, _ = wk.simulation.build_bicycle(BASE)
-    gains, _ = wk.simulation.controller_gains(BASE, design)
+    from whipple_kick import lsoda, slip
+    moore, design, _ = wk.assembly.build_bicycle(BASE)
+    gains, _ = wk.assembly.controller_gains(BASE, design)
     rear, front, _ = build_tyres(BASE)
     ss = slip.steady_state(slip.model_parameters(moore, rear, front, gains=gains), 3.0)
     for torque in (0.0, 2 * ss.params["T6c"]):
         params = dict(ss.params, T6c=torque)
-        tr = integrate.integrate(slip.CompiledRHS(params), ss.x, 20.0, output_rate=10)
+        tr = lsoda.integrate(slip.CompiledRHS(params), ss.x, 20.0, output_rate=10)
         speed = np.hypot(tr.state("u1"), tr.state("u2"))
         print(f"T6c = {torque:+.4f} N m from the steady state: speed after 20 s {speed[-1]:.4f} m/s")
 

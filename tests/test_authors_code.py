@@ -10,7 +10,8 @@ import pathlib
 import numpy as np
 import pytest
 
-from whipple_kick import authors_code, simulation, slip
+import whipple_kick as wk
+from whipple_kick import authors_code, slip
 from whipple_kick.errors import InputError
 from whipple_kick.simulation import Scenario, run
 
@@ -72,8 +73,8 @@ def test_parameters_equal_the_authors_number_for_number(stored):
     """Every value of their parameter array that their standard run uses, their tyre's coefficients and its
     friction factor equal ours (exactly)."""
     sc = Scenario.authors_code()
-    moore, _, _ = simulation.build_bicycle(sc)
-    rear, front, _ = simulation.build_tyres(sc)
+    moore, _, _ = wk.assembly.build_bicycle(sc)
+    rear, front, _ = wk.assembly.build_tyres(sc)
     params = slip.model_parameters(moore, rear, front)
     for theirs, ours in authors_code.PARAMETER_NAMES.items():
         assert params[ours] == stored.parameters[theirs], (theirs, ours)
@@ -81,7 +82,7 @@ def test_parameters_equal_the_authors_number_for_number(stored):
     for tyre in (rear, front):
         (weight, fy, mz), = tyre.blend    # one measured pressure: their 500 kPa set
         assert weight == 1.0 and fy.tolist() == stored.tyre["Fy_coef"] and mz.tolist() == stored.tyre["Mz_coef"]
-    assert simulation.controller_gains(sc, moore)[0] == {"kq4": -19.5679, "kq7": 15.4934,
+    assert wk.assembly.controller_gains(sc, moore)[0] == {"kq4": -19.5679, "kq7": 15.4934,
                                                           "ku4": -6.7665, "ku7": 1.5876}
 
 
@@ -90,8 +91,8 @@ def test_upright_pitch_without_compression_is_theirs(stored, compat):
     same angle (measured equal to 1e-15 rad). Our start also solves the compressions (vertical
     equilibrium), theirs splits the weight as on rigid tyres: their loads 682.8 and 256.5 N, ours 684.4
     and 254.9 N (0.23 %, 0.61 %; the same total, the weight: measured 2e-16 apart, asserted 1e-6)."""
-    params = slip.model_parameters(*simulation.build_bicycle(Scenario.authors_code())[:1],
-                                   *simulation.build_tyres(Scenario.authors_code())[:2])
+    params = slip.model_parameters(*wk.assembly.build_bicycle(Scenario.authors_code())[:1],
+                                   *wk.assembly.build_tyres(Scenario.authors_code())[:2])
     x = np.zeros(len(slip.STATE_NAMES))
     x[slip.X["u1"]] = 3.0
     pitch = slip.solve_pitch(slip.CompiledRHS(params), x)[slip.X["q5"]]

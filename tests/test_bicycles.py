@@ -1,5 +1,4 @@
 """Bicycle parameter files: every file loads, converts and round-trips; bad files are InputErrors."""
-import math
 
 import pytest
 

@@ -55,7 +55,7 @@ def test_missing_compiler_is_a_clear_error(monkeypatch):
 def test_concurrent_builds_share_one_library(tmp_path):
     """Two processes building into the same empty cache both succeed; one library results."""
     env = dict(os.environ, WHIPPLE_KICK_CACHE=str(tmp_path / "cache"))
-    code = ("from whipple_kick import slip, integrate\n"
+    code = ("from whipple_kick import slip, lsoda\n"
             "import numpy as np\n"
             "lib = slip.library(); print('ok')\n")
     procs = [subprocess.Popen([sys.executable, "-c", code], env=env, stdout=subprocess.PIPE,

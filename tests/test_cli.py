@@ -398,7 +398,7 @@ def test_no_steady_motion_is_one_physical_line_and_status_2(tmp_path, capsys, mo
 
 
 def test_numerical_failure_keeps_the_partial_run(tmp_path, capsys, monkeypatch):
-    monkeypatch.setattr(wk.integrate, "DEFAULT_BUDGET", wk.integrate.Budget(allowance=1000, per_second=1000.0))
+    monkeypatch.setattr(wk.lsoda, "DEFAULT_BUDGET", wk.lsoda.Budget(allowance=1000, per_second=1000.0))
     out = tmp_path / "stalled"
     status, stdout, err = _simulate(["--duration", "2", "--no-plot", "--out", str(out)], capsys)
     assert status == 1 and stdout == ""

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import whipple_kick as wk
-from whipple_kick import benchmark, classic, integrate, slip, slip_build
+from whipple_kick import benchmark, classic, lsoda, slip, slip_build
 
 
 @pytest.fixture(scope="module")
@@ -62,7 +62,7 @@ def test_linearisation_predicts_the_response_about_a_steady_turn(rider_bike, gai
     x0 = ss.x.copy()
     x0[slip.X["u4"]] += 1e-3
     x0[slip.X["u7"]] += 1e-3
-    tr = integrate.integrate(rhs, x0, 2.0, rtol=1e-11, output_rate=100)
+    tr = lsoda.integrate(rhs, x0, 2.0, rtol=1e-11, output_rate=100)
     z_ref = slip.heading_state(ss.x)
     dz0 = slip.heading_state(x0) - z_ref
     worst = 0.0
@@ -101,7 +101,7 @@ def test_energy_never_increases_with_slip_and_damping(rider_bike, t03):
     x0 = ss.x.copy()
     x0[slip.X["u4"]], x0[slip.X["u7"]], x0[slip.X["u10"]] = 0.3, 0.2, 0.05
     rhs = slip.CompiledRHS(ss.params)
-    tr = integrate.integrate(rhs, x0, 5.0, rtol=1e-11, output_rate=200)
+    tr = lsoda.integrate(rhs, x0, 5.0, rtol=1e-11, output_rate=200)
     assert not tr.fell
     out = _outputs(rhs, tr)
     energy = out[:, slip.OUT["kinetic_energy"]] + out[:, slip.OUT["potential_energy"]] + out[:, slip.OUT["spring_energy"]]
@@ -118,7 +118,7 @@ def test_energy_conserved_without_damping_and_slip(rider_bike, t03):
     x0 = ss.x.copy()
     x0[slip.X["u4"]], x0[slip.X["u7"]], x0[slip.X["u10"]] = 0.3, 0.2, 0.05
     rhs = slip.CompiledRHS(ss.params)
-    tr = integrate.integrate(rhs, x0, 5.0, rtol=1e-11, output_rate=200)
+    tr = lsoda.integrate(rhs, x0, 5.0, rtol=1e-11, output_rate=200)
     out = _outputs(rhs, tr)
     energy = out[:, slip.OUT["kinetic_energy"]] + out[:, slip.OUT["potential_energy"]] + out[:, slip.OUT["spring_energy"]]
     # Without lateral forces the bicycle slides over and may fall; the run
@@ -132,7 +132,7 @@ def test_steady_start_does_not_drift(rider_bike, gains, t03, symmetric):
     par = slip.model_parameters(rider_bike, t03, t03, gains=gains, symmetric=symmetric)
     ss = slip.steady_state(par, 3.0)
     rhs = slip.CompiledRHS(ss.params)
-    tr = integrate.integrate(rhs, ss.x, 10.0, rtol=1e-10, output_rate=100)
+    tr = lsoda.integrate(rhs, ss.x, 10.0, rtol=1e-10, output_rate=100)
     assert not tr.fell
     roll, steer = tr.state("q4"), tr.state("q7")
     speed = np.hypot(tr.state("u1"), tr.state("u2"))
@@ -219,7 +219,7 @@ def test_mirror_symmetric_kicks(rider_bike, gains, t03):
                                     kick=dict(t0=0.0, duration=0.15, displacement=0.15 * sign))
         ss = slip.steady_state(par, 3.0)
         rhs = slip.CompiledRHS(ss.params)
-        tr = integrate.integrate(rhs, ss.x, 3.0, t_start=-0.2, breakpoints=(0.0, 0.15), rtol=1e-11, output_rate=200)
+        tr = lsoda.integrate(rhs, ss.x, 3.0, t_start=-0.2, breakpoints=(0.0, 0.15), rtol=1e-11, output_rate=200)
         responses.append(tr)
     a, b = responses
     for name in ("u3", "u4", "u7", "q4", "q7", "fyr"):
@@ -377,7 +377,7 @@ def test_steady_motion_moved_in_time_is_a_solution(rider_bike, gains, t03):
     start = slip.advance_steady(rhs, ss.x, -2.0)
     # Measured yaw -0.190 rad, rear contact 6 m back on a 32 m circle.
     assert start[slip.X["q3"]] == pytest.approx(-2.0 * ss.x[slip.X["u3"]], rel=1e-14)
-    tr = integrate.integrate(rhs, start, 0.0, t_start=-2.0, rtol=1e-12, output_rate=10)
+    tr = lsoda.integrate(rhs, start, 0.0, t_start=-2.0, rtol=1e-12, output_rate=10)
     dyn = [slip.X[n] for n in slip.DYNAMIC_STATES]
     # Measured 3e-11 (positions in m, angles in rad, speeds): integration accuracy at rtol 1e-12.
     np.testing.assert_allclose(tr.end_state[dyn], ss.x[dyn], rtol=0, atol=1e-9)
@@ -394,7 +394,7 @@ def test_plate_stop_impulse_is_the_limit_of_a_short_stop(rider_bike, gains, t03)
     par = slip.model_parameters(rider_bike, t03, t03, gains=gains, kick=dict(t0=0.0, duration=T, displacement=D))
     ss = slip.steady_state(par, 3.0)
     rhs = slip.CompiledRHS(ss.params)
-    x_stop = integrate.integrate(rhs, ss.x, T, rtol=1e-12, output_rate=1000).end_state
+    x_stop = lsoda.integrate(rhs, ss.x, T, rtol=1e-12, output_rate=1000).end_state
     x_impulse, info = slip.velocity_jump(rhs, T, x_stop, impulse=True)
     # The impulse's work equals the kinetic-energy change computed from the energy expression.
     assert info["impulse_work_j"] == pytest.approx(info["kinetic_energy_change_j"], abs=1e-9)
@@ -410,7 +410,7 @@ def test_plate_stop_impulse_is_the_limit_of_a_short_stop(rider_bike, gains, t03)
     for delta in (1e-5, 1e-6):
         short = slip.CompiledRHS(dict(ss.params, kick_profile=2.0, kick_t0=T, kick_c0=D, kick_c1=v,
                                       kick_c2=-v / (2 * delta), kick_c3=0.0))
-        x = integrate.integrate(short, x_stop, T + delta, t_start=T, rtol=1e-12, samples=np.array([T])).end_state
+        x = lsoda.integrate(short, x_stop, T + delta, t_start=T, rtol=1e-12, samples=np.array([T])).end_state
         errors.append(np.max(np.abs(x[ind] - x_impulse[ind])))
         changes.append(rhs.outputs(T + delta, x)[1][slip.OUT["kinetic_energy"]] - ke)
     assert errors[1] < 3e-5 and errors[0] / errors[1] > 8.0        # converges, linearly
@@ -467,14 +467,14 @@ def test_kept_speeds_leave_the_rear_sliding_at_the_plate_velocity_times_sin_yaw(
     par = slip.model_parameters(rider_bike, t03, t03, gains=gains, kick=dict(t0=0.0, duration=T, displacement=D))
     ss = slip.steady_state(par, 3.0)
     rhs = slip.CompiledRHS(ss.params)
-    x_stop = integrate.integrate(rhs, ss.x, T, rtol=1e-12, output_rate=1000).end_state
+    x_stop = lsoda.integrate(rhs, ss.x, T, rtol=1e-12, output_rate=1000).end_state
     slide = slip.kept_speeds_slide(rhs, T, x_stop)
     assert slide == pytest.approx(2 * D / T * np.sin(x_stop[slip.X["q3"]]), rel=1e-9)
     assert abs(slide) > 0.05
     after = slip.CompiledRHS(dict(ss.params, vsx_r=slide))
     before = rhs.outputs(np.nextafter(T, 0.0), x_stop)[1][:10]
     np.testing.assert_allclose(after.outputs(T, x_stop)[1][:10], before, rtol=0, atol=1e-12)
-    tr = integrate.integrate(after, x_stop, T + 1.0, t_start=T, rtol=1e-12, output_rate=100)
+    tr = lsoda.integrate(after, x_stop, T + 1.0, t_start=T, rtol=1e-12, output_rate=100)
     for t, x in zip(tr.t, tr.x):
         _, A, a0 = after.impulse_terms(t, x)
         u = after.outputs(t, x)[1][:10]

@@ -8,7 +8,7 @@ import pandas as pd
 import pytest
 
 import whipple_kick as wk
-from whipple_kick import classic, cli, simulation, slip, stability
+from whipple_kick import classic, cli, slip, stability
 from whipple_kick.simulation import Scenario
 
 #: The default case of the stability command: T03 at 400 kPa, 635 N, offsets removed.
@@ -51,9 +51,9 @@ def test_heading_linearisation_equals_the_central_difference_one(symmetric, spee
     is a steady turn, so the rotating-frame terms are exercised.
     """
     sc = Scenario(symmetric_tyres=symmetric, controller=controller, speed=speed)
-    moore, design, _ = simulation.build_bicycle(sc)
-    rear, front, _ = simulation.build_tyres(sc)
-    gains, _ = simulation.controller_gains(sc, design)
+    moore, design, _ = wk.assembly.build_bicycle(sc)
+    rear, front, _ = wk.assembly.build_tyres(sc)
+    gains, _ = wk.assembly.controller_gains(sc, design)
     params = slip.model_parameters(moore, rear, front, gains=gains, symmetric=symmetric)
     steady = wk.steady.find_steady_state(params, speed).steady
     rhs = slip.CompiledRHS(steady.params)
@@ -72,8 +72,8 @@ def test_holonomic_row_is_the_front_contact_height_gradient():
     Measured agreement 6e-11 of the row's largest entry (central differences, step 1e-6 rad or m).
     """
     sc = Scenario(speed=3.0)
-    moore, design, _ = simulation.build_bicycle(sc)
-    rear, front, _ = simulation.build_tyres(sc)
+    moore, design, _ = wk.assembly.build_bicycle(sc)
+    rear, front, _ = wk.assembly.build_tyres(sc)
     steady = slip.steady_state(slip.model_parameters(moore, rear, front), 3.0)
     rhs = slip.CompiledRHS(steady.params)
     row = rhs.impulse_terms(0.0, steady.x)[1][slip.HOLONOMIC_ROW]
@@ -189,7 +189,7 @@ def test_stiff_tyres_give_the_classic_speeds_and_modes(rigid_sweep):
     1e-8 m/s (two root-finders on two routes to the same matrices).
     """
     s = rigid_sweep.summary
-    moore, _, _ = simulation.build_bicycle(DEFAULT)
+    moore, _, _ = wk.assembly.build_bicycle(DEFAULT)
     weave, capsize = classic.weave_speed(moore, (2.0, 8.0)), classic.capsize_speed(moore, (4.0, 15.0))
     assert abs(s["no-slip"]["open"]["weave_speed_m_s"] - weave) < 1e-8
     assert abs(s["no-slip"]["open"]["capsize_speed_m_s"] - capsize) < 1e-8
@@ -251,7 +251,7 @@ def test_wobble_exists_and_matches_a_free_response(pressure):
     """
     model = stability.linear_model(Scenario(symmetric_tyres=True, pressure_kpa=pressure), 3.0, "closed")
     lam, vec = np.linalg.eig(model.matrix)
-    wheelbase = stability._wheelbase(simulation.build_bicycle(DEFAULT)[0])
+    wheelbase = stability._wheelbase(wk.assembly.build_bicycle(DEFAULT)[0])
     named = [(k, stability.name_mode(stability.mode_content(model, lam[k], vec[:, k], wheelbase)[0],
                                      lam[k].imag == 0, abs(lam[k].imag) / (2 * math.pi)))
              for k in range(lam.size)]
@@ -321,8 +321,8 @@ def test_state_space_has_named_states_and_the_loops_poles():
     closed = ct.feedback(sys_ol, ct.ss([], [], [], model.K), sign=-1)
     assert np.allclose(np.sort_complex(closed.poles()), ref, rtol=1e-9, atol=1e-9)
     # the rider's gains, by name, on roll, steer and their rates
-    gains, _ = simulation.controller_gains(simulation.with_changes(DEFAULT, speed=4.0),
-                                           simulation.build_bicycle(DEFAULT)[1])
+    gains, _ = wk.assembly.controller_gains(DEFAULT.with_changes(speed=4.0),
+                                           wk.assembly.build_bicycle(DEFAULT)[1])
     for g, state in (("kq4", "q4"), ("kq7", "q7"), ("ku4", "u4"), ("ku7", "u7")):
         assert model.K[0, model.states.index(state)] == gains[g]
 
@@ -336,7 +336,7 @@ def test_tables_and_summary(default_sweep):
     assert np.isfinite(table.select_dtypes("number").to_numpy()).all()
     shares = table[[f"share_{g}" for g in stability.GROUPS]].sum(axis=1)
     assert np.allclose(shares, 1.0)
-    json.dumps(simulation._clean(default_sweep.summary), allow_nan=False)
+    json.dumps(wk.results.clean(default_sweep.summary), allow_nan=False)
     steady = default_sweep.steady
     assert steady["found_by"].notna().all() and steady["roll_rad"].abs().max() < 1e-12
     # the state space of one sweep speed

@@ -5,14 +5,14 @@ import numpy as np
 import pytest
 
 import whipple_kick as wk
-from whipple_kick import control, simulation, slip, steady
+from whipple_kick import control, slip, steady
 from whipple_kick.simulation import Scenario
 
 
 def _params(pressure=400.0, fz=635.0, design_speed=3.0, symmetric=False):
     sc = Scenario(pressure_kpa=pressure, fz_n=fz)
-    moore, design, _ = simulation.build_bicycle(sc)
-    rear, front, _ = simulation.build_tyres(sc)
+    moore, design, _ = wk.assembly.build_bicycle(sc)
+    rear, front, _ = wk.assembly.build_tyres(sc)
     gains = control.gains_dict(control.lqr_gains(design, design_speed)[0])
     return slip.model_parameters(moore, rear, front, gains=gains, symmetric=symmetric)
 

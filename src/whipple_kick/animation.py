@@ -1,6 +1,6 @@
 """Animation of a kick-plate run: the bicycle, rider, plate, lane and tyre forces, frame by frame.
 
-:func:`animate` turns a :class:`whipple_kick.simulation.Result` into a video
+:func:`animate` turns a :class:`whipple_kick.results.Result` into a video
 (``.mp4`` through ffmpeg, or ``.gif`` through Pillow when no video encoder
 is installed):
 
@@ -278,15 +278,15 @@ def _bicycle_bodies(scenario, summary, params):
 
 def _model_parameters(result, tyres):
     """Moore's parameters of the run's bicycle+rider with the tyres' crown radii, by name."""
-    from . import simulation
+    from . import assembly
 
     scenario = result.scenario
-    moore, _, _ = simulation.build_bicycle(scenario)
+    moore, _, _ = assembly.build_bicycle(scenario)
     if tyres is None:
         if str(result.summary.get("tyres", {}).get("name", "")).startswith("custom"):
             raise InputError("this run used custom tyre objects: pass the same ones as tyres=(rear, front) "
                              "so the animation knows their crown radii (m)")
-        rear, front, _ = simulation.build_tyres(scenario)
+        rear, front, _ = assembly.build_tyres(scenario)
     else:
         rear, front = tyres
     return dict(moore, rtr=rear.crown_radius, rtf=front.crown_radius)
@@ -402,7 +402,7 @@ def build_scene(result, times, tyres=None, moments=True):
 
     Parameters
     ----------
-    result : whipple_kick.simulation.Result
+    result : whipple_kick.results.Result
     times : array_like
         Frame times [s] within the run.
     tyres : (rear, front), optional
@@ -1047,7 +1047,7 @@ def animate(result, path, *, fps=30.0, slow_motion=0.2, slow_after=1.0, time_ran
 
     Parameters
     ----------
-    result : whipple_kick.simulation.Result
+    result : whipple_kick.results.Result
     path : str or pathlib.Path
         ``*.mp4`` (needs a video encoder: the ``video`` extra or ffmpeg on
         PATH) or ``*.gif``.
@@ -1078,7 +1078,7 @@ def animate(result, path, *, fps=30.0, slow_motion=0.2, slow_after=1.0, time_ran
     Example
     -------
     >>> import whipple_kick as wk
-    >>> result = wk.simulation.run(wk.simulation.Scenario(duration=1.0))
+    >>> result = wk.run(wk.Scenario(duration=1.0))
     >>> wk.animation.animate(result, "kick.gif", fps=10, size=(320, 180)).frames
     56
     """
@@ -1114,7 +1114,7 @@ def still(result, path, at, *, size=(1280, 720), dpi=100, tyres=None, moments=Tr
     Example
     -------
     >>> import whipple_kick as wk
-    >>> result = wk.simulation.run(wk.simulation.Scenario(duration=1.0))
+    >>> result = wk.run(wk.Scenario(duration=1.0))
     >>> wk.animation.still(result, "kick.png", 0.2)
     """
     from PIL import Image

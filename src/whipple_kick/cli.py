@@ -8,7 +8,7 @@ import sys
 
 import numpy as np
 
-from .errors import InputError
+from .errors import InputError, SimulationError
 
 
 def _run(main, argv):
@@ -77,7 +77,8 @@ def _model_options(p, symmetric_flag=True, design_default="the run's --speed"):
     what the LQR design speed is by default. Returns the "riding and
     control" group, for the caller's speed option.
     """
-    from . import simulation, tyres
+    from . import tyres
+    from .scenario import CAMBER_SIGNS, CONTROLLERS, TYRE_TRANSIENTS
     g = p.add_argument_group("tyres")
     g.add_argument("--pressure", type=_number("kPa"), metavar="KPA",
                    help="inflation pressure of both tyres in kPa (default 400)")
@@ -96,11 +97,11 @@ def _model_options(p, symmetric_flag=True, design_default="the run's --speed"):
     if symmetric_flag:
         g.add_argument("--symmetric-tyres", action="store_true",
                        help="zero the tyres' zero-slip offsets (exactly upright steady running)")
-    g.add_argument("--tyre-transient", choices=simulation.TYRE_TRANSIENTS, default="contact_patch",
+    g.add_argument("--tyre-transient", choices=TYRE_TRANSIENTS, default="contact_patch",
                    help="how the tyre forces build up: contact_patch (default: lagged contact-patch slip and "
                         "camber, relaxation length shortening as the force saturates; passive, friction-limited), "
                         "slip_lag (the same with a constant relaxation length) or force_lag (the thesis' lagged force)")
-    g.add_argument("--camber-sign", choices=simulation.CAMBER_SIGNS, default="physical",
+    g.add_argument("--camber-sign", choices=CAMBER_SIGNS, default="physical",
                    help="physical (default: a leaning wheel is pushed toward the lean) or reversed (away from it, "
                         "as the thesis authors' published code; not physical)")
     g = p.add_argument_group("bicycle and rider")
@@ -114,7 +115,7 @@ def _model_options(p, symmetric_flag=True, design_default="the run's --speed"):
     g.add_argument("--low-inertia", action="store_true",
                    help="halve the rear frame's inertias and mass-centre height (thesis Figure 8.9)")
     g = p.add_argument_group("riding and control")
-    g.add_argument("--controller", choices=simulation.CONTROLLERS, default="lqr",
+    g.add_argument("--controller", choices=CONTROLLERS, default="lqr",
                    help="lqr: designed on the linearised classic model (default); thesis: Table 8.4 "
                         "gains (570, 635, 701 N only); off: no steer torque")
     g.add_argument("--design-speed", type=_number("m/s"), metavar="M/S",
@@ -129,7 +130,8 @@ def _model_options(p, symmetric_flag=True, design_default="the run's --speed"):
 
 
 def _simulate_parser():
-    from . import simulation
+    from .inputs import DIRECTIONS, PROFILES
+    from .scenario import KICK_HEADINGS, PLATE_STOPS, STARTS
     p = _OneLineParser(
         prog="simulate", allow_abbrev=False,
         description="Kick-plate test on the nonlinear Carvallo-Whipple bicycle-rider model with "
@@ -154,7 +156,7 @@ def _simulate_parser():
     # the default so that it can be refused with --kick-table.
     g.add_argument("--kick-displacement", type=_number("m"), metavar="M",
                    help="plate travel in m (default 0.150)")
-    g.add_argument("--kick-profile", choices=simulation.PROFILES,
+    g.add_argument("--kick-profile", choices=PROFILES,
                    help="constant acceleration (default, thesis), smooth (minimum jerk) or table "
                         "(plate displacement from --kick-table)")
     g.add_argument("--kick-table", metavar="FILE",
@@ -162,14 +164,14 @@ def _simulate_parser():
                         "y (in m, + right); a header-less file is read as two columns time, y. The plate "
                         "follows the clamped cubic spline through the rows (implies --kick-profile table; "
                         "not with --kick-accel/--kick-duration/--kick-displacement)")
-    g.add_argument("--kick-direction", choices=simulation.DIRECTIONS, default="right",
+    g.add_argument("--kick-direction", choices=DIRECTIONS, default="right",
                    help="direction the plate moves (default right)")
-    g.add_argument("--plate-stop", choices=simulation.PLATE_STOPS, default="impulse",
+    g.add_argument("--plate-stop", choices=PLATE_STOPS, default="impulse",
                    help="speeds across the constant profile's instant plate stop: impulse (default: the rear "
                         "no-slip constraint's impulse), resolve (dependent speeds only, the earlier model) or "
                         "keep_speeds (no jump; the rear contact is left sliding along its heading, as the "
                         "authors' published code)")
-    g.add_argument("--kick-heading", choices=simulation.KICK_HEADINGS, default="fixed",
+    g.add_argument("--kick-heading", choices=KICK_HEADINGS, default="fixed",
                    help="fixed (default): heading perpendicular to the plate at the kick start, whatever --settle; "
                         "settled: the steady motion starts so at -settle (the earlier model)")
     g = p.add_argument_group("run and output")
@@ -179,7 +181,7 @@ def _simulate_parser():
                         "rtol 1e-12, camber sign reversed, upright start, kick at t = 0, speeds kept at the plate "
                         "stop; --pressure defaults to 500; other flags given override its settings. For explaining "
                         "that code's runs, not for predictions")
-    g.add_argument("--start", choices=simulation.STARTS, default="steady",
+    g.add_argument("--start", choices=STARTS, default="steady",
                    help="steady (default: the solved steady motion) or upright (upright straight running, not an "
                         "equilibrium with measured tyres, as the authors' code; needs --settle 0)")
     g.add_argument("--duration", type=_number("s"), default=6.0, metavar="S",
@@ -259,7 +261,7 @@ def _model_fields(args):
 
 def _scenario_from_args(args, given=()):
     """The scenario of the parsed flags; with ``--compat``, the preset with the ``given`` flags' fields changed."""
-    from .simulation import Scenario
+    from .scenario import Scenario
     fields = _model_fields(args)
     profile = args.kick_profile
     if args.kick_table is not None:
@@ -399,19 +401,19 @@ def _write_results(result, out):
 
 def _simulate(argv):
     import shutil
-    from . import simulation
+    from . import assembly, simulation
     args = _simulate_parser().parse_args(argv)
     given = _flags_given(argv) if args.compat is not None else ()
-    scenario = simulation.preflight(_scenario_from_args(args, given))
+    scenario = assembly.preflight(_scenario_from_args(args, given))
     movie_options = _animation_options(args)
     out, created = _prepare_out(args.out if args.out else _default_out(scenario), args.force)
     try:
         result = simulation.run(scenario)
-    except simulation.SimulationError as exc:
+    except SimulationError as exc:
         if exc.partial is not None:
             # What ran before the failure is kept for the user to inspect.
             _write_results(exc.partial, out)
-            raise simulation.SimulationError(
+            raise SimulationError(
                 f"{exc}; the run up to t = {exc.partial.summary['end_time_s']:g} s is in {out}") from None
         if created and not any(out.iterdir()):
             shutil.rmtree(out, ignore_errors=True)
@@ -447,7 +449,6 @@ def _simulate(argv):
 
 def simulate_main(argv=None):
     """Console script ``simulate``: one kick-plate run (see ``simulate --help``)."""
-    from .simulation import SimulationError
     try:
         status = _run(_simulate, argv)
     except SimulationError as exc:
@@ -462,7 +463,7 @@ def simulate_main(argv=None):
 # ------------------------------------------------------------ recommend-pressure
 
 def _recommend(argv):
-    from . import sweep, tyres
+    from . import recommend, tyres
     p = _OneLineParser(
         prog="recommend-pressure",
         description="Recommend the tyre inflation pressure with the fastest recovery after a "
@@ -484,7 +485,7 @@ def _recommend(argv):
                    help="also try a grid of interpolated pressures between the measured ones")
     p.add_argument("--step", type=_number("kPa"), default=10.0, metavar="KPA",
                    help="step of the --fine grid in kPa (default 10)")
-    p.add_argument("--criterion", choices=tuple(k.replace("_", "-") for k in sweep.CRITERIA), default="settling",
+    p.add_argument("--criterion", choices=tuple(k.replace("_", "-") for k in recommend.CRITERIA), default="settling",
                    help="settling (default): time from which yaw, roll and steer rates all stay within 5 %% "
                         "of their first peaks; last-peak: the thesis' rule, time of the last yaw-rate peak "
                         "above 8 %% of the largest")
@@ -498,23 +499,23 @@ def _recommend(argv):
                    help="with --out: add these runs to a folder that holds another sweep")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     args = p.parse_args(argv)
-    from .simulation import Scenario
+    from .scenario import Scenario
     base = Scenario(duration=args.duration)
     base.validate()
-    recs = sweep.recommend_pressures(
+    recs = recommend.recommend_pressures(
         args.fz, tyre=args.tyre, pressures=args.pressures, fine=args.fine, step_kpa=args.step,
         base=base, criterion=args.criterion, workers=args.workers, folder=args.out, extend=args.extend,
         progress=not args.no_progress and sys.stderr.isatty())
     for k, rec in enumerate(recs):
         if k:
             print()
-        print(sweep.format_recommendation(rec))
+        print(recommend.format_recommendation(rec))
     return 0
 
 
 def recommend_main(argv=None):
     """Console script ``recommend-pressure`` (see ``recommend-pressure --help``)."""
-    from .sweep import SweepInterrupted
+    from .sweep_engine import SweepInterrupted
     try:
         status = _run(_recommend, argv)
     except (SweepInterrupted, OSError) as exc:
@@ -562,13 +563,14 @@ def _stability_parser():
 def _stability(argv):
     import shutil
     import time
-    from . import simulation, stability
+    from . import assembly, stability
+    from .scenario import Scenario
     args = _stability_parser().parse_args(argv)
     started = time.perf_counter()
     speeds = stability.parse_speeds(args.speeds)
-    scenario = simulation.Scenario(**_model_fields(args), symmetric_tyres=args.tyre_offsets == "zero",
+    scenario = Scenario(**_model_fields(args), symmetric_tyres=args.tyre_offsets == "zero",
                                    speed=float(speeds[0]))
-    simulation.preflight(scenario)
+    assembly.preflight(scenario)
     out, created = _prepare_out(args.out if args.out else _default_out(scenario, "stability"), args.force)
     try:
         result = stability.analyse(scenario, speeds)

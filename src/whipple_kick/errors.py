@@ -1,9 +1,11 @@
-"""Exceptions that mean "the user asked for something invalid".
+"""The package's two kinds of failure: the user's mistake, and numerical trouble.
 
 Command-line entry points catch :class:`InputError`, print its one-line
 message and exit with status 2 (no traceback). Library code raises it for
 every user mistake: a value outside its allowed range, an unknown name, a
-malformed parameter file. Numerical trouble is *not* an InputError.
+malformed parameter file. Numerical trouble is *not* an InputError: a run
+that fails numerically raises :class:`SimulationError`, carrying what was
+computed before the failure.
 """
 
 
@@ -46,3 +48,18 @@ def check_range(name, value, low, high, unit, *, low_open=False, high_open=False
     if bad:
         raise InputError(f"{name} = {value!r} {unit} is outside the allowed range {bracket} {unit}")
     return x
+
+
+class SimulationError(RuntimeError):
+    """The integration failed numerically (not a user mistake).
+
+    Attributes
+    ----------
+    partial : whipple_kick.results.Result or None
+        What was computed before the failure (trajectory up to it, summary
+        with ``status`` "failed"), when there is anything.
+    """
+
+    def __init__(self, message, partial=None):
+        super().__init__(message)
+        self.partial = partial

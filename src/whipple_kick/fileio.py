@@ -98,7 +98,7 @@ def write_csv(frame, path) -> None:
                 fh.write(chunk)
 
 
-def read_csv(path, what: str, **options):
+def read_csv(path, what: str, *, name: str | None = None, **options):
     """Read a CSV file with ``pandas.read_csv``; a file that cannot be read is a one-line InputError.
 
     Parameters
@@ -106,6 +106,8 @@ def read_csv(path, what: str, **options):
     path : path-like
     what : str
         What the file is, for the message (e.g. ``"kick table"``).
+    name : str, optional
+        How the message names the file (default ``path`` as given).
     **options
         Passed to ``pandas.read_csv`` (e.g. ``comment="#"``, ``header=None``).
 
@@ -122,16 +124,17 @@ def read_csv(path, what: str, **options):
     import pandas as pd
 
     p = pathlib.Path(path)
+    label = f"{what} {str(path) if name is None else name!r}"
     if not p.is_file():
-        raise InputError(f"{what} {str(path)!r} {'is not a file' if p.exists() else 'does not exist'}")
+        raise InputError(f"{label} {'is not a file' if p.exists() else 'does not exist'}")
     try:
         return pd.read_csv(p, encoding="utf-8-sig", **options)
     except UnicodeDecodeError:
-        raise InputError(f"{what} {str(path)!r} is not a UTF-8 text file") from None
+        raise InputError(f"{label} is not a UTF-8 text file") from None
     except pd.errors.EmptyDataError:
-        raise InputError(f"{what} {str(path)!r} has no rows") from None
+        raise InputError(f"{label} has no rows") from None
     except pd.errors.ParserError as exc:
         first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        raise InputError(f"{what} {str(path)!r} is not a delimited table: {first}") from None
+        raise InputError(f"{label} is not a delimited table: {first}") from None
     except OSError as exc:
-        raise InputError(f"{what} {str(path)!r} cannot be read: {exc.strerror or exc}") from None
+        raise InputError(f"{label} cannot be read: {exc.strerror or exc}") from None

@@ -118,7 +118,7 @@ def response_figure(runs, path=None, title=None, kick=None, time_range=None, dpi
     Example
     -------
     >>> import whipple_kick as wk
-    >>> result = wk.simulation.run(wk.simulation.Scenario(controller="off", duration=2.0))
+    >>> result = wk.run(wk.Scenario(controller="off", duration=2.0))
     >>> fig = response_figure([("", result)], kick=(0.0, 0.15))
     >>> [t.get_text() for t in fig.axes[0].texts if t.get_text().startswith("fell")]
     ['fell at 1.345 s']
@@ -220,7 +220,7 @@ def animate(result, path, **options):
     Example
     -------
     >>> import whipple_kick as wk
-    >>> result = wk.simulation.run(wk.simulation.Scenario(duration=1.0))
+    >>> result = wk.run(wk.Scenario(duration=1.0))
     >>> wk.plotting.animate(result, "kick.gif", fps=10, size=(320, 180)).frames
     56
     """

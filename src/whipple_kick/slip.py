@@ -155,6 +155,11 @@ def library_path():
     return lib_path
 
 
+def model_hash():
+    """Name of the compiled slip model in use (``slip_<key>``, its cache entry): what a sweep folder records."""
+    return os.path.splitext(os.path.basename(library()._name))[0]
+
+
 @functools.lru_cache(maxsize=None)
 def library():
     """The compiled slip model (ctypes library of :func:`library_path`), loaded once per process."""

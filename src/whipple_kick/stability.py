@@ -1,7 +1,7 @@
 """Linear stability of the slip model against speed: weave, capsize, wobble and the tyre modes.
 
 For a bicycle, rider, tyre, pressure and load (a
-:class:`whipple_kick.simulation.Scenario`), at each speed of a sweep:
+:class:`whipple_kick.scenario.Scenario`), at each speed of a sweep:
 
 1. the steady motion is found (:func:`whipple_kick.slip.steady_state`,
    continued from the previous speed's solution; the robust
@@ -30,7 +30,7 @@ Example
 -------
 >>> import numpy as np
 >>> from whipple_kick import stability
->>> from whipple_kick.simulation import Scenario
+>>> from whipple_kick import Scenario
 >>> result = stability.analyse(Scenario(symmetric_tyres=True), np.arange(2.0, 6.01, 0.5),
 ...                            loops=("open",))                      # doctest: +SKIP
 >>> result.summary["open"]["weave_speed_m_s"]                       # doctest: +SKIP
@@ -40,8 +40,9 @@ import math
 
 import numpy as np
 
-from . import fileio, simulation, slip
+from . import assembly, fileio, results, slip
 from .errors import InputError, check_range
+from .scenario import Scenario
 
 #: Loops analysed: without rider control, and with the scenario's rider.
 LOOPS = ("open", "closed")
@@ -87,9 +88,9 @@ MAX_SPEEDS = 2000
 # Heading-frame states at constant speed and how the summary and StateSpace name them.
 STATES = tuple(n for n in slip.LINEAR_STATES if n != "v_fwd")
 _LABELS = {
-    **{q: col for q, col in simulation._COORDINATE_COLUMNS.items()},
-    **{u: col for u, col in simulation._SPEED_COLUMNS.items()},
-    **simulation._PATCH_STATE_COLUMNS,
+    **{q: col for q, col in results.COORDINATE_COLUMNS.items()},
+    **{u: col for u, col in results.SPEED_COLUMNS.items()},
+    **{state: (col, "rad") for state, col in results.PATCH_STATE_COLUMNS.items()},
     "v_fwd": ("forward_velocity", "m/s"), "v_lat": ("lateral_velocity", "m/s"),
     "fyr": ("fy_rear", "N"), "fyf": ("fy_front", "N"), "mzr": ("mz_rear", "N m"), "mzf": ("mz_front", "N m"),
 }
@@ -253,10 +254,10 @@ class _Setup:
 
 
 def _setup(scenario, tyres=None):
-    simulation.preflight(scenario)
-    moore, design, info = simulation.build_bicycle(scenario)
+    assembly.preflight(scenario)
+    moore, design, info = assembly.build_bicycle(scenario)
     if tyres is None:
-        rear, front, notes = simulation.build_tyres(scenario)
+        rear, front, notes = assembly.build_tyres(scenario)
     else:
         (rear, front), notes = tyres, [f"tyres given: {tyres[0]!r} (rear), {tyres[1]!r} (front)"]
     return _Setup(scenario, moore, design, info, (rear, front), notes, scenario.controller)
@@ -274,7 +275,7 @@ def _loop_params(setup, speed, loop, base=None):
     """Slip-model parameters at ``speed`` for ``loop`` (the rider's gains designed for that speed)."""
     params = dict(_base_params(setup) if base is None else base)
     if loop == "closed":
-        gains, _ = simulation.controller_gains(simulation.with_changes(setup.scenario, speed=float(speed)),
+        gains, _ = assembly.controller_gains(setup.scenario.with_changes(speed=float(speed)),
                                                setup.design)
         params.update(gains)
     return params
@@ -297,7 +298,7 @@ def linear_model(scenario, speed, loop="open", *, tyres=None):
 
     Parameters
     ----------
-    scenario : whipple_kick.simulation.Scenario
+    scenario : whipple_kick.scenario.Scenario
         Bicycle, rider, tyres, controller (its speed is replaced by ``speed``).
     speed : float
         Forward speed [m/s].
@@ -313,14 +314,14 @@ def linear_model(scenario, speed, loop="open", *, tyres=None):
 
     Example
     -------
-    >>> from whipple_kick.simulation import Scenario
+    >>> from whipple_kick import Scenario
     >>> model = linear_model(Scenario(symmetric_tyres=True), 4.0)    # doctest: +SKIP
     >>> model.state_space().nstates                                   # doctest: +SKIP
     14
     """
     _check_loop(loop)
     speed = check_range("speed", speed, 0.0, 15.0, "m/s", low_open=True)
-    setup = _setup(simulation.with_changes(scenario, speed=float(speed)), tyres)
+    setup = _setup(scenario.with_changes(speed=float(speed)), tyres)
     params = _loop_params(setup, speed, loop)
     steady_state, found_by = _steady(params, speed, None)
     return linearise(params, steady_state, loop, found_by)
@@ -679,7 +680,7 @@ class Stability:
 
     Attributes
     ----------
-    scenario : whipple_kick.simulation.Scenario
+    scenario : whipple_kick.scenario.Scenario
     speeds : ndarray
         Speeds of the sweep [m/s].
     eigenvalues : pandas.DataFrame
@@ -780,7 +781,7 @@ def analyse(scenario, speeds, *, loops=None, tyres=None):
 
     Parameters
     ----------
-    scenario : whipple_kick.simulation.Scenario
+    scenario : whipple_kick.scenario.Scenario
         Bicycle, rider, tyres, controller. Its kick and run fields are not
         used, nor its speed. With the measured tyres' zero-slip offsets the
         steady motions are turns (large ones where the loop has a real
@@ -800,7 +801,7 @@ def analyse(scenario, speeds, *, loops=None, tyres=None):
 
     Example
     -------
-    >>> from whipple_kick.simulation import Scenario
+    >>> from whipple_kick import Scenario
     >>> res = analyse(Scenario(symmetric_tyres=True), [3.0, 4.0, 5.0], loops=("open",))   # doctest: +SKIP
     >>> sorted(set(res.eigenvalues["mode"]))                                             # doctest: +SKIP
     """
@@ -929,7 +930,7 @@ def _classic_rows(setup, speeds, loops, raw=None):
 
 def _classic_gains(setup, speed):
     from . import control
-    gains, _ = simulation.controller_gains(simulation.with_changes(setup.scenario, speed=float(speed)), setup.design)
+    gains, _ = assembly.controller_gains(setup.scenario.with_changes(speed=float(speed)), setup.design)
     return np.array([gains.get(n, 0.0) for n in control.GAIN_ORDER])
 
 
@@ -1260,10 +1261,10 @@ def free_response(model, vector, amplitude=1e-4, duration=2.0, rate=500.0, rtol=
     >>> fit_eigenvalue(t, np.column_stack([modal_coordinate(model, k, dev).real,
     ...                                    modal_coordinate(model, k, dev).imag]))  # doctest: +SKIP
     """
-    from . import integrate
+    from . import lsoda
     rhs = slip.CompiledRHS(model.steady.params)
     x0 = perturbed_state(model, vector, amplitude)
-    traj = integrate.integrate(rhs, x0, duration, rtol=rtol, output_rate=rate)
+    traj = lsoda.integrate(rhs, x0, duration, rtol=rtol, output_rate=rate)
     if traj.failed or traj.fell:
         raise FloatingPointError(f"the free response did not complete: {traj.message}")
     keep = [slip.LINEAR_STATES.index(n) for n in model.states]
@@ -1587,7 +1588,7 @@ def pressure_load_table(pressures=THESIS_PRESSURES_KPA, loads=THESIS_LOADS_N, *,
         Inflation pressures of both tyres [kPa] (default the thesis' 300, 400, 500).
     loads : sequence of float
         Static rear-tyre loads [N] the rider is sized for (default 570, 635, 701).
-    base : whipple_kick.simulation.Scenario, optional
+    base : whipple_kick.scenario.Scenario, optional
         Everything else (default: offsets removed, the default rider designed at each speed).
     speeds : array_like, optional
         Sweep speeds [m/s] (default :data:`DEFAULT_SPEEDS`).
@@ -1605,12 +1606,12 @@ def pressure_load_table(pressures=THESIS_PRESSURES_KPA, loads=THESIS_LOADS_N, *,
     >>> table[["pressure_kpa", "weave_speed_m_s", "capsize_speed_m_s"]]   # doctest: +SKIP
     """
     import pandas as pd
-    base = simulation.Scenario(symmetric_tyres=True) if base is None else base
+    base = Scenario(symmetric_tyres=True) if base is None else base
     speeds = parse_speeds("{}:{}:{}".format(*DEFAULT_SPEEDS)) if speeds is None else check_speeds(speeds)
     rows = []
     for load in loads:
         for pressure in pressures:
-            sc = simulation.with_changes(base, pressure_kpa=float(pressure), fz_n=float(load),
+            sc = base.with_changes(pressure_kpa=float(pressure), fz_n=float(load),
                                          pressure_front_kpa=None, pressure_rear_kpa=None)
             rows.append(case_row(analyse(sc, speeds), at_speed))
     return pd.DataFrame(rows)
@@ -1623,7 +1624,7 @@ def describe(scenario, info=None):
 
     Example
     -------
-    >>> from whipple_kick.simulation import Scenario
+    >>> from whipple_kick import Scenario
     >>> describe(Scenario(symmetric_tyres=True, controller="off"))
     'T03 400 kPa (zero-slip offsets removed, contact_patch), balanceassist_v1; no rider control'
     """
@@ -1660,7 +1661,7 @@ def write(result, out, plot=True):
     import pathlib
     out = pathlib.Path(out)
     fileio.write_csv(result.eigenvalues, out / "eigenvalues.csv")
-    summary = simulation._clean(result.summary)
+    summary = results.clean(result.summary)
     fileio.write_atomic(out / "summary.json", json.dumps(summary, indent=2, allow_nan=False) + "\n")
     files = ["eigenvalues.csv", "summary.json"]
     if plot:

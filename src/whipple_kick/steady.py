@@ -29,11 +29,11 @@ in one line, never with the solver's own message.
 
 Example
 -------
->>> from whipple_kick import simulation, slip, steady
->>> sc = simulation.Scenario()
->>> moore, design, _ = simulation.build_bicycle(sc)
->>> rear, front, _ = simulation.build_tyres(sc)
->>> gains, _ = simulation.controller_gains(sc, design)
+>>> from whipple_kick import Scenario, assembly, slip, steady
+>>> sc = Scenario()
+>>> moore, design, _ = assembly.build_bicycle(sc)
+>>> rear, front, _ = assembly.build_tyres(sc)
+>>> gains, _ = assembly.controller_gains(sc, design)
 >>> found = steady.find_steady_state(slip.model_parameters(moore, rear, front, gains=gains), 3.0)
 >>> found.route
 'direct'

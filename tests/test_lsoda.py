@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from whipple_kick import integrate, slip
+from whipple_kick import lsoda, slip
 
 N = len(slip.STATE_NAMES)
 ROLL, ROLL_RATE = slip.X["q4"], slip.X["u4"]
@@ -28,7 +28,7 @@ def test_fall_event_against_the_exact_fall_time_and_solve_ivp():
     """roll = 0.01 cosh t reaches 45 deg at acosh(78.54...) = 5.0567 s. The careful path steps the
     same LSODA as solve_ivp and finds the same event time bit for bit."""
     fall_angle = math.radians(45.0)
-    traj = integrate.integrate(capsize, _start(), 10.0, rtol=1e-10, output_rate=100.0, fall_angle=fall_angle)
+    traj = lsoda.integrate(capsize, _start(), 10.0, rtol=1e-10, output_rate=100.0, fall_angle=fall_angle)
     assert traj.fell and not traj.failed
     assert traj.fall_time == pytest.approx(math.acosh(fall_angle / 0.01), abs=1e-7)
     assert traj.t[-1] == traj.fall_time and abs(traj.x[-1, ROLL]) == pytest.approx(fall_angle, abs=1e-12)
@@ -41,7 +41,7 @@ def test_fall_event_against_the_exact_fall_time_and_solve_ivp():
     times = traj.t[start:-1]
     times = np.r_[times, 5.5]
     ref = solve_ivp(capsize, (5.0, 5.5), traj.x[start], method="LSODA", t_eval=times, events=fall,
-                    rtol=1e-10, atol=integrate.default_atol(1e-10))
+                    rtol=1e-10, atol=lsoda.default_atol(1e-10))
     assert ref.t_events[0][0] == traj.fall_time
     # Every sample after the chunk's start (which solve_ivp gives from its interpolant, to round-off).
     np.testing.assert_array_equal(ref.y.T[1:], traj.x[start + 1:-1])
@@ -56,10 +56,10 @@ def chatter(t, x):
 
 
 def test_a_stalling_integration_ends_as_a_failure_with_its_samples():
-    budget = integrate.Budget(allowance=5000, per_second=5000.0, stall_window=2000, stall_progress=1e-3)
+    budget = lsoda.Budget(allowance=5000, per_second=5000.0, stall_window=2000, stall_progress=1e-3)
     x0 = np.zeros(N)
     x0[ROLL] = 0.01
-    traj = integrate.integrate(chatter, x0, 2.0, output_rate=1000.0, rtol=1e-10, budget=budget)
+    traj = lsoda.integrate(chatter, x0, 2.0, output_rate=1000.0, rtol=1e-10, budget=budget)
     assert traj.failed and not traj.fell and traj.message.startswith("integration stalled at t = ")
     # x reaches the switching line at t = 0.01 / 0.5 = 0.02 s, where the steps collapse.
     stall = float(traj.message.split("t = ")[1].split(" s")[0])
@@ -76,11 +76,11 @@ def test_a_run_slower_than_the_budget_rate_fails_and_a_normal_run_does_not():
         dx = np.zeros_like(x)
         dx[ROLL], dx[ROLL_RATE] = x[ROLL_RATE], -4e6 * x[ROLL]
         return dx
-    tight = integrate.Budget(allowance=200, per_second=100.0)
-    traj = integrate.integrate(fast, _start(1e-3), 1.0, output_rate=100.0, budget=tight)
+    tight = lsoda.Budget(allowance=200, per_second=100.0)
+    traj = lsoda.integrate(fast, _start(1e-3), 1.0, output_rate=100.0, budget=tight)
     assert traj.failed and "more than the budget 200 + 100/s" in traj.message
     assert traj.evaluations <= tight.limit(traj.t[-1]) + 100
-    ok = integrate.integrate(fast, _start(1e-3), 0.05, output_rate=100.0)
+    ok = lsoda.integrate(fast, _start(1e-3), 0.05, output_rate=100.0)
     assert not ok.failed and ok.t[-1] == pytest.approx(0.05)
 
 
@@ -89,7 +89,7 @@ def test_a_run_slower_than_the_budget_rate_fails_and_a_normal_run_does_not():
 def _every_chunk_careful():
     """A budget whose fast path gives up after 2 steps between samples (mxstep = stall_window // 4), so
     every chunk is integrated by the careful path; it never runs out and never judges a stall."""
-    return integrate.Budget(allowance=10**9, per_second=0.0, stall_window=8, stall_progress=0.0)
+    return lsoda.Budget(allowance=10**9, per_second=0.0, stall_window=8, stall_progress=0.0)
 
 
 @pytest.mark.parametrize("budget", [None, "careful"])
@@ -105,7 +105,7 @@ def test_a_fall_right_after_a_jump_map_is_exact(budget):
         x = x.copy()
         x[ROLL_RATE] = 0.5
         return x
-    traj = integrate.integrate(capsize, _start(), 4.0, breakpoints=(1.0,), rtol=1e-11, output_rate=100.0,
+    traj = lsoda.integrate(capsize, _start(), 4.0, breakpoints=(1.0,), rtol=1e-11, output_rate=100.0,
                                fall_angle=fall_angle, jumps={1.0: kick}, budget=budget)
     assert traj.fell and not traj.failed
     r1, w1 = 0.01 * math.cosh(1.0), 0.5
@@ -131,8 +131,8 @@ def test_a_stall_right_after_a_jump_map_keeps_the_samples_up_to_it():
         x = x.copy()
         x[ROLL] = 0.001
         return x
-    budget = integrate.Budget(allowance=5000, per_second=5000.0, stall_window=2000, stall_progress=1e-3)
-    traj = integrate.integrate(after_one_second, np.zeros(N), 2.0, breakpoints=(1.0,), output_rate=1000.0,
+    budget = lsoda.Budget(allowance=5000, per_second=5000.0, stall_window=2000, stall_progress=1e-3)
+    traj = lsoda.integrate(after_one_second, np.zeros(N), 2.0, breakpoints=(1.0,), output_rate=1000.0,
                                rtol=1e-10, jumps={1.0: move}, budget=budget)
     assert traj.failed and not traj.fell and traj.message.startswith("integration stalled at t = ")
     stall = float(traj.message.split("t = ")[1].split(" s")[0])
@@ -166,9 +166,9 @@ def test_the_budget_counts_the_evaluations_inside_the_jacobian():
 
         def jacobian_function(self, scale):
             return make_jac(self.cost)
-    budget = integrate.Budget(allowance=2000, per_second=2000.0)
-    free = integrate.integrate(Model(0), _start(), 1.0, output_rate=100.0, budget=budget)
+    budget = lsoda.Budget(allowance=2000, per_second=2000.0)
+    free = lsoda.integrate(Model(0), _start(), 1.0, output_rate=100.0, budget=budget)
     assert not free.failed and free.njev > 0 and free.evaluations == free.nfev
-    costly = integrate.integrate(Model(1000), _start(), 1.0, output_rate=100.0, budget=budget)
+    costly = lsoda.integrate(Model(1000), _start(), 1.0, output_rate=100.0, budget=budget)
     assert costly.failed and "more than the budget 2000 + 2000/s" in costly.message
     assert costly.evaluations == costly.nfev + 1000 * costly.njev

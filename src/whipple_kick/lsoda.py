@@ -315,11 +315,11 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
     Example
     -------
     >>> import numpy as np
-    >>> from whipple_kick import integrate
+    >>> from whipple_kick import lsoda
     >>> def decay(t, x):            # any f(t, x) of the state layout's length
     ...     return -x
-    >>> x0 = np.full(len(integrate.slip.STATE_NAMES), 1e-3)
-    >>> traj = integrate.integrate(decay, x0, 1.0, output_rate=10.0)
+    >>> x0 = np.full(len(lsoda.slip.STATE_NAMES), 1e-3)
+    >>> traj = lsoda.integrate(decay, x0, 1.0, output_rate=10.0)
     >>> round(float(traj.x[-1, 0] / 1e-3), 6), traj.failed
     (0.367879, False)
     """

@@ -1,0 +1,406 @@
+"""Assembly: bicycle, rider, tyres and the rider's gains -> the slip model's parameters and its steady motion.
+
+The second step of a run (:func:`whipple_kick.simulation.run`): from a
+validated :class:`~whipple_kick.scenario.Scenario` and its kick
+(:mod:`whipple_kick.inputs`), :func:`assemble` seats the Yeadon rider on
+the bicycle (:func:`build_bicycle`), loads the tyres (:func:`build_tyres`),
+designs or looks up the rider's steer-torque gains (:func:`controller_gains`),
+names every parameter of the compiled model
+(:func:`whipple_kick.slip.model_parameters`), finds the steady motion the
+run starts from (:func:`start_state`) and judges whether the rider is
+linearly stable about it (:func:`linear_stability`). The result is one
+:class:`Assembly`, handed to the integration.
+"""
+import copy
+from dataclasses import dataclass
+import functools
+import pathlib
+
+import numpy as np
+
+from . import slip
+from .errors import InputError, SimulationError, check_range
+from .scenario import LOW_INERTIA_KEYS, THESIS_DESIGN_SPEED
+
+#: |steady yaw rate| [rad/s] below which steady running counts as straight (a yaw-angle gain needs it).
+STRAIGHT_YAW_RATE = 1e-9
+
+
+@dataclass
+class Assembly:
+    """Everything a run integrates and reports about its set-up.
+
+    Attributes
+    ----------
+    rear, front : whipple_kick.tyres.Tyre
+        The tyres (or the caller's tyre objects).
+    tyre_notes : list of str
+        What the summary says about them (missing M_z data, custom tyres).
+    moore : dict
+        Moore parameters of the bicycle with rider (low-inertia change applied).
+    bicycle : dict
+        The summary's ``bicycle`` section: rider mass [kg], static loads [N], total mass [kg].
+    gains : dict
+        Steer-torque gains by name (N m/rad, N m s/rad).
+    design_poles : ndarray or None
+        The LQR design's closed-loop poles at its design speed [1/s].
+    controller : str
+        ``lqr``, ``thesis``, ``off`` or ``custom gains``.
+    params : dict
+        The compiled model's parameters (the steady drive torque T6c included).
+    found : whipple_kick.steady.Found
+        The steady motion stability is judged about, and how it was found.
+    start : whipple_kick.slip.SteadyState
+        The state the run starts from (the steady motion, or an upright start).
+    stability : dict
+        :func:`linear_stability`'s verdict.
+    """
+
+    rear: object
+    front: object
+    tyre_notes: list
+    moore: dict
+    bicycle: dict
+    gains: dict
+    design_poles: np.ndarray | None
+    controller: str
+    params: dict
+    found: object
+    start: object
+    stability: dict
+
+    @property
+    def reference(self):
+        """The steady motion recovery is measured back to (upright running when the tyres allow none)."""
+        return self.start if self.found.route == SYMMETRIC_ROUTE else self.found.steady
+
+
+def assemble(scenario, kick, *, tyres=None, gains=None) -> Assembly:
+    """Build the model of one run: tyres, bicycle with rider, gains, parameters, steady motion, stability.
+
+    Parameters
+    ----------
+    scenario : whipple_kick.scenario.Scenario
+        Validated.
+    kick : whipple_kick.inputs.Kick
+        The plate motion (its first piece enters the parameters).
+    tyres : (rear, front), optional
+        Tyre objects instead of the scenario's tyre and pressures.
+    gains : mapping, optional
+        Steer-torque gains by name instead of the scenario's controller.
+
+    Returns
+    -------
+    Assembly
+
+    Raises
+    ------
+    InputError
+        A tyre, bicycle, rider or gain the scenario names is unknown or out
+        of range; no steady motion to start from
+        (:class:`whipple_kick.steady.NoSteadyMotion`); a yaw-angle gain with
+        a steady turn.
+    """
+    custom = None if gains is None else custom_gains(gains)
+    # Tyres first: a pressure outside the measured range is the commonest mistake and cheap to find.
+    if tyres is None:
+        rear, front, notes = build_tyres(scenario)
+    else:
+        rear, front = tyres
+        notes = [f"custom tyre objects (the scenario's tyre and pressures are not used): "
+                 f"rear {rear!r}, front {front!r}"]
+    moore, design, info = build_bicycle(scenario)
+    if custom is None:
+        gains, poles = controller_gains(scenario, design)
+        controller = scenario.controller
+    else:
+        gains, poles, controller = custom, None, "custom gains"
+    params = slip.model_parameters(moore, rear, front, gains=gains, symmetric=scenario.symmetric_tyres,
+                                   kick=kick.model_kick(), tyre_transient=scenario.tyre_transient,
+                                   reverse_camber=scenario.camber_sign == "reversed")
+    found, start = start_state(params, scenario, controller)
+    stability = linear_stability(scenario, moore, gains, found, controller)
+    steady_yaw_rate = float(start.x[slip.X["u3"]])
+    if gains.get("kq3", 0.0) and abs(steady_yaw_rate) > STRAIGHT_YAW_RATE:
+        # In a steady turn the yaw angle grows without bound, and so would kq3's torque.
+        raise InputError(f"a yaw-angle gain kq3 needs straight steady running, but the steady yaw rate is "
+                         f"{steady_yaw_rate:.3g} rad/s (allowed |yaw rate| <= {STRAIGHT_YAW_RATE:g} rad/s): "
+                         f"use tyres without zero-slip offsets (symmetric_tyres=True)")
+    return Assembly(rear, front, notes, moore, info, gains, poles, controller, start.params, found, start, stability)
+
+
+# ------------------------------------------------------------------ the parts
+
+def build_bicycle(scenario):
+    """Bicycle with rider for ``scenario``: (moore parameters, design parameters, info dict).
+
+    The info holds the rider mass [kg] and the static loads [N] of the
+    unmodified bicycle; ``moore`` has the low-inertia change applied if asked.
+    ``design`` is the unmodified set the LQR is designed on. Cached per
+    process on the fields it reads (a sweep over pressures, speeds or kicks
+    seats the Yeadon rider once); callers get their own copies.
+    """
+    key = (scenario.bicycle, _file_stamp(scenario.bicycle), scenario.fz_n, scenario.rider_mass_kg,
+           scenario.rider, scenario.low_inertia)
+    return copy.deepcopy(_bicycle_setup(*key))
+
+
+def _file_stamp(name):
+    """Modification time of a parameter file given by path (so an edited file is re-read)."""
+    path = pathlib.Path(str(name))
+    return path.stat().st_mtime_ns if path.suffix == ".toml" and path.is_file() else None
+
+
+@functools.lru_cache(maxsize=256)
+def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia):
+    from . import benchmark, bicycles, riders
+
+    bike = bicycles.load(bicycle)
+    if bike.includes_rider:
+        if fz_n is not None or rider_mass_kg is not None:
+            raise InputError(f"bicycle {bike.name!r} already includes its rider; "
+                             "do not give a rear-tyre load fz or a rider mass with it")
+        combined, rider_mass = bike, None
+    elif rider_mass_kg is not None:
+        rider = riders.yeadon_rider(rider_name, mass_kg=rider_mass_kg)
+        combined, rider_mass = riders.seat(bike, rider), float(rider_mass_kg)
+    else:
+        fz = 635.0 if fz_n is None else fz_n
+        combined, rider_mass = riders.for_rear_load(bike, fz, rider=rider_name)
+    rear_n, front_n = riders.static_loads(combined)
+    design = dict(combined.moore)
+    moore = dict(design)
+    if low_inertia:
+        bench = dict(combined.benchmark)
+        for key in LOW_INERTIA_KEYS:
+            bench[key] *= 0.5
+        moore = benchmark.to_moore(bench)
+    info = {"bicycle": bike.name, "includes_rider_preset": bike.includes_rider,
+            "rider_mass_kg": rider_mass, "static_load_rear_n": rear_n, "static_load_front_n": front_n,
+            "total_mass_kg": sum(float(combined.benchmark[k]) for k in ("mR", "mB", "mH", "mF"))}
+    return moore, design, info
+
+
+@functools.lru_cache(maxsize=256)
+def _lqr(design_items, speed):
+    # A sweep over pressures or kicks designs the same rider once per process.
+    from . import control
+    K, poles = control.lqr_gains(dict(design_items), speed)
+    return tuple(np.ravel(K)), tuple(np.ravel(poles))
+
+
+def controller_gains(scenario, design):
+    """Steer-torque gains by name, and the LQR design's closed-loop poles at its design speed (or None).
+
+    The LQR rider is designed at :attr:`Scenario.lqr_design_speed` (the run's
+    speed unless ``design_speed`` is given).
+    """
+    from . import control
+
+    if scenario.controller == "off":
+        return {k: 0.0 for k in control.GAIN_ORDER}, None
+    if scenario.controller == "thesis":
+        gains = control.thesis_gains(thesis_load(scenario))
+        return {k: scenario.gain_scale * v for k, v in gains.items()}, None
+    K, poles = _lqr(tuple(sorted(design.items())), float(scenario.lqr_design_speed))
+    return control.gains_dict(K, scenario.gain_scale), np.asarray(poles)
+
+
+def thesis_load(scenario):
+    """Rear load [N] whose Table 8.4 row ``controller="thesis"`` uses.
+
+    ``thesis_load_n`` if given, else ``fz_n``, else the load a preset with
+    rider is labelled with (``balanceassist_635N``: 635 N), else 635 N for a
+    bicycle whose rider is seated for the default load.
+    """
+    from . import bicycles
+
+    if scenario.thesis_load_n is not None:
+        return scenario.thesis_load_n
+    if scenario.fz_n is not None:
+        return scenario.fz_n
+    bike = bicycles.load(scenario.bicycle)
+    if bike.includes_rider and bike.thesis_rear_load_n is not None:
+        return bike.thesis_rear_load_n
+    if scenario.rider_mass_kg is None and not bike.includes_rider:
+        return 635.0
+    raise InputError("controller thesis uses Table 8.4 gains for a rear load of 570, 635 or 701 N: give fz (N), "
+                     "or thesis_load_n (--thesis-load N) for a rider given by mass or a preset with rider")
+
+
+def build_tyres(scenario):
+    """(rear, front) tyres and a list of notes about them."""
+    from . import tyres
+
+    notes = []
+    rear_p, front_p = scenario.pressures
+    loaded = []
+    for p in (rear_p, front_p):
+        tyre = tyres.load(scenario.tyre, p, coefficient_set=scenario.coefficient_set,
+                          friction=scenario.friction, missing_moment="error")
+        try:
+            tyre.blend   # raises when the tyre has no M_z coefficients
+            loaded.append(tyre)
+        except InputError as exc:
+            # Tyres without published M_z data: run with M_z = 0 and say so.
+            if "aligning-moment" not in str(exc):
+                raise
+            loaded.append(tyres.load(scenario.tyre, p, coefficient_set=scenario.coefficient_set,
+                                     friction=scenario.friction, missing_moment="zero"))
+            note = f"{scenario.tyre} has no published aligning-moment data: M_z = 0"
+            if note not in notes:
+                notes.append(note)
+    return loaded[0], loaded[1], notes
+
+
+def preflight(scenario):
+    """Cheap checks of everything a user can get wrong, before any long work.
+
+    Field ranges, tyre name and pressure range, bicycle name and rider
+    conflicts, the Table 8.4 row of ``controller="thesis"``. Raises
+    :class:`InputError`; returns ``scenario``.
+    """
+    from . import bicycles, control
+
+    scenario.validate()
+    build_tyres(scenario)
+    bike = bicycles.load(scenario.bicycle)
+    if bike.includes_rider and (scenario.fz_n is not None or scenario.rider_mass_kg is not None):
+        raise InputError(f"bicycle {bike.name!r} already includes its rider; "
+                         "do not give a rear-tyre load fz or a rider mass with it")
+    if scenario.controller == "thesis":
+        control.thesis_gains(thesis_load(scenario))
+    return scenario
+
+
+#: A closed-loop pole whose real part exceeds this [1/s] makes the rider linearly unstable
+#: (slower growth, by less than 1 % over a 10 s run, is not reported).
+UNSTABLE_REAL_PART = 1e-3
+
+
+def who_rides(scenario, controller_type):
+    """How the summary and the messages name the rider in use."""
+    if controller_type == "lqr":
+        return f"the LQR rider designed at {scenario.lqr_design_speed:g} m/s"
+    if controller_type == "thesis":
+        return f"the thesis' Table 8.4 rider (designed at {THESIS_DESIGN_SPEED:g} m/s)"
+    if controller_type == "off":
+        return "the bicycle without steer control"
+    return "the rider with the given gains"
+
+
+def _steady_advice(scenario, controller_type):
+    """What a user can change when there is no steady motion (for the one-line error)."""
+    if controller_type == "lqr" and scenario.design_speed is not None:
+        return (f"the rider is designed at {scenario.design_speed:g} m/s: choose another design speed "
+                "(--design-speed; by default the run's speed) or another speed")
+    if controller_type == "thesis":
+        return (f"Table 8.4's rider was designed at {THESIS_DESIGN_SPEED:g} m/s: choose controller lqr "
+                "(designed at the run's speed) or another speed")
+    return "choose another speed, rider or tyre pressure, or symmetric tyres"
+
+
+def steady_motion(params, scenario, controller_type):
+    """The steady motion before the kick (:func:`whipple_kick.steady.find_steady_state`)."""
+    from . import steady
+    return steady.find_steady_state(params, scenario.speed, advice=_steady_advice(scenario, controller_type))
+
+
+#: What an upright start's stability is judged about when the tyres' offsets allow no steady motion.
+SYMMETRIC_ABOUT = "upright running without the tyres' zero-slip offsets"
+SYMMETRIC_ROUTE = f"{SYMMETRIC_ABOUT} (no steady motion with them)"
+
+
+def start_state(params, scenario, controller_type):
+    """The steady motion the rider's stability is judged about, and the state the run starts from.
+
+    With ``start="steady"`` both are the steady motion. With
+    ``start="upright"`` the run starts from :func:`whipple_kick.slip.upright_state`;
+    stability is judged about the steady motion of the same model if there
+    is one, else about upright running with the tyres' offsets removed (an
+    exact equilibrium).
+
+    Returns
+    -------
+    found : whipple_kick.steady.Found
+    start : whipple_kick.slip.SteadyState
+    """
+    from . import steady
+
+    if scenario.start == "steady":
+        found = steady_motion(params, scenario, controller_type)
+        return found, found.steady
+    try:
+        start = slip.upright_state(params, scenario.speed)
+    except FloatingPointError as exc:
+        raise SimulationError(str(exc)) from None
+    try:
+        found = steady_motion(params, scenario, controller_type)
+    except steady.NoSteadyMotion:
+        symmetric = slip.steady_state(steady.offset_scaled(params, 0.0), scenario.speed)
+        found = steady.Found(symmetric, SYMMETRIC_ROUTE, 1)
+    return found, start
+
+
+def linear_stability(scenario, moore, gains, found, controller_type):
+    """Is the rider in use linearly stable at the run's speed?
+
+    Poles of the slip model linearised about the steady motion at constant
+    speed (:func:`whipple_kick.steady.lateral_poles`; decisive) and of the
+    no-slip classic model of the same bicycle with the same gains
+    (:func:`whipple_kick.control.closed_loop_poles`). A yaw-angle gain breaks
+    the slip linearisation's heading invariance: then the classic model decides.
+
+    Returns
+    -------
+    dict
+        ``stable``, ``message`` (one line, None when stable), ``slowest_pole_1_s``,
+        ``model`` (which linearisation decided), ``poles_slip_model_1_s``,
+        ``poles_no_slip_model_1_s`` (each as [real, imag] pairs), ``criterion``.
+    """
+    from . import control, steady
+
+    classic = control.closed_loop_poles(moore, scenario.speed, gains)
+    slip_poles = None
+    if not gains.get("kq3", 0.0):
+        try:
+            slip_poles = steady.lateral_poles(found.steady.params, found.steady.x)
+        except FloatingPointError:   # the linearisation's pitch solve failed: the classic model decides
+            slip_poles = None
+    about = SYMMETRIC_ABOUT if found.route == SYMMETRIC_ROUTE else "the steady motion"
+    decisive, model = ((slip_poles, f"slip model about {about}, constant speed")
+                       if slip_poles is not None else (classic, "no-slip classic model"))
+    slowest = decisive[0]
+    stable = bool(slowest.real <= UNSTABLE_REAL_PART)
+    message = None
+    if not stable:
+        message = (f"{who_rides(scenario, controller_type)} is linearly unstable at {scenario.speed:g} m/s: "
+                   f"slowest closed-loop pole {_pole_text(slowest)} 1/s ({model}; no-slip model "
+                   f"{_pole_text(classic[0])} 1/s)")
+    pairs = lambda poles: None if poles is None else [[float(p.real), float(p.imag)] for p in poles]
+    return {"stable": stable, "message": message, "slowest_pole_1_s": pairs([slowest])[0], "model": model,
+            "poles_slip_model_1_s": pairs(slip_poles), "poles_no_slip_model_1_s": pairs(classic),
+            "criterion": f"unstable when a closed-loop pole has real part > {UNSTABLE_REAL_PART:g} 1/s"}
+
+
+def _pole_text(pole):
+    text = f"{pole.real:+.3f}"
+    return text + (f" +- {abs(pole.imag):.3f}j" if abs(pole.imag) > 1e-9 else "")
+
+
+def custom_gains(gains):
+    """Check user-given steer-torque gains (by name) and fill the missing ones with 0."""
+    from . import control, symbols
+
+    unknown = sorted(set(gains) - set(slip.GAIN_NAMES))
+    if unknown:
+        raise InputError(f"unknown steer-torque gain(s) {unknown}; known: {list(slip.GAIN_NAMES)}")
+    # The four of the thesis' law always; the yaw gains only when given.
+    names = control.GAIN_ORDER + tuple(n for n in ("kq3", "ku3") if n in gains)
+    return {name: check_range(f"gain {name}", gains.get(name, 0.0), None, None, symbols.info(name).unit)
+            for name in names}
+
+
+def control_law(gains):
+    """``T7 = -(kq4 q4 + ...)`` with the gains in use (gain k<x> multiplies state <x>), for the summary."""
+    return "T7 = -(" + " + ".join(f"{name} {name[1:]}" for name in gains) + ")"

@@ -1,0 +1,330 @@
+"""Results of one run: the trajectory table with units, the response metrics and the summary.
+
+The fourth step of a run (:func:`whipple_kick.simulation.run`): the
+integrated :class:`~whipple_kick.integration.Solution` becomes a
+:class:`Result`, the time histories as a pandas DataFrame (:func:`trajectory_frame`,
+columns and units in :data:`UNITS`) and a JSON-ready summary
+(:func:`summarise`): outcome, set-up, steady state, peaks, energy balance,
+the recovery and the Section 8.3 metrics of :mod:`whipple_kick.analysis`,
+numerics. Nothing in a result is NaN (:func:`clean`).
+"""
+from dataclasses import dataclass, field
+import math
+
+import numpy as np
+
+from . import energy, lsoda, slip
+from .errors import InputError, SimulationError
+
+# Moore's coordinates and speeds, named for the trajectory table: state -> (column, unit).
+COORDINATE_COLUMNS = {
+    "q1": ("x_rear", "m"), "q2": ("y_rear", "m"), "q3": ("yaw", "rad"), "q4": ("roll", "rad"),
+    "q5": ("pitch", "rad"), "q6": ("rear_wheel_angle", "rad"), "q7": ("steer", "rad"),
+    "q8": ("front_wheel_angle", "rad"), "q9": ("compression_rear", "m"),
+    "q10": ("compression_front", "m"),
+}
+SPEED_COLUMNS = {
+    "u1": ("u1", "m/s"), "u2": ("u2", "m/s"), "u3": ("yaw_rate", "rad/s"), "u4": ("roll_rate", "rad/s"),
+    "u5": ("pitch_rate", "rad/s"), "u6": ("rear_wheel_rate", "rad/s"), "u7": ("steer_rate", "rad/s"),
+    "u8": ("front_wheel_rate", "rad/s"), "u9": ("compression_rate_rear", "m/s"),
+    "u10": ("compression_rate_front", "m/s"),
+}
+#: The force and moment each tyre applies to the bicycle (in every transient form): output -> column.
+APPLIED_COLUMNS = {"fy_r": "fy_rear", "fy_f": "fy_front", "mz_r": "mz_rear", "mz_f": "mz_front"}
+#: The other named outputs of the compiled model: output -> column (units: :data:`whipple_kick.slip.OUTPUTS`).
+OUTPUT_COLUMNS = {
+    "slip_r": "slip_rear", "slip_f": "slip_front", "camber_r": "camber_rear", "camber_f": "camber_front",
+    "vx_r": "rolling_speed_rear", "vx_f": "rolling_speed_front", "fz_r": "fz_rear", "fz_f": "fz_front",
+    "fy_ss_r": "fy_steady_rear", "fy_ss_f": "fy_steady_front", "mz_ss_r": "mz_steady_rear",
+    "mz_ss_f": "mz_steady_front", "T7": "steer_torque", "yp": "plate_y", "vp": "plate_velocity",
+    "ap": "plate_acceleration", "kinetic_energy": "kinetic_energy", "potential_energy": "potential_energy",
+    "spring_energy": "spring_energy", "sliding_power": "sliding_power", "holonomic": "holonomic_residual",
+    "sigma_r": "relaxation_length_rear", "sigma_f": "relaxation_length_front",
+}
+#: Contact-patch states (transient forms contact_patch and slip_lag only): state -> column.
+PATCH_STATE_COLUMNS = {"slip_patch_r": "slip_patch_rear", "slip_patch_f": "slip_patch_front",
+                       "camber_patch_r": "camber_patch_rear", "camber_patch_f": "camber_patch_front"}
+#: Energy balance residual column [J] (:func:`whipple_kick.energy.balance_residual`).
+BALANCE_COLUMN = "energy_balance_residual"
+#: Unit of every trajectory column (from the symbol registry and :data:`whipple_kick.slip.OUTPUTS`).
+UNITS = {"time": "s", **dict(COORDINATE_COLUMNS.values()), **dict(SPEED_COLUMNS.values()),
+         **{c: "rad" for c in PATCH_STATE_COLUMNS.values()},
+         **{c: slip.OUTPUTS[o][0] for o, c in {**APPLIED_COLUMNS, **OUTPUT_COLUMNS}.items()},
+         **dict(energy.COLUMNS.values()), BALANCE_COLUMN: "J"}
+#: Columns whose peaks after the kick the summary lists (``max_abs_<column>``).
+PEAK_COLUMNS = ("yaw_rate", "roll_rate", "steer_rate", "roll", "steer", "slip_rear", "fy_rear", "fy_front",
+                "steer_torque")
+
+
+@dataclass
+class Result:
+    """Outcome of :func:`whipple_kick.simulation.run`.
+
+    Attributes
+    ----------
+    scenario : Scenario
+    trajectory : pandas.DataFrame
+        Time histories, columns named as in :data:`UNITS` (time from the kick start).
+    summary : dict
+        JSON-ready summary (no NaN): outcome, model set-up, steady state,
+        peaks, recovery metrics, numerics.
+    """
+
+    scenario: "object"
+    trajectory: "object"
+    summary: dict = field(default_factory=dict)
+
+
+def trajectory_frame(solution, tyre_transient="contact_patch"):
+    """DataFrame of states and named outputs at every sample of a :class:`~whipple_kick.integration.Solution`.
+
+    The patch states are columns in the contact-patch forms only; the
+    energy columns and the balance residual (:mod:`whipple_kick.energy`) in
+    every form.
+
+    Raises
+    ------
+    SimulationError
+        A value is not finite (never NaN in a result).
+    """
+    import pandas as pd
+
+    traj = solution.trajectory
+    outs = solution.outputs()
+    cols = {"time": traj.t}
+    for q, (name, _) in COORDINATE_COLUMNS.items():
+        cols[name] = traj.x[:, slip.X[q]]
+    for u, (name, _) in SPEED_COLUMNS.items():
+        cols[name] = outs[:, slip.OUT[u]]   # includes the dependent speeds u5 u6 u8
+    for o, name in APPLIED_COLUMNS.items():
+        cols[name] = outs[:, slip.OUT[o]]
+    if tyre_transient != "force_lag":
+        for state, name in PATCH_STATE_COLUMNS.items():
+            cols[name] = traj.x[:, slip.X[state]]
+    for o, name in OUTPUT_COLUMNS.items():
+        cols[name] = outs[:, slip.OUT[o]]
+    for state, (name, _) in energy.COLUMNS.items():
+        cols[name] = traj.x[:, slip.X[state]]
+    frame = pd.DataFrame(cols)
+    frame[BALANCE_COLUMN] = energy.balance_residual(frame)
+    if not np.all(np.isfinite(frame.to_numpy())):
+        raise SimulationError("non-finite values in the trajectory")
+    return frame
+
+
+def response_metrics(df, baseline, x0, scenario, traj):
+    """Section 8.3 metrics (``metrics``, ``unavailable``) and the recovery of a (possibly partial) run."""
+    from . import analysis
+
+    fall_roll = math.radians(scenario.fall_angle_deg)
+    ended = None
+    if traj.fell:
+        ended = f"fell {traj.fall_time:.3f} s after the kick start"
+    elif traj.failed:
+        ended = "the integration failed before the end of the run"
+    try:
+        metrics = analysis.kick_metrics(df, t_kick=0.0, baseline=baseline, include_spectra=False,
+                                        fall_roll=fall_roll)
+        rec = analysis.recovery(df, 0.0, {name: float(x0[slip.X[state]]) for name, state in
+                                          (("yaw_rate", "u3"), ("roll_rate", "u4"), ("steer_rate", "u7"))},
+                                ended=ended)
+    except InputError as exc:   # a failure so early that too little of the response exists
+        metrics = {"unavailable": {"all": f"no response to analyse: {exc}"}}
+        rec = {"time_s": None, "reason": ended or str(exc), "signals": {}}
+    # The integrator's event is exact; kick_metrics sees |roll| only up to the limit.
+    metrics["fell"] = bool(traj.fell)
+    metrics["fall_time"] = traj.fall_time
+    unavailable = metrics.setdefault("unavailable", {})
+    if traj.fell:
+        unavailable.pop("fall_time", None)
+    if ended is not None and metrics.get("last_peak_time") is not None:
+        # The last peak above 8 % before a fall or a failure is not the end of the response.
+        metrics["last_peak_time"], unavailable["last_peak_time"] = None, ended
+    return metrics, rec
+
+
+def clean(value):
+    """JSON-ready copy: numpy scalars/arrays to Python, NaN/inf refused."""
+    if isinstance(value, dict):
+        return {str(k): clean(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return [clean(v) for v in value]
+    if isinstance(value, (np.bool_, bool)):
+        return bool(value)
+    if isinstance(value, (np.integer, int)):
+        return int(value)
+    if isinstance(value, (np.floating, float)):
+        v = float(value)
+        if not math.isfinite(v):
+            raise SimulationError(f"non-finite value {v} in the summary")
+        return v
+    if isinstance(value, complex):
+        return [clean(value.real), clean(value.imag)]
+    return value
+
+
+def _rear_wheel_torque(steady):
+    """Summary entries of the steady rear-wheel torque T6c: value, sign convention, role, and what it balances."""
+    rhs = slip.CompiledRHS(steady.params)
+    dx, out = rhs.outputs(0.0, steady.x)
+    torque = float(steady.params["T6c"])
+    power = {name: float(dx[slip.X[state]]) for name, state in (
+        ("rear_wheel_torque", "W_wheel"), ("zero_slip_forces", "W_zero_slip"), ("aligning_moments", "W_moment"),
+        ("sliding", "D_slide"))}
+    power["sliding"] = -power["sliding"]   # dissipation enters the balance with a minus
+    role = "none" if torque == 0.0 else ("brake" if torque * out[slip.OUT["u6"]] < 0.0 else "drive")
+    return {
+        "rear_wheel_torque_n_m": torque,
+        "rear_wheel_torque_convention": ("on the rear wheel about the rear frame's C.y axis (pointing to the "
+                                         "rider's right); + opposes forward rolling (the wheel spins about -C.y)"),
+        "rear_wheel_torque_role": role,
+        "steady_power_w": power,
+    }
+
+
+def _energy_summary(df, jumps, scenario):
+    """Totals of the energy accounting after the kick, the balance residual and the velocity jumps."""
+    after = df["time"].to_numpy() >= 0.0
+    totals = {f"{column}_j": float(df[column].iloc[-1]) for column, _ in energy.COLUMNS.values()}
+    stored = sum(df[c].to_numpy() for c in energy.STORED)
+    dissipation = df["sliding_dissipation"].to_numpy() + df["damper_dissipation"].to_numpy()
+    residual = np.abs(df[BALANCE_COLUMN].to_numpy())
+    return {
+        "convention": ("works done ON the bicycle and dissipations, cumulative from the kick start (J); "
+                       "stored = kinetic + potential + tyre springs + carcasses; balance residual = "
+                       "change of stored - (works - dissipations)"),
+        **totals,
+        "stored_change_after_kick_j": float(stored[-1] - stored[after][0]) if after.any() else 0.0,
+        "balance_residual_max_abs_j": float(residual.max()),
+        "dissipation_largest_decrease_j": float(max(0.0, -np.diff(dissipation).min())) if len(df) > 1 else 0.0,
+        "plate_stop": scenario.plate_stop,
+        "velocity_jumps": jumps,
+    }
+
+
+# ------------------------------------------------------------------ the summary
+
+def summarise(scenario, kick, assembly, solution, frame, *, custom_tyres=False) -> dict:
+    """The JSON-ready summary of a run, section by section (see :func:`whipple_kick.simulation.run`).
+
+    Parameters
+    ----------
+    scenario : whipple_kick.scenario.Scenario
+    kick : whipple_kick.inputs.Kick
+    assembly : whipple_kick.assembly.Assembly
+    solution : whipple_kick.integration.Solution
+    frame : pandas.DataFrame
+        :func:`trajectory_frame` of the solution.
+    custom_tyres : bool
+        The run used the caller's tyre objects (not the scenario's tyre and pressures).
+
+    Returns
+    -------
+    dict
+        No NaN, numpy types converted (:func:`clean`).
+    """
+    traj = solution.trajectory
+    baseline = float(assembly.reference.x[slip.X["u3"]])
+    metrics, recovery = response_metrics(frame, baseline, assembly.reference.x, scenario, traj)
+    summary = {
+        "outcome": "failed" if traj.failed else "fell" if traj.fell else "completed",
+        "fell": bool(traj.fell),
+        "fall_time_s": traj.fall_time,
+        "fall_reason": traj.fall_reason,
+        "end_time_s": float(frame["time"].iloc[-1]),
+        "message": traj.message,
+        "bicycle": assembly.bicycle,
+        "tyres": _tyres_section(scenario, assembly, custom_tyres),
+        "controller": _controller_section(scenario, assembly),
+        "linear_stability": assembly.stability,
+        "kick": kick.summary(scenario.kick_direction),
+        "steady_state": _steady_section(scenario, assembly, baseline),
+        "peaks": _peaks(frame),
+        "energy": _energy_summary(frame, solution.jumps, scenario),
+        "recovery": recovery,
+        "metrics": {k: v for k, v in metrics.items() if k != "unavailable"},
+        "metrics_unavailable": metrics["unavailable"],
+        "numerics": _numerics_section(scenario, solution, frame),
+        "scenario": scenario.to_dict(),
+        "units": {column: UNITS[column] for column in frame.columns},
+    }
+    return clean(summary)
+
+
+def _tyres_section(scenario, assembly, custom_tyres):
+    rear, front = scenario.pressures
+    return {
+        "name": f"custom: rear {assembly.rear!r}, front {assembly.front!r}" if custom_tyres else scenario.tyre,
+        "coefficient_set": scenario.coefficient_set,
+        "friction": scenario.friction, "symmetric": scenario.symmetric_tyres,
+        "transient": scenario.tyre_transient,
+        "pressure_rear_kpa": None if custom_tyres else rear,
+        "pressure_front_kpa": None if custom_tyres else front,
+        "notes": assembly.tyre_notes,
+    }
+
+
+def _controller_section(scenario, assembly):
+    from . import assembly as assembly_module
+    from . import symbols
+    from .scenario import THESIS_DESIGN_SPEED
+
+    kind, gains = assembly.controller, assembly.gains
+    poles = assembly.design_poles
+    return {
+        "type": kind, "gain_scale": None if kind == "custom gains" else scenario.gain_scale,
+        "design_speed_m_s": {"lqr": scenario.lqr_design_speed, "thesis": THESIS_DESIGN_SPEED}.get(kind),
+        "rider": assembly_module.who_rides(scenario, kind),
+        "gains": gains,
+        "gain_units": {name: symbols.info(name).unit for name in gains},
+        "law": assembly_module.control_law(gains),
+        # At the run's speed, for the gains used (the LQR design's own poles are at its design speed).
+        "linear_closed_loop_poles": assembly.stability["poles_no_slip_model_1_s"],
+        "design_poles": None if poles is None else [[p.real, p.imag] for p in poles],
+    }
+
+
+def _steady_section(scenario, assembly, baseline):
+    start, reference = assembly.start, assembly.reference
+    x0 = start.x
+    if scenario.start == "steady":
+        found_by = assembly.found.route
+    else:
+        found_by = (f"upright start (start 'upright'): not a steady motion, the tyres' zero-slip forces act from "
+                    f"t = 0 (largest lateral acceleration there {start.unknowns['largest_rate']:.3g} m/s^2 or "
+                    f"rad/s^2); yaw-rate peaks and recovery are measured from "
+                    + (f"the steady motion's yaw rate {baseline:.4g} rad/s" if reference is not start
+                       else "upright running (no steady motion with these tyres)"))
+    return {
+        "speed_m_s": scenario.speed,
+        "roll_rad": float(x0[slip.X["q4"]]), "steer_rad": float(x0[slip.X["q7"]]),
+        "pitch_rad": float(x0[slip.X["q5"]]), "yaw_rate_rad_s": float(x0[slip.X["u3"]]),
+        "yaw_rate_baseline_rad_s": baseline,
+        "lateral_drift_m_s": float(x0[slip.X["u2"]]),
+        "compression_rear_m": float(x0[slip.X["q9"]]), "compression_front_m": float(x0[slip.X["q10"]]),
+        **_rear_wheel_torque(start),
+        "residual": float(start.residual),
+        "found_by": found_by,
+    }
+
+
+def _peaks(frame):
+    after = frame["time"].to_numpy() >= 0.0
+    return {f"max_abs_{name}": float(np.max(np.abs(frame[name].to_numpy()[after]), initial=0.0))
+            for name in PEAK_COLUMNS}
+
+
+def _numerics_section(scenario, solution, frame):
+    traj = solution.trajectory
+    return {
+        "method": "LSODA", "rtol": scenario.rtol, "piecewise": scenario.piecewise,
+        "plate_stop": scenario.plate_stop, "kick_heading": scenario.kick_heading,
+        "breakpoints_s": list(solution.breakpoints), "nfev": int(traj.nfev), "njev": int(traj.njev),
+        # What the budget counts: LSODA's evaluations and those inside its Jacobians.
+        "evaluations": int(traj.evaluations),
+        "budget": {"allowance": lsoda.DEFAULT_BUDGET.allowance,
+                   "per_simulated_second": lsoda.DEFAULT_BUDGET.per_second},
+        "integration_wall_s": solution.wall_s,
+        "max_abs_holonomic_m": float(np.max(np.abs(frame["holonomic_residual"]))),
+        "model_hash": slip.model_hash(),
+    }

@@ -1,0 +1,321 @@
+"""One kick-plate run described: the :class:`Scenario` dataclass and its validation.
+
+A :class:`Scenario` holds everything a run of the thesis' kick-plate test
+(Dell'Orto 2025, Sections 8.3-8.4) depends on, with the thesis' settings as
+defaults: the bicycle and rider, the tyres, the speed, the rider's control,
+the kick (:mod:`whipple_kick.inputs` turns its fields into the plate's
+motion), the numerics. :meth:`Scenario.validate` checks every field and
+raises one-line :class:`~whipple_kick.errors.InputError` messages naming
+the value, the allowed range and the unit. docs/simulate.md lists every
+decision.
+
+Example
+-------
+>>> sc = Scenario(pressure_kpa=300.0, fz_n=701.0).validate()
+>>> sc.pressures, sc.with_changes(speed=4.0).lqr_design_speed
+((300.0, 300.0), 4.0)
+"""
+from dataclasses import asdict, dataclass, replace
+
+from . import inputs, transient
+from .errors import InputError, check_range
+
+#: Rider models: the LQR designed on the linearised classic model, the thesis' Table 8.4 gains, or none.
+CONTROLLERS = ("lqr", "thesis", "off")
+#: Rear-frame entries halved by the "low inertia" variant (thesis Figure 8.9).
+LOW_INERTIA_KEYS = ("IBxx", "IByy", "IBzz", "IBxz", "zB")
+#: Table 8.4's gains were designed at this speed [m/s] (thesis Section 8.3).
+THESIS_DESIGN_SPEED = 3.0
+#: Tyre transient forms (:mod:`whipple_kick.transient`): the default and the others.
+TYRE_TRANSIENTS = transient.TRANSIENTS
+#: What happens to the speeds when the thesis' plate stops instantly (2 m/s to 0):
+#: ``impulse`` (the rear no-slip constraint's impulse, momentum-consistent),
+#: ``resolve`` (only the dependent speeds re-solved, as before the impulse existed)
+#: or ``keep_speeds`` (no speed jumps; the rear contact is left sliding along its
+#: heading at a constant velocity for the rest of the run: the authors' published code).
+PLATE_STOPS = ("impulse", "resolve", "keep_speeds")
+#: Heading at the kick start: ``fixed`` (heading N.x, perpendicular to the plate's
+#: motion, whatever the settle time; the settle is display only) or ``settled``
+#: (the steady motion starts at heading N.x at -settle, as before).
+KICK_HEADINGS = ("fixed", "settled")
+#: Sign of the camber the Magic Formula is fed: ``physical`` (a leaning wheel is
+#: pushed toward the lean) or ``reversed`` (away from it: the authors' published code).
+CAMBER_SIGNS = ("physical", "reversed")
+#: State at the start of the run: ``steady`` (the solved steady motion) or
+#: ``upright`` (upright straight running, not an equilibrium with measured tyres:
+#: the authors' published code).
+STARTS = ("steady", "upright")
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """One kick-plate run; the defaults are the thesis' simulation settings.
+
+    Units are SI except pressures [kPa]. ``None`` means "the default rule"
+    described per field.
+
+    Attributes
+    ----------
+    bicycle : str
+        Bicycle parameter set (:func:`whipple_kick.bicycles.available`) or a
+        path. A set without rider gets the Yeadon rider seated; a preset with
+        the rider included is used as it is (then ``fz_n`` and
+        ``rider_mass_kg`` must be None).
+    fz_n, rider_mass_kg : float or None
+        Static rear-tyre load [N] the rider's mass is chosen for, or the
+        rider's mass [kg]; at most one. Default 635 N for a bicycle without rider.
+    rider : str
+        Yeadon rider file.
+    tyre : str
+        Tyre on both wheels (default T03, the kick-plate bicycle's tyre).
+    pressure_kpa : float
+        Inflation pressure of both tyres [kPa], unless overridden per wheel by
+        ``pressure_front_kpa`` / ``pressure_rear_kpa``.
+    coefficient_set : str
+        Magic-Formula coefficient set (``"table7_9"`` or, T03 only, ``"chapter8"``,
+        the fit the thesis' Chapter 8 code used).
+    friction : {"none", "plate", "thesis"}
+        Friction mode of both tyres (:data:`whipple_kick.tyres.FRICTION_MODES`).
+    symmetric_tyres : bool
+        Zero the tyres' zero-slip offsets, so the steady motion is exactly upright.
+    speed : float
+        Forward speed [m/s] of the steady motion before the kick.
+    controller : {"lqr", "thesis", "off"}
+        LQR designed on the linearised classic model at ``design_speed``;
+        the thesis' Table 8.4 gains (for 570/635/701 N); or no steer torque.
+    design_speed : float or None
+        LQR design speed [m/s]. Default None: the run's ``speed``, as a real
+        rider adapts to the speed. Give 3.0 to fix the rider as the thesis
+        did. Used by ``controller="lqr"`` only (Table 8.4's gains were
+        designed at 3 m/s).
+    gain_scale : float
+        Multiplies every controller gain (thesis Figure 8.7: 0.5).
+    thesis_load_n : float or None
+        Rear load [N] whose Table 8.4 gains ``controller="thesis"`` uses;
+        default ``fz_n``, or for a preset that already includes the rider the
+        load it is labelled with (``balanceassist_635N``: 635 N).
+    low_inertia : bool
+        Halve the rear frame's IBxx, IByy, IBzz, IBxz and mass-centre height zB
+        (thesis Figure 8.9). The LQR is still designed on the unmodified
+        bicycle (the rider's controller does not change, the plant does).
+    kick_displacement : float
+        Plate travel [m] (>= 0; direction by ``kick_direction``). With a
+        table the travel comes from the table: leave it at its default.
+    kick_duration, kick_accel : float or None
+        Plate travel time [s] or peak plate acceleration [m/s^2]; at most
+        one. Default 0.150 s (13.3 m/s^2 for the thesis' 0.150 m). Not with
+        a table.
+    kick_profile : {"constant", "smooth", "table"}
+        Constant acceleration (thesis), minimum-jerk quintic (finite jerk),
+        or the plate displacement tabulated in ``kick_table``.
+    kick_table : str or None
+        CSV of the plate's lateral displacement (``kick_profile="table"``
+        only; see :func:`whipple_kick.inputs.load_kick_table`): columns ``time`` [s, from the
+        kick start, the trajectory's clock] and ``y`` [m, + to the right].
+        The plate follows the clamped cubic spline through the rows
+        (:func:`whipple_kick.inputs.cubic_segments`), rests at the first
+        row's y before the first time and at the last row's y after the
+        last; the table must lie within [-settle, duration].
+    kick_direction : {"right", "left"}
+        Plate moves to the bicycle's right (+y) or left; ``left`` mirrors a
+        table's y.
+    settle : float
+        Steady running shown before the kick [s].
+    duration : float
+        Simulated time after the kick starts [s].
+    rtol : float
+        LSODA relative tolerance (thesis 1e-12).
+    output_rate : float
+        Samples per second of the trajectory [Hz].
+    fall_angle_deg : float
+        |roll| [deg] that counts as a fall and ends the run.
+    steer_limit_deg : float
+        |steer| [deg] that also ends the run as lost (``fall_reason``
+        "steer"): past 90 deg the front wheel rolls backwards, which the tyre
+        model (forward rolling, pneumatic trail behind the contact) does not
+        describe, and no rider recovers from a fork turned over. Without
+        steer control the fork turns over before the roll reaches 45 deg.
+    piecewise : bool
+        Restart the integrator at the kick's start and end (default). False
+        integrates from -settle across the kick and the plate stop in one
+        LSODA run, without the plate stop's impulse (for comparison only;
+        not with a table, whose every interval is its own parameter set).
+    tyre_transient : {"contact_patch", "slip_lag", "force_lag"}
+        How the tyre forces build up (:mod:`whipple_kick.transient`):
+        lagged contact-patch slip and camber with a slip-dependent
+        relaxation length (default, passive and friction-limited); the same
+        with a constant relaxation length; or the thesis' lagged force.
+    plate_stop : {"impulse", "resolve"}
+        Speeds across the constant-acceleration profile's instant plate
+        stop: the rear no-slip constraint's impulse (default) or a re-solve
+        of the dependent speeds only (the earlier model, which removes
+        energy no force accounts for). The other profiles stop the plate
+        smoothly.
+    kick_heading : {"fixed", "settled"}
+        ``fixed`` (default): the post-kick run starts from the exact steady
+        motion with heading N.x (perpendicular to the plate's motion) and
+        the rear contact at the origin, whatever ``settle``; the settle is
+        integrated separately and is display only. ``settled``: the steady
+        motion starts so at -settle (the earlier model: with a steady turn
+        the heading at the kick then depends on ``settle``).
+    camber_sign : {"physical", "reversed"}
+        Sign of the camber fed to the Magic Formula. ``physical`` (default):
+        a leaning wheel is pushed toward the lean, as measured. ``reversed``:
+        away from it, as in the thesis authors' published code (the curves
+        evaluated at the opposite camber:
+        :func:`whipple_kick.magic_formula.camber_reversed`). Not physical;
+        it exists to explain that code's runs.
+    start : {"steady", "upright"}
+        ``steady`` (default): the run starts from the solved steady motion.
+        ``upright``: from upright straight running with the tyre states at
+        their zero-slip values and no rear-wheel torque
+        (:func:`whipple_kick.slip.upright_state`), as the authors' code
+        starts; with measured tyres this is not an equilibrium (their
+        offsets act from t = 0). Needs ``settle = 0`` (the kick starts the run).
+    """
+
+    bicycle: str = "balanceassist_v1"
+    fz_n: float | None = None
+    rider_mass_kg: float | None = None
+    rider: str = "jason"
+    tyre: str = "T03"
+    pressure_kpa: float = 400.0
+    pressure_front_kpa: float | None = None
+    pressure_rear_kpa: float | None = None
+    coefficient_set: str = "table7_9"
+    friction: str = "none"
+    symmetric_tyres: bool = False
+    speed: float = 3.0
+    controller: str = "lqr"
+    design_speed: float | None = None
+    gain_scale: float = 1.0
+    thesis_load_n: float | None = None
+    low_inertia: bool = False
+    kick_displacement: float = 0.150
+    kick_duration: float | None = None
+    kick_accel: float | None = None
+    kick_profile: str = "constant"
+    kick_table: str | None = None
+    kick_direction: str = "right"
+    settle: float = 0.5
+    duration: float = 6.0
+    rtol: float = 1e-10
+    output_rate: float = 1000.0
+    fall_angle_deg: float = 45.0
+    steer_limit_deg: float = 90.0
+    piecewise: bool = True
+    tyre_transient: str = "contact_patch"
+    plate_stop: str = "impulse"
+    kick_heading: str = "fixed"
+    camber_sign: str = "physical"
+    start: str = "steady"
+
+    @classmethod
+    def thesis(cls, pressure_kpa=400.0, **changes):
+        """The Chapter 8 runs as the authors' code made them.
+
+        Bicycle+rider preset ``balanceassist_635N``, Table 8.4 gains for
+        635 N, T03 with the ``chapter8`` coefficients and the ``thesis``
+        friction mode, the thesis' lagged-force tyre transient
+        (``tyre_transient="force_lag"``), LSODA rtol 1e-12. The plate stop
+        and the heading at the kick are the project's (impulse, fixed).
+        ``changes`` override any field.
+        """
+        base = dict(bicycle="balanceassist_635N", controller="thesis", thesis_load_n=635.0,
+                    coefficient_set="chapter8", friction="thesis", rtol=1e-12,
+                    pressure_kpa=pressure_kpa, tyre_transient="force_lag")
+        base.update(changes)
+        return cls(**base)
+
+    @classmethod
+    def authors_code(cls, pressure_kpa=500.0, **changes):
+        """The thesis authors' published code (bicycle-kickplate-model, ``base_simulation.py``), reproduced.
+
+        For explaining that code's runs, not for predictions: it feeds the
+        camber to the Magic Formula with the opposite sign (camber thrust
+        away from the lean), starts from upright running that is not an
+        equilibrium, and leaves the rear contact sliding after the plate
+        stops. :meth:`thesis` with ``camber_sign="reversed"``,
+        ``start="upright"``, ``settle=0`` (the kick at t = 0) and
+        ``plate_stop="keep_speeds"``; their standard run is at 500 kPa.
+        Each of these can be switched back alone through ``changes``.
+        docs/validation.md ("The authors' published code") compares it with
+        that code's stored run.
+
+        Example
+        -------
+        >>> Scenario.authors_code().camber_sign, Scenario.authors_code(start="steady", settle=0.5).start
+        ('reversed', 'steady')
+        """
+        base = dict(camber_sign="reversed", start="upright", settle=0.0, plate_stop="keep_speeds")
+        base.update(changes)
+        return cls.thesis(pressure_kpa, **base)
+
+    # ------------------------------------------------------------ derived values
+
+    @property
+    def lqr_design_speed(self) -> float:
+        """Speed [m/s] the LQR rider is designed at: ``design_speed``, or the run's speed."""
+        return self.speed if self.design_speed is None else self.design_speed
+
+    @property
+    def pressures(self) -> tuple[float, float]:
+        """(rear, front) pressures [kPa]."""
+        rear = self.pressure_kpa if self.pressure_rear_kpa is None else self.pressure_rear_kpa
+        front = self.pressure_kpa if self.pressure_front_kpa is None else self.pressure_front_kpa
+        return rear, front
+
+    def validate(self) -> "Scenario":
+        """Check every field; raise :class:`InputError` naming value, range and unit. Returns ``self``."""
+        check_range("speed", self.speed, 0.0, 15.0, "m/s", low_open=True)
+        if self.design_speed is not None:
+            check_range("design speed", self.design_speed, 0.0, 15.0, "m/s", low_open=True)
+        check_range("duration", self.duration, 0.0, 120.0, "s", low_open=True)
+        check_range("settle time", self.settle, 0.0, 60.0, "s")
+        check_range("rtol", self.rtol, 1e-14, 1e-3, "(relative)")
+        check_range("output rate", self.output_rate, 1.0, 1e5, "Hz")
+        check_range("fall angle", self.fall_angle_deg, 0.0, 90.0, "deg", low_open=True, high_open=True)
+        check_range("steer limit", self.steer_limit_deg, 0.0, 180.0, "deg", low_open=True)
+        check_range("gain scale", self.gain_scale, 0.0, 10.0, "(factor)")
+        if self.controller not in CONTROLLERS:
+            raise InputError(f"controller {self.controller!r} is unknown; choose one of {', '.join(CONTROLLERS)}")
+        for label, value, choices in (("tyre transient", self.tyre_transient, TYRE_TRANSIENTS),
+                                      ("plate stop", self.plate_stop, PLATE_STOPS),
+                                      ("kick heading", self.kick_heading, KICK_HEADINGS),
+                                      ("camber sign", self.camber_sign, CAMBER_SIGNS),
+                                      ("start", self.start, STARTS)):
+            if value not in choices:
+                raise InputError(f"{label} {value!r} is unknown; choose one of {', '.join(choices)}")
+        if self.start == "upright" and self.settle != 0.0:
+            raise InputError(f"settle time = {self.settle:g} s conflicts with start 'upright' (upright running is "
+                             "not a steady motion: the kick starts the run); allowed: 0 s")
+        if self.plate_stop == "keep_speeds" and not self.piecewise:
+            raise InputError("plate stop 'keep_speeds' needs piecewise = True (the single LSODA run re-solves "
+                             "the speeds at the plate stop)")
+        if self.controller == "off" and self.gain_scale != 1.0:
+            raise InputError(f"gain scale = {self.gain_scale:g} conflicts with controller off "
+                             "(there are no gains to scale)")
+        if self.fz_n is not None and self.rider_mass_kg is not None:
+            raise InputError("give the rear-tyre load fz (N) or the rider mass (kg), not both")
+        if self.fz_n is not None:
+            check_range("rear-tyre load fz", self.fz_n, 0.0, None, "N", low_open=True)
+        for name, p in (("pressure", self.pressure_kpa), ("front pressure", self.pressure_front_kpa),
+                        ("rear pressure", self.pressure_rear_kpa)):
+            if p is not None:
+                check_range(name, p, 0.0, None, "kPa", low_open=True)
+        inputs.kick_of(self)
+        return self
+
+    def to_dict(self) -> dict:
+        """Fields as a plain dict (JSON-ready)."""
+        return asdict(self)
+
+    def with_changes(self, **changes) -> "Scenario":
+        """A copy with fields changed (not validated: :meth:`validate` does that).
+
+        Example
+        -------
+        >>> Scenario().with_changes(pressure_kpa=300.0).pressure_kpa
+        300.0
+        """
+        return replace(self, **changes)

@@ -1,0 +1,91 @@
+"""Assembly: bicycle with rider, tyres, the rider's gains, the model's parameters, steady motion and stability."""
+import numpy as np
+import pytest
+
+import whipple_kick as wk
+from whipple_kick import assembly, inputs, slip
+from whipple_kick.errors import InputError
+from whipple_kick.scenario import Scenario
+from whipple_kick.simulation import run
+
+
+def test_assemble_hands_over_a_finished_model():
+    """Parameters by name for the compiled model, a steady start (no drift), the rider's verdict."""
+    sc = Scenario(pressure_kpa=400.0, fz_n=635.0).validate()
+    model = assembly.assemble(sc, inputs.kick_of(sc))
+    assert set(model.params) == set(slip.PARAMETER_NAMES)
+    assert model.controller == "lqr" and set(model.gains) == {"kq4", "kq7", "ku4", "ku7"}
+    assert model.start is model.found.steady and model.reference is model.start
+    # Steady: every acceleration of the heading-frame state vanishes (measured residual < 1e-12).
+    dx = slip.CompiledRHS(model.params)(0.0, model.start.x)
+    for name in ("u4", "u7", "u9", "u10"):
+        assert abs(dx[slip.X[name]]) < 1e-8, name
+    assert model.stability["stable"] and model.bicycle["static_load_rear_n"] == pytest.approx(635.0)
+    assert model.params["kq4"] == model.gains["kq4"] and model.params["kick_D"] == 0.15
+
+
+def test_low_inertia_halves_rear_frame_inertia_and_height():
+    sc = Scenario(fz_n=635.0)
+    original, design, _ = wk.assembly.build_bicycle(sc)
+    low, design_low, _ = wk.assembly.build_bicycle(Scenario(fz_n=635.0, low_inertia=True))
+    b0, b1 = wk.benchmark.from_moore(original), wk.benchmark.from_moore(low)
+    for key in wk.scenario.LOW_INERTIA_KEYS:
+        assert b1[key] == pytest.approx(0.5 * b0[key])
+    for key in ("mB", "xB", "IHxx", "w"):
+        assert b1[key] == pytest.approx(b0[key])
+    assert design_low == design   # the controller is designed on the unmodified bicycle
+    r = run(Scenario(fz_n=635.0, low_inertia=True, duration=1.0))
+    assert np.all(np.isfinite(r.trajectory.to_numpy()))
+
+
+def test_controller_variants_and_their_errors():
+    gains, poles = wk.assembly.controller_gains(Scenario(controller="thesis", fz_n=635.0, gain_scale=0.5), None)
+    assert gains["kq4"] == pytest.approx(0.5 * -19.5679)
+    gains, poles = wk.assembly.controller_gains(Scenario(controller="off"), None)
+    assert set(gains.values()) == {0.0} and poles is None
+    with pytest.raises(InputError, match="570, 635 and 701 N"):
+        wk.assembly.controller_gains(Scenario(controller="thesis", fz_n=600.0), None)
+    with pytest.raises(InputError, match="conflicts with controller off"):
+        Scenario(controller="off", gain_scale=0.5).validate()
+    with pytest.raises(InputError, match="already includes its rider"):
+        wk.assembly.preflight(Scenario(bicycle="balanceassist_635N", fz_n=635.0))
+    with pytest.raises(InputError, match="300, 500"):
+        wk.assembly.preflight(Scenario(pressure_kpa=600.0))
+
+
+@pytest.mark.parametrize("gains, fragment", [
+    ({"kq5": 1.0}, "unknown steer-torque gain(s) ['kq5']"),
+    ({"kq4": float("nan")}, "gain kq4"),
+    ({"ku7": "fast"}, "gain ku7"),
+])
+def test_custom_gains_are_checked(gains, fragment):
+    with pytest.raises(InputError) as err:
+        run(Scenario(duration=0.3), gains=gains)
+    assert fragment in str(err.value) and "\n" not in str(err.value)
+
+
+def test_yaw_angle_gain_needs_straight_steady_running():
+    # Measured T03 has zero-slip offsets, so its steady motion is a slow
+    # turn (yaw rate ~0.09 rad/s): kq3 q3 would grow without bound.
+    with pytest.raises(InputError) as err:
+        run(Scenario(duration=0.3), gains={"kq3": -1.0})
+    message = str(err.value)
+    assert "kq3 needs straight steady running" in message and "rad/s" in message and "\n" not in message
+
+
+def test_upright_start_without_a_steady_motion_is_judged_about_upright_running(monkeypatch):
+    """With no steady motion for these tyres (forced here), an upright start still runs; stability and
+    recovery are then judged about upright running with the offsets removed, and the summary says so."""
+    from whipple_kick import steady
+
+    def none(*args, **kwargs):
+        raise steady.NoSteadyMotion("no steady motion (forced by the test)")
+    monkeypatch.setattr(wk.assembly, "steady_motion", none)
+    r = run(Scenario(start="upright", settle=0.0, duration=0.2))
+    stability, st = r.summary["linear_stability"], r.summary["steady_state"]
+    assert "upright running without the tyres' zero-slip offsets" in stability["model"]
+    assert stability["stable"]
+    assert "upright running (no steady motion with these tyres)" in st["found_by"]
+    assert st["yaw_rate_baseline_rad_s"] == 0.0
+    with pytest.raises(steady.NoSteadyMotion):
+        run(Scenario(duration=0.2))

@@ -1,0 +1,73 @@
+"""The Scenario: thesis defaults, presets, validation with one-line errors, copies with changes."""
+import json
+import re
+
+import pytest
+
+from whipple_kick.errors import InputError
+from whipple_kick.scenario import Scenario
+
+
+def test_defaults_are_the_thesis_settings_and_validate_returns_the_scenario():
+    sc = Scenario()
+    assert sc.validate() is sc
+    assert (sc.tyre, sc.pressure_kpa, sc.speed, sc.kick_displacement, sc.rtol) == ("T03", 400.0, 3.0, 0.150, 1e-10)
+    assert sc.pressures == (400.0, 400.0) and sc.lqr_design_speed == 3.0
+    assert Scenario(pressure_front_kpa=300.0, pressure_rear_kpa=500.0).pressures == (500.0, 300.0)
+    assert Scenario(design_speed=3.0, speed=5.0).lqr_design_speed == 3.0
+    json.dumps(sc.to_dict(), allow_nan=False)
+
+
+def test_with_changes_copies_and_leaves_the_original():
+    sc = Scenario()
+    other = sc.with_changes(pressure_kpa=300.0, fz_n=701.0)
+    assert (other.pressure_kpa, other.fz_n, sc.pressure_kpa, sc.fz_n) == (300.0, 701.0, 400.0, None)
+    with pytest.raises(TypeError):
+        sc.with_changes(pressure=300.0)   # not a field
+
+
+@pytest.mark.parametrize("changes, fragment", [
+    ({"speed": 0.0}, "speed = 0.0 m/s is outside the allowed range (0, 15] m/s"),
+    ({"duration": 200.0}, "duration = 200.0 s is outside the allowed range (0, 120] s"),
+    ({"rtol": 1e-16}, "rtol = 1e-16 (relative) is outside"),
+    ({"fall_angle_deg": 90.0}, "fall angle = 90.0 deg is outside the allowed range (0, 90) deg"),
+    ({"controller": "pid"}, "controller 'pid' is unknown; choose one of lqr, thesis, off"),
+    ({"fz_n": 635.0, "rider_mass_kg": 70.0}, "give the rear-tyre load fz (N) or the rider mass (kg), not both"),
+    ({"pressure_kpa": -1.0}, "pressure = -1.0 kPa is outside the allowed range (0, inf] kPa"),
+    ({"kick_accel": 0.0}, "kick peak acceleration = 0.0 m/s^2 is outside"),
+])
+def test_fields_out_of_range_are_one_line_input_errors(changes, fragment):
+    with pytest.raises(InputError, match=re.escape(fragment)) as info:
+        Scenario(**changes).validate()
+    assert "\n" not in str(info.value)
+
+
+def test_bad_model_options_are_input_errors():
+    for field_name, value, fragment in (("tyre_transient", "lagged", "tyre transient 'lagged' is unknown"),
+                                        ("plate_stop", "stop", "plate stop 'stop' is unknown"),
+                                        ("kick_heading", "north", "kick heading 'north' is unknown")):
+        with pytest.raises(InputError, match=re.escape(fragment)):
+            Scenario(**{field_name: value}).validate()
+
+
+def test_thesis_preset_uses_the_force_lag():
+    assert Scenario.thesis().tyre_transient == "force_lag"
+
+
+def test_authors_code_preset_is_the_thesis_preset_with_their_assumptions():
+    sc = Scenario.authors_code()
+    thesis = Scenario.thesis(500.0)
+    differ = {f: (getattr(thesis, f), getattr(sc, f)) for f in sc.to_dict() if getattr(sc, f) != getattr(thesis, f)}
+    assert differ == {"camber_sign": ("physical", "reversed"), "start": ("steady", "upright"),
+                      "settle": (0.5, 0.0), "plate_stop": ("impulse", "keep_speeds")}
+    assert sc.pressure_kpa == 500.0 and Scenario.authors_code(400.0, rtol=1e-10).pressure_kpa == 400.0
+    # Each assumption switches back alone; an upright start needs the kick to start the run.
+    assert Scenario.authors_code(plate_stop="impulse").validate().camber_sign == "reversed"
+    with pytest.raises(InputError, match=r"settle time = 0.5 s conflicts with start 'upright'.*allowed: 0 s"):
+        Scenario.authors_code(settle=0.5).validate()
+    with pytest.raises(InputError, match="camber sign 'negative' is unknown; choose one of physical, reversed"):
+        Scenario(camber_sign="negative").validate()
+    with pytest.raises(InputError, match="start 'level' is unknown; choose one of steady, upright"):
+        Scenario(start="level").validate()
+    with pytest.raises(InputError, match="keep_speeds' needs piecewise = True"):
+        Scenario(plate_stop="keep_speeds", piecewise=False).validate()

@@ -1,0 +1,107 @@
+"""Sweeps: cases, parallel runs, the table of results, executors, saved trajectories."""
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import whipple_kick as wk
+from whipple_kick.errors import InputError
+from whipple_kick.scenario import Scenario
+
+# Short runs: the sweep machinery, not the physics, is under test here.
+BASE = Scenario(duration=3.0, settle=0.1, output_rate=200.0, fz_n=635.0)
+# 600 kPa is outside T03's measured 300-500 kPa: that case fails with an InputError.
+GRID = {"pressure_kpa": [300, 400, 500, 600]}
+
+
+@pytest.fixture(scope="module")
+def default_run(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("sweep") / "grid"
+    table = wk.sweep(GRID, base=BASE, folder=folder, progress=False)
+    return folder, table
+
+
+def test_table_has_one_row_per_case_with_inputs_and_metrics(default_run):
+    folder, table = default_run
+    assert list(table["pressure_kpa"]) == [300.0, 400.0, 500.0, 600.0]
+    assert list(table["status"]) == ["ok", "ok", "ok", "failed"]
+    assert table["error"].iloc[:3].isna().all()
+    # Every scenario field is a column, then the flattened results.
+    for column in ("fz_n", "tyre", "duration", "last_peak_time", "damping_ratio_1_3", "recovery.time_s",
+                   "recovery.signals.roll_rate.time_s", "linear_stability.stable", "steady_state.found_by",
+                   "steady_state.roll_rad", "controller.gains.kq4", "numerics.model_hash", "run.worker"):
+        assert column in table.columns, column
+    assert table["case_id"].is_unique
+    assert table["case_id"].iloc[1] == wk.sweep_store.case_id(BASE.with_changes(pressure_kpa=400.0))
+
+
+def test_failing_case_is_recorded_with_its_error(default_run):
+    folder, table = default_run
+    row = table.iloc[3]
+    assert row["error"].startswith("InputError: ") and "600" in row["error"] and "kPa" in row["error"]
+    assert np.isnan(row["last_peak_time"])
+    log = wk.sweep_store.read_log(folder)
+    assert log[row["case_id"]]["status"] == "failed"
+    assert not wk.sweep_store.trajectory_path(folder, row["case_id"]).exists()
+
+
+def test_sweep_results_equal_a_direct_run(default_run):
+    # The per-process cache of rider and LQR must not change any number.
+    _, table = default_run
+    direct = wk.run(BASE.with_changes(pressure_kpa=400.0)).summary
+    flat = wk.sweep_engine.flatten_summary(direct)
+    row = table.iloc[1]
+    assert flat["last_peak_time"] is not None
+    for key, value in flat.items():
+        if key in wk.sweep_engine.VOLATILE_COLUMNS:
+            continue
+        if value is None:
+            assert pd.isna(row[key]), key
+        else:
+            assert row[key] == value, key
+
+
+def test_dask_executor_gives_the_same_table(default_run):
+    distributed = pytest.importorskip("distributed")
+    _, table = default_run
+    with distributed.LocalCluster(processes=True, n_workers=2, threads_per_worker=1,
+                                  dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+        dask_table = wk.sweep(GRID, base=BASE, executor=client.get_executor(), progress=False)
+        workers = set(dask_table["run.worker"])
+    assert len(workers) == 2   # both Dask workers ran cases
+    keep = [c for c in table.columns if c not in wk.sweep_engine.VOLATILE_COLUMNS]
+    pd.testing.assert_frame_equal(dask_table[keep], table[keep])
+
+
+def test_case_ids_and_input_errors():
+    a = BASE.with_changes(pressure_kpa=400)
+    b = BASE.with_changes(pressure_kpa=np.float64(400.0))
+    assert wk.sweep_store.case_id(a) == wk.sweep_store.case_id(b) == wk.sweep_store.case_id(BASE.__class__(**BASE.to_dict()))
+    assert wk.sweep_store.case_id(a) != wk.sweep_store.case_id(BASE.with_changes(pressure_kpa=400.001))
+    cases = wk.sweep_engine.make_cases({"speed": [2, 3], "tyre": "T04"}, cases=[{"fz_n": 570}, {"fz_n": 701}])
+    assert [c[0] for c in cases] == [
+        {"fz_n": 570.0, "speed": 2.0, "tyre": "T04"}, {"fz_n": 570.0, "speed": 3.0, "tyre": "T04"},
+        {"fz_n": 701.0, "speed": 2.0, "tyre": "T04"}, {"fz_n": 701.0, "speed": 3.0, "tyre": "T04"}]
+    with pytest.raises(InputError, match="unknown scenario field.*'presure_kpa'"):
+        wk.sweep_engine.make_cases({"presure_kpa": [300]})
+    with pytest.raises(InputError, match="no values"):
+        wk.sweep_engine.make_cases({"pressure_kpa": []})
+    with pytest.raises(InputError, match="workers"):
+        wk.sweep({"pressure_kpa": [300]}, base=BASE, workers=0)
+
+
+def test_saved_trajectory_is_thinned_and_keeps_the_fall():
+    scenario = Scenario(duration=3.0, settle=0.1, controller="off", fz_n=635.0,
+                                   fall_angle_deg=20.0)   # the roll reaches 20 deg before the fork turns over
+    spec = {"columns": ("time", "roll"), "dtype": "float64", "rate_hz": 100.0}
+    record = wk.sweep_engine.run_case(scenario, "x", spec)
+    t = record["trajectory"]["time"]
+    summary = json.loads(record["summary"])
+    assert summary["fell"]
+    np.testing.assert_allclose(np.diff(t[:-1]), 0.01, rtol=1e-9)   # 1000 Hz output, every 10th
+    assert t[-1] == summary["end_time_s"] == pytest.approx(summary["fall_time_s"])
+    assert summary["fall_reason"] == "roll"
+    assert abs(record["trajectory"]["roll"][-1]) == pytest.approx(np.radians(20.0))
+    with pytest.raises(InputError, match="trajectory_rate"):
+        wk.sweep({"pressure_kpa": [300]}, base=BASE, trajectory_rate=0)

@@ -1,0 +1,114 @@
+"""The sweep folder: manifest, log, table and trajectories; resuming, truncated logs, another sweep's folder."""
+import concurrent.futures as cf
+import os
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import whipple_kick as wk
+from whipple_kick.errors import InputError
+from whipple_kick.scenario import Scenario
+
+# Short runs: the sweep machinery, not the physics, is under test here.
+BASE = Scenario(duration=3.0, settle=0.1, output_rate=200.0, fz_n=635.0)
+# 600 kPa is outside T03's measured 300-500 kPa: that case fails with an InputError.
+GRID = {"pressure_kpa": [300, 400, 500, 600]}
+
+
+@pytest.fixture(scope="module")
+def default_run(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("sweep") / "grid"
+    table = wk.sweep(GRID, base=BASE, folder=folder, progress=False)
+    return folder, table
+
+
+def test_folder_holds_manifest_table_and_trajectories(default_run):
+    folder, table = default_run
+    manifest = wk.sweep_store.read_manifest(folder)
+    assert manifest["status"] == "complete"
+    assert (manifest["n_ok"], manifest["n_failed"]) == (3, 1)
+    assert manifest["model_hash"] == wk.slip.model_hash()
+    assert manifest["versions"]["numpy"] == np.__version__
+    assert manifest["base_scenario"]["duration"] == 3.0
+    assert [c["case_id"] for c in manifest["cases"]] == list(table["case_id"])
+    assert manifest["cases"][0]["overrides"] == {"pressure_kpa": 300.0}
+    on_disk = pd.read_csv(folder / wk.sweep_store.TABLE_FILE)
+    assert list(on_disk["case_id"]) == list(table["case_id"])
+    np.testing.assert_allclose(on_disk["last_peak_time"], table["last_peak_time"], rtol=1e-11)
+    traj, summary = wk.sweep_store.load_trajectory(folder, table["case_id"].iloc[0])
+    assert list(traj.columns) == list(wk.sweep_engine.DEFAULT_TRAJECTORY_COLUMNS)
+    assert traj["yaw_rate"].dtype == np.float32
+    assert len(traj) == 621   # -0.1 .. 3.0 s at 200 Hz
+    assert summary["scenario"]["pressure_kpa"] == 300.0
+
+
+class KillAfter(cf.Executor):
+    """A one-process pool whose worker is killed instead of running case ``n + 1``.
+
+    Cases 1..n run normally; the worker then exits in the middle of the sweep
+    (``os._exit``), which breaks the pool, so every later case is lost.
+    """
+
+    def __init__(self, n):
+        self.pool = cf.ProcessPoolExecutor(max_workers=1)
+        self.n, self.submitted = n, 0
+
+    def submit(self, fn, *args, **kwargs):
+        self.submitted += 1
+        if self.submitted == self.n + 1:
+            return self.pool.submit(os._exit, 1)
+        return self.pool.submit(fn, *args, **kwargs)
+
+    def shutdown(self, wait=True, *, cancel_futures=False):
+        self.pool.shutdown(wait=wait, cancel_futures=cancel_futures)
+
+
+def test_interrupted_sweep_resumes_without_redoing_or_losing_cases(tmp_path):
+    folder = tmp_path / "resume"
+    grid = {"pressure_kpa": [300, 350, 400, 450, 500]}
+    killer = KillAfter(2)
+    with pytest.raises(wk.sweep_engine.SweepInterrupted, match="3 of 5 cases were not run"):
+        wk.sweep(grid, base=BASE, folder=folder, executor=killer, progress=False)
+    killer.shutdown()
+    first = wk.sweep_store.read_log(folder)
+    assert len(first) == 2 and all(r["status"] == "ok" for r in first.values())
+    assert wk.sweep_store.read_manifest(folder)["status"] == "incomplete"
+    assert len(pd.read_csv(folder / wk.sweep_store.TABLE_FILE)) == 2
+    assert len(list((folder / wk.sweep_store.TRAJECTORY_DIR).glob("*.npz"))) == 2
+
+    table = wk.sweep(grid, base=BASE, folder=folder, progress=False)
+    assert list(table["pressure_kpa"]) == [300.0, 350.0, 400.0, 450.0, 500.0]
+    assert (table["status"] == "ok").all()
+    lines = (folder / wk.sweep_store.LOG_FILE).read_text().splitlines()
+    assert len(lines) == 5          # each case ran exactly once over both runs
+    finished = dict(zip(table["case_id"], table["run.finished"]))
+    for cid, rec in first.items():  # the first run's cases were kept, not redone
+        assert finished[cid] == rec["run"]["finished"]
+    assert wk.sweep_store.read_manifest(folder)["status"] == "complete"
+
+    # A third run finds everything done and runs nothing.
+    again = wk.sweep(grid, base=BASE, folder=folder, progress=False)
+    assert len((folder / wk.sweep_store.LOG_FILE).read_text().splitlines()) == 5
+    pd.testing.assert_frame_equal(again, table)
+
+
+def test_truncated_log_line_is_ignored_and_the_case_rerun(tmp_path):
+    folder = tmp_path / "crash"
+    grid = {"pressure_kpa": [300, 400]}
+    wk.sweep(grid, base=BASE, folder=folder, progress=False, trajectory_columns=None)
+    log = folder / wk.sweep_store.LOG_FILE
+    lines = log.read_text().splitlines()
+    log.write_text(lines[0] + "\n" + lines[1][: len(lines[1]) // 2])   # a crash mid-write
+    table = wk.sweep(grid, base=BASE, folder=folder, progress=False, trajectory_columns=None)
+    assert (table["status"] == "ok").all()
+
+
+def test_folder_of_another_sweep_is_refused_unless_extended(default_run, tmp_path):
+    folder, table = default_run
+    with pytest.raises(InputError, match="holds a different sweep"):
+        wk.sweep({"pressure_kpa": [300]}, base=BASE, folder=folder, progress=False)
+    small = tmp_path / "small"
+    wk.sweep({"pressure_kpa": [300]}, base=BASE, folder=small, progress=False)
+    both = wk.sweep({"pressure_kpa": [500]}, base=BASE, folder=small, progress=False, extend=True)
+    assert list(both["pressure_kpa"]) == [300.0, 500.0]
