@@ -46,7 +46,8 @@ def _stored():
 def _outcome(result):
     s = result.summary
     if s["fell"]:
-        return f"falls at {s['fall_time_s']:.3f} s"
+        return (f"falls at {s['fall_time_s']:.3f} s" if s["fall_reason"] == "roll"
+                else f"lost at {s['fall_time_s']:.3f} s (the fork turned over)")
     rec = s["recovery"]
     return (f"no fall in {s['end_time_s']:g} s, recovery {rec['time_s']:.2f} s" if rec["time_s"] is not None
             else f"no fall in {s['end_time_s']:g} s, not recovered within it")
@@ -206,7 +207,7 @@ def thesis():
         def times(signals, names):
             return " / ".join(f"{signals[n]['time_s']:.2f}" if signals[n]["time_s"] is not None else "not in 6 s"
                               for n in names)
-        half_text = ("falls at {:.2f} s".format(half.summary["fall_time_s"]) if half.summary["fell"]
+        half_text = (_outcome(half) if half.summary["fell"]
                      else times(half.summary["recovery"]["signals"], ("roll_rate", "steer_rate")))
         peak = full.summary["metrics"]["peak_values"][0]
         print(f"| {pressure:g} kPa | {peak:+.3f} | "

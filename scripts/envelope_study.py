@@ -82,18 +82,22 @@ def envelope():
                 row["unstable"] += not summary["linear_stability"]["stable"]
                 row["turn"] += summary["steady_state"]["found_by"] != "direct"
                 row["recovered"] += summary["recovery"]["time_s"] is not None
+                row["steer"] += summary.get("fall_reason") == "steer"
             if status in ("failed", "no steady motion"):
                 notes.append(f"{v:g} m/s, {p:g} kPa, {fz:g} N: {error}")
+            elif status == "fell" and rider.startswith("adaptive"):
+                notes.append(f"{v:g} m/s, {p:g} kPa, {fz:g} N: {summary['message']}")
             slow.append((wall, f"{v:g} m/s, {p:g} kPa, {fz:g} N ({status})"))
         slow.sort(reverse=True)
         total = sum(per_speed.values(), collections.Counter())
         print(f"### {rider}: {len(cases)} cases\n")
-        print("| speed [m/s] | cases | completed (recovered in 6 s) | fell | failed | no steady motion | "
+        print("| speed [m/s] | cases | completed (recovered in 6 s) | fell (of which the fork turned over) | failed "
+              "| no steady motion | "
               "steady motion not the direct solve | rider linearly unstable |\n|---|---|---|---|---|---|---|---|")
         for v, row in sorted(per_speed.items()) + [("all", total)]:
             n = sum(row[k] for k in ("completed", "fell", "failed", "no steady motion"))
             label = v if v == "all" else f"{v:g}"
-            print(f"| {label} | {n} | {row['completed']} ({row['recovered']}) | {row['fell']} | {row['failed']} | "
+            print(f"| {label} | {n} | {row['completed']} ({row['recovered']}) | {row['fell']} ({row['steer']}) | {row['failed']} | "
                   f"{row['no steady motion']} | {row['turn']} | {row['unstable']} |")
         print("\nslowest runs: " + "; ".join(f"{w:.2f} s {label}" for w, label in slow[:3]))
         for note in notes:
@@ -206,6 +210,8 @@ def budget():
             # integration's evaluations count, per integrate() call (each has its own budget).
             per_call = [budget_used(log.times[a:b], t0, budget_) for a, b, t0 in log.calls if b > a]
             span = summary["end_time_s"] + scenario.settle
+            if status == "fell":
+                status = f"fell ({summary['fall_reason']})"
             rows.append((max(u for u, _ in per_call), min(p for _, p in per_call), label, status,
                          summary["numerics"]["evaluations"], span, None))
     rows.sort(key=lambda r: -r[0])

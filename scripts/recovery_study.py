@@ -13,8 +13,9 @@ sets the recovery time, one factor at a time, and prints four Markdown tables:
    rider's gains; then the same cases' acceptance behaviour, with the
    default tyre transient and with the thesis' force lag: the recovery
    time with full gains, roll and steer settling with 50 % gains, the
-   outcome without control (fall time, or where the integration failed)
-   and when the fork turned past 90 deg, and the thesis' last-peak time;
+   outcome without control (when and why the run ended: |roll| at the
+   fall angle, |steer| at the steer limit, or a failed integration) and
+   the roll at that end, and the thesis' last-peak time;
 2. the slowest linear pole at 400 kPa, 635 N with one tyre property
    switched off at a time (aligning moment front/rear, camber force) and
    linear tyres from T03's cornering stiffness to near-rigid;
@@ -130,7 +131,7 @@ def describe(label, result, pole):
     cell = lambda t: "> run" if t is None else f"{t:.2f}"
     df = result.trajectory
     roll = math.degrees(np.abs(df["roll"] - result.summary["steady_state"]["roll_rad"]).max())
-    fell = " (fell)" if result.summary["fell"] else ""
+    fell = f" (lost: {result.summary['fall_reason']})" if result.summary["fell"] else ""
     return (f"| {label}{fell} | {cell(rec['yaw_rate'])} | {cell(rec['roll_rate'])} | {cell(rec['steer_rate'])} "
             f"| {roll:.1f} | {pole_text(pole)} |")
 
@@ -166,23 +167,17 @@ def _run_summary(scenario):
     return result.summary, result.trajectory
 
 
-def fork_over_time(trajectory):
-    """First time after the kick at which |steer| passes 90 deg (the front wheel turned backwards), or None."""
-    t = trajectory["time"].to_numpy()
-    over = np.flatnonzero((t >= 0.0) & (np.abs(trajectory["steer"].to_numpy()) > math.pi / 2))
-    return float(t[over[0]]) if over.size else None
-
-
 def nine_case_acceptance(transient):
     """The acceptance behaviour on the default 6 s run in one tyre transient form: full gains, 50 % gains,
-    no control (outcome, and when the fork turned over)."""
+    no control (when and why the run ended, and the roll there)."""
     cell = lambda t: "-" if t is None else f"{t:.2f}"
     print(f"Nine thesis cases, tyre transient {transient}, 6 s runs: recovery (yaw, roll and steer settled) "
           "with full gains; roll and steer settling with 50 % gains (\"-\": not within the run); without "
-          "control: the outcome (fall time, or where the integration failed) and when |steer| first passed "
-          "90 deg; the thesis' last-peak time with full gains\n")
+          "control: when and why the run ended (\"steer\": |steer| reached the steer limit, \"roll\": |roll| "
+          "reached the fall angle, or where the integration failed) and |roll| there; the thesis' last-peak "
+          "time with full gains\n")
     print("| case | recovery, full gains [s] (yaw / roll / steer) | 50 % gains: roll / steer [s] | "
-          "controller off: end [s] | controller off: steer past 90 deg [s] | last-peak time [s] |"
+          "controller off: end [s] | controller off: roll at the end [deg] | last-peak time [s] |"
           "\n|---|---|---|---|---|---|")
     for fz in (570.0, 635.0, 701.0):
         for pressure in (300.0, 400.0, 500.0):
@@ -191,13 +186,13 @@ def nine_case_acceptance(transient):
                 for changes in ({}, {"gain_scale": 0.5}, {"controller": "off"}))
             sig = {name: full["recovery"]["signals"][name]["time_s"] for name in SIGNALS}
             half_sig = half["recovery"]["signals"]
-            half_text = ("fell" if half["fell"] else
+            half_text = (f"lost: {half['fall_reason']}" if half["fell"] else
                          f"{cell(half_sig['roll_rate']['time_s'])} / {cell(half_sig['steer_rate']['time_s'])}")
-            off_text = {"fell": f"fell {cell(off['fall_time_s'])}",
+            off_text = {"fell": f"{off['fall_reason']} {cell(off['fall_time_s'])}",
                         "failed": f"failed {cell(off['end_time_s'])}"}.get(off["outcome"], "no fall")
             print(f"| {pressure:.0f} kPa, {fz:.0f} N | {cell(full['recovery']['time_s'])} "
                   f"({' / '.join(cell(sig[n]) for n in SIGNALS)}) | {half_text} | {off_text} | "
-                  f"{cell(fork_over_time(off_df))} | {cell(full['metrics']['last_peak_time'])} |")
+                  f"{math.degrees(abs(off_df['roll'].iloc[-1])):.1f} | {cell(full['metrics']['last_peak_time'])} |")
     print()
 
 

@@ -138,7 +138,7 @@ def main(argv=None):
     if args.thesis_form:
         for name in args.thesis_form:
             s = rewrite_thesis_form(name).summary
-            end = f"fell at {s['fall_time_s']:.3f} s" if s["fell"] else f"{s['end_time_s']:g} s"
+            end = f"fell at {s['fall_time_s']:.3f} s ({s['fall_reason']})" if s["fell"] else f"{s['end_time_s']:g} s"
             print(f"{name:22s} {end:18s} -> thesis_form/{name}.npz")
         reason = f"thesis_form/ {', '.join(args.thesis_form)} only: {reason}"
     else:
@@ -147,7 +147,7 @@ def main(argv=None):
         for name, scenario in cases().items():
             result = write_case(name, scenario, OUT / f"{name}.npz")
             s = result.summary
-            end = f"fell at {s['fall_time_s']:.3f} s" if s["fell"] else f"{s['end_time_s']:g} s"
+            end = f"fell at {s['fall_time_s']:.3f} s ({s['fall_reason']})" if s["fell"] else f"{s['end_time_s']:g} s"
             print(f"{name:22s} {end:18s} -> {name}.npz")
     if not CHANGELOG.exists():
         CHANGELOG.write_text(

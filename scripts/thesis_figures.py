@@ -45,7 +45,7 @@ def _figure(args, name, runs, title):
         t = time.perf_counter()
         result = run(scenario)
         s = result.summary
-        outcome = f"fell at {s['fall_time_s']:.3f} s" if s["fell"] else "no fall"
+        outcome = f"fell at {s['fall_time_s']:.3f} s ({s['fall_reason']})" if s["fell"] else "no fall"
         print(f"  {name}: {label}: {outcome}; recovery (yaw, roll, steer rates within 5 %) "
               f"{s['recovery']['time_s']} s; {time.perf_counter() - t:.2f} s", file=sys.stderr)
         results.append((label, result))

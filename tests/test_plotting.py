@@ -9,9 +9,10 @@ from whipple_kick import plotting, simulation
 
 @pytest.fixture(scope="module")
 def fall():
-    """Controller off, thesis force-lag tyre: the bicycle falls at 1.345 s, its steer rate reaching -67 rad/s at the end."""
+    """Controller off, thesis force-lag tyre, no steer limit: falls by roll at 1.35 s, its steer rate reaching
+    -67 rad/s at the end."""
     result = simulation.run(simulation.Scenario(controller="off", duration=2.0, tyre_transient="force_lag",
-                                                 steer_limit_deg=180.0))
+                                                 steer_limit_deg=None))
     assert result.summary["fell"]
     return result
 
@@ -112,3 +113,19 @@ def test_upright_start_draws_the_steady_motion_as_the_baseline():
                for t in _texts(fig))
     line, = [line for line in fig.axes[0].lines if line.get_gid() == "baseline"]
     assert line.get_ydata()[0] == st["yaw_rate_baseline_rad_s"]
+
+def test_axis_limits_stop_where_the_fork_turns_over():
+    """A run lost at the steer limit whose roll never reaches half the fall angle (500 kPa, 570 N, controller
+    off: |roll| stays below 22.5 deg): only the steer cut (half the steer limit, 45 deg) can keep the fork's
+    last spin off the steer-rate axis."""
+    result = simulation.run(simulation.Scenario(controller="off", duration=2.0, pressure_kpa=500.0, fz_n=570.0))
+    assert result.summary["fall_reason"] == "steer"
+    df = result.trajectory
+    fig = plotting.response_figure([("", result)], kick=(0.0, 0.15))
+    panels = dict(zip((c for c, _ in plotting.RESPONSE_PANELS), fig.axes, strict=True))
+    low, high = panels["steer_rate"].get_ylim()
+    assert np.max(np.abs(df["roll"].to_numpy())) < 0.5 * math.radians(45.0)
+    before = np.arange(len(df)) < np.flatnonzero(np.abs(df["steer"].to_numpy()) >= 0.5 * math.radians(90.0))[0]
+    peak = np.max(np.abs(df["steer_rate"].to_numpy()[before]))
+    assert max(-low, high) == pytest.approx(peak * 1.16, rel=0.1)
+    assert np.max(np.abs(df["steer_rate"].to_numpy())) > 2.0 * max(-low, high)   # the spin is off the scale

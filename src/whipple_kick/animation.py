@@ -742,6 +742,8 @@ class _Frames:
         t = frame[COLUMNS["time"]].to_numpy()
         kick = result.summary["kick"]
         fall_roll = math.radians(result.scenario.fall_angle_deg)
+        steer_deg = getattr(result.scenario, "steer_limit_deg", None)
+        steer_limit = None if steer_deg is None else math.radians(steer_deg)
         self.traces = []
         panels = (("roll_rate", "roll rate [rad/s]"), ("steer_rate", "steer rate [rad/s]"),
                   ("yaw_rate", "yaw rate [rad/s]"))
@@ -753,7 +755,8 @@ class _Frames:
             tax.axvspan(kick["start_s"], kick["start_s"] + kick["duration_s"], color="0.85", zorder=0)
             # The part of the run animated (a still shows the whole run).
             shown = (float(scene.times[0]), float(scene.times[-1])) if scene.times.size > 1 else (t[0], t[-1])
-            tax.set_ylim(*plotting.motion_limits(t, y, frame[COLUMNS["q4"]].to_numpy(), fall_roll, shown))
+            tax.set_ylim(*plotting.motion_limits(t, y, frame[COLUMNS["q4"]].to_numpy(), fall_roll, shown,
+                                                 frame[COLUMNS["q7"]].to_numpy(), steer_limit))
             tax.set_xlim(*shown)
             tax.set_title(label, fontsize=8, loc="left")
             tax.tick_params(labelsize=7)

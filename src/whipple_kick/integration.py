@@ -116,7 +116,7 @@ def sample_times(scenario):
 def end_limits(scenario):
     """The limits that end a run as lost (``lsoda.integrate`` keywords): |roll| and |steer| [rad]."""
     return {"fall_angle": math.radians(scenario.fall_angle_deg),
-            "steer_limit": math.radians(scenario.steer_limit_deg)}
+            "steer_limit": None if scenario.steer_limit_deg is None else math.radians(scenario.steer_limit_deg)}
 
 
 def _integrate(steady, scenario, kick):

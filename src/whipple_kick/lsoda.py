@@ -410,8 +410,8 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
                     message = f"fell: |roll| reached {np.rad2deg(fall_angle):.0f} deg at t = {fall_time:.4f} s"
                 else:
                     fall_reason = "steer"
-                    message = (f"lost: |steer| reached {np.rad2deg(steer_limit):.0f} deg (the front wheel turned "
-                               f"sideways) at t = {fall_time:.4f} s")
+                    message = (f"lost: |steer| reached {np.rad2deg(steer_limit):.0f} deg (the fork turned over) "
+                               f"at t = {fall_time:.4f} s")
             elif status == "failed":
                 failed, message = True, why
             if status != "completed":

@@ -36,13 +36,14 @@ def _frame_of(run):
     return getattr(run, "trajectory", run)
 
 
-def motion_limits(time, values, roll, fall_roll, time_range=None):
+def motion_limits(time, values, roll, fall_roll, time_range=None, steer=None, steer_limit=None):
     """Axis limits of a signal from the motion before the fall.
 
     Only the samples before the bicycle first leans past
-    :data:`LIMIT_ROLL_FRACTION` of the fall angle count (all of them if it
-    never does), within ``time_range`` if given; the range is padded by
-    :data:`LIMIT_PADDING` on both sides.
+    :data:`LIMIT_ROLL_FRACTION` of the fall angle (or, given ``steer`` and
+    ``steer_limit``, first steers past that fraction of the steer limit)
+    count (all of them if it never does), within ``time_range`` if given;
+    the range is padded by :data:`LIMIT_PADDING` on both sides.
 
     Parameters
     ----------
@@ -52,6 +53,10 @@ def motion_limits(time, values, roll, fall_roll, time_range=None):
         |roll| [rad] that counts as a fall.
     time_range : (float, float), optional
         Only samples within it count [s].
+    steer : array_like, optional
+        Steer angle [rad] at the same samples.
+    steer_limit : float, optional
+        |steer| [rad] that ends a run (None: no limit).
 
     Returns
     -------
@@ -67,7 +72,11 @@ def motion_limits(time, values, roll, fall_roll, time_range=None):
     """
     t = np.asarray(time, dtype=float)
     y = np.asarray(values, dtype=float)
-    over = np.flatnonzero(np.abs(np.asarray(roll, dtype=float)) >= LIMIT_ROLL_FRACTION * fall_roll)
+    past = np.abs(np.asarray(roll, dtype=float)) >= LIMIT_ROLL_FRACTION * fall_roll
+    if steer is not None and steer_limit is not None:
+        # A fork turning over ends a run too; its last spin would stretch the axes just the same.
+        past |= np.abs(np.asarray(steer, dtype=float)) >= LIMIT_ROLL_FRACTION * steer_limit
+    over = np.flatnonzero(past)
     keep = np.arange(t.size) < (over[0] if over.size else t.size)
     if time_range is not None:
         keep &= (t >= time_range[0]) & (t <= time_range[1])
@@ -79,15 +88,18 @@ def motion_limits(time, values, roll, fall_roll, time_range=None):
 
 
 def _outcome(run):
-    """(fell, fall time or None, steady yaw rate or None, fall angle [rad]) of a Result; DataFrames: unknown."""
+    """(fell, fall time or None, steady yaw rate or None, fall angle [rad], steer limit [rad] or None) of a
+    Result; DataFrames: unknown."""
     summary = getattr(run, "summary", None) or {}
     scenario = getattr(run, "scenario", None)
     fall_angle = math.radians(getattr(scenario, "fall_angle_deg", DEFAULT_FALL_ANGLE_DEG))
+    steer_deg = getattr(scenario, "steer_limit_deg", None)
+    steer_limit = None if steer_deg is None else math.radians(steer_deg)
     fell = bool(summary.get("fell", False))
     steady = summary.get("steady_state", {})
     # The yaw-rate metrics' baseline: the steady turn, also after an upright start (which is not one).
     baseline = steady.get("yaw_rate_baseline_rad_s", steady.get("yaw_rate_rad_s"))
-    return fell, summary.get("fall_time_s") if fell else None, baseline, fall_angle
+    return fell, summary.get("fall_time_s") if fell else None, baseline, fall_angle, steer_limit
 
 
 def response_figure(runs, path=None, title=None, kick=None, time_range=None, dpi=150):
@@ -121,7 +133,7 @@ def response_figure(runs, path=None, title=None, kick=None, time_range=None, dpi
     >>> result = wk.run(wk.Scenario(controller="off", duration=2.0))
     >>> fig = response_figure([("", result)], kick=(0.0, 0.15))
     >>> [t.get_text() for t in fig.axes[0].texts if t.get_text().startswith("fell")]
-    ['fell at 1.345 s']
+    ['fell at 1.585 s']
     """
     import matplotlib.transforms as mtransforms
     from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -134,13 +146,14 @@ def response_figure(runs, path=None, title=None, kick=None, time_range=None, dpi
     baselines = []
     for k, (label, run) in enumerate(runs):
         df = _frame_of(run)
-        fell, fall_time, baseline, fall_angle = _outcome(run)
+        fell, fall_time, baseline, fall_angle, steer_limit = _outcome(run)
         color = f"C{k}"
         text = f"{label} (fell at {fall_time:.3f} s)" if fell and label else label
         t = df["time"].to_numpy()
         for ax, (column, _) in zip(axes, RESPONSE_PANELS):
             ax.plot(t, df[column], lw=1.2, label=text, color=color)
-            limits[column].append(motion_limits(t, df[column], df["roll"], fall_angle, time_range))
+            limits[column].append(motion_limits(t, df[column], df["roll"], fall_angle, time_range,
+                                                df["steer"] if "steer" in df else None, steer_limit))
             if fell:
                 ax.axvline(fall_time, color=color, lw=1.0, ls="--", gid="fall")
         if fell:

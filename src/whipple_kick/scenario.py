@@ -129,12 +129,14 @@ class Scenario:
         Samples per second of the trajectory [Hz].
     fall_angle_deg : float
         |roll| [deg] that counts as a fall and ends the run.
-    steer_limit_deg : float
+    steer_limit_deg : float or None
         |steer| [deg] that also ends the run as lost (``fall_reason``
         "steer"): past 90 deg the front wheel rolls backwards, which the tyre
         model (forward rolling, pneumatic trail behind the contact) does not
         describe, and no rider recovers from a fork turned over. Without
         steer control the fork turns over before the roll reaches 45 deg.
+        None: no steer limit (a fork past 90 deg spins on, so 180 is not
+        the same as no limit).
     piecewise : bool
         Restart the integrator at the kick's start and end (default). False
         integrates from -settle across the kick and the plate stop in one
@@ -202,7 +204,7 @@ class Scenario:
     rtol: float = 1e-10
     output_rate: float = 1000.0
     fall_angle_deg: float = 45.0
-    steer_limit_deg: float = 90.0
+    steer_limit_deg: float | None = 90.0
     piecewise: bool = True
     tyre_transient: str = "contact_patch"
     plate_stop: str = "impulse"
@@ -275,7 +277,8 @@ class Scenario:
         check_range("rtol", self.rtol, 1e-14, 1e-3, "(relative)")
         check_range("output rate", self.output_rate, 1.0, 1e5, "Hz")
         check_range("fall angle", self.fall_angle_deg, 0.0, 90.0, "deg", low_open=True, high_open=True)
-        check_range("steer limit", self.steer_limit_deg, 0.0, 180.0, "deg", low_open=True)
+        if self.steer_limit_deg is not None:
+            check_range("steer limit", self.steer_limit_deg, 0.0, 180.0, "deg", low_open=True)
         check_range("gain scale", self.gain_scale, 0.0, 10.0, "(factor)")
         if self.controller not in CONTROLLERS:
             raise InputError(f"controller {self.controller!r} is unknown; choose one of {', '.join(CONTROLLERS)}")
