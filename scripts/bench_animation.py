@@ -34,8 +34,8 @@ def _empty_frames(fmt, path, frames, size, fps, dpi):
     import matplotlib
     matplotlib.use("Agg")
     from matplotlib import animation as manim
-    from matplotlib.figure import Figure
     from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
 
     from whipple_kick import animation
 
@@ -56,10 +56,10 @@ def _empty_frames(fmt, path, frames, size, fps, dpi):
 
 def _compare_3d(result, repeats, fps=30.0, size=(1280, 720), dpi=100):
     """Median ms per frame: this renderer vs mplot3d on the same scene (drawing only)."""
-    import numpy as np
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
     from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
+    import numpy as np
     from scipy.spatial import ConvexHull
 
     from whipple_kick import animation

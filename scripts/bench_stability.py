@@ -55,8 +55,8 @@ def bench_linearisation(repeats):
             rounds["fast"].append(_per_call(lambda: slip.heading_linearisation(rhs, st.x), 300))
             rounds["old"].append(_per_call(lambda: slip.linearize(rhs, st.x), 30))
         med = {k: statistics.median(v) for k, v in rounds.items()}
-        ratios_fast = [f / r for f, r in zip(rounds["fast"], rounds["rhs"])]
-        ratios_old = [o / r for o, r in zip(rounds["old"], rounds["rhs"])]
+        ratios_fast = [f / r for f, r in zip(rounds["fast"], rounds["rhs"], strict=True)]
+        ratios_old = [o / r for o, r in zip(rounds["old"], rounds["rhs"], strict=True)]
         print(f"{label}: RHS call {med['rhs'] * 1e6:.1f} us; heading_linearisation {med['fast'] * 1e6:.0f} us "
               f"= {statistics.median(ratios_fast):.1f} RHS evaluations (rounds {[round(v, 1) for v in ratios_fast]}); "
               f"slip.linearize {med['old'] * 1e6:.0f} us = {statistics.median(ratios_old):.0f} RHS evaluations "
@@ -77,7 +77,7 @@ def bench_sweep(repeats):
 
     def central_difference_route(rhs_, x, t=0.0):
         """The same (A, B) from slip.linearize (two of them for B, as slip.linear_state_space)."""
-        params = {n: float(v) for n, v in zip(slip.PARAMETER_NAMES, rhs_.p)}
+        params = {n: float(v) for n, v in zip(slip.PARAMETER_NAMES, rhs_.p, strict=True)}
         A, B, K = slip.linear_state_space(params, x)
         return A - B @ K, B
 
@@ -97,7 +97,7 @@ def bench_sweep(repeats):
     print(f"analyse, {speeds.size} speeds x 2 loops (+ no-slip model, refinements), warm process: median "
           f"{med:.2f} s (runs {[round(v, 2) for v in fast]}) = {med / statistics.median(rhs_times):.0f} RHS "
           f"evaluations; with slip.linearize instead: median {statistics.median(old):.2f} s "
-          f"(ratio {statistics.median([f / o for f, o in zip(fast, old)]):.2f}, {repeats} interleaved rounds)")
+          f"(ratio {statistics.median([f / o for f, o in zip(fast, old, strict=True)]):.2f}, {repeats} interleaved rounds)")
 
 
 def _command(name):

@@ -78,6 +78,7 @@ def bench_nine(repeats, duration):
 
 def bench_many(n, duration, workers, folder):
     import numpy as np
+
     import whipple_kick as wk
     from whipple_kick import simulation
     # A pressure x load grid of about n cases (interpolated tyres between the measured pressures).

@@ -195,7 +195,7 @@ def budget():
         t = np.arange(151) / 1000.0
         s = t / 0.15
         table.write_text("time,y\n" + "".join(f"{float(a)!r},{float(0.15 * (10 * b**3 - 15 * b**4 + 6 * b**5))!r}\n"
-                                              for a, b in zip(t, s)))
+                                              for a, b in zip(t, s, strict=True)))
         log = CallLog()
         log.install()
         rows = []

@@ -28,11 +28,11 @@ import sys
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
 
-import whipple_kick as wk  # noqa: E402
-from whipple_kick.errors import InputError  # noqa: E402
+import whipple_kick as wk
+from whipple_kick.errors import InputError
 
 
 def _parser():

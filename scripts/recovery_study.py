@@ -254,7 +254,7 @@ def heading_gains(scenario):
     """The heading-holding LQR rider (Q = I, R = 1), by name."""
     design = wk.assembly.build_bicycle(scenario)[1]
     K, _ = control.heading_lqr_gains(design, scenario.lqr_design_speed)
-    return dict(zip(control.HEADING_GAIN_ORDER, K))
+    return dict(zip(control.HEADING_GAIN_ORDER, K, strict=True))
 
 
 def measured_pair(scenario, **switches):
@@ -269,7 +269,7 @@ def tyre_properties():
     rear, front, _ = wk.assembly.build_tyres(base)
     moore, _, info = wk.assembly.build_bicycle(base)
     loads = (info["static_load_rear_n"], info["static_load_front_n"])
-    coefficient = [t.cornering_stiffness(fz) / fz for t, fz in zip((rear, front), loads)]
+    coefficient = [t.cornering_stiffness(fz) / fz for t, fz in zip((rear, front), loads, strict=True)]
 
     def linear(c, sigma=rear.relaxation_length, kz=rear.vertical_stiffness):
         return tuple(tyres.linear_tyre(ci, sigma, kz) for ci in c)

@@ -57,7 +57,7 @@ def _write_kick_table(path):
     s = times / 0.150
     y = 0.150 * (10 * s**3 - 15 * s**4 + 6 * s**5)
     lines = ["# minimum-jerk plate motion, 150 mm in 150 ms, rows every 10 ms (regression case)", "time,y"]
-    lines += [f"{t!r},{v!r}" for t, v in zip(times.tolist(), y.tolist())]
+    lines += [f"{t!r},{v!r}" for t, v in zip(times.tolist(), y.tolist(), strict=True)]
     path.write_text("\n".join(lines) + "\n")
 
 

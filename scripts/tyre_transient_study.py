@@ -201,7 +201,7 @@ def secant():
     peak = math.degrees(np.radians(np.linspace(0, 90, 9001))[np.argmax(force)])
     print(f"T03 400 kPa 635 N: peak of F_y at {peak:.2f} deg, secant ratio there "
           f"{float(tyre.secant_ratio(math.radians(peak), 635.0)):.3f}")
-    print(", ".join(f"{math.degrees(s):g} deg: {g:.4f}" for s, g in zip(slips, ratio)))
+    print(", ".join(f"{math.degrees(s):g} deg: {g:.4f}" for s, g in zip(slips, ratio, strict=True)))
 
 
 def _curve_peak(tyre, camber, fz, kind):

@@ -1,7 +1,7 @@
 """The animation: its timeline, what the scene puts where, and the files it writes (read back)."""
 import math
 
-import imageio_ffmpeg   # the test extra installs it: the mp4 path is tested, not skipped
+import imageio_ffmpeg  # the test extra installs it: the mp4 path is tested, not skipped
 import numpy as np
 import pytest
 
@@ -238,7 +238,7 @@ def test_unknown_suffix_and_custom_tyres_are_input_errors(tmp_path):
     tyre = wk.tyres.linear_tyre(100.0, 0.01, 1e5)
     result = simulation.run(simulation.Scenario(symmetric_tyres=True, duration=0.2, settle=0.1),
                             tyres=(tyre, tyre))
-    with pytest.raises(InputError, match="tyres=.rear, front."):
+    with pytest.raises(InputError, match=r"tyres=.rear, front."):
         animation.animate(result, tmp_path / "x.gif", size=(160, 90))
     movie = animation.animate(result, tmp_path / "x.gif", size=(160, 90), tyres=(tyre, tyre))
     assert movie.frames > 1

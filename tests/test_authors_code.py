@@ -109,7 +109,7 @@ def test_stored_run_is_read_with_our_names_and_checked(stored, tmp_path):
     assert list(stored.samples.columns) == ["time", *authors_code.SIGNALS]
     assert len(stored.samples) == 1001 and stored.samples["time"].iloc[-1] == pytest.approx(1.0)
     assert stored.whole["time"].iloc[-1] == pytest.approx(stored.fall_time_s, abs=1e-3)
-    with pytest.raises(InputError, match="run_0-1s_1kHz.csv.gz"):
+    with pytest.raises(InputError, match=r"run_0-1s_1kHz\.csv\.gz"):
         authors_code.load_run(tmp_path)
     short = stored.samples[stored.samples["time"] <= 0.5]
     with pytest.raises(InputError, match="window"):

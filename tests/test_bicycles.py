@@ -68,7 +68,7 @@ def test_published_moore_values_are_kept_verbatim():
 
 
 def test_unknown_name_is_an_input_error():
-    with pytest.raises(InputError, match="unknown bicycle 'nope'.*balanceassist_v1"):
+    with pytest.raises(InputError, match=r"unknown bicycle 'nope'.*balanceassist_v1"):
         wk.bicycles.load("nope")
 
 

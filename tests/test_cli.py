@@ -7,7 +7,6 @@ import sys
 import pytest
 
 import whipple_kick as wk
-
 from whipple_kick.cli import simulate_main
 
 

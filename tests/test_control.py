@@ -351,5 +351,5 @@ def test_closed_loop_poles_by_name_agree_with_the_matrix_forms(combined):
                                np.sort_complex(control.closed_loop_poles(moore, 3.0, gains)), rtol=1e-6)
     # The heading-holding LQR's own design poles are what closed_loop_poles gives for its gains.
     K5, design_poles = control.heading_lqr_gains(moore, 3.0)
-    heading = control.closed_loop_poles(moore, 3.0, dict(zip(control.HEADING_GAIN_ORDER, K5)))
+    heading = control.closed_loop_poles(moore, 3.0, dict(zip(control.HEADING_GAIN_ORDER, K5, strict=True)))
     np.testing.assert_allclose(np.sort_complex(heading), np.sort_complex(design_poles), rtol=1e-9)

@@ -137,7 +137,7 @@ def test_many_instants_at_once_equal_one_by_one(steady):
 
 def test_missing_names_are_input_errors():
     p = dict(wk.bicycles.load("balanceassist_v1").moore, rtr=0.01)
-    q = {name: 0.0 for name in geometry.COORDINATES}
+    q = dict.fromkeys(geometry.COORDINATES, 0.0)
     with pytest.raises(InputError, match="rtf"):
         geometry.evaluate(q, p)
     p["rtf"] = 0.01

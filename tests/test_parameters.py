@@ -21,9 +21,9 @@ def test_shipped_files_are_the_repository_parameter_files(kind):
 
 
 def test_the_loaders_read_the_shipped_folders():
-    assert wk.tyres.TYRE_DIR == parameters.shipped("tyres")
-    assert wk.bicycles.BICYCLE_DIR == parameters.shipped("bicycles")
-    assert wk.riders.RIDER_DIR == parameters.shipped("riders")
+    assert parameters.shipped("tyres") == wk.tyres.TYRE_DIR
+    assert parameters.shipped("bicycles") == wk.bicycles.BICYCLE_DIR
+    assert parameters.shipped("riders") == wk.riders.RIDER_DIR
     assert [name for name, _, _ in wk.tyres.available()] == ["T01", "T02", "T03", "T04", "T05"]
     assert "balanceassist_v1" in wk.bicycles.available() and wk.riders.available() == ["jason"]
 

@@ -62,7 +62,7 @@ def test_axis_limits_come_from_the_motion_before_the_fall(fall):
     +-1.65 rad/s, so the kick response fills the panel.
     """
     fig = plotting.response_figure([("", fall)], kick=(0.0, 0.15))
-    panels = dict(zip((c for c, _ in plotting.RESPONSE_PANELS), fig.axes))
+    panels = dict(zip((c for c, _ in plotting.RESPONSE_PANELS), fig.axes, strict=True))
     df = fall.trajectory
     low, high = panels["steer_rate"].get_ylim()
     assert df["steer_rate"].min() < -60.0           # the fall itself ...

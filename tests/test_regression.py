@@ -44,7 +44,7 @@ from whipple_kick import simulation
 DATA = pathlib.Path(__file__).parent / "data" / "regression"
 THESIS_FORM = DATA / "thesis_form"
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "scripts"))
-import regenerate_regression  # noqa: E402
+import regenerate_regression
 
 TOLERANCE = 1e-4      # of each column's largest |reference value|
 TIME_TOLERANCE = 1e-6  # s

@@ -73,7 +73,7 @@ def test_heading_rider_gains_are_applied_and_reported():
     scenario = Scenario(pressure_kpa=400.0, fz_n=635.0, symmetric_tyres=True, duration=8.0)
     design = wk.assembly.build_bicycle(scenario)[1]
     K, _ = wk.control.heading_lqr_gains(design, 3.0)
-    held = run(scenario, gains=dict(zip(wk.control.HEADING_GAIN_ORDER, K)))
+    held = run(scenario, gains=dict(zip(wk.control.HEADING_GAIN_ORDER, K, strict=True)))
     free = run(scenario)
     ctl = held.summary["controller"]
     assert ctl["law"] == "T7 = -(kq4 q4 + kq7 q7 + ku4 u4 + ku7 u7 + kq3 q3)"
@@ -438,7 +438,7 @@ def _smooth_y(t):
 
 
 def _write_table(path, t, y, header="time,y"):
-    lines = ([header] if header else []) + [f"{float(a)!r},{float(b)!r}" for a, b in zip(t, y)]
+    lines = ([header] if header else []) + [f"{float(a)!r},{float(b)!r}" for a, b in zip(t, y, strict=True)]
     path.write_text("\n".join(lines) + "\n")
     return str(path)
 
@@ -526,7 +526,7 @@ def test_table_with_an_offset_start_and_off_grid_times(tables):
     # Units in the header, an extra column (ignored), a comment line.
     path = tables["folder"] / "offset.csv"
     path.write_text("# plate of the test rig\nTime [s],y (m),note\n"
-                    + "".join(f"{float(a)!r},{float(b)!r},x\n" for a, b in zip(t, y)))
+                    + "".join(f"{float(a)!r},{float(b)!r},x\n" for a, b in zip(t, y, strict=True)))
     path = str(path)
     # Both runs below start the steady turn at heading 0 at -0.5 s (kick_heading="settled"): with the
     # heading fixed at each kick's start instead, they would differ by the 0.2 s of turning between the

@@ -26,7 +26,7 @@ def t03():
 
 
 def _outputs(rhs, trajectory):
-    return np.array([rhs.outputs(t, x)[1] for t, x in zip(trajectory.t, trajectory.x)])
+    return np.array([rhs.outputs(t, x)[1] for t, x in zip(trajectory.t, trajectory.x, strict=True)])
 
 
 @pytest.mark.parametrize("speed", [3.0, 5.0, 7.0])
@@ -66,7 +66,7 @@ def test_linearisation_predicts_the_response_about_a_steady_turn(rider_bike, gai
     z_ref = slip.heading_state(ss.x)
     dz0 = slip.heading_state(x0) - z_ref
     worst = 0.0
-    for t, x in zip(tr.t[::10], tr.x[::10]):
+    for t, x in zip(tr.t[::10], tr.x[::10], strict=True):
         dz_nonlinear = slip.heading_state(x) - z_ref
         dz_linear = expm(A * t) @ dz0
         worst = max(worst, np.abs(dz_nonlinear - dz_linear)[:11].max())
@@ -450,7 +450,7 @@ def test_upright_start_is_upright_and_balanced_vertically_but_not_steady(rider_b
     dx, out = rhs.outputs(0.0, x)
     assert abs(out[slip.OUT["holonomic"]]) < 1e-10
     assert abs(dx[slip.X["u9"]]) < 1e-6 and abs(dx[slip.X["u10"]]) < 1e-6
-    for slot, name in zip(slip.TYRE_STATES, ("fy_ss_r", "fy_ss_f", "mz_ss_r", "mz_ss_f")):
+    for slot, name in zip(slip.TYRE_STATES, ("fy_ss_r", "fy_ss_f", "mz_ss_r", "mz_ss_f"), strict=True):
         assert x[slip.X[slot]] == out[slip.OUT[name]] != 0.0
     assert start.unknowns["largest_rate"] > 0.05
     symmetric = slip.model_parameters(rider_bike, t03, t03, gains=gains, symmetric=True)
@@ -475,7 +475,7 @@ def test_kept_speeds_leave_the_rear_sliding_at_the_plate_velocity_times_sin_yaw(
     before = rhs.outputs(np.nextafter(T, 0.0), x_stop)[1][:10]
     np.testing.assert_allclose(after.outputs(T, x_stop)[1][:10], before, rtol=0, atol=1e-12)
     tr = lsoda.integrate(after, x_stop, T + 1.0, t_start=T, rtol=1e-12, output_rate=100)
-    for t, x in zip(tr.t, tr.x):
+    for t, x in zip(tr.t, tr.x, strict=True):
         _, A, a0 = after.impulse_terms(t, x)
         u = after.outputs(t, x)[1][:10]
         residual_without_slide = A @ u + a0 + np.array([slide, 0.0, 0.0])

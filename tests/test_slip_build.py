@@ -52,7 +52,7 @@ def test_c_agrees_with_numpy_oracle(rider_bike, gains, t03, transient):
         x = ss.x.copy()
         for name, spread in (("q3", 0.5), ("q4", 0.3), ("q7", 0.3), ("q5", 0.01), ("u1", 1.0), ("u2", 0.5),
                              ("u3", 1.0), ("u4", 1.0), ("u7", 1.0), ("u9", 0.05), ("u10", 0.05),
-                             *zip(slip.PATCH_STATES, _TYRE_SPREAD[transient])):
+                             *zip(slip.PATCH_STATES, _TYRE_SPREAD[transient], strict=True)):
             x[slip.X[name]] += rng.uniform(-spread, spread)
         x[slip.X["q9"]] = rng.uniform(0.0, 0.01)
         x[slip.X["q10"]] = rng.uniform(0.0, 0.01)

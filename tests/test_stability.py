@@ -115,7 +115,7 @@ def test_tracking_keeps_identity_where_real_parts_cross():
         lams.append(lam[order])
         vecs.append(np.hstack([a_vec, b_vec])[:, order])
     ids = stability.track(lams, vecs)
-    for lam, cur in zip(lams, ids):
+    for lam, cur in zip(lams, ids, strict=True):
         first = lam[cur == ids[0][np.argmax(lams[0].imag)]][0]
         assert first.imag == 3.0                          # the same mode all along
 
@@ -165,7 +165,7 @@ def test_mode_names_are_continuous_on_the_default_case(default_sweep):
                         kept = dist(k, i, k + 1, i) + dist(k, j, k + 1, j)
                         swapped = dist(k, i, k + 1, j) + dist(k, j, k + 1, i)
                         worst = max(worst, kept / swapped)
-        for speed, rows in g.groupby("speed_m_s"):
+        for _speed, rows in g.groupby("speed_m_s"):
             for r in rows[rows["imag_1_s"] > 0].itertuples():
                 partner = rows[(rows["real_1_s"] == r.real_1_s) & (rows["imag_1_s"] == -r.imag_1_s)]
                 assert list(partner["mode"]) == [r.mode]
@@ -230,7 +230,7 @@ def test_measured_tyres_shrink_the_self_stable_range(default_sweep):
     above = table[(table["model"] == "slip") & (table["loop"] == "open") & (table["speed_m_s"] > 4.0)]
     capsize = above[above["mode"] == "capsize"].groupby("speed_m_s")["real_1_s"].max()
     assert len(capsize) == len(above["speed_m_s"].unique())
-    assert 0.4 < capsize.min() and capsize.max() < 0.75
+    assert capsize.min() > 0.4 and capsize.max() < 0.75
     wobble = _eigs(table, "slip", "open", 1.0, "wobble")
     assert np.allclose(wobble, [-1.27 - 59.69j, -1.27 + 59.69j], atol=0.02)
     noslip = default_sweep.summary["no-slip"]["open"]["stable_speed_ranges"]

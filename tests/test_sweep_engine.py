@@ -83,7 +83,7 @@ def test_case_ids_and_input_errors():
     assert [c[0] for c in cases] == [
         {"fz_n": 570.0, "speed": 2.0, "tyre": "T04"}, {"fz_n": 570.0, "speed": 3.0, "tyre": "T04"},
         {"fz_n": 701.0, "speed": 2.0, "tyre": "T04"}, {"fz_n": 701.0, "speed": 3.0, "tyre": "T04"}]
-    with pytest.raises(InputError, match="unknown scenario field.*'presure_kpa'"):
+    with pytest.raises(InputError, match=r"unknown scenario field.*'presure_kpa'"):
         wk.sweep_engine.make_cases({"presure_kpa": [300]})
     with pytest.raises(InputError, match="no values"):
         wk.sweep_engine.make_cases({"pressure_kpa": []})

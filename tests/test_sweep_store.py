@@ -82,7 +82,7 @@ def test_interrupted_sweep_resumes_without_redoing_or_losing_cases(tmp_path):
     assert (table["status"] == "ok").all()
     lines = (folder / wk.sweep_store.LOG_FILE).read_text().splitlines()
     assert len(lines) == 5          # each case ran exactly once over both runs
-    finished = dict(zip(table["case_id"], table["run.finished"]))
+    finished = dict(zip(table["case_id"], table["run.finished"], strict=True))
     for cid, rec in first.items():  # the first run's cases were kept, not redone
         assert finished[cid] == rec["run"]["finished"]
     assert wk.sweep_store.read_manifest(folder)["status"] == "complete"

@@ -127,7 +127,7 @@ def stiffness_deviation_table():
     for name, (loads, by_pressure) in MEASURED_STIFFNESS.items():
         for pressure, measured in by_pressure.items():
             fitted = _fitted_stiffness_n_per_deg(name, pressure, loads)
-            for fz, m, f in zip(loads, measured, fitted):
+            for fz, m, f in zip(loads, measured, fitted, strict=True):
                 rows.append((name, pressure, fz, m, f, 100.0 * (f / m - 1.0)))
     return rows
 

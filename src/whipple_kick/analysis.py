@@ -203,7 +203,7 @@ def _lobes(x, band):
     edges = np.flatnonzero(np.diff(state)) + 1
     starts = np.concatenate(([0], edges))
     stops = np.concatenate((edges, [x.size]))
-    return [(a, b, int(state[a])) for a, b in zip(starts, stops) if state[a] != 0]
+    return [(a, b, int(state[a])) for a, b in zip(starts, stops, strict=True) if state[a] != 0]
 
 
 def _refine(t, x, i, points):
@@ -326,7 +326,7 @@ def yaw_rate_peaks(t, signal, t_kick=0.0, threshold=0.08, *, hysteresis=None,
             times = [k[0] for k in kept]
             half = max(np.diff(times), default=times[0] - t_kick)
             reason = "decayed" if tw[-1] - times[-1] >= 2 * half else "end_of_record"
-    tp, v, i = (np.array(col) for col in zip(*kept))
+    tp, v, i = (np.array(col) for col in zip(*kept, strict=True))
     return PeakSeries(tp, v, i.astype(int) + first, t_kick, largest, threshold, reason)
 
 
@@ -698,7 +698,7 @@ def kick_metrics(data, t_kick=0.0, threshold=0.08, *, baseline=0.0, lowpass_hz=N
             for key in keys:
                 out[key], missing[key] = None, str(exc)
             return
-        out.update(zip(keys, values))
+        out.update(zip(keys, values, strict=True))
 
     attempt(["last_peak_time"], lambda: [last_peak_time(peaks)])
     for a, b in PEAK_PAIRS:

@@ -29,6 +29,7 @@ decisions and measured speed.
 """
 import dataclasses
 import functools
+import itertools
 import math
 import pathlib
 import shutil
@@ -178,7 +179,7 @@ def _yeadon_segments(human, seat, to_bike):
         for solid in segment.solids:
             start = np.ravel(solid.pos)
             if hasattr(solid, "stads"):
-                for level, stadium in zip((0.0, solid.height), solid.stads):
+                for level, stadium in zip((0.0, solid.height), solid.stads, strict=True):
                     flat = _stadium(stadium.radius, stadium.thickness, solid.alignment)
                     local = np.c_[flat, np.full(len(flat), level)]
                     points.append(start + local @ rot.T)
@@ -778,7 +779,7 @@ class _Frames:
         starts = np.cumsum([0] + sizes)
         self.solid_points = np.concatenate([item.points for item in solids], axis=1)
         self.solid_items = solids
-        self.solid_slices = [slice(a, b) for a, b in zip(starts[:-1], starts[1:])]
+        self.solid_slices = [slice(a, b) for a, b in itertools.pairwise(starts)]
         # Hulls: point indices padded to one length (the padding repeats a point of the same item).
         hulls = [i for i, item in enumerate(solids) if item.kind == "hull"]
         width = max([sizes[i] for i in hulls], default=1)
@@ -881,7 +882,7 @@ class _Frames:
 
 # -------------------------------------------------------------------- writers
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def video_encoder():
     """Path of an ffmpeg executable, or None.
 
@@ -895,7 +896,7 @@ def video_encoder():
         return shutil.which("ffmpeg")
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _h264_codec(exe):
     """libx264 when this ffmpeg has it, else its built-in MPEG-4 part 2 encoder."""
     listing = subprocess.run([exe, "-hide_banner", "-encoders"], capture_output=True, text=True).stdout

@@ -198,7 +198,7 @@ def controller_gains(scenario, design):
     from . import control
 
     if scenario.controller == "off":
-        return {k: 0.0 for k in control.GAIN_ORDER}, None
+        return dict.fromkeys(control.GAIN_ORDER, 0.0), None
     if scenario.controller == "thesis":
         gains = control.thesis_gains(thesis_load(scenario))
         return {k: scenario.gain_scale * v for k, v in gains.items()}, None
@@ -239,7 +239,7 @@ def build_tyres(scenario):
         tyre = tyres.load(scenario.tyre, p, coefficient_set=scenario.coefficient_set,
                           friction=scenario.friction, missing_moment="error")
         try:
-            tyre.blend   # raises when the tyre has no M_z coefficients
+            tyre.blend   # noqa: B018 -- the property raises when the tyre has no M_z coefficients
             loaded.append(tyre)
         except InputError as exc:
             # Tyres without published M_z data: run with M_z = 0 and say so.

@@ -22,8 +22,8 @@ import math
 import types
 
 from . import benchmark as _benchmark
-from .errors import InputError
 from . import parameters
+from .errors import InputError
 
 #: Folder of the shipped bicycle files (package data, :func:`whipple_kick.parameters.shipped`).
 BICYCLE_DIR = parameters.shipped("bicycles")

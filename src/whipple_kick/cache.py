@@ -71,7 +71,7 @@ def source_hash(module_names, extra=""):
     return digest.hexdigest()[:20]
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def sympy_version():
     """Version of the installed SymPy, read from its metadata (SymPy itself is not imported)."""
     try:

@@ -69,7 +69,7 @@ def _generate_source():
     return "\n\n".join(parts)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def generated():
     """The generated NumPy module of the classic model (built once, then cached)."""
     key = cache.source_hash(_SOURCES, extra=_LAYOUT)
@@ -181,7 +181,7 @@ def _reduced_rhs(x, u6, p, r):
 @functools.lru_cache(maxsize=64)
 def _nominal_pitch(p_tuple):
     p = np.array(p_tuple)
-    moore = dict(zip(CLASSIC_CONSTANTS, p))
+    moore = dict(zip(CLASSIC_CONSTANTS, p, strict=True))
     from .benchmark import steer_axis_tilt
     q = np.zeros(8)
     q[Q["q5"]] = steer_axis_tilt(moore)
@@ -338,5 +338,5 @@ def simulate(moore, q0, u_ind0, t_end, steer_torque=None, rtol=1e-10, atol=1e-12
         return np.concatenate([u, udot[_PARTITION.ind]])
 
     x0 = np.concatenate([q0, u_ind0])
-    from scipy.integrate import solve_ivp   # 0.5-0.9 s to import; the linear analyses do not need it
+    from scipy.integrate import solve_ivp  # 0.5-0.9 s to import; the linear analyses do not need it
     return solve_ivp(rhs, (0.0, t_end), x0, method="LSODA", rtol=rtol, atol=atol, t_eval=t_eval)

@@ -4,6 +4,7 @@ User mistakes (:class:`whipple_kick.errors.InputError`) print one line on
 stderr and exit with status 2, without a traceback.
 """
 import argparse
+import math
 import sys
 
 import numpy as np
@@ -33,7 +34,7 @@ def _benchmark(argv):
     eigs = classic.eigenvalues(moore, speeds)
     print("Benchmark bicycle (Meijaard et al. 2007), classic no-slip model, eigenvalues [1/s]")
     print(f"{'v [m/s]':>8}  " + "  ".join(f"{'eigenvalue ' + str(i + 1):>26}" for i in range(4)))
-    for v, row in zip(speeds, eigs):
+    for v, row in zip(speeds, eigs, strict=True):
         cells = [f"{e.real:+.10f}{e.imag:+.10f}j" for e in row]
         print(f"{v:8.3f}  " + "  ".join(f"{c:>26}" for c in cells))
     print(f"weave speed   {classic.weave_speed(moore):.10f} m/s (published {benchmark.WEAVE_SPEED:.10f})")
@@ -64,7 +65,7 @@ def _number(unit):
             value = float(text)
         except ValueError:
             raise argparse.ArgumentTypeError(f"{text!r} is not a number ({unit})") from None
-        if value != value or value in (float("inf"), float("-inf")):
+        if not math.isfinite(value):
             raise argparse.ArgumentTypeError(f"{text!r} is not a finite number ({unit})")
         return value
     return parse
@@ -393,6 +394,7 @@ def _print_summary(result, out, files):
 def _write_results(result, out):
     """trajectory.csv and summary.json of ``result`` in ``out`` (each written atomically); returns the file names."""
     import json
+
     from . import fileio
     fileio.write_csv(result.trajectory, out / "trajectory.csv")
     fileio.write_atomic(out / "summary.json", json.dumps(result.summary, indent=2, allow_nan=False) + "\n")
@@ -401,12 +403,13 @@ def _write_results(result, out):
 
 def _simulate(argv):
     import shutil
+
     from . import assembly, simulation
     args = _simulate_parser().parse_args(argv)
     given = _flags_given(argv) if args.compat is not None else ()
     scenario = assembly.preflight(_scenario_from_args(args, given))
     movie_options = _animation_options(args)
-    out, created = _prepare_out(args.out if args.out else _default_out(scenario), args.force)
+    out, created = _prepare_out(args.out or _default_out(scenario), args.force)
     try:
         result = simulation.run(scenario)
     except SimulationError as exc:
@@ -563,6 +566,7 @@ def _stability_parser():
 def _stability(argv):
     import shutil
     import time
+
     from . import assembly, stability
     from .scenario import Scenario
     args = _stability_parser().parse_args(argv)
@@ -571,7 +575,7 @@ def _stability(argv):
     scenario = Scenario(**_model_fields(args), symmetric_tyres=args.tyre_offsets == "zero",
                                    speed=float(speeds[0]))
     assembly.preflight(scenario)
-    out, created = _prepare_out(args.out if args.out else _default_out(scenario, "stability"), args.force)
+    out, created = _prepare_out(args.out or _default_out(scenario, "stability"), args.force)
     try:
         result = stability.analyse(scenario, speeds)
     except InputError:

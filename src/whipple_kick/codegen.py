@@ -77,4 +77,4 @@ def numpy_function(name, arguments, outputs, doc=""):
     return "\n".join(lines) + "\n"
 
 
-__all__ = ["plain", "plain_symbol", "numpy_function"]
+__all__ = ["numpy_function", "plain", "plain_symbol"]

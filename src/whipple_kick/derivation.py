@@ -75,7 +75,7 @@ def kinematics(tyre_model=False):
     u = S.dyns([n.replace("q", "u") for n in names_q])
     q1, q2, q3, q4, q5, q6, q7, q8 = q[:8]
     u1, u2, u3, u4, u5, u6, u7, u8 = u[:8]
-    qd_to_u = {qi.diff(me.dynamicsymbols._t): ui for qi, ui in zip(q, u)}
+    qd_to_u = {qi.diff(me.dynamicsymbols._t): ui for qi, ui in zip(q, u, strict=True)}
     p = {n: S.sym(n) for n in S.CLASSIC_CONSTANTS}
 
     N = me.ReferenceFrame("N")
@@ -209,7 +209,7 @@ class EquationsOfMotion:
 
 def kane_full(kin, loads):
     """Kane's ``F_r + F_r^* = 0`` for all speeds: returns (mass matrix, forcing)."""
-    kdes = [qi.diff(me.dynamicsymbols._t) - ui for qi, ui in zip(kin.q, kin.u)]
+    kdes = [qi.diff(me.dynamicsymbols._t) - ui for qi, ui in zip(kin.q, kin.u, strict=True)]
     kane = me.KanesMethod(kin.frames["N"], q_ind=list(kin.q), u_ind=list(kin.u), kd_eqs=kdes)
     kane.kanes_equations(kin.bodies, loads)
     return kane.mass_matrix, kane.forcing
@@ -231,7 +231,7 @@ def constraint_terms(rows, kin, time_terms=None):
     q = sm.Matrix(kin.q)
     rows = sm.Matrix(rows)
     A = rows.jacobian(u)
-    a0 = rows.subs({ui: 0 for ui in u})   # rows are linear in u
+    a0 = rows.subs(dict.fromkeys(u, 0))   # rows are linear in u
     # d/dt(A u + a0) with dq/dt = u: (d(A u + a0)/dq) u + d(a0)/dt|explicit inputs.
     b = (A * u + a0).jacobian(q) * u
     for s, sdot in (time_terms or {}).items():

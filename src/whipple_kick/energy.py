@@ -55,6 +55,7 @@ def common_rates(extra, u, t6):
         ``W_steer``, ``W_wheel``, ``W_moment``, ``D_damper``.
     """
     import sympy as sm
+
     from . import symbols as S
 
     fy_r, mz_r, mz_f, t7 = S.syms(["Fy_r", "Mz_r", "Mz_f", "T7"])

@@ -7,6 +7,7 @@ malformed parameter file. Numerical trouble is *not* an InputError: a run
 that fails numerically raises :class:`SimulationError`, carrying what was
 computed before the failure.
 """
+import math
 
 
 class InputError(ValueError):
@@ -40,7 +41,7 @@ def check_range(name, value, low, high, unit, *, low_open=False, high_open=False
     lo_txt = "-inf" if low is None else f"{low:g}"
     hi_txt = "inf" if high is None else f"{high:g}"
     bracket = ("(" if low_open else "[") + f"{lo_txt}, {hi_txt}" + (")" if high_open else "]")
-    bad = x != x or x in (float("inf"), float("-inf"))
+    bad = not math.isfinite(x)
     if low is not None:
         bad = bad or (x <= low if low_open else x < low)
     if high is not None:

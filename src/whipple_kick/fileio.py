@@ -9,10 +9,10 @@ the text of ``DataFrame.to_csv(index=False)`` (faster for the all-float
 trajectory), :func:`read_csv` reads with ``pandas.read_csv`` and turns a
 file that cannot be read into a one-line :class:`~whipple_kick.errors.InputError`.
 """
+from collections.abc import Iterator
 import contextlib
 import os
 import pathlib
-from collections.abc import Iterator
 
 import numpy as np
 
@@ -94,8 +94,7 @@ def write_csv(frame, path) -> None:
             return
         with open(tmp, "w", newline="") as fh:
             fh.write(frame.iloc[:0].to_csv(index=False, lineterminator="\n"))   # pandas' own header
-            for chunk in csv_text_rows(values):
-                fh.write(chunk)
+            fh.writelines(csv_text_rows(values))
 
 
 def read_csv(path, what: str, *, name: str | None = None, **options):

@@ -12,8 +12,8 @@ motion integrate.
 Ground frame N: x, y horizontal, z DOWN (Moore 2012), origin where the rear
 contact starts. Positions are in metres.
 """
-import functools
 from dataclasses import dataclass
+import functools
 
 import numpy as np
 
@@ -45,7 +45,7 @@ _SOURCES = ("symbols", "derivation", "codegen", "geometry")
 _LAYOUT = "geometry-v1"   # bump when numpy_source changes what it writes
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _expressions():
     """(outputs, coordinate symbols, parameter symbols) as plain SymPy expressions."""
     import sympy as sm
@@ -84,7 +84,7 @@ def numpy_source():
     ])
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _module():
     key = cache.source_hash(_SOURCES, extra=_LAYOUT)
     path = cache.build_once(f"geometry_{key}.py", lambda tmp: tmp.write_text(numpy_source()))
@@ -125,7 +125,7 @@ def parameter_vector(parameters):
         raise InputError(f"geometry parameters are missing: {', '.join(missing)} (m)")
     values = np.array([float(parameters[name]) for name in PARAMETER_NAMES])
     if not np.all(np.isfinite(values)):
-        bad = [n for n, v in zip(PARAMETER_NAMES, values) if not np.isfinite(v)]
+        bad = [n for n, v in zip(PARAMETER_NAMES, values, strict=True) if not np.isfinite(v)]
         raise InputError(f"geometry parameters must be finite (m): {', '.join(bad)}")
     return values
 
@@ -165,11 +165,11 @@ def evaluate(coordinates, parameters):
     q = np.array([np.broadcast_to(c, (n,)) for c in columns])
     out = _module().pose(q, parameter_vector(parameters))
     k = len(POINTS)
-    points = {name: np.moveaxis(np.asarray(v, dtype=float), -1, 0) for name, v in zip(POINTS, out[:k])}
+    points = {name: np.moveaxis(np.asarray(v, dtype=float), -1, 0) for name, v in zip(POINTS, out[:k], strict=True)}
     frames = {name: np.moveaxis(np.asarray(v, dtype=float), -1, 0)
-              for name, v in zip(FRAMES, out[k:k + len(FRAMES)])}
+              for name, v in zip(FRAMES, out[k:k + len(FRAMES)], strict=True)}
     directions = {name: np.moveaxis(np.asarray(v, dtype=float), -1, 0)
-                  for name, v in zip(DIRECTIONS, out[k + len(FRAMES):])}
+                  for name, v in zip(DIRECTIONS, out[k + len(FRAMES):], strict=True)}
     return Pose(points=points, frames=frames, directions=directions)
 
 
@@ -187,7 +187,7 @@ def nominal_coordinates(parameters):
     """
     from .benchmark import steer_axis_tilt
 
-    q = {name: 0.0 for name in COORDINATES}
+    q = dict.fromkeys(COORDINATES, 0.0)
     q["q5"] = steer_axis_tilt(parameters)
     return q
 

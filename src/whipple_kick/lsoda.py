@@ -19,10 +19,10 @@ it produced so far, in bounded time.
 """
 import collections
 from dataclasses import dataclass
-
-import numpy as np
+import itertools
 import warnings
 
+import numpy as np
 from scipy.integrate import LSODA, odeint
 
 from . import slip
@@ -172,7 +172,7 @@ def _careful_chunk(rhs, x, times, rtol, atol, fall, spent, budget, t_start, jac=
         g_new = fall(t_new, solver.y)
         if g_old >= 0.0 >= g_new:   # |roll| rose through the limit (the event's direction)
             dense = solver.dense_output()
-            t_fall = brentq(lambda t: fall(t, dense(t)), solver.t_old, t_new,
+            t_fall = brentq(lambda t, dense=dense: fall(t, dense(t)), solver.t_old, t_new,
                             xtol=4 * np.finfo(float).eps, rtol=4 * np.finfo(float).eps)
             t_new, end, status = t_fall, (t_fall, dense(t_fall)), "fell"
         g_old = g_new
@@ -369,7 +369,7 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
     # evaluations, a stiff one with a new Jacobian the most), so a stall wastes about one window
     # here; a legitimate interval needs far fewer steps (docs/simulate.md).
     mxstep = max(1, budget.stall_window // 4)
-    for a, b in zip(edges[:-1], edges[1:]):
+    for a, b in itertools.pairwise(edges):
         at_a = samples[np.abs(samples - a) <= eps]
         at_b = samples[(np.abs(samples - b) <= eps) & (samples > a + eps)]
         inside = samples[(samples > a + eps) & (samples < b - eps)]
@@ -382,7 +382,7 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
         else:
             marks = np.searchsorted(grid, a + chunk * np.arange(1, int(np.ceil((b - a) / chunk))))
             cuts = sorted({0, len(grid) - 1, *(int(m) for m in marks if 0 < m < len(grid) - 1)})
-        for i0, i1 in zip(cuts[:-1], cuts[1:]):
+        for i0, i1 in itertools.pairwise(cuts):
             times = grid[i0:i1 + 1]
             # A sample at the piece's end is emitted after the jump map (below).
             last = -1 if i1 == len(grid) - 1 else None

@@ -59,14 +59,29 @@ import functools
 import numpy as np
 
 __all__ = [
-    "N_FY_COEFFICIENTS", "N_MZ_COEFFICIENTS", "FY_OFFSET_INDICES", "MZ_OFFSET_INDICES",
-    "FY_CAMBER_ODD_INDICES", "MZ_CAMBER_ODD_INDICES", "camber_reversed",
-    "lateral_force_factors", "aligning_moment_factors",
-    "lateral_force_formula", "aligning_moment_formula",
-    "lateral_force_model", "aligning_moment_model", "cornering_stiffness_model", "lateral_secant_model",
-    "SECANT_SERIES_LIMIT", "OFFSET_FADE_LOAD", "offset_fade",
-    "lateral_force_numpy", "aligning_moment_numpy", "cornering_stiffness_numpy",
-    "lateral_force_factors_numpy", "lateral_secant_numpy",
+    "FY_CAMBER_ODD_INDICES",
+    "FY_OFFSET_INDICES",
+    "MZ_CAMBER_ODD_INDICES",
+    "MZ_OFFSET_INDICES",
+    "N_FY_COEFFICIENTS",
+    "N_MZ_COEFFICIENTS",
+    "OFFSET_FADE_LOAD",
+    "SECANT_SERIES_LIMIT",
+    "aligning_moment_factors",
+    "aligning_moment_formula",
+    "aligning_moment_model",
+    "aligning_moment_numpy",
+    "camber_reversed",
+    "cornering_stiffness_model",
+    "cornering_stiffness_numpy",
+    "lateral_force_factors",
+    "lateral_force_factors_numpy",
+    "lateral_force_formula",
+    "lateral_force_model",
+    "lateral_force_numpy",
+    "lateral_secant_model",
+    "lateral_secant_numpy",
+    "offset_fade",
 ]
 
 #: Number of Pacejka 1989 lateral-force coefficients a0..a13.
@@ -412,7 +427,7 @@ def lateral_secant_model(slip_rad, fz_n, a, friction_scale=1):
 _FACTOR_NAMES = ("B", "C", "D", "E", "Sh", "Sv")
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _numpy_function(which):
     """Lambdify one of the model expressions (cached: built on first use)."""
     import sympy as sm
@@ -499,4 +514,4 @@ def lateral_force_factors_numpy(camber, fz, a, friction_scale=1.0):
     with np.errstate(all="ignore"):
         values = _numpy_function("fy_factors")(camber, fz, float(friction_scale), *coefficients)
     return {key: np.broadcast_to(np.asarray(v, dtype=float), fz.shape).copy()
-            for key, v in zip(_FACTOR_NAMES, values)}
+            for key, v in zip(_FACTOR_NAMES, values, strict=True)}

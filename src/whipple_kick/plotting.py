@@ -135,9 +135,9 @@ def response_figure(runs, path=None, title=None, kick=None, time_range=None, dpi
     >>> [t.get_text() for t in fig.axes[0].texts if t.get_text().startswith("fell")]
     ['fell at 1.585 s']
     """
-    import matplotlib.transforms as mtransforms
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
+    import matplotlib.transforms as mtransforms
 
     fig = Figure(figsize=(8.0, 9.0))
     FigureCanvasAgg(fig)   # its own canvas: no pyplot, no global backend
@@ -150,7 +150,7 @@ def response_figure(runs, path=None, title=None, kick=None, time_range=None, dpi
         color = f"C{k}"
         text = f"{label} (fell at {fall_time:.3f} s)" if fell and label else label
         t = df["time"].to_numpy()
-        for ax, (column, _) in zip(axes, RESPONSE_PANELS):
+        for ax, (column, _) in zip(axes, RESPONSE_PANELS, strict=True):
             ax.plot(t, df[column], lw=1.2, label=text, color=color)
             limits[column].append(motion_limits(t, df[column], df["roll"], fall_angle, time_range,
                                                 df["steer"] if "steer" in df else None, steer_limit))
@@ -164,7 +164,7 @@ def response_figure(runs, path=None, title=None, kick=None, time_range=None, dpi
         if baseline is not None:
             axes[0].axhline(baseline, color=color, lw=0.8, ls=":", gid="baseline")
             baselines.append(baseline)
-    for ax, (column, ylabel) in zip(axes, RESPONSE_PANELS):
+    for ax, (column, ylabel) in zip(axes, RESPONSE_PANELS, strict=True):
         ax.set_ylabel(ylabel)
         ax.grid(True, lw=0.4, alpha=0.5)
         ax.axvline(0.0, color="0.4", lw=0.6, ls=":")

@@ -48,7 +48,7 @@ PATCH_STATE_COLUMNS = {"slip_patch_r": "slip_patch_rear", "slip_patch_f": "slip_
 BALANCE_COLUMN = "energy_balance_residual"
 #: Unit of every trajectory column (from the symbol registry and :data:`whipple_kick.slip.OUTPUTS`).
 UNITS = {"time": "s", **dict(COORDINATE_COLUMNS.values()), **dict(SPEED_COLUMNS.values()),
-         **{c: "rad" for c in PATCH_STATE_COLUMNS.values()},
+         **dict.fromkeys(PATCH_STATE_COLUMNS.values(), "rad"),
          **{c: slip.OUTPUTS[o][0] for o, c in {**APPLIED_COLUMNS, **OUTPUT_COLUMNS}.items()},
          **dict(energy.COLUMNS.values()), BALANCE_COLUMN: "J"}
 #: Columns whose peaks after the kick the summary lists (``max_abs_<column>``).

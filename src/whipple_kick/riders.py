@@ -37,9 +37,9 @@ import numpy as np
 from scipy.optimize import fsolve
 
 from . import benchmark as _benchmark
+from . import parameters
 from .bicycles import Bicycle
 from .errors import InputError, check_range
-from . import parameters
 
 #: Folder of the shipped rider files.
 RIDER_DIR = parameters.shipped("riders")
@@ -386,7 +386,7 @@ def place(bike, rider):
                B1B2extension=arm[3])
     import yeadon
 
-    for key, (low, high) in zip(yeadon.Human.CFGnames, yeadon.Human.CFGbounds):
+    for key, (low, high) in zip(yeadon.Human.CFGnames, yeadon.Human.CFGbounds, strict=True):
         if not low <= cfg[key] <= high:
             raise InputError(f"rider {rider.name!r} (height {rider.height_m:.3f} m) does not fit "
                              f"bicycle {bike.name!r}: seated {key} = {cfg[key]:.3f} rad is outside "
@@ -509,7 +509,7 @@ def static_loads(params):
     masses = (bench["mR"], bench["mB"], bench["mH"], bench["mF"])
     xs = (0.0, bench["xB"], bench["xH"], w)
     m = sum(masses)
-    x = sum(mi * xi for mi, xi in zip(masses, xs)) / m
+    x = sum(mi * xi for mi, xi in zip(masses, xs, strict=True)) / m
     weight = m * bench["g"]
     return weight * (w - x) / w, weight * x / w
 

@@ -142,7 +142,7 @@ def library_path():
     name = f"slip_{key}.so"
 
     def build(tmp):
-        from . import slip_build   # SymPy and the derivation: only on a cache miss
+        from . import slip_build  # SymPy and the derivation: only on a cache miss
         slip_build.build_library(tmp, key, cc, _CFLAGS)
 
     lib_path = cache.build_once(name, build)
@@ -160,7 +160,7 @@ def model_hash():
     return os.path.splitext(os.path.basename(library()._name))[0]
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def library():
     """The compiled slip model (ctypes library of :func:`library_path`), loaded once per process."""
     lib = ctypes.CDLL(str(library_path()))
@@ -475,6 +475,7 @@ def steady_state(params, speed, tol=1e-13, guess=None):
     SteadyState
     """
     from scipy.optimize import root
+
     from .benchmark import steer_axis_tilt
 
     rhs = CompiledRHS(params)
@@ -486,12 +487,12 @@ def steady_state(params, speed, tol=1e-13, guess=None):
     z0 = np.array([0.0, 0.0, steer_axis_tilt(params),
                    0.5 * weight / params["kzr"], 0.5 * weight / params["kzf"], 0.0, 0.0, 0.0])
     if guess is not None:
-        z0 = np.array([float(guess.get(name, value)) for name, value in zip(names, z0)])
+        z0 = np.array([float(guess.get(name, value)) for name, value in zip(names, z0, strict=True)])
     scale = np.array([1.0, 1.0, 1.0, 1e-3, 1e-3, 1.0, 1.0, 1.0])
 
     def state(z):
         xs = x.copy()
-        for name, value in zip(names[:-1], z[:-1]):
+        for name, value in zip(names[:-1], z[:-1], strict=True):
             xs[X[name]] = value
         rhs.p[P["T6c"]] = z[-1]
         return _steady_tyre_states(rhs, xs)
@@ -515,7 +516,7 @@ def steady_state(params, speed, tol=1e-13, guess=None):
     xs = state(z)
     out_params = dict(params)
     out_params["T6c"] = float(z[-1])
-    return SteadyState(xs, out_params, res, dict(zip(names, z)))
+    return SteadyState(xs, out_params, res, dict(zip(names, z, strict=True)))
 
 
 def _steady_tyre_states(rhs, x):
@@ -529,7 +530,7 @@ def _steady_tyre_states(rhs, x):
              else ("slip_r", "slip_f", "camber_r", "camber_f"))
     x = np.array(x, dtype=float)
     _, out = rhs.outputs(0.0, x)
-    for slot, out_name in zip(PATCH_STATES, names):
+    for slot, out_name in zip(PATCH_STATES, names, strict=True):
         x[X[slot]] = out[OUT[out_name]]
     return x
 
@@ -567,6 +568,7 @@ def upright_state(params, speed, tol=1e-13):
     (0.0, 0.0)
     """
     from scipy.optimize import root
+
     from .benchmark import steer_axis_tilt
 
     out_params = dict(params)
@@ -579,7 +581,7 @@ def upright_state(params, speed, tol=1e-13):
 
     def state(z):
         xs = x.copy()
-        for name, value in zip(names, z):
+        for name, value in zip(names, z, strict=True):
             xs[X[name]] = value
         return _steady_tyre_states(rhs, xs)
 
@@ -594,7 +596,7 @@ def upright_state(params, speed, tol=1e-13):
         raise FloatingPointError(f"upright start not found at {speed} m/s: {sol.message} (residual {res:.3g})")
     xs = state(sol.x)
     dx = rhs(0.0, xs)
-    unknowns = dict(zip(names, (float(v) for v in sol.x)))
+    unknowns = dict(zip(names, (float(v) for v in sol.x), strict=True))
     unknowns["largest_rate"] = float(max(abs(dx[X[n]]) for n in ("u2", "u3", "u4", "u7")))
     return SteadyState(xs, out_params, res, unknowns)
 
@@ -768,7 +770,7 @@ def _heading_derivative(rhs, x_ref, z, t, resolve_pitch):
     """d/dt of the heading-frame state ``z`` (yaw set to 0; pitch re-solved if a coordinate moved)."""
     x = np.array(x_ref, dtype=float)
     x[X["q3"]] = 0.0
-    for name, value in zip(LINEAR_STATES, z):
+    for name, value in zip(LINEAR_STATES, z, strict=True):
         if name == "v_fwd":
             x[X["u1"]] = value
         elif name == "v_lat":
@@ -829,7 +831,7 @@ def linearize(rhs, x, step=1e-7, t=0.0):
 HOLONOMIC_ROW = 2
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _difference_scales(form):
     """Typical size of each state for the C Jacobian's steps ``1.5e-8 max(|x_j|, scale_j)``.
 

@@ -30,8 +30,22 @@ from sympy.printing.c import C99CodePrinter
 
 from . import cache, codegen, energy, fileio, kane, magic_formula, transient
 from . import symbols as S
-from .slip import (COORDINATES, DEPENDENT, DYNAMIC_STATES, INDEPENDENT, OUTPUT_NAMES, OUTPUTS, P, PARAMETER_NAMES,
-                   PATCH_STATES, QUADRATURE_STATES, SPEEDS, STATE_NAMES, _PARTITION, _SOURCES)
+from .slip import (
+    _PARTITION,
+    _SOURCES,
+    COORDINATES,
+    DEPENDENT,
+    DYNAMIC_STATES,
+    INDEPENDENT,
+    OUTPUT_NAMES,
+    OUTPUTS,
+    PARAMETER_NAMES,
+    PATCH_STATES,
+    QUADRATURE_STATES,
+    SPEEDS,
+    STATE_NAMES,
+    P,
+)
 
 #: Tyre-block inputs computed with Kane's terms (plain symbols, registered in :mod:`symbols`).
 _KINEMATICS = ("vsy_r", "vsy_f", "vx_r", "vx_f", "camber_r", "camber_f", "fz_r", "fz_f",
@@ -94,7 +108,7 @@ def _called_curves():
 
 # ---------------------------------------------------------------- expressions
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _expressions():
     """Everything both printers need, as plain-symbol SymPy expressions.
 
@@ -125,7 +139,7 @@ def _expressions():
     G = forcing.jacobian(applied)
     if G.free_symbols & set(applied):
         raise RuntimeError("Kane's forcing is not linear in the tyre loads")
-    f0 = forcing.xreplace({s: 0 for s in applied})
+    f0 = forcing.xreplace(dict.fromkeys(applied, 0))
     kin = {name: plain(ex[name]) for name in _KINEMATICS}
     u = {f"u{i + 1}": codegen.plain_symbol(s) for i, s in enumerate(eom.u)}
     sigma0 = {"r": S.sym("sigr"), "f": S.sym("sigf")}
@@ -254,7 +268,7 @@ def _c_block(exprs, targets, indent="    "):
     printer = _Printer()
     replacements, reduced = sm.cse(list(exprs), symbols=sm.numbered_symbols("x_"), order="none")
     lines = [f"{indent}const double {lhs} = {printer.doprint(rhs)};" for lhs, rhs in replacements]
-    lines += [f"{indent}{target} = {printer.doprint(e)};" for target, e in zip(targets, reduced)]
+    lines += [f"{indent}{target} = {printer.doprint(e)};" for target, e in zip(targets, reduced, strict=True)]
     return "\n".join(lines)
 
 
@@ -298,7 +312,7 @@ def c_source():
     ex = _expressions()
     sy = ex["symbols"]
     n, m, k = len(SPEEDS), len(DEPENDENT), len(INDEPENDENT)
-    ns, nd, nq = len(STATE_NAMES), len(DYNAMIC_STATES), len(QUADRATURE_STATES)
+    ns, nd = len(STATE_NAMES), len(DYNAMIC_STATES)
     nt = len(PATCH_STATES)
     no = len(OUTPUT_NAMES) - n
     dep = [SPEEDS.index(x) for x in DEPENDENT]
@@ -348,7 +362,7 @@ def c_source():
     # The active transient form's tyre block (only its branch runs).
     block_targets = list(_APPLIED) + [f"trate[{i}]" for i in range(nt)] + list(_BLOCK_EXTRAS)
     lines.append(f"    double {', '.join(_APPLIED)}, trate[{nt}], {', '.join(_BLOCK_EXTRAS)};")
-    lines.append(f"    const int mode = (int)tyre_transient;")
+    lines.append("    const int mode = (int)tyre_transient;")
     for code, name in enumerate(transient.TRANSIENTS):
         head = "if" if code == 0 else "else if"
         cond = f"(mode == {code})" if code < len(transient.TRANSIENTS) - 1 else "(1)"
@@ -398,7 +412,7 @@ def c_source():
         lines.append(f"    dx[{q0 + QUADRATURE_STATES.index(nm)}] = {local};")
     # Work of the rear no-slip constraint's force while the plate moves:
     # u . (M du/dt - f) = -lambda . a0 (zero when a0 = 0, so skipped then).
-    lines.append(f"    if (a0[0] != 0.0 || a0[1] != 0.0 || a0[2] != 0.0) {{")
+    lines.append("    if (a0[0] != 0.0 || a0[1] != 0.0 || a0[2] != 0.0) {")
     lines.append(f"        double ud[{n}], pc = 0.0;")
     lines.append(f"        for (int i = 0; i < {n}; i++) {{ double s = t0[i]; for (int j = 0; j < {k}; j++) s += T[i * {k} + j] * r[j]; ud[i] = s; }}")
     lines.append(f"        for (int i = 0; i < {n}; i++) {{ double s = -f[i]; for (int j = 0; j < {n}; j++) s += M[i * {n} + j] * ud[j]; pc += u[i] * s; }}")
@@ -483,7 +497,7 @@ def numpy_source():
     return "\n\n".join(parts)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def numpy_module():
     """The generated NumPy oracle module (cached like the C library)."""
     key = cache.source_hash(_SOURCES, extra="numpy")
@@ -511,9 +525,9 @@ def numpy_rhs(t, x, p, with_outputs=False):
         udot = _PARTITION.accelerations(M, f, A, b)
         rates = np.zeros(len(QUADRATURE_STATES))
         common = mod.common([t], q, u, kin, applied, p)[0]
-        for value, nm in zip(common, ("W_plate", "W_steer", "W_wheel", "W_moment", "D_damper")):
+        for value, nm in zip(common, ("W_plate", "W_steer", "W_wheel", "W_moment", "D_damper"), strict=True):
             rates[QUADRATURE_STATES.index(nm)] = value
-        extras = dict(zip(_BLOCK_EXTRAS, block[8:]))
+        extras = dict(zip(_BLOCK_EXTRAS, block[8:], strict=True))
         for nm, local in (("W_zero_slip", "W0"), ("D_slide", "D_slide"), ("E_carcass_r", "P_carcass_r"),
                           ("E_carcass_f", "P_carcass_f")):
             rates[QUADRATURE_STATES.index(nm)] = extras[local]

@@ -178,7 +178,7 @@ class LinearModel:
         >>> sys.input_labels                                                      # doctest: +SKIP
         ['steer_torque']
         """
-        import control as ct   # slow import: only when asked for
+        import control as ct  # slow import: only when asked for
         closed = self.loop == "closed" if closed is None else closed
         names = [name for name, _ in self.labels]
         n = len(names)
@@ -526,7 +526,7 @@ def track(eigenvalues, vectors):
     """
     from scipy.optimize import linear_sum_assignment
     ids, next_id, prev = [], 0, None
-    for lam, vec in zip(eigenvalues, vectors):
+    for lam, vec in zip(eigenvalues, vectors, strict=True):
         if lam is None:
             ids.append(None)
             prev = None
@@ -611,7 +611,7 @@ def name_tracks(points, min_run=MIN_NAME_RUN):
         for start, stop in _segments(keys):
             branch = pts[start:stop]
             names = [name_mode(p["shares"], p["real"], p["frequency_hz"]) for p in branch]
-            for p, name in zip(branch, _merge_short_runs(names, min_run)):
+            for p, name in zip(branch, _merge_short_runs(names, min_run), strict=True):
                 p["mode"] = name
 
 
@@ -883,7 +883,7 @@ def _named_rows(model_name, loop, speeds, lams, vecs, shares_all, raw=None):
     if raw is not None:
         raw[model_name, loop] = (lams, vecs, ids)
     points = []
-    for k, (lam, cur, shares) in enumerate(zip(lams, ids, shares_all)):
+    for k, (lam, cur, shares) in enumerate(zip(lams, ids, shares_all, strict=True)):
         if lam is None:
             continue
         for j in range(lam.size):
@@ -897,7 +897,7 @@ def _named_rows(model_name, loop, speeds, lams, vecs, shares_all, raw=None):
     for p in points:
         shares = p.pop("shares")
         p.pop("real")
-        rows.append({**p, **{f"share_{g}": float(s) for g, s in zip(GROUPS, shares)}})
+        rows.append({**p, **{f"share_{g}": float(s) for g, s in zip(GROUPS, shares, strict=True)}})
     return rows
 
 
@@ -982,7 +982,7 @@ class _Sweep:
         """Eigenvalues named ``mode`` at speed index ``k`` (with their tracks)."""
         if not self.present(k):
             return []
-        return [(complex(l), int(t)) for l, t in zip(self.lams[k], self.ids[k]) if self.name[k, int(t)] == mode]
+        return [(complex(l), int(t)) for l, t in zip(self.lams[k], self.ids[k], strict=True) if self.name[k, int(t)] == mode]
 
     def eigenvalue(self, k, track_id):
         if not self.present(k):
@@ -1224,7 +1224,7 @@ def perturbed_state(model, vector, amplitude):
     big = max((vector[idx["q4"]], vector[idx["q7"]]), key=abs)
     dz = (vector * (abs(big) / big)).real * (amplitude / abs(big))
     x = np.array(model.steady.x, dtype=float)
-    for name, value in zip(model.states, dz):
+    for name, value in zip(model.states, dz, strict=True):
         x[slip.X[{"v_lat": "u2", "v_fwd": "u1"}.get(name, name)]] += value
     return slip.solve_pitch(slip.CompiledRHS(model.steady.params), x)
 
@@ -1375,7 +1375,7 @@ def _branch_lines(table):
     """
     speeds_all = np.unique(np.round(table["speed_m_s"].to_numpy(), 9))
     lines = {}
-    for (track_id, mode), g in table.groupby(["track", "mode"], sort=False):
+    for (_track, mode), g in table.groupby(["track", "mode"], sort=False):
         g = g.sort_values("speed_m_s")
         if (g["imag_1_s"] < 0).all():
             continue   # the conjugate of a drawn pair
@@ -1384,7 +1384,7 @@ def _branch_lines(table):
         parts = lines.setdefault(mode, ([], [], []))
         for piece in np.split(np.arange(len(g)), breaks):
             sub = g.iloc[piece]
-            for store, values in zip(parts, (sub["speed_m_s"], sub["real_1_s"], np.abs(sub["imag_1_s"]))):
+            for store, values in zip(parts, (sub["speed_m_s"], sub["real_1_s"], np.abs(sub["imag_1_s"])), strict=True):
                 store += [*np.asarray(values, dtype=float), np.nan]
     return {mode: tuple(np.array(v) for v in parts) for mode, parts in lines.items()}
 
@@ -1451,6 +1451,7 @@ def figure(result, path, title=None):
     >>> figure(analyse(Scenario(symmetric_tyres=True), [3.0, 4.0, 5.0]), "stability.png")   # doctest: +SKIP
     """
     import pathlib
+
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
     from matplotlib.lines import Line2D
@@ -1717,6 +1718,7 @@ def pressure_load_figure(table, path):
     >>> pressure_load_figure(pressure_load_table(), "stability_pressure_load.png")   # doctest: +SKIP
     """
     import pathlib
+
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -1724,7 +1726,7 @@ def pressure_load_figure(table, path):
     FigureCanvasAgg(fig)
     axes = fig.subplots(1, 3)
     rate_axis, wobble_damping_axis = axes[1].twinx(), axes[2].twinx()
-    colours = dict(zip(sorted(set(table["fz_n"])), ("tab:blue", "tab:orange", "tab:green", "tab:red")))
+    colours = dict(zip(sorted(set(table["fz_n"])), ("tab:blue", "tab:orange", "tab:green", "tab:red"), strict=True))
     at = float(table["at_speed_m_s"].iloc[0])
     for load, g in table.groupby("fz_n"):
         c, p = colours[load], g["pressure_kpa"]

@@ -75,7 +75,7 @@ def expand_grid(grid):
             raise InputError(f"grid field {name!r} has no values")
         names.append(name)
         choices.append(values)
-    return [dict(zip(names, combo)) for combo in itertools.product(*choices)]
+    return [dict(zip(names, combo, strict=True)) for combo in itertools.product(*choices)]
 
 
 def make_cases(grid=None, cases=None, base=None):
@@ -245,7 +245,7 @@ def run_case(scenario, case_id, trajectory=None):
         with threadpool_limits(limits=1):
             result = simulation.run(scenario)
         _keep(record, result, trajectory)
-    except Exception as exc:  # noqa: BLE001 - a failing case must not stop the sweep
+    except Exception as exc:
         record.update(status="failed", error=f"{type(exc).__name__}: {exc}", results={},
                       summary=None, trajectory=None)
         partial = getattr(exc, "partial", None)   # a numerical failure keeps what ran before it
@@ -425,7 +425,7 @@ def _preload():
     inherit the modules and the loaded compiled model instead of importing
     them each; with other start methods this costs the main process ~1 s.
     """
-    from . import analysis, control, lsoda, riders, slip, tyres  # noqa: F401
+    from . import slip
     slip.library()
 
 
@@ -443,7 +443,7 @@ def _collect(executor, todo, records, store, progress, total, spec, table_interv
         for fut in cf.as_completed(futures):
             try:
                 record = fut.result()
-            except Exception as exc:  # noqa: BLE001 - the executor, not the case, failed
+            except Exception as exc:
                 # Not recorded: a resumed sweep runs this case again.
                 lost.append(f"{type(exc).__name__}: {exc}")
                 continue

@@ -134,9 +134,8 @@ def load_trajectory(folder, case_id):
 def _save_trajectory(folder, record):
     traj = record["trajectory"]
     # A file under its final name is always complete; savez wants a name ending in .npz.
-    with fileio.atomic_path(trajectory_path(folder, record["case_id"])) as tmp:
-        with open(tmp, "wb") as fh:
-            np.savez_compressed(fh, columns=np.array(list(traj)), summary_json=np.array(record["summary"]), **traj)
+    with fileio.atomic_path(trajectory_path(folder, record["case_id"])) as tmp, open(tmp, "wb") as fh:
+        np.savez_compressed(fh, columns=np.array(list(traj)), summary_json=np.array(record["summary"]), **traj)
 
 
 def table(case_list, records):

@@ -209,7 +209,7 @@ def info(name):
 
 def sym(name):
     """Return the (real) SymPy symbol for a registered constant or input."""
-    import sympy as sm   # the build side only: the registry itself is plain data
+    import sympy as sm  # the build side only: the registry itself is plain data
 
     entry = info(name)
     if entry.kind in ("coordinate", "speed", "state"):
@@ -219,7 +219,7 @@ def sym(name):
 
 def dyn(name):
     """Return the dynamicsymbol (function of time) for a registered coordinate, speed or state."""
-    import sympy.physics.mechanics as me   # the build side only
+    import sympy.physics.mechanics as me  # the build side only
 
     entry = info(name)
     if entry.kind not in ("coordinate", "speed", "state"):

@@ -24,13 +24,26 @@ import warnings
 import numpy as np
 
 from . import magic_formula as mf
-from .errors import InputError, check_range
 from . import parameters
-from .parameters import fail as _fail, load_toml, table as _table, text as _text
+from .errors import InputError, check_range
+from .parameters import fail as _fail
+from .parameters import load_toml
+from .parameters import table as _table
+from .parameters import text as _text
 
-__all__ = ["Tyre", "TyreFile", "LinearTyre", "available", "linear_tyre", "load", "read_tyre_file",
-           "DEFAULT_COEFFICIENT_SET", "FRICTION_MODES", "MISSING_MOMENT_MODES",
-           "ZERO_MOMENT_COEFFICIENTS"]
+__all__ = [
+    "DEFAULT_COEFFICIENT_SET",
+    "FRICTION_MODES",
+    "MISSING_MOMENT_MODES",
+    "ZERO_MOMENT_COEFFICIENTS",
+    "LinearTyre",
+    "Tyre",
+    "TyreFile",
+    "available",
+    "linear_tyre",
+    "load",
+    "read_tyre_file",
+]
 
 #: Folder of the shipped tyre files (package data, :func:`whipple_kick.parameters.shipped`).
 TYRE_DIR = parameters.shipped("tyres")
