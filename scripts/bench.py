@@ -111,15 +111,52 @@ def _simulate_command():
     return [sys.executable, "-c", "from whipple_kick.cli import simulate_main; simulate_main()"]
 
 
+_BASELINE = "import numpy, scipy.integrate, pandas, matplotlib"
+
+# One warm run in a fresh process, each stage of simulate timed (the same calls the CLI makes).
+_STAGES = r"""
+import json, sys, time
+t0 = time.perf_counter()
+stages = {}
+import numpy, scipy.integrate, pandas, matplotlib
+stages["import numpy, scipy, pandas, matplotlib"] = time.perf_counter() - t0
+t = time.perf_counter()
+from whipple_kick import assembly, cli, plotting, simulation, slip
+from whipple_kick.scenario import Scenario
+stages["import whipple_kick (cli, simulation, plotting)"] = time.perf_counter() - t
+t = time.perf_counter()
+slip.library()
+stages["load the compiled model"] = time.perf_counter() - t
+t = time.perf_counter()
+scenario = assembly.preflight(Scenario(pressure_kpa=400.0, fz_n=635.0))
+result = simulation.run(scenario)
+stages["run() total"] = time.perf_counter() - t
+stages["  of which integration"] = result.summary["numerics"]["integration_wall_s"]
+t = time.perf_counter()
+cli._write_results(result, __import__("pathlib").Path(sys.argv[1]))
+stages["trajectory.csv + summary.json"] = time.perf_counter() - t
+t = time.perf_counter()
+k = result.summary["kick"]
+plotting.response_figure([("", result)], sys.argv[1] + "/response.png", title=plotting.result_title(result),
+                         kick=(k["start_s"], k["start_s"] + k["duration_s"]))
+stages["response.png"] = time.perf_counter() - t
+stages["total in process"] = time.perf_counter() - t0
+print(json.dumps(stages))
+"""
+
+
 def bench_cli(repeats):
     """Wall time of the whole command, each run in a fresh process writing into a new folder.
 
     Uses the normal per-user cache (or $WHIPPLE_KICK_CACHE); one untimed run
     first makes sure it is warm, so this measures what a user sees on every
-    run after the first.
+    run after the first. Each round also times the baseline
+    ``python -c "import numpy, scipy.integrate, pandas, matplotlib"`` (the
+    bound is <= 1.5 s and <= 0.6 s above it) and a staged run in process.
     """
+    import json
     command = _simulate_command() + ["--pressure", "400", "--fz", "635", "--quiet"]
-    times = []
+    times, base, stages = [], [], []
     with tempfile.TemporaryDirectory() as tmp:
         for k in range(repeats + 1):
             out = os.path.join(tmp, f"run{k}")
@@ -127,8 +164,23 @@ def bench_cli(repeats):
             subprocess.run(command + ["--out", out], check=True)
             if k:   # the first run only warms the cache
                 times.append(time.perf_counter() - t0)
+                t0 = time.perf_counter()
+                subprocess.run([sys.executable, "-c", _BASELINE], check=True)
+                base.append(time.perf_counter() - t0)
+                staged = os.path.join(tmp, f"staged{k}")
+                os.mkdir(staged)
+                done = subprocess.run([sys.executable, "-c", _STAGES, staged], check=True, capture_output=True,
+                                      text=True)
+                stages.append(json.loads(done.stdout.splitlines()[-1]))
+    median, baseline = statistics.median(times), statistics.median(base)
     print(f"simulate --pressure 400 --fz 635 --quiet (warm cache, fresh process): "
-          f"median {statistics.median(times):.2f} s  runs {[round(v, 2) for v in times]}")
+          f"median {median:.2f} s  runs {[round(v, 2) for v in times]}")
+    print(f"baseline python -c '{_BASELINE}': median {baseline:.2f} s  runs {[round(v, 2) for v in base]}")
+    print(f"simulate - baseline: {median - baseline:.2f} s (bound 0.6 s); simulate / baseline: "
+          f"{median / baseline:.2f}")
+    print("stages of a warm run in one process (medians):")
+    for name in stages[0]:
+        print(f"  {name:<48s} {statistics.median(st[name] for st in stages):.3f} s")
 
 
 # Runs in either checkout (no newer API): dumps the base case's state and parameters and the library path.
