@@ -82,7 +82,7 @@ def case_id(scenario):
 def _versions():
     from importlib import metadata
     out = {"python": platform.python_version(), "platform": platform.platform()}
-    for name in ("whipple_kick", "numpy", "scipy", "pandas", "sympy", "pydy", "control", "yeadon"):
+    for name in ("whipple_kick", "numpy", "scipy", "pandas", "sympy", "control", "yeadon"):
         try:
             out[name] = metadata.version(name)
         except metadata.PackageNotFoundError:
