@@ -100,20 +100,49 @@ def check_private_file(path):
         raise PermissionError(f"cached file {path} is writable by others; refusing to load it")
 
 
+def _manifest_path(path):
+    return pathlib.Path(str(path) + ".sha256")
+
+
+def _fingerprint(path):
+    """``"<size> <sha256>"`` of a file's bytes."""
+    data = pathlib.Path(path).read_bytes()
+    return f"{len(data)} {hashlib.sha256(data).hexdigest()}"
+
+
+def intact(path):
+    """Whether the cache entry at ``path`` exists and matches its manifest (size and SHA-256).
+
+    The manifest is written after the entry, atomically, so an entry
+    without one was never finished; one that no longer matches was cut
+    short or changed on disk (a truncated shared library would crash the
+    process with SIGBUS when loaded, so it is checked before loading).
+    """
+    try:
+        check_private_file(_manifest_path(path))
+        return _manifest_path(path).read_text().strip() == _fingerprint(path)
+    except OSError:
+        return False
+
+
 def build_once(name, build):
-    """Path of the cache entry ``name``, building it with ``build(path)`` if absent.
+    """Path of the cache entry ``name``, building it with ``build(path)`` if absent or damaged.
 
     ``build`` must write the complete entry to the path it is given (a
     temporary name in the cache folder); it is renamed into place
-    atomically. Concurrent builders of the same entry wait on a lock, and
-    the second finds the entry already built.
+    atomically and its size and SHA-256 recorded in ``<name>.sha256``
+    (:func:`intact`). An entry that does not match its manifest is built
+    again. Concurrent builders of the same entry wait on a lock, and the
+    second finds the entry already built.
     """
     path = cache_dir() / name
-    if not path.exists():
+    if not intact(path):
         with locked(path):
-            if not path.exists():
+            if not intact(path):
+                _manifest_path(path).unlink(missing_ok=True)
                 with fileio.atomic_path(path, private=True) as tmp:
                     build(tmp)
+                fileio.write_atomic(_manifest_path(path), _fingerprint(path) + "\n", private=True)
     check_private_file(path)
     return path
 

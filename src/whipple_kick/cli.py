@@ -1,7 +1,11 @@
 """Command-line entry points.
 
-User mistakes (:class:`whipple_kick.errors.InputError`) print one line on
-stderr and exit with status 2, without a traceback.
+Every failure prints one line on stderr, without a traceback, and exits
+with a status that says whose it is: 2 the user's input (an
+:class:`~whipple_kick.errors.InputError`, an unwritable output folder),
+1 the machine's set-up or the numerics (a C compiler that fails, a run
+that fails numerically), 130 interrupted (Ctrl-C, as shells report
+SIGINT). An output folder a command created and did not fill is removed.
 """
 import argparse
 import math
@@ -9,15 +13,25 @@ import sys
 
 import numpy as np
 
-from .errors import InputError, SimulationError
+from .errors import BuildError, InputError, SimulationError
+
+#: Exit status of a command interrupted by Ctrl-C (128 + SIGINT, as shells report it).
+EXIT_INTERRUPTED = 130
 
 
-def _run(main, argv):
+def _run(main, argv, prog="whipple_kick"):
+    """Run a command's ``main(argv)``, turning each kind of failure into one line and its exit status."""
     try:
         return main(argv)
     except InputError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
+    except BuildError as exc:
+        print(f"{prog}: cannot build the compiled model: {exc}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print(f"{prog}: interrupted; no results were kept", file=sys.stderr)
+        return EXIT_INTERRUPTED
 
 
 def _benchmark(argv):
@@ -161,8 +175,9 @@ def _simulate_parser():
                    help="constant acceleration (default, thesis), smooth (minimum jerk) or table "
                         "(plate displacement from --kick-table)")
     g.add_argument("--kick-table", metavar="FILE",
-                   help="CSV of the plate's displacement, columns time (in s, from the kick start) and "
-                        "y (in m, + right); a header-less file is read as two columns time, y. The plate "
+                   help="CSV of the plate's displacement, columns time (from the kick start) and y (+ right), "
+                        "units in the header: 'time [s]' or 'time [ms]', 'y [m]' or 'y [mm]' (none: s, m); "
+                        "a header-less file is read as two columns time [s], y [m]. The plate "
                         "follows the clamped cubic spline through the rows (implies --kick-profile table; "
                         "not with --kick-accel/--kick-duration/--kick-displacement)")
     g.add_argument("--kick-direction", choices=DIRECTIONS, default="right",
@@ -290,7 +305,20 @@ def _scenario_from_args(args, given=()):
     return Scenario.authors_code(**changes)
 
 
-_OUTPUT_FILES = ("trajectory.csv", "summary.json", "response.png")
+#: Every file ``simulate`` may write (``--force`` removes them before a run).
+_OUTPUT_FILES = ("trajectory.csv", "summary.json", "response.png", "animation.mp4", "animation.gif")
+#: Every file ``stability`` may write.
+_STABILITY_FILES = ("eigenvalues.csv", "summary.json", "stability.png")
+
+
+def _discard(out, created, written):
+    """Remove what an unfinished command left: the folder it created, else the files it wrote."""
+    import shutil
+    if created:
+        shutil.rmtree(out, ignore_errors=True)
+        return
+    for name in written:
+        (out / name).unlink(missing_ok=True)
 
 
 def _default_out(scenario, prefix="kick"):
@@ -309,8 +337,14 @@ def _default_out(scenario, prefix="kick"):
     return out
 
 
-def _prepare_out(path, force):
-    """Create/check the output folder before the (longer) run. Returns (path, created)."""
+def _prepare_out(path, force, previous=()):
+    """Create/check the output folder before the (longer) run. Returns (path, created).
+
+    With ``force``, the files named in ``previous`` (what the command
+    writes) are removed first, so no file of an earlier run (say its
+    response.png beside a new ``--no-plot`` summary) is left to contradict
+    the new one.
+    """
     import os
     import pathlib
     out = pathlib.Path(path)
@@ -320,6 +354,12 @@ def _prepare_out(path, force):
         raise InputError(f"output folder {str(out)!r} exists and is not empty; "
                          "use --force to overwrite its files or choose another --out")
     created = not out.exists()
+    if force and not created:
+        for name in previous:
+            try:
+                (out / name).unlink(missing_ok=True)
+            except OSError as exc:
+                raise InputError(f"--force cannot remove {str(out / name)!r}: {exc.strerror or exc}") from None
     try:
         out.mkdir(parents=True, exist_ok=True)
         probe = out / f".simulate-probe-{os.getpid()}"
@@ -401,31 +441,64 @@ def _write_results(result, out):
     return ["trajectory.csv", "summary.json"]
 
 
-def _simulate(argv):
-    import shutil
+def _data_warnings(prog, quiet):
+    """Print each tyre file's data warning once, as one line on stderr (none with ``quiet``; summary.json lists them).
 
-    from . import assembly, simulation
+    Python's own warning of it (:class:`whipple_kick.tyres.DataQualityWarning`)
+    is silenced: it would print the source line and repeat per call site.
+    """
+    import warnings
+
+    from . import tyres
+    warnings.filterwarnings("ignore", category=tyres.DataQualityWarning)
+
+    def report(summary):
+        for message in summary["tyres"]["data_warnings"] if not quiet else ():
+            print(f"{prog}: warning: {message}", file=sys.stderr)
+    return report
+
+
+def _simulate(argv):
+    from . import assembly
     args = _simulate_parser().parse_args(argv)
+    report_data_warnings = _data_warnings("simulate", args.quiet)
     given = _flags_given(argv) if args.compat is not None else ()
     scenario = assembly.preflight(_scenario_from_args(args, given))
     movie_options = _animation_options(args)
-    out, created = _prepare_out(args.out or _default_out(scenario), args.force)
+    out, created = _prepare_out(args.out or _default_out(scenario), args.force, _OUTPUT_FILES)
+    written = []
     try:
-        result = simulation.run(scenario)
+        result, files, note = _simulate_into(args, scenario, movie_options, out, written)
     except SimulationError as exc:
-        if exc.partial is not None:
-            # What ran before the failure is kept for the user to inspect.
-            _write_results(exc.partial, out)
-            raise SimulationError(
-                f"{exc}; the run up to t = {exc.partial.summary['end_time_s']:g} s is in {out}") from None
-        if created and not any(out.iterdir()):
-            shutil.rmtree(out, ignore_errors=True)
+        if exc.partial is None:
+            _discard(out, created, written)
+            raise
+        # What ran before the failure is kept for the user to inspect.
+        _write_results(exc.partial, out)
+        raise SimulationError(
+            f"{exc}; the run up to t = {exc.partial.summary['end_time_s']:g} s is in {out}") from None
+    except BaseException:
+        # A failure or Ctrl-C before every file is written: leave nothing half done.
+        _discard(out, created, written)
         raise
-    except InputError:
-        if created and not any(out.iterdir()):
-            shutil.rmtree(out, ignore_errors=True)
-        raise
+    report_data_warnings(result.summary)
+    if not args.quiet:
+        _print_summary(result, out, files)
+        if note:
+            print(f"  note: {note}")
+    return 0
+
+
+def _simulate_into(args, scenario, movie_options, out, written):
+    """Run ``scenario`` and write its files into ``out``, each name appended to ``written`` once it is there.
+
+    Returns (result, files, note): the run's result, the written files'
+    descriptions and a note for the user or None.
+    """
+    from . import simulation
+    result = simulation.run(scenario)
     files = _write_results(result, out)
+    written.extend(files)
     if not result.summary["linear_stability"]["stable"]:
         # A warning, not a failure: the run is valid (the bicycle may well fall).
         print(f"simulate: warning: {result.summary['linear_stability']['message']}", file=sys.stderr)
@@ -435,6 +508,7 @@ def _simulate(argv):
         plotting.response_figure([("", result)], out / "response.png", title=plotting.result_title(result),
                                  kick=(k["start_s"], k["start_s"] + k["duration_s"]))
         files.append("response.png")
+        written.append("response.png")
     note = None
     if movie_options is not None:
         from . import animation
@@ -442,18 +516,15 @@ def _simulate(argv):
         if suffix == "gif":
             note = "no video encoder installed: wrote a GIF (pip install 'whipple_kick[video]' for mp4)"
         movie = animation.animate(result, out / f"animation.{suffix}", **movie_options)
+        written.append(movie.path.name)
         files.append(f"{movie.path.name} ({movie.frames} frames, {movie.video_duration_s:.1f} s)")
-    if not args.quiet:
-        _print_summary(result, out, files)
-        if note:
-            print(f"  note: {note}")
-    return 0
+    return result, files, note
 
 
 def simulate_main(argv=None):
     """Console script ``simulate``: one kick-plate run (see ``simulate --help``)."""
     try:
-        status = _run(_simulate, argv)
+        status = _run(_simulate, argv, "simulate")
     except SimulationError as exc:
         print(f"simulate: numerical failure: {exc}", file=sys.stderr)
         status = 1

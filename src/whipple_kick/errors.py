@@ -1,11 +1,13 @@
-"""The package's two kinds of failure: the user's mistake, and numerical trouble.
+"""The package's kinds of failure: the user's mistake, numerical trouble, and a broken build environment.
 
 Command-line entry points catch :class:`InputError`, print its one-line
 message and exit with status 2 (no traceback). Library code raises it for
 every user mistake: a value outside its allowed range, an unknown name, a
 malformed parameter file. Numerical trouble is *not* an InputError: a run
 that fails numerically raises :class:`SimulationError`, carrying what was
-computed before the failure.
+computed before the failure. A C compiler that cannot build the model is
+:class:`BuildError` (the machine's set-up, not the user's input: exit
+status 1).
 """
 import math
 
@@ -64,3 +66,11 @@ class SimulationError(RuntimeError):
     def __init__(self, message, partial=None):
         super().__init__(message)
         self.partial = partial
+
+
+class BuildError(RuntimeError):
+    """The compiled model could not be built (the C compiler failed).
+
+    The message is one line naming the compiler and where its full output
+    was saved.
+    """

@@ -37,6 +37,15 @@ DIRECTIONS = ("right", "left")
 #: The thesis' plate travel [m] and travel time [s] (Section 8.3): the defaults.
 DEFAULT_DISPLACEMENT = 0.150
 DEFAULT_DURATION = 0.150
+#: Plausibility caps of every kick, built-in or tabulated: plate travel [m] and peak
+#: |acceleration| [m/s^2] (the measured plate peaks were 30-40 m/s^2, Dell'Orto 2025
+#: Section 8.4); peak |velocity| [m/s] is the most a built-in kick within both caps reaches
+#: (constant profile: v = sqrt(a D)).
+MAX_DISPLACEMENT = 1.0
+MAX_ACCELERATION = 1000.0
+MAX_VELOCITY = math.sqrt(MAX_ACCELERATION * MAX_DISPLACEMENT)
+#: Units a kick table's header may give each column, as factors to s and m; no unit means s and m.
+TABLE_UNITS = {"time": {"s": 1.0, "ms": 1e-3}, "y": {"m": 1.0, "mm": 1e-3}}
 
 
 @dataclass(frozen=True)
@@ -134,12 +143,13 @@ def kick_of(scenario) -> Kick:
             hint = "; for a tabulated plate motion use kick_profile='table' with kick_table='FILE.csv'"
         raise InputError(f"kick profile {scenario.kick_profile!r} is unknown; choose one of "
                          f"{', '.join(PROFILES)}{hint}")
-    disp = check_range("kick displacement", scenario.kick_displacement, 0.0, 1.0, "m")
+    disp = check_range("kick displacement", scenario.kick_displacement, 0.0, MAX_DISPLACEMENT, "m")
     factor = PEAK_ACCEL_FACTOR[scenario.kick_profile]
     if scenario.kick_duration is not None and scenario.kick_accel is not None:
         raise InputError("give the kick's duration (s) or its peak acceleration (m/s^2), not both")
     if scenario.kick_accel is not None:
-        accel = check_range("kick peak acceleration", scenario.kick_accel, 0.0, 1000.0, "m/s^2", low_open=True)
+        accel = check_range("kick peak acceleration", scenario.kick_accel, 0.0, MAX_ACCELERATION, "m/s^2",
+                            low_open=True)
         if disp == 0.0:
             raise InputError("a kick acceleration needs a kick displacement > 0 m")
         dur = math.sqrt(factor * disp / accel)
@@ -179,7 +189,21 @@ def _table_of(scenario, sign):
         raise InputError(f"kick table {name!r} spans [{times[0]:g}, {times[-1]:g}] s, outside the run "
                          f"[-settle, duration] = [{-scenario.settle:g}, {scenario.duration:g}] s; times are "
                          "from the kick start: trim the table or change settle/duration")
-    return KickTable.from_points(name, times, sign * y)
+    table = KickTable.from_points(name, times, sign * y)
+    _check_table_caps(table)
+    return table
+
+
+def _check_table_caps(table):
+    """Hold a tabulated kick to the built-in kicks' caps (a table in mm read as m fails here)."""
+    travel = float(np.max(np.abs(table.y - table.y[0])))
+    for what, value, cap, unit in (("plate travel from the first row", travel, MAX_DISPLACEMENT, "m"),
+                                   ("peak plate velocity", table.peak_velocity, MAX_VELOCITY, "m/s"),
+                                   ("peak plate acceleration", table.peak_acceleration, MAX_ACCELERATION, "m/s^2")):
+        if value > cap:
+            raise InputError(f"kick table {table.name!r}: {what} = {value:.4g} {unit} is implausible; allowed "
+                             f"[0, {cap:.4g}] {unit} (as the built-in kicks; give the units in the header, "
+                             "e.g. 'time [ms]', 'y [mm]')")
 
 
 # ------------------------------------------------------------ tabulated kick
@@ -190,11 +214,12 @@ def load_kick_table(path) -> tuple[np.ndarray, np.ndarray]:
     The file is comma-separated text (UTF-8), read with ``pandas.read_csv``
     (:func:`whipple_kick.fileio.read_csv`); blank lines and ``#`` comments
     are skipped. With a header row, the columns named ``time`` and ``y``
-    are used (case-insensitive; a unit suffix such as ``time [s]`` or
-    ``y (m)`` is allowed; other columns are ignored). Without a header,
-    i.e. when the first row is all numbers, the file must have exactly two
-    columns, time then y: a header-less file with more columns is ambiguous
-    and refused.
+    are used (case-insensitive; other columns are ignored), each with an
+    optional unit in brackets or parentheses: ``time [s]`` or ``time [ms]``,
+    ``y [m]`` or ``y [mm]`` (:data:`TABLE_UNITS`; no unit means s and m;
+    any other unit is refused). Without a header, i.e. when the first row
+    is all numbers, the file must have exactly two columns, time [s] then
+    y [m]: a header-less file with more columns is ambiguous and refused.
 
     Parameters
     ----------
@@ -210,7 +235,8 @@ def load_kick_table(path) -> tuple[np.ndarray, np.ndarray]:
     InputError
         One line naming the file and the problem (missing file, missing
         column, empty, non-numeric or non-finite entry with its line,
-        non-increasing time, fewer than 2 rows).
+        non-increasing time, fewer than 2 rows, a unit other than s, ms,
+        m, mm).
     """
     p = pathlib.Path(path)
     if not p.is_file():
@@ -245,16 +271,22 @@ def _read_kick_table(resolved, name, mtime_ns, size):
             fail(f"line {lines[0]} has {len(first)} columns and no header; a file without header "
                  "must have exactly two columns, time (s) then y (m)")
         columns, rows, row_lines = {"time": 0, "y": 1}, cells, lines
+        scale = {"time": 1.0, "y": 1.0}
     else:
-        names = [re.sub(r"\s*[\[(][^\])]*[\])]$", "", c).strip().lower() for c in first]
-        columns = {}
-        for want in ("time", "y"):
+        parsed = [re.fullmatch(r"(.*?)\s*(?:[\[(]([^\])]*)[\])])?", c) for c in first]
+        names = [m.group(1).strip().lower() for m in parsed]
+        columns, scale = {}, {}
+        for want, allowed in TABLE_UNITS.items():
             hits = [i for i, n in enumerate(names) if n == want]
             if not hits:
                 fail(f"has no column {want!r} (header: {', '.join(first)}); name the columns time (s) and y (m)")
             if len(hits) > 1:
                 fail(f"has {len(hits)} columns named {want!r}")
             columns[want] = hits[0]
+            unit = (parsed[hits[0]].group(2) or next(iter(allowed))).strip()
+            if unit not in allowed:
+                fail(f"column {first[hits[0]]!r} has unit {unit!r}; allowed: {', '.join(allowed)}")
+            scale[want] = allowed[unit]
         rows, row_lines = cells[1:], lines[1:]
     values = np.empty((len(rows), 2))
     for k, (row, line) in enumerate(zip(rows, row_lines, strict=True)):
@@ -270,7 +302,7 @@ def _read_kick_table(resolved, name, mtime_ns, size):
             values[k, j] = v
     if len(rows) < 2:
         fail(f"has {len(rows)} data row{'s' if len(rows) != 1 else ''}; at least 2 are needed")
-    t, y = values[:, 0].copy(), values[:, 1].copy()
+    t, y = values[:, 0] * scale["time"], values[:, 1] * scale["y"]
     bad = np.flatnonzero(np.diff(t) <= 0.0)
     if bad.size:
         k = bad[0] + 1

@@ -261,6 +261,9 @@ def _tyres_section(scenario, assembly, custom_tyres):
         "pressure_rear_kpa": None if custom_tyres else rear,
         "pressure_front_kpa": None if custom_tyres else front,
         "notes": assembly.tyre_notes,
+        # The tyre files' own warnings about their data (custom tyre objects may have none).
+        "data_warnings": sorted({w for w in (getattr(assembly.rear, "data_warning", None),
+                                             getattr(assembly.front, "data_warning", None)) if w}),
     }
 
 

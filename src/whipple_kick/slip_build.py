@@ -30,6 +30,7 @@ from sympy.printing.c import C99CodePrinter
 
 from . import cache, codegen, energy, fileio, kane, magic_formula, transient
 from . import symbols as S
+from .errors import BuildError
 from .slip import (
     _PARTITION,
     _SOURCES,
@@ -590,8 +591,8 @@ def build_library(path, key, compiler, flags):
 
     Raises
     ------
-    RuntimeError
-        The compiler failed (its last 4000 characters of output in the message).
+    BuildError
+        The compiler failed (one line; its full output saved beside the source).
     """
     print("whipple_kick: building the slip model once for this version (SymPy derivation, C code generation and "
           "compilation; about 20-30 s)...", file=sys.stderr, flush=True)
@@ -601,6 +602,10 @@ def build_library(path, key, compiler, flags):
     proc = subprocess.run([compiler, *flags, "-o", str(path), str(src_path), "-lm"],
                           capture_output=True, text=True, check=False)
     if proc.returncode != 0:
-        raise RuntimeError(f"compiling the slip model failed ({compiler}):\n{proc.stderr[-4000:]}")
+        log = folder / f"slip_{key}.build.log"
+        fileio.write_atomic(log, proc.stdout + proc.stderr, private=True)
+        last = (proc.stderr.strip().splitlines() or ["no output"])[-1]
+        raise BuildError(f"the C compiler {compiler} failed (exit status {proc.returncode}: {last[:200]}); "
+                         f"its output is in {log}; install a working gcc or set CC")
     fileio.write_atomic(folder / f"slip_{key}.json", json.dumps(metadata(key, compiler, flags), indent=1) + "\n",
                         private=True)

@@ -286,8 +286,17 @@ def load(name, pressure_kpa, coefficient_set=DEFAULT_COEFFICIENT_SET, friction="
         raise InputError(f"coefficient_set = {coefficient_set!r} does not exist for tyre {name}; "
                          f"choose one of {', '.join(data.sets)}")
     if data.warning:
-        warnings.warn(data.warning, UserWarning, stacklevel=2)
+        warnings.warn(data.warning, DataQualityWarning, stacklevel=2)
     return Tyre(data, pressure_kpa, coefficient_set, friction, missing_moment)
+
+
+class DataQualityWarning(UserWarning):
+    """A tyre file's own warning about its data (e.g. T02's fit that misses its published factors).
+
+    Issued by :func:`load`; a run's summary lists it under
+    ``tyres.data_warnings`` whatever the warning filters, and the command-line
+    tools print it once, in one line, instead of Python's warning.
+    """
 
 
 def _bracket(pressure, measured, name, coefficient_set):
@@ -331,6 +340,8 @@ class Tyre:
         mode, else 1.
     has_aligning_moment : bool
         Whether published M_z coefficients exist for this tyre.
+    data_warning : str or None
+        The tyre file's warning about its data.
     """
 
     def __init__(self, data, pressure_kpa, coefficient_set, friction, missing_moment):
@@ -339,6 +350,7 @@ class Tyre:
         self.coefficient_set = coefficient_set
         self.friction = friction
         self.missing_moment = missing_moment
+        self.data_warning = data.warning
         coefficients = data.sets[coefficient_set]
         self._weights = _bracket(pressure_kpa, coefficients, data.name, coefficient_set)
         self.pressure_kpa = float(pressure_kpa)

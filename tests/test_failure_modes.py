@@ -1,0 +1,226 @@
+"""Failure modes a user meets: one line on stderr, the right exit status, nothing half-written left.
+
+Exit statuses: 2 the user's input, 1 the machine's set-up (a C compiler that
+fails) or the numerics, 130 Ctrl-C. Subprocess tests run the installed
+console script as a user would.
+"""
+import json
+import os
+import pathlib
+import shutil
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+from whipple_kick import cache, cli, inputs, slip, slip_build
+from whipple_kick.cli import simulate_main
+from whipple_kick.errors import BuildError, InputError
+
+
+def _simulate(argv, capsys):
+    """Run ``simulate`` in-process; return (status, stdout, stderr)."""
+    with pytest.raises(SystemExit) as info:
+        simulate_main(argv)
+    out, err = capsys.readouterr()
+    return info.value.code, out, err
+
+
+def _console_script(name):
+    exe = pathlib.Path(sys.executable).with_name(name)
+    assert exe.exists(), f"console script {name} not installed (pip install -e .)"
+    return str(exe)
+
+
+# ------------------------------------------------------------ C compiler
+
+def test_failing_compiler_is_one_line_naming_compiler_and_log(tmp_path, monkeypatch):
+    """A compiler that exits non-zero: BuildError, one line, full output saved beside the source."""
+    monkeypatch.setenv("WHIPPLE_KICK_CACHE", str(tmp_path / "cache"))
+    monkeypatch.setattr(slip_build, "c_source", lambda: "int main(void) { return 0; }\n")
+    failing = shutil.which("false")
+    with pytest.raises(BuildError) as info:
+        slip_build.build_library(tmp_path / "cache" / "x.so", "k", failing, ("-O2",))
+    message = str(info.value)
+    assert "\n" not in message and failing in message and "exit status 1" in message
+    assert (tmp_path / "cache" / "slip_k.build.log").exists()
+
+
+def test_failing_compiler_from_simulate_is_status_1_and_leaves_no_folder(tmp_path, capsys, monkeypatch):
+    def fail():
+        raise BuildError("the C compiler /bin/false failed (exit status 1: no output)")
+    monkeypatch.setattr(slip, "library_path", fail)
+    slip.library.cache_clear()
+    try:
+        out = tmp_path / "run"
+        status, stdout, err = _simulate(["--duration", "0.6", "--no-plot", "--out", str(out)], capsys)
+    finally:
+        slip.library.cache_clear()
+    assert status == 1 and stdout == ""
+    assert err.count("\n") == 1 and err.startswith("simulate: cannot build the compiled model: the C compiler")
+    assert not out.exists()                      # the folder it made is removed
+
+
+@pytest.mark.slow
+def test_failing_compiler_end_to_end(tmp_path):
+    """CC=false on a fresh cache: the build line, then one error line; status 1; no folder (about 30 s)."""
+    env = dict(os.environ, WHIPPLE_KICK_CACHE=str(tmp_path / "cache"), CC=shutil.which("false"))
+    proc = subprocess.run([_console_script("simulate"), "--out", str(tmp_path / "run")], env=env,
+                          capture_output=True, text=True, timeout=600)
+    lines = proc.stderr.splitlines()
+    assert proc.returncode == 1 and "Traceback" not in proc.stderr
+    assert len(lines) == 2 and lines[0].startswith("whipple_kick: building") and "C compiler" in lines[1]
+    assert not (tmp_path / "run").exists()
+
+
+# ------------------------------------------------------------ damaged cache entry
+
+def test_truncated_cache_entry_is_rebuilt(tmp_path, monkeypatch):
+    monkeypatch.setenv("WHIPPLE_KICK_CACHE", str(tmp_path / "cache"))
+    builds = []
+
+    def build(tmp):
+        builds.append(tmp)
+        tmp.write_bytes(b"\x7fELF" + bytes(range(256)) * 40)
+
+    path = cache.build_once("lib.so", build)
+    good = path.read_bytes()
+    assert cache.intact(path) and len(builds) == 1
+    assert cache.build_once("lib.so", build) == path and len(builds) == 1      # warm: not rebuilt
+    path.write_bytes(good[:1000])                                              # cut short, e.g. a full disk
+    assert not cache.intact(path)
+    assert cache.build_once("lib.so", build) == path and len(builds) == 2
+    assert path.read_bytes() == good
+    path.with_name("lib.so.sha256").unlink()                                   # never finished
+    cache.build_once("lib.so", build)
+    assert len(builds) == 3 and cache.intact(path)
+
+
+def test_the_compiled_model_in_use_is_checked_against_its_manifest():
+    path = slip.library_path()
+    assert cache.intact(path)
+    size, digest = path.with_name(path.name + ".sha256").read_text().split()
+    assert int(size) == path.stat().st_size and len(digest) == 64
+
+
+# ------------------------------------------------------------ Ctrl-C
+
+def test_ctrl_c_during_a_run_is_status_130_and_leaves_no_folder(tmp_path):
+    """SIGINT once the output folder exists: one line, status 130, the folder removed.
+
+    The run (120 s simulated at rtol 1e-12, several seconds of work) is far
+    longer than the time the signal takes to arrive; the test waits for the
+    folder, not for a fixed time.
+    """
+    out = tmp_path / "run"
+    proc = subprocess.Popen([_console_script("simulate"), "--duration", "120", "--rtol", "1e-12", "--no-plot",
+                             "--out", str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while not out.exists() and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert proc.poll() is None, proc.communicate()
+    proc.send_signal(signal.SIGINT)
+    stdout, stderr = proc.communicate(timeout=120)
+    assert proc.returncode == cli.EXIT_INTERRUPTED == 130
+    assert stdout == "" and stderr == "simulate: interrupted; no results were kept\n"
+    assert not out.exists()
+
+
+def test_interrupted_run_in_an_existing_folder_removes_only_its_own_files(tmp_path, capsys, monkeypatch):
+    out = tmp_path / "run"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine\n")
+    from whipple_kick import plotting
+
+    def interrupt(*args, **kwargs):
+        raise KeyboardInterrupt
+    monkeypatch.setattr(plotting, "response_figure", interrupt)
+    status, stdout, err = _simulate(["--duration", "0.6", "--force", "--out", str(out)], capsys)
+    assert status == 130 and err == "simulate: interrupted; no results were kept\n"
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
+
+
+# ------------------------------------------------------------ --force
+
+def test_force_removes_the_previous_runs_files(tmp_path, capsys):
+    out = tmp_path / "run"
+    out.mkdir()
+    for name in ("response.png", "animation.mp4", "summary.json"):
+        (out / name).write_text("from an earlier run")
+    (out / "notes.txt").write_text("mine\n")
+    status, _, err = _simulate(["--duration", "0.6", "--force", "--no-plot", "--quiet", "--out", str(out)], capsys)
+    assert status == 0, err
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt", "summary.json", "trajectory.csv"]
+
+
+# ------------------------------------------------------------ kick table units
+
+def _write(path, text):
+    path.write_text(text)
+    return path
+
+
+def test_kick_table_units_from_the_header(tmp_path):
+    t = np.linspace(0.0, 0.15, 16)
+    y = (0.15 * (t / 0.15) ** 2).tolist()
+    t = t.tolist()
+    si = _write(tmp_path / "si.csv", "time [s],y [m]\n" + "".join(f"{a!r},{b!r}\n" for a, b in zip(t, y, strict=True)))
+    milli = _write(tmp_path / "milli.csv",
+                   "Time (ms),Y (mm)\n" + "".join(f"{a * 1e3!r},{b * 1e3!r}\n" for a, b in zip(t, y, strict=True)))
+    plain = _write(tmp_path / "plain.csv", "time,y\n" + "".join(f"{a!r},{b!r}\n" for a, b in zip(t, y, strict=True)))
+    ts, ys = inputs.load_kick_table(si)
+    for other in (milli, plain):
+        to, yo = inputs.load_kick_table(other)
+        # ms -> s and mm -> m are one multiplication by 1e-3 of a printed decimal: equal to round-off.
+        np.testing.assert_allclose(to, ts, rtol=1e-15, atol=1e-18)
+        np.testing.assert_allclose(yo, ys, rtol=1e-15, atol=1e-18)
+    assert ts[-1] == 0.15 and ys[-1] == 0.15
+
+
+def test_kick_table_with_an_unknown_unit_names_the_column_and_the_allowed_units(tmp_path):
+    table = _write(tmp_path / "cm.csv", "time [s],y [cm]\n0,0\n0.15,15\n")
+    with pytest.raises(InputError, match=r"column 'y \[cm\]' has unit 'cm'; allowed: m, mm"):
+        inputs.load_kick_table(table)
+
+
+def test_kick_table_in_mm_read_as_metres_is_implausible(tmp_path, capsys, monkeypatch):
+    """The issue's case: 150 'm' in 0.15 s would be a 40,000 m/s^2 kick; refused like a built-in one."""
+    table = _write(tmp_path / "plate.csv", "time,y\n0,0\n0.075,75\n0.15,150\n")
+    monkeypatch.chdir(tmp_path)
+    status, stdout, err = _simulate(["--kick-table", str(table), "--quiet"], capsys)
+    assert status == 2 and stdout == "" and err.count("\n") == 1
+    assert "plate travel from the first row = 150 m is implausible; allowed [0, 1] m" in err
+    assert "y [mm]" in err
+
+
+@pytest.mark.parametrize("rows, what", [
+    ("0,0\n0.001,0.5\n0.002,0\n", "peak plate velocity"),          # 0.5 m in 1 ms
+    ("0,0\n0.002,0.01\n0.004,0.01\n", "peak plate acceleration"),   # 10 mm in 2 ms
+])
+def test_kick_table_held_to_the_built_in_caps(rows, what, tmp_path):
+    from whipple_kick.scenario import Scenario
+    table = _write(tmp_path / "plate.csv", "time,y\n" + rows)
+    with pytest.raises(InputError, match=what):
+        inputs.kick_of(Scenario(kick_profile="table", kick_table=str(table)))
+
+
+# ------------------------------------------------------------ data-quality warnings
+
+def test_data_warning_is_one_line_silenced_by_quiet_and_kept_in_the_summary(tmp_path, capsys):
+    out = tmp_path / "loud"
+    status, _, err = _simulate(["--tyre", "T02", "--duration", "0.6", "--no-plot", "--out", str(out)], capsys)
+    assert status == 0
+    warning_lines = [line for line in err.splitlines() if "T02" in line]
+    assert len(warning_lines) == 1 and warning_lines[0].startswith("simulate: warning: tyre T02:")
+    assert "UserWarning" not in err and "warnings.warn" not in err
+    quiet = tmp_path / "quiet"
+    status, stdout, err = _simulate(["--tyre", "T02", "--duration", "0.6", "--no-plot", "--quiet",
+                                     "--out", str(quiet)], capsys)
+    assert status == 0 and stdout == "" and err == ""
+    summary = json.loads((quiet / "summary.json").read_text())
+    assert len(summary["tyres"]["data_warnings"]) == 1 and "T02" in summary["tyres"]["data_warnings"][0]
+    base = json.loads((out / "summary.json").read_text())
+    assert base["tyres"]["data_warnings"] == summary["tyres"]["data_warnings"]
