@@ -224,3 +224,105 @@ def test_data_warning_is_one_line_silenced_by_quiet_and_kept_in_the_summary(tmp_
     assert len(summary["tyres"]["data_warnings"]) == 1 and "T02" in summary["tyres"]["data_warnings"][0]
     base = json.loads((out / "summary.json").read_text())
     assert base["tyres"]["data_warnings"] == summary["tyres"]["data_warnings"]
+
+
+# ------------------------------------------------------------ sweeps
+
+def _children(pid):
+    """Pids of the live (not zombie) child processes of ``pid``, from /proc."""
+    found = []
+    for stat in pathlib.Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == pid and fields[0] != "Z":
+            found.append(int(stat.parent.name))
+    return found
+
+
+def _alive(pid):
+    try:
+        state = pathlib.Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"
+
+
+def _start_long_sweep(folder):
+    """recommend-pressure on 201 cases (300-500 kPa every 1 kPa, 6 s each: minutes of work) into ``folder``."""
+    return subprocess.Popen([_console_script("recommend-pressure"), "--fz", "635", "--pressures", "300", "500",
+                             "--fine", "--step", "1", "--workers", "2", "--out", str(folder)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
+def _wait_until_running(proc, folder, workers=0):
+    """Wait (up to 2 min) until the manifest says running and ``workers`` pool processes exist."""
+    deadline = time.monotonic() + 120
+    while proc.poll() is None and time.monotonic() < deadline:
+        manifest = folder / "manifest.json"
+        if (manifest.exists() and json.loads(manifest.read_text()).get("status") == "running"
+                and len(_children(proc.pid)) >= workers):
+            return
+        time.sleep(0.02)
+    raise AssertionError(f"the sweep did not start: {proc.poll()} {proc.communicate() if proc.poll() else ''}")
+
+
+def test_sigterm_ends_the_sweeps_workers_and_records_interrupted(tmp_path):
+    folder = tmp_path / "sweep"
+    proc = _start_long_sweep(folder)
+    try:
+        _wait_until_running(proc, folder, workers=2)
+        workers = _children(proc.pid)
+        proc.send_signal(signal.SIGTERM)
+        _, stderr = proc.communicate(timeout=120)
+    finally:
+        proc.kill()
+    assert proc.returncode == cli.EXIT_TERMINATED == 143
+    assert stderr.startswith("recommend-pressure: terminated (SIGTERM)") and stderr.count("\n") == 1, stderr
+    manifest = json.loads((folder / "manifest.json").read_text())
+    assert manifest["status"] == "interrupted" and manifest["n_done"] < manifest["n_cases"] == 201
+    assert workers and not any(_alive(pid) for pid in workers)
+
+
+def test_second_sweep_on_the_same_folder_is_refused_in_one_line(tmp_path):
+    folder = tmp_path / "sweep"
+    first = _start_long_sweep(folder)
+    try:
+        _wait_until_running(first, folder)
+        second = subprocess.run([_console_script("recommend-pressure"), "--fz", "635", "--pressures", "300", "500",
+                                 "--fine", "--step", "1", "--out", str(folder)],
+                                capture_output=True, text=True, timeout=120)
+    finally:
+        first.send_signal(signal.SIGTERM)
+        first.communicate(timeout=120)
+    assert second.returncode == 2 and second.stderr.count("\n") == 1
+    assert f"is in use by another sweep (process {first.pid}, sweep.lock)" in second.stderr
+
+
+def test_lock_of_a_dead_process_is_taken_over(tmp_path):
+    """The lock is the operating system's (flock): it goes with its holder, whatever the file says."""
+    from whipple_kick import sweep_store
+    folder = tmp_path / "sweep"
+    folder.mkdir()
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
+    (folder / sweep_store.LOCK_FILE).write_text(dead.stdout)
+    fd = sweep_store._lock(folder)
+    try:
+        assert (folder / sweep_store.LOCK_FILE).read_text() == f"{os.getpid()}\n"
+        # While this live process holds it, another process is refused, the message naming us.
+        held = subprocess.run([sys.executable, "-c", f"from whipple_kick import sweep_store; sweep_store._lock({str(folder)!r})"],
+                              capture_output=True, text=True, timeout=120)
+        assert held.returncode == 1 and f"in use by another sweep (process {os.getpid()}," in held.stderr
+    finally:
+        sweep_store._unlock(fd)
+
+
+def test_progress_bar_only_on_a_terminal_unless_asked(tmp_path):
+    args = ["--fz", "635", "--pressures", "400", "--duration", "0.6"]
+    quiet = subprocess.run([_console_script("recommend-pressure"), *args], capture_output=True, text=True,
+                           timeout=300)
+    assert quiet.returncode == 0 and "sweep" not in quiet.stderr and "case/s" not in quiet.stderr
+    asked = subprocess.run([_console_script("recommend-pressure"), *args, "--progress"], capture_output=True,
+                           text=True, timeout=300)
+    assert asked.returncode == 0 and "sweep: 100%" in asked.stderr

@@ -17,10 +17,15 @@ from .errors import BuildError, InputError, SimulationError
 
 #: Exit status of a command interrupted by Ctrl-C (128 + SIGINT, as shells report it).
 EXIT_INTERRUPTED = 130
+#: Exit status of a sweep ended by SIGTERM (128 + SIGTERM).
+EXIT_TERMINATED = 143
 
 
-def _run(main, argv, prog="whipple_kick"):
-    """Run a command's ``main(argv)``, turning each kind of failure into one line and its exit status."""
+def _run(main, argv, prog="whipple_kick", kept="no results were kept"):
+    """Run a command's ``main(argv)``, turning each kind of failure into one line and its exit status.
+
+    ``kept`` says what an interrupted command leaves behind.
+    """
     try:
         return main(argv)
     except InputError as exc:
@@ -30,7 +35,7 @@ def _run(main, argv, prog="whipple_kick"):
         print(f"{prog}: cannot build the compiled model: {exc}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
-        print(f"{prog}: interrupted; no results were kept", file=sys.stderr)
+        print(f"{prog}: interrupted; {kept}", file=sys.stderr)
         return EXIT_INTERRUPTED
 
 
@@ -571,7 +576,10 @@ def _recommend(argv):
                    help="sweep folder keeping every run (re-running with it resumes)")
     p.add_argument("--extend", action="store_true",
                    help="with --out: add these runs to a folder that holds another sweep")
-    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    bar = p.add_mutually_exclusive_group()
+    bar.add_argument("--progress", action="store_true", default=None,
+                     help="show the progress bar (default: only when stderr is a terminal)")
+    bar.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
     args = p.parse_args(argv)
     from .scenario import Scenario
     base = Scenario(duration=args.duration)
@@ -579,7 +587,7 @@ def _recommend(argv):
     recs = recommend.recommend_pressures(
         args.fz, tyre=args.tyre, pressures=args.pressures, fine=args.fine, step_kpa=args.step,
         base=base, criterion=args.criterion, workers=args.workers, folder=args.out, extend=args.extend,
-        progress=not args.no_progress and sys.stderr.isatty())
+        progress=sys.stderr.isatty() if args.progress is None else args.progress)
     for k, rec in enumerate(recs):
         if k:
             print()
@@ -589,13 +597,18 @@ def _recommend(argv):
 
 def recommend_main(argv=None):
     """Console script ``recommend-pressure`` (see ``recommend-pressure --help``)."""
-    from .sweep_engine import SweepInterrupted
+    from .sweep_engine import SweepInterrupted, SweepTerminated
     try:
-        status = _run(_recommend, argv)
+        status = _run(_recommend, argv, "recommend-pressure",
+                      "finished cases are kept in the --out folder (if given); run again on it to resume")
     except (SweepInterrupted, OSError) as exc:
         # An unwritable --out folder is the user's to fix (2); lost worker processes are not (1).
         print(f"recommend-pressure: {exc}", file=sys.stderr)
         status = 2 if isinstance(exc, OSError) else 1
+    except SweepTerminated:
+        print("recommend-pressure: terminated (SIGTERM); finished cases are kept in the --out folder, "
+              "run again on it to resume", file=sys.stderr)
+        status = EXIT_TERMINATED
     sys.exit(status)
 
 
@@ -635,7 +648,6 @@ def _stability_parser():
 
 
 def _stability(argv):
-    import shutil
     import time
 
     from . import assembly, stability
@@ -646,15 +658,15 @@ def _stability(argv):
     scenario = Scenario(**_model_fields(args), symmetric_tyres=args.tyre_offsets == "zero",
                                    speed=float(speeds[0]))
     assembly.preflight(scenario)
-    out, created = _prepare_out(args.out or _default_out(scenario, "stability"), args.force)
+    out, created = _prepare_out(args.out or _default_out(scenario, "stability"), args.force, _STABILITY_FILES)
     try:
         result = stability.analyse(scenario, speeds)
-    except InputError:
-        if created and not any(out.iterdir()):
-            shutil.rmtree(out, ignore_errors=True)
+        result.summary["numerics"] = {"wall_s": time.perf_counter() - started}
+        files = stability.write(result, out, plot=not args.no_plot)
+    except BaseException:
+        # A failure or Ctrl-C before every file is written: leave nothing half done.
+        _discard(out, created, _STABILITY_FILES)
         raise
-    result.summary["numerics"] = {"wall_s": time.perf_counter() - started}
-    files = stability.write(result, out, plot=not args.no_plot)
     missing = {loop: m["speeds_without_steady_motion"] for loop, m in result.summary["steady_motion"].items()
                if m["speeds_without_steady_motion"]}
     for loop, count in missing.items():
@@ -671,7 +683,7 @@ def _stability(argv):
 def stability_main(argv=None):
     """Console script ``stability``: eigenvalues of the slip model against speed (see ``stability --help``)."""
     try:
-        status = _run(_stability, argv)
+        status = _run(_stability, argv, "stability")
     except OSError as exc:
         print(f"stability: cannot write the results: {exc}", file=sys.stderr)
         status = 2

@@ -18,12 +18,16 @@ Example
 """
 import atexit
 import concurrent.futures as cf
+import contextlib
 import dataclasses
 import datetime
 import itertools
 import json
 import os
+import signal
 import socket
+import sys
+import threading
 import time
 
 import numpy as np
@@ -48,6 +52,28 @@ DEFAULT_TRAJECTORY_COLUMNS = (
 #: wall times, worker): they differ between two runs of the same case.
 VOLATILE_COLUMNS = ("run.started", "run.finished", "run.wall_s", "run.cpu_s", "run.worker",
                     "numerics.wall_s", "numerics.integration_wall_s")
+
+
+class SweepTerminated(BaseException):
+    """SIGTERM reached the process running a sweep (a BaseException, like KeyboardInterrupt,
+    so that no ``except Exception`` of a case swallows it)."""
+
+
+def _raise_terminated(signum, frame):
+    raise SweepTerminated("terminated (SIGTERM)")
+
+
+@contextlib.contextmanager
+def _terminate_raises():
+    """Within the block, SIGTERM raises :class:`SweepTerminated` (main thread only; elsewhere a no-op)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _raise_terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
 
 
 class SweepInterrupted(RuntimeError):
@@ -272,7 +298,7 @@ def _keep(record, result, trajectory):
 # ----------------------------------------------------------------------- the sweep
 
 def sweep(grid=None, cases=None, *, base=None, folder=None, executor=None, workers=None,
-          progress=True, trajectory_columns=DEFAULT_TRAJECTORY_COLUMNS, trajectory_dtype="float32",
+          progress=None, trajectory_columns=DEFAULT_TRAJECTORY_COLUMNS, trajectory_dtype="float32",
           trajectory_rate=200.0, retry_failed=False, extend=False, table_interval=1.0):
     """Run many kick-plate cases in parallel and tabulate them.
 
@@ -296,8 +322,9 @@ def sweep(grid=None, cases=None, *, base=None, folder=None, executor=None, worke
     workers : int, optional
         Size of the default process pool (default: one per CPU core, at most
         one per case).
-    progress : bool
-        Show a tqdm progress bar (on stderr).
+    progress : bool or None
+        Show a tqdm progress bar on stderr; None (default): only when stderr
+        is a terminal.
     trajectory_columns : sequence of str, "all" or None
         Trajectory columns saved per case (with ``folder``); None saves none.
     trajectory_dtype : str
@@ -331,9 +358,14 @@ def sweep(grid=None, cases=None, *, base=None, folder=None, executor=None, worke
     SweepInterrupted
         The executor lost cases (e.g. its workers were killed). Finished cases
         are saved; run the sweep again on the folder to complete it.
+    KeyboardInterrupt, SweepTerminated
+        Ctrl-C or SIGTERM: the default pool's workers are ended, finished
+        cases are saved and the manifest's status is ``interrupted``.
     """
     case_list = make_cases(grid, cases, base)
     base = Scenario() if base is None else base
+    if progress is None:
+        progress = sys.stderr.isatty()
     spec = _trajectory_spec(trajectory_columns, trajectory_dtype, trajectory_rate)
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, (int, np.integer))
                                 or workers < 1):
@@ -358,25 +390,36 @@ def sweep(grid=None, cases=None, *, base=None, folder=None, executor=None, worke
 
     unique = list({cid: sc for _, sc, cid in case_list}.items())
     todo = [(cid, sc) for cid, sc in unique if not finished(cid)]
-    if store is not None:
-        store.write_manifest("running", n_cases=len(unique), n_done=len(unique) - len(todo))
-
-    own = executor is None and todo
-    if own:
-        executor = _default_pool(workers or os.cpu_count() or 1)
-    lost = []
+    lost, interrupted, own = [], False, False
     try:
-        _collect(executor, todo, records, store, progress, len(unique), spec, table_interval, lost)
+        with _terminate_raises():
+            if store is not None:
+                store.write_manifest("running", n_cases=len(unique), n_done=len(unique) - len(todo))
+            own = executor is None and todo
+            if own:
+                executor = _default_pool(workers or os.cpu_count() or 1)
+            try:
+                _collect(executor, todo, records, store, progress, len(unique), spec, table_interval, lost)
+            except (KeyboardInterrupt, SweepTerminated):
+                interrupted = True
+                if own:
+                    _discard_default_pool(end_workers=True)   # no worker outlives the sweep
+                raise
+            finally:
+                if own and lost:
+                    _discard_default_pool()
     finally:
-        if own and lost:
-            _discard_default_pool()
         if store is not None:
             n_ok = sum(1 for cid, _ in unique if records.get(cid, {}).get("status") == "ok")
             n_failed = sum(1 for cid, _ in unique if records.get(cid, {}).get("status") == "failed")
-            status = "complete" if n_ok + n_failed == len(unique) else "incomplete"
-            store.write_table(force=True)
-            store.write_manifest(status, n_cases=len(unique), n_ok=n_ok, n_failed=n_failed,
-                                 n_done=n_ok + n_failed)
+            status = ("complete" if n_ok + n_failed == len(unique)
+                      else "interrupted" if interrupted else "incomplete")
+            try:
+                store.write_table(force=True)
+                store.write_manifest(status, n_cases=len(unique), n_ok=n_ok, n_failed=n_failed,
+                                     n_done=n_ok + n_failed)
+            finally:
+                store.close()
     if lost:
         where = f"; run the sweep again on {str(store.path)!r} to finish" if store is not None else ""
         raise SweepInterrupted(f"{len(lost)} of {len(unique)} cases were not run: the executor failed "
@@ -401,15 +444,27 @@ def _default_pool(n):
         _discard_default_pool()
     if _pool is None:
         _preload()
-        _pool = cf.ProcessPoolExecutor(max_workers=n)
+        _pool = cf.ProcessPoolExecutor(max_workers=n, initializer=_worker_start)
         _pool_workers = n
     return _pool
 
 
-def _discard_default_pool():
+def _worker_start():
+    """In each pool worker: SIGTERM ends it (a worker forked during a sweep inherits the sweep's handler)."""
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
+def _discard_default_pool(end_workers=False):
+    """Drop the default pool; ``end_workers`` also ends its worker processes (SIGTERM) instead of
+    letting them finish the cases they run."""
     global _pool, _pool_workers
     if _pool is not None:
+        workers = list((getattr(_pool, "_processes", None) or {}).values()) if end_workers else []
         _pool.shutdown(wait=False, cancel_futures=True)
+        for process in workers:
+            process.terminate()
+        for process in workers:
+            process.join(timeout=10)
     _pool, _pool_workers = None, None
 
 

@@ -13,8 +13,10 @@ Example
 >>> from whipple_kick import sweep_store
 >>> frame, summary = sweep_store.load_trajectory("thesis_grid", case_id)   # doctest: +SKIP
 """
+import contextlib
 import dataclasses
 import datetime
+import fcntl
 import hashlib
 import json
 import os
@@ -33,6 +35,8 @@ MANIFEST_FILE = "manifest.json"
 LOG_FILE = "cases.jsonl"
 TABLE_FILE = "table.csv"
 TRAJECTORY_DIR = "trajectories"
+#: Held (flock) by the process running a sweep on the folder; holds its pid.
+LOCK_FILE = "sweep.lock"
 #: Version of the folder layout written into the manifest.
 FOLDER_FORMAT = 1
 
@@ -168,13 +172,64 @@ def slim(record):
     return line
 
 
+def _lock(folder):
+    """Take the folder's sweep lock (an exclusive ``flock`` on :data:`LOCK_FILE`) and write our pid into it.
+
+    The operating system drops the lock when its holder dies, so a lock
+    left by a killed sweep is simply taken over. Returns the open file
+    descriptor (:func:`_unlock` releases it).
+
+    Raises
+    ------
+    InputError
+        Another process holds the lock (one line naming its pid).
+    """
+    path = pathlib.Path(folder) / LOCK_FILE
+    fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        holder = os.pread(fd, 32, 0).decode(errors="replace").strip() or "unknown"
+        os.close(fd)
+        raise InputError(f"sweep folder {str(folder)!r} is in use by another sweep (process {holder}, "
+                         f"{LOCK_FILE}); wait for it to finish, then run again to resume") from None
+    os.ftruncate(fd, 0)
+    os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+    return fd
+
+
+def _unlock(fd):
+    # LOCK_UN releases the lock even where forked pool workers still hold the descriptor.
+    with contextlib.suppress(OSError):
+        fcntl.flock(fd, fcntl.LOCK_UN)
+        os.close(fd)
+
+
 class Folder:
-    """Manifest, append-only log, table and trajectories of one sweep."""
+    """Manifest, append-only log, table and trajectories of one sweep.
+
+    Creating one takes the folder's lock (:func:`_lock`): a second sweep on
+    the same folder is refused while the first runs. :meth:`close` releases it.
+    """
 
     def __init__(self, path, case_list, base, extend, trajectory):
         self.path = pathlib.Path(path)
         self.case_list = case_list
         self.path.mkdir(parents=True, exist_ok=True)
+        self._lock_fd = _lock(self.path)
+        try:
+            self._open(case_list, base, extend, trajectory)
+        except BaseException:
+            self.close()
+            raise
+
+    def close(self):
+        """Release the folder's lock (idempotent)."""
+        if self._lock_fd is not None:
+            _unlock(self._lock_fd)
+            self._lock_fd = None
+
+    def _open(self, case_list, base, extend, trajectory):
         (self.path / TRAJECTORY_DIR).mkdir(exist_ok=True)
         self.model = slip.model_hash()
         old = read_manifest(self.path)
