@@ -37,10 +37,13 @@ DIRECTIONS = ("right", "left")
 #: The thesis' plate travel [m] and travel time [s] (Section 8.3): the defaults.
 DEFAULT_DISPLACEMENT = 0.150
 DEFAULT_DURATION = 0.150
-#: Plausibility caps of every kick, built-in or tabulated: plate travel [m] and peak
-#: |acceleration| [m/s^2] (the measured plate peaks were 30-40 m/s^2, Dell'Orto 2025
-#: Section 8.4); peak |velocity| [m/s] is the most a built-in kick within both caps reaches
-#: (constant profile: v = sqrt(a D)).
+#: Plausibility caps of the kicks: plate travel [m] and peak |acceleration| [m/s^2] of the
+#: built-in profiles (the measured plate peaks were 30-40 m/s^2, Dell'Orto 2025 Section 8.4);
+#: peak |velocity| [m/s] is the most a built-in kick within both caps reaches (constant
+#: profile: v = sqrt(a D)). A table is held to the travel and velocity caps, not to the
+#: acceleration cap: the built-in constant profile itself stops the plate instantly, and a
+#: table of it stops it within one row interval (6.9e3 m/s^2 at 1 kHz rows), so a plausible
+#: table can exceed it. A table in mm read as metres exceeds the travel cap 1000-fold.
 MAX_DISPLACEMENT = 1.0
 MAX_ACCELERATION = 1000.0
 MAX_VELOCITY = math.sqrt(MAX_ACCELERATION * MAX_DISPLACEMENT)
@@ -195,11 +198,10 @@ def _table_of(scenario, sign):
 
 
 def _check_table_caps(table):
-    """Hold a tabulated kick to the built-in kicks' caps (a table in mm read as m fails here)."""
+    """Hold a tabulated kick to the built-in kicks' travel and velocity caps (a table in mm read as m fails here)."""
     travel = float(np.max(np.abs(table.y - table.y[0])))
     for what, value, cap, unit in (("plate travel from the first row", travel, MAX_DISPLACEMENT, "m"),
-                                   ("peak plate velocity", table.peak_velocity, MAX_VELOCITY, "m/s"),
-                                   ("peak plate acceleration", table.peak_acceleration, MAX_ACCELERATION, "m/s^2")):
+                                   ("peak plate velocity", table.peak_velocity, MAX_VELOCITY, "m/s")):
         if value > cap:
             raise InputError(f"kick table {table.name!r}: {what} = {value:.4g} {unit} is implausible; allowed "
                              f"[0, {cap:.4g}] {unit} (as the built-in kicks; give the units in the header, "
