@@ -440,8 +440,8 @@ def _write_results(result, out):
     """trajectory.csv and summary.json of ``result`` in ``out`` (each written atomically); returns the file names."""
     import json
 
-    from . import fileio
-    fileio.write_csv(result.trajectory, out / "trajectory.csv")
+    from . import fileio, results
+    fileio.write_csv(result.trajectory, out / "trajectory.csv", significant_digits=results.TRAJECTORY_CSV_DIGITS)
     fileio.write_atomic(out / "summary.json", json.dumps(result.summary, indent=2, allow_nan=False) + "\n")
     return ["trajectory.csv", "summary.json"]
 

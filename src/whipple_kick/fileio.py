@@ -63,38 +63,55 @@ def write_atomic(path, data: str | bytes, *, private: bool = False) -> None:
             tmp.write_text(data)
 
 
-def csv_text_rows(values: np.ndarray) -> Iterator[str]:
-    """Lines of CSV text for a 2-D float array, each float as its ``repr`` (pandas' own float text)."""
-    for start in range(0, len(values), 2000):   # bounded memory for long runs
+def csv_text_rows(values: np.ndarray, significant_digits: int | None = None) -> Iterator[str]:
+    """Lines of CSV text for a 2-D float array.
+
+    Each float is its ``repr`` (pandas' own float text, every bit kept), or
+    with ``significant_digits`` the ``%.{n}g`` text (``to_csv``'s
+    ``float_format``), about 2.5 times faster to write for 13 digits.
+    """
+    if significant_digits is not None:
+        line = ",".join([f"%.{significant_digits}g"] * values.shape[1]) + "\n"
+        for start in range(0, len(values), 2000):   # bounded memory for long runs
+            yield "".join([line % tuple(row) for row in values[start:start + 2000].tolist()])
+        return
+    for start in range(0, len(values), 2000):
         # str() of a list of floats writes each float's repr in C, about as fast as
         # formatting can be in Python; finite floats' reprs hold no '[', ',' or ' '.
         text = str(values[start:start + 2000].tolist())
         yield text[2:-2].replace("], [", "\n").replace(", ", ",") + "\n"
 
 
-def write_csv(frame, path) -> None:
+def write_csv(frame, path, *, significant_digits: int | None = None) -> None:
     """Write a DataFrame as CSV without its index, atomically: the text of ``frame.to_csv(index=False)``.
 
     An all-finite float64 frame (a trajectory) is formatted by
     :func:`csv_text_rows`, about twice as fast as ``to_csv`` and the same
     bytes (``tests/test_fileio.py``); every float is its ``repr``, so
     ``pandas.read_csv`` gives back the identical table. Anything else goes
-    through ``to_csv`` itself.
+    through ``to_csv`` itself. With ``significant_digits`` the floats are
+    written to that many significant digits (the text of ``to_csv`` with
+    ``float_format="%.{n}g"``): a relative round-off of at most
+    0.5 * 10**(1 - n) per value, for tables whose values are not exact to the
+    last bit anyway (an integrated trajectory).
 
     Parameters
     ----------
     frame : pandas.DataFrame
     path : path-like
+    significant_digits : int, optional
+        Significant digits of every float; None: all (each float's repr).
     """
     values = frame.to_numpy()
     fast = all(str(t) == "float64" for t in frame.dtypes) and bool(np.isfinite(values).all())
     with atomic_path(path) as tmp:
         if not fast:
-            frame.to_csv(tmp, index=False, lineterminator="\n")
+            float_format = None if significant_digits is None else f"%.{significant_digits}g"
+            frame.to_csv(tmp, index=False, lineterminator="\n", float_format=float_format)
             return
         with open(tmp, "w", newline="") as fh:
             fh.write(frame.iloc[:0].to_csv(index=False, lineterminator="\n"))   # pandas' own header
-            fh.writelines(csv_text_rows(values))
+            fh.writelines(csv_text_rows(values, significant_digits))
 
 
 def read_csv(path, what: str, *, name: str | None = None, **options):

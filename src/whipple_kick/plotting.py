@@ -29,6 +29,15 @@ DEFAULT_FALL_ANGLE_DEG = 45.0
 LIMIT_ROLL_FRACTION = 0.5
 #: Margin added on both sides of the data range, as a fraction of it.
 LIMIT_PADDING = 0.08
+#: Subplot margins of the response figure (fractions of its 8 x 9 in): what ``tight_layout`` gave for
+#: the default run, the left one widened to fit six-character tick labels such as "-0.075". Fixed,
+#: because ``tight_layout`` lays out every tick label once more before the drawing does (about a
+#: quarter of the figure's time).
+RESPONSE_MARGINS = {"left": 0.11, "right": 0.98, "bottom": 0.065, "hspace": 0.12}
+#: Top margin with and without a title.
+RESPONSE_TOP = {True: 0.948, False: 0.985}
+#: zlib level of the PNG: 1 writes about twice as fast as the default 6, for a file ~10 % larger.
+PNG_COMPRESS_LEVEL = 1
 
 
 def _frame_of(run):
@@ -191,10 +200,10 @@ def response_figure(runs, path=None, title=None, kick=None, time_range=None, dpi
         axes[0].legend(loc="upper right", fontsize=8)
     if title:
         fig.suptitle(title, fontsize=10)
-    fig.tight_layout()
+    fig.subplots_adjust(top=RESPONSE_TOP[bool(title)], **RESPONSE_MARGINS)
     if path is None:
         return fig
-    fig.savefig(path, dpi=dpi)
+    fig.savefig(path, dpi=dpi, pil_kwargs={"compress_level": PNG_COMPRESS_LEVEL})
     return None
 
 
