@@ -324,6 +324,7 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
     (0.367879, False)
     """
     transient = getattr(rhs, "transient", "contact_patch")
+    plain = getattr(rhs, "fast", rhs)   # the compiled model's one-foreign-call f(t, x)
     atol = default_atol(rtol, transient) if atol is None else np.asarray(atol, dtype=float)
     jac = rhs.jacobian_function(atol / rtol) if hasattr(rhs, "jacobian_function") else None
     jumps = dict(jumps or {})
@@ -395,7 +396,7 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
                 continue
             # A failed fast attempt is redone here, so only this attempt counts against the budget.
             sample_t, sample_x, (t_reached, x), status, why, (n, nj, used) = _careful_chunk(
-                rhs, x, times, rtol, atol, fall, spent, budget, t_start, jac)
+                plain, x, times, rtol, atol, fall, spent, budget, t_start, jac)
             nfev, njev, spent = nfev + n, njev + nj, spent + used
             if status == "completed" and last is not None and sample_t.size and sample_t[-1] == times[-1]:
                 sample_t, sample_x = sample_t[:-1], sample_x[:-1]
