@@ -1,15 +1,18 @@
 """Speed benchmarks of the slip model (medians; ratios against a baseline in the same process).
 
 Usage:
-    python scripts/bench.py rhs        # one RHS evaluation: compiled C vs NumPy (lambdify-style) oracle
+    python scripts/bench.py rhs        # one RHS call from Python vs the C function alone (a C loop), and vs
+                                       # the NumPy (lambdify-style) oracle
     python scripts/bench.py build      # cold build (derive + generate + compile) and warm start, fresh processes
     python scripts/bench.py run        # the 6 s kick-plate base case at rtol 1e-12 and 1e-8, C vs NumPy RHS
     python scripts/bench.py cli        # end to end: `simulate --pressure 400 --fz 635 --out NEW --quiet`, warm cache
     python scripts/bench.py all
     python scripts/bench.py compare --against DIR [--against-cache DIR]
                                        # this checkout against another one (e.g. main) in the same session:
-                                       # RHS call cost (both compiled libraries in one process, interleaved
-                                       # rounds) and the 6 s default run (interleaved fresh processes)
+                                       # RHS call cost, the C function alone and the call from Python (both
+                                       # compiled libraries in one process, interleaved rounds), and the 6 s
+                                       # default run at rtol 1e-10 and 1e-12, and with tyre_transient
+                                       # "force_lag" against the other's default (interleaved fresh processes)
 """
 import argparse
 import os
@@ -215,7 +218,9 @@ from whipple_kick.simulation import Scenario, run
 changes = json.loads(sys.argv[1])
 run(Scenario(duration=0.2, **changes))
 runs = [run(Scenario(**changes)).summary["numerics"] for _ in range(3)]
-print(json.dumps([statistics.median(r[k] for r in runs) for k in ("integration_wall_s", "wall_s", "nfev")]))
+# all evaluations, the Jacobians' included (a checkout without a C Jacobian counts its differences in nfev)
+print(json.dumps([statistics.median(r[k] for r in runs) for k in ("integration_wall_s", "wall_s")]
+                 + [statistics.median(r.get("evaluations", r["nfev"]) for r in runs)]))
 """
 
 #: 6 s default runs compared: (label, this checkout's Scenario changes, the other's). The other
@@ -305,7 +310,7 @@ def bench_compare(args):
                 out = subprocess.run([sys.executable, "-c", _RUN, json.dumps(changes[label])], env=env,
                                      capture_output=True, text=True, check=True, cwd=tempfile.gettempdir())
                 runs[label].append(json.loads(out.stdout.strip().splitlines()[-1]))
-        for k, name in enumerate(("integration [s]", "run() wall [s]", "RHS evaluations")):
+        for k, name in enumerate(("integration [s]", "run() wall [s]", "RHS evaluations (Jacobians' included)")):
             this, against = (statistics.median(r[k] for r in runs[label]) for label in ("this", "against"))
             print(f"6 s run, {case}, {name}: this {this:.4g}, against {against:.4g}, ratio {this / against:.3f} "
                   f"(medians of {args.repeats} interleaved processes x 3 runs)")

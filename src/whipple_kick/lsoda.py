@@ -368,7 +368,9 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
 
     def emit(times, states):
         nonlocal last_t
-        keep = np.isin(times, samples) & (times > last_t)
+        # Sample membership by binary search (times are sorted and taken from `samples`, or piece edges).
+        at = np.minimum(np.searchsorted(samples, times), samples.size - 1)
+        keep = (samples[at] == times) & (times > last_t) if samples.size else np.zeros(times.size, bool)
         if keep.any():
             ts.append(times[keep])
             xs.append(states[keep])

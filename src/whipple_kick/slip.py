@@ -112,6 +112,12 @@ def _compiler():
 _CFLAGS = ("-O2", "-fPIC", "-shared", "-std=c99")
 
 
+@functools.cache
+def _native_call():
+    """The compiled call extension (:func:`whipple_kick.rhs_call.module`), or None; looked up once per process."""
+    return rhs_call.module(_compiler())
+
+
 def layout():
     """The layouts the running code expects of the compiled library (as its metadata records them)."""
     return {"states": list(STATE_NAMES), "parameters": list(PARAMETER_NAMES), "outputs": list(OUTPUT_NAMES),
@@ -241,7 +247,7 @@ class CompiledRHS:
         calls per run). Otherwise one Python frame with everything bound
         locally around the ctypes call. Without ``exception`` nothing is checked.
         """
-        native = rhs_call.module(_compiler())
+        native = _native_call()
         if native is not None:
             address = ctypes.cast(self.lib.wk_slip_rhs, ctypes.c_void_p).value
             return native.Rhs(address, self.p, len(STATE_NAMES), _raise_status, exception, index, limit, index2,
