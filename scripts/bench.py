@@ -1,15 +1,18 @@
 """Speed benchmarks of the slip model (medians; ratios against a baseline in the same process).
 
 Usage:
-    python scripts/bench.py rhs        # one RHS evaluation: compiled C vs NumPy (lambdify-style) oracle
+    python scripts/bench.py rhs        # one RHS call from Python vs the C function alone (a C loop), and vs
+                                       # the NumPy (lambdify-style) oracle
     python scripts/bench.py build      # cold build (derive + generate + compile) and warm start, fresh processes
     python scripts/bench.py run        # the 6 s kick-plate base case at rtol 1e-12 and 1e-8, C vs NumPy RHS
     python scripts/bench.py cli        # end to end: `simulate --pressure 400 --fz 635 --out NEW --quiet`, warm cache
     python scripts/bench.py all
     python scripts/bench.py compare --against DIR [--against-cache DIR]
                                        # this checkout against another one (e.g. main) in the same session:
-                                       # RHS call cost (both compiled libraries in one process, interleaved
-                                       # rounds) and the 6 s default run (interleaved fresh processes)
+                                       # RHS call cost, the C function alone and the call from Python (both
+                                       # compiled libraries in one process, interleaved rounds), and the 6 s
+                                       # default run at rtol 1e-10 and 1e-12, and with tyre_transient
+                                       # "force_lag" against the other's default (interleaved fresh processes)
 """
 import argparse
 import os
@@ -44,19 +47,29 @@ def bench_rhs(repeats):
     x = ss.x.copy()
     x[slip.X["u4"]] = 0.1
     n_c, n_np = 20000, 200
-    c_times, np_times = [], []
+    c_times, alone_times, np_times = [], [], []
     slip_build.numpy_rhs(0.05, x, p)  # import and warm up
+    f = rhs.fast   # what the integrators call
+    native = hasattr(f, "repeat")
     for _ in range(repeats):
         t0 = time.perf_counter()
         for _ in range(n_c):
-            rhs(0.05, x)
+            f(0.05, x)
         c_times.append((time.perf_counter() - t0) / n_c)
+        if native:   # the C function alone: a C loop over the prepared pointers
+            t0 = time.perf_counter()
+            f.repeat(0.05, x, n_c)
+            alone_times.append((time.perf_counter() - t0) / n_c)
         t0 = time.perf_counter()
         for _ in range(n_np):
             slip_build.numpy_rhs(0.05, x, p)
         np_times.append((time.perf_counter() - t0) / n_np)
     c, n = statistics.median(c_times), statistics.median(np_times)
-    print(f"RHS call, compiled C (incl. ctypes + copy): median {c * 1e6:.2f} us  ({repeats} runs x {n_c} calls)")
+    print(f"RHS call from Python ({'rhs_call extension' if native else 'ctypes fallback'}): median "
+          f"{c * 1e6:.2f} us  ({repeats} runs x {n_c} calls)")
+    if native:
+        alone = statistics.median(alone_times)
+        print(f"the C function alone (C loop): median {alone * 1e6:.2f} us; call / alone {c / alone:.3f} (bound 1.3)")
     print(f"RHS call, NumPy oracle (same expressions):  median {n * 1e6:.1f} us  ({repeats} runs x {n_np} calls)")
     print(f"speed-up C / NumPy: {n / c:.0f}x")
 
@@ -203,12 +216,25 @@ np.save(sys.argv[1] + "_x.npy", x); np.save(sys.argv[1] + "_p.npy", slip.paramet
 print(slip.library()._name)
 """
 _RUN = r"""
-import json, statistics
+import json, statistics, sys
 from whipple_kick.simulation import Scenario, run
-run(Scenario(duration=0.2))
-runs = [run(Scenario()).summary["numerics"] for _ in range(3)]
-print(json.dumps([statistics.median(r[k] for r in runs) for k in ("integration_wall_s", "wall_s", "nfev")]))
+changes = json.loads(sys.argv[1])
+run(Scenario(duration=0.2, **changes))
+runs = [run(Scenario(**changes)).summary["numerics"] for _ in range(3)]
+# all evaluations, the Jacobians' included (a checkout without a C Jacobian counts its differences in nfev)
+print(json.dumps([statistics.median(r[k] for r in runs) for k in ("integration_wall_s", "wall_s")]
+                 + [statistics.median(r.get("evaluations", r["nfev"]) for r in runs)]))
 """
+
+#: 6 s default runs compared: (label, this checkout's Scenario changes, the other's). The other
+#: checkout may predate ``tyre_transient`` (06612a3 has only the relaxed-force tyre, this
+#: checkout's "force_lag"), so like is compared with like beside the two defaults.
+_RUN_CASES = (
+    ("defaults, rtol 1e-10", {"rtol": 1e-10}, {"rtol": 1e-10}),
+    ("defaults, rtol 1e-12", {"rtol": 1e-12}, {"rtol": 1e-12}),
+    ("force_lag vs its default, rtol 1e-10", {"rtol": 1e-10, "tyre_transient": "force_lag"}, {"rtol": 1e-10}),
+    ("force_lag vs its default, rtol 1e-12", {"rtol": 1e-12, "tyre_transient": "force_lag"}, {"rtol": 1e-12}),
+)
 
 
 def _environments(args):
@@ -236,32 +262,61 @@ def bench_compare(args):
             x = np.load(os.path.join(tmp, f"{label}_x.npy"))
             libs[label] = (lib, x, np.load(os.path.join(tmp, f"{label}_p.npy")), np.empty(x.size))
 
-    def loop(label, n):
+    # The C function alone: a C loop over the prepared pointers (rhs_call's repeat), the same
+    # method for both libraries. The call from Python: this checkout's as the integrator makes it
+    # (slip.CompiledRHS.fast), the other's as its CompiledRHS.__call__ did (contiguous input,
+    # x.ctypes, ctypes call, copy).
+    from whipple_kick import rhs_call, slip
+    native = rhs_call.module(slip._compiler())
+
+    def c_alone(label, n):
+        lib, x, p, _ = libs[label]
+        address = ctypes.cast(lib.wk_slip_rhs, ctypes.c_void_p).value
+        f = native.Rhs(address, p, x.size, lambda status, t: None)
+        t0 = time.perf_counter()
+        f.repeat(0.05, x, n)
+        return (time.perf_counter() - t0) / n
+
+    def from_python(label, n):
         lib, x, p, dx = libs[label]
+        if label == "this":
+            address = ctypes.cast(lib.wk_slip_rhs, ctypes.c_void_p).value
+            f = native.Rhs(address, p, x.size, lambda status, t: None)
+            t0 = time.perf_counter()
+            for _ in range(n):
+                f(0.05, x)
+            return (time.perf_counter() - t0) / n
         fn, p_ptr, dx_ptr = lib.wk_slip_rhs, p.ctypes.data, dx.ctypes.data
         t0 = time.perf_counter()
-        for _ in range(n):   # as CompiledRHS.__call__: contiguous input, C call, copy
+        for _ in range(n):
             fn(0.05, np.ascontiguousarray(x, dtype=float).ctypes.data, p_ptr, dx_ptr, None)
             dx.copy()
         return (time.perf_counter() - t0) / n
 
-    times = {label: [] for label in libs}
+    times = {(label, how): [] for label in libs for how in ("C", "py")}
     for _ in range(max(args.repeats, 1) * 8):
         for label in libs:
-            times[label].append(loop(label, 5000))
-    this, against = (statistics.median(times[k]) for k in ("this", "against"))
-    print(f"RHS call (ctypes + copy): this {this * 1e6:.2f} us, against {against * 1e6:.2f} us, "
-          f"ratio {this / against:.3f} (medians of {len(times['this'])} interleaved rounds of 5000 calls)")
-    runs = {label: [] for label in envs}
-    for _ in range(args.repeats):
-        for label, env in envs.items():
-            out = subprocess.run([sys.executable, "-c", _RUN], env=env, capture_output=True, text=True,
-                                 check=True, cwd=tempfile.gettempdir())
-            runs[label].append(json.loads(out.stdout.strip().splitlines()[-1]))
-    for k, name in enumerate(("integration", "run() wall", "RHS evaluations")):
-        this, against = (statistics.median(r[k] for r in runs[label]) for label in ("this", "against"))
-        print(f"6 s default run, {name}: this {this:.4g}, against {against:.4g}, ratio {this / against:.3f} "
-              f"(medians of {args.repeats} interleaved processes x 3 runs)")
+            times[label, "C"].append(c_alone(label, 5000))
+            times[label, "py"].append(from_python(label, 5000))
+    med = {k: statistics.median(v) for k, v in times.items()}
+    for label in libs:
+        print(f"RHS, {label}: C alone {med[label, 'C'] * 1e6:.2f} us, call from Python {med[label, 'py'] * 1e6:.2f} us, "
+              f"ratio {med[label, 'py'] / med[label, 'C']:.3f} (medians of {len(times[label, 'C'])} interleaved "
+              f"rounds of 5000 calls)")
+    print(f"RHS C alone this/against {med['this', 'C'] / med['against', 'C']:.3f}; "
+          f"call from Python this/against {med['this', 'py'] / med['against', 'py']:.3f}")
+    for case, this_changes, other_changes in _RUN_CASES:
+        changes = {"this": this_changes, "against": other_changes}
+        runs = {label: [] for label in envs}
+        for _ in range(args.repeats):
+            for label, env in envs.items():
+                out = subprocess.run([sys.executable, "-c", _RUN, json.dumps(changes[label])], env=env,
+                                     capture_output=True, text=True, check=True, cwd=tempfile.gettempdir())
+                runs[label].append(json.loads(out.stdout.strip().splitlines()[-1]))
+        for k, name in enumerate(("integration [s]", "run() wall [s]", "RHS evaluations (Jacobians' included)")):
+            this, against = (statistics.median(r[k] for r in runs[label]) for label in ("this", "against"))
+            print(f"6 s run, {case}, {name}: this {this:.4g}, against {against:.4g}, ratio {this / against:.3f} "
+                  f"(medians of {args.repeats} interleaved processes x 3 runs)")
 
 
 def main():

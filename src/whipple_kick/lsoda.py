@@ -7,7 +7,10 @@ is integrated on its own and the state is carried across the breakpoint,
 through a jump map where the caller gives one (the plate stop's impulse).
 A fall (|roll| beyond a limit) ends the run as an event, not an error.
 LSODA's stiff steps use the compiled model's Jacobian (forward differences
-in C over the dynamic states; the energy quadratures feed nothing back).
+in C over the dynamic states, one foreign call; the energy quadratures feed
+nothing back). LSODA calls the compiled model through
+``CompiledRHS.fast`` (:mod:`whipple_kick.rhs_call`: one foreign call per
+evaluation, the roll and steer limits checked in C on the fast path).
 
 No integration runs for ever: a :class:`Budget` bounds the right-hand-side
 evaluations per simulated second (those LSODA makes and those inside each
@@ -49,10 +52,19 @@ class Trajectory:
         return self.x[:, slip.X[name]]
 
 
-#: Fast-path chunk length [s]. Measured on the 6 s base case (median of 7):
-#: 0.25 / 0.5 / 1 / 2 s / one run give 0.125 / 0.139 / 0.164 / 0.175 / 0.174 s
-#: at rtol 1e-12 and 0.045 / 0.041 / 0.033 / 0.030 / 0.028 s at rtol 1e-8;
-#: 0.5 s balances the two, and keeps redoing a chunk after a fall cheap.
+#: Fast-path chunk length [s]: each chunk is one odeint (LSODA restarted), and
+#: a chunk in which a limit is passed is redone with events. Restarting is not
+#: the cost it looks: on the 6 s default run (compiled Jacobian, medians of 5,
+#: wall relative to 0.5 s) chunks of 0.5 / 1 / 2 s / one run per piece take
+#: 1.00 / 1.31 / 1.39 / 1.36 (8835 / 12089 / 12865 / 13154 evaluations) at rtol
+#: 1e-10 and 1.00 / 0.95 / 1.50 / 1.53 (22757 / 17659 / 24390 / 24778) at 1e-12;
+#: with ``tyre_transient="force_lag"`` 1.00 / 0.86 / 0.86 / 0.77 at 1e-10 and
+#: 1.00 / 1.19 / 1.13 / 1.39 at 1e-12. A long LSODA run makes more Jacobians
+#: (63 against 224 at 1e-10; its switch between the Adams and the stiff method
+#: decides), so 0.5 s stays: never much worse, and redoing a chunk after a fall
+#: is cheap.
+#: (Starting each chunk with the previous chunk's last step moved these
+#: counts by -35 % to +62 % case by case: no consistent gain, not used.)
 DEFAULT_CHUNK = 0.5
 
 
@@ -324,6 +336,7 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
     (0.367879, False)
     """
     transient = getattr(rhs, "transient", "contact_patch")
+    plain = getattr(rhs, "fast", rhs)   # the compiled model's one-foreign-call f(t, x)
     atol = default_atol(rtol, transient) if atol is None else np.asarray(atol, dtype=float)
     jac = rhs.jacobian_function(atol / rtol) if hasattr(rhs, "jacobian_function") else None
     jumps = dict(jumps or {})
@@ -355,7 +368,9 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
 
     def emit(times, states):
         nonlocal last_t
-        keep = np.isin(times, samples) & (times > last_t)
+        # Sample membership by binary search (times are sorted and taken from `samples`, or piece edges).
+        at = np.minimum(np.searchsorted(samples, times), samples.size - 1)
+        keep = (samples[at] == times) & (times > last_t) if samples.size else np.zeros(times.size, bool)
         if keep.any():
             ts.append(times[keep])
             xs.append(states[keep])
@@ -395,7 +410,7 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
                 continue
             # A failed fast attempt is redone here, so only this attempt counts against the budget.
             sample_t, sample_x, (t_reached, x), status, why, (n, nj, used) = _careful_chunk(
-                rhs, x, times, rtol, atol, fall, spent, budget, t_start, jac)
+                plain, x, times, rtol, atol, fall, spent, budget, t_start, jac)
             nfev, njev, spent = nfev + n, njev + nj, spent + used
             if status == "completed" and last is not None and sample_t.size and sample_t[-1] == times[-1]:
                 sample_t, sample_x = sample_t[:-1], sample_x[:-1]

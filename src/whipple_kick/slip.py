@@ -25,7 +25,7 @@ import shutil
 
 import numpy as np
 
-from . import cache, energy, kane, magic_formula, transient
+from . import cache, energy, kane, magic_formula, rhs_call, transient
 from . import symbols as S
 from .errors import InputError
 
@@ -110,6 +110,12 @@ def _compiler():
 
 
 _CFLAGS = ("-O2", "-fPIC", "-shared", "-std=c99")
+
+
+@functools.cache
+def _native_call():
+    """The compiled call extension (:func:`whipple_kick.rhs_call.module`), or None; looked up once per process."""
+    return rhs_call.module(_compiler())
 
 
 def layout():
@@ -222,6 +228,7 @@ class CompiledRHS:
         self._dx_ptr = self._dx.ctypes.data
         self._out = np.empty(len(OUTPUT_NAMES))
         self._out_ptr = self._out.ctypes.data
+        self.fast = self.guarded()   # f(t, x): one foreign call (what the integrators call)
 
     @property
     def transient(self):
@@ -229,26 +236,33 @@ class CompiledRHS:
         return transient.TRANSIENTS[int(self.p[P["tyre_transient"]])]
 
     def __call__(self, t, x):
-        x = np.ascontiguousarray(x, dtype=float)
-        status = self.lib.wk_slip_rhs(t, x.ctypes.data, self._p_ptr, self._dx_ptr, None)
-        if status:
-            raise FloatingPointError(_STATUS.get(status, f"status {status}") + f" at t = {t:.6g} s")
-        return self._dx.copy()
+        return self.fast(t, x)
 
-    def guarded(self, index, limit, exception, index2=0, limit2=math.inf):
+    def guarded(self, index=0, limit=math.inf, exception=None, index2=0, limit2=math.inf):
         """A fast ``f(t, x)`` that raises ``exception`` once ``|x[index]| > limit`` or ``|x[index2]| > limit2``.
 
-        One Python frame per call with everything bound locally: the
-        integrator's hot path (about 2e4 calls per run).
+        Where the Python headers are available this is an object of the
+        compiled :mod:`whipple_kick.rhs_call` extension: one foreign call,
+        no Python code, per evaluation (the integrator's hot path, about 1e4
+        calls per run). Otherwise one Python frame with everything bound
+        locally around the ctypes call. Without ``exception`` nothing is checked.
         """
+        native = _native_call()
+        if native is not None:
+            address = ctypes.cast(self.lib.wk_slip_rhs, ctypes.c_void_p).value
+            return native.Rhs(address, self.p, len(STATE_NAMES), _raise_status, exception, index, limit, index2,
+                              limit2)
         fn, p_ptr, dx_ptr, dx = self.lib.wk_slip_rhs, self._p_ptr, self._dx_ptr, self._dx
+        if exception is None:
+            index, limit = 0, math.inf
 
         def f(t, x):
             if abs(x[index]) > limit or abs(x[index2]) > limit2:
                 raise exception
+            x = np.ascontiguousarray(x, dtype=float)
             status = fn(t, x.ctypes.data, p_ptr, dx_ptr, None)
             if status:
-                raise FloatingPointError(_STATUS.get(status, f"status {status}") + f" at t = {t:.6g} s")
+                _raise_status(status, t)
             return dx.copy()
         return f
 
@@ -275,7 +289,7 @@ class CompiledRHS:
             J = np.empty((n, n))
             status = fn(t, x.ctypes.data, p_ptr, s_ptr, J.ctypes.data)
             if status:
-                raise FloatingPointError(_STATUS.get(status, f"status {status}") + f" at t = {t:.6g} s")
+                _raise_status(status, t)
             return J
         jac.scale = scale   # keeps the array alive with the closure
         jac.evaluations = len(DYNAMIC_STATES) + 1   # right-hand-side evaluations per call (the budget counts them)
@@ -319,7 +333,7 @@ class CompiledRHS:
         x = np.ascontiguousarray(x, dtype=float)
         status = self.lib.wk_slip_rhs(t, x.ctypes.data, self._p_ptr, self._dx_ptr, self._out_ptr)
         if status:
-            raise FloatingPointError(_STATUS.get(status, f"status {status}") + f" at t = {t:.6g} s")
+            _raise_status(status, t)
         return self._dx.copy(), self._out.copy()
 
 
@@ -327,6 +341,11 @@ _STATUS = {
     1: "singular constraint or mass matrix in the slip model",
     2: "non-finite derivative in the slip model",
 }
+
+
+def _raise_status(status, t):
+    """Raise the model's error for a nonzero status of its C function at time ``t`` [s]."""
+    raise FloatingPointError(_STATUS.get(status, f"status {status}") + f" at t = {t:.6g} s")
 
 
 # ------------------------------------------------------- parameters and steady state
