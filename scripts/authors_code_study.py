@@ -178,7 +178,7 @@ def energy():
     df = result.trajectory
     w = stored.whole
     theirs = (np.cos(w["q3"]) * w["u1"] + np.sin(w["q3"]) * w["u2"]).to_numpy()
-    ours = (np.cos(df["yaw"]) * df["u1"] + np.sin(df["yaw"]) * df["u2"]).to_numpy()
+    ours = df["forward_speed"].to_numpy()
     k, j = int(np.argmax(ours)), int(np.argmax(theirs))
     print(f"rear contact speed along the heading: ours 3.000 -> {ours[k]:.3f} m/s at {df['time'].iloc[k]:.2f} s "
           f"(roll {math.degrees(df['roll'].iloc[k]):.1f} deg), {ours[-1]:.3f} m/s at the fall; theirs 3.000 -> "

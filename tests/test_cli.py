@@ -30,7 +30,8 @@ def test_main_job_writes_the_three_files(tmp_path, capsys):
     assert summary["fell"] is False
     assert summary["scenario"]["pressure_kpa"] == 400.0 and summary["scenario"]["fz_n"] == 635.0
     header = (out / "trajectory.csv").read_text().splitlines()[0].split(",")
-    for column in ("time", "yaw_rate", "roll_rate", "steer_rate", "fy_rear", "plate_y", "steer_torque"):
+    for column in ("time [s]", "yaw_rate [rad/s]", "roll_rate [rad/s]", "steer_rate [rad/s]", "fy_rear [N]",
+                   "plate_y [m]", "steer_torque [N m]", "forward_speed [m/s]", "velocity_x_fixed [m/s]"):
         assert column in header
     assert "no fall" in stdout and "trajectory.csv" in stdout
     roll = summary["recovery"]["signals"]["roll_rate"]["time_s"]
@@ -121,7 +122,7 @@ def test_thesis_tyre_transient_and_earlier_options_reach_the_summary(tmp_path, c
     jump, = s["energy"]["velocity_jumps"]
     assert jump["impulse_work_j"] is None and jump["kinetic_energy_change_j"] < -0.1
     assert "transient force_lag" in stdout and "plate stop (resolve)" in stdout
-    header = (out / "trajectory.csv").read_text().splitlines()[0].split(",")
+    header = [c.split(" [")[0] for c in (out / "trajectory.csv").read_text().splitlines()[0].split(",")]
     assert "fy_rear" in header and "plate_work" in header and "slip_patch_rear" not in header
     assert s["steady_state"]["rear_wheel_torque_role"] == "brake" and "brake" in stdout
 

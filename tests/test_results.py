@@ -34,7 +34,7 @@ def test_base_run_outputs(base):
     for name in wk.analysis.COLUMNS:
         assert name in df.columns
     for name in ("plate_y", "plate_velocity", "plate_acceleration", "steer_torque", "fz_rear", "fz_front",
-                 "mz_rear", "mz_front", "camber_rear", "camber_front", "slip_front", "pitch"):
+                 "mz_rear", "mz_front", "camber_rear", "camber_front", "slip_front", "frame_pitch"):
         assert name in df.columns and name in wk.results.UNITS
     assert np.all(np.isfinite(df.to_numpy()))
     t = df["time"].to_numpy()
@@ -115,3 +115,30 @@ def test_dissipation_never_decreases_with_symmetric_tyres():
     assert np.min(np.diff(dissipation)) > -1e-9
     assert dissipation[-1] > 10.0
     assert np.max(np.abs(df[wk.results.BALANCE_COLUMN])) < 1e-3
+
+
+def test_heading_speeds_are_the_steady_motion_before_the_kick(base):
+    """forward_speed and lateral_speed rotate the fixed-frame velocity by the yaw: during the settle (steady
+    turn) they stay the run's speed and the steady drift, while the fixed-frame components turn with the
+    heading. Tolerance 1e-6 m/s: the steady turn is held to ~1e-6 of its states over the settle."""
+    df, st = base.trajectory, base.summary["steady_state"]
+    settle = df[df["time"] < 0.0]
+    np.testing.assert_allclose(settle["forward_speed"], st["speed_m_s"], rtol=0, atol=1e-6)
+    np.testing.assert_allclose(settle["lateral_speed"], st["lateral_drift_m_s"], rtol=0, atol=1e-6)
+    speed = np.hypot(df["velocity_x_fixed"], df["velocity_y_fixed"])
+    np.testing.assert_allclose(np.hypot(df["forward_speed"], df["lateral_speed"]), speed, rtol=1e-12)
+    assert np.ptp(df["velocity_x_fixed"]) > 0.5     # the fixed-frame components are not the forward speed
+
+
+def test_trajectory_csv_names_carry_units_and_read_back(base, tmp_path):
+    """The file's header is '<name> [<unit>]' for every column; read_trajectory gives the plain names back,
+    with values within the file's 13 significant digits (5e-13 relative)."""
+    path = tmp_path / "trajectory.csv"
+    wk.fileio.write_csv(wk.results.with_units(base.trajectory), path,
+                        significant_digits=wk.results.TRAJECTORY_CSV_DIGITS)
+    header = path.read_text().splitlines()[0].split(",")
+    assert header == [f"{c} [{wk.results.UNITS[c]}]" for c in base.trajectory.columns]
+    assert "roll [rad]" in header and "time [s]" in header and "fy_rear [N]" in header
+    back = wk.results.read_trajectory(path)
+    assert list(back.columns) == list(base.trajectory.columns)
+    np.testing.assert_allclose(back.to_numpy(), base.trajectory.to_numpy(), rtol=6e-13, atol=1e-300)

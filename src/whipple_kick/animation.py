@@ -47,10 +47,10 @@ from .errors import InputError, check_range
 #: coordinates (see :data:`whipple_kick.geometry.COORDINATES`).
 COLUMNS = {
     "time": "time",
-    "q1": "x_rear", "q2": "y_rear", "q3": "yaw", "q4": "roll", "q5": "pitch",
+    "q1": "x_rear", "q2": "y_rear", "q3": "yaw", "q4": "roll", "q5": "frame_pitch",
     "q6": "rear_wheel_angle", "q7": "steer", "q8": "front_wheel_angle",
     "q9": "compression_rear", "q10": "compression_front",
-    "velocity_x": "u1", "velocity_y": "u2",          # rear contact velocity along N.x, N.y [m/s]
+    "velocity_x": "velocity_x_fixed", "velocity_y": "velocity_y_fixed",          # rear contact velocity along N.x, N.y [m/s]
     "yaw_rate": "yaw_rate", "roll_rate": "roll_rate", "steer_rate": "steer_rate",
     "fy_rear": "fy_rear", "fy_front": "fy_front",    # applied lateral tyre forces [N]
     "mz_rear": "mz_rear", "mz_front": "mz_front",    # applied self-aligning moments [N m]

@@ -441,7 +441,8 @@ def _write_results(result, out):
     import json
 
     from . import fileio, results
-    fileio.write_csv(result.trajectory, out / "trajectory.csv", significant_digits=results.TRAJECTORY_CSV_DIGITS)
+    fileio.write_csv(results.with_units(result.trajectory), out / "trajectory.csv",
+                     significant_digits=results.TRAJECTORY_CSV_DIGITS)
     fileio.write_atomic(out / "summary.json", json.dumps(result.summary, indent=2, allow_nan=False) + "\n")
     return ["trajectory.csv", "summary.json"]
 

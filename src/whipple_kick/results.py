@@ -21,19 +21,24 @@ from .errors import InputError, SimulationError
 #: about 2.5 times faster to write than every float's 17-digit repr.
 TRAJECTORY_CSV_DIGITS = 13
 
-# Moore's coordinates and speeds, named for the trajectory table: state -> (column, unit).
+# Moore's coordinates and speeds, named for the trajectory table: state -> (column, unit). q5 is
+# Moore's pitch of the rear frame (its rotation about the rear wheel axle, 0 when the frame's reference
+# line is level; about 14.7 deg for the default bicycle), hence "frame_pitch"; u1, u2 are the rear
+# contact's velocity along the fixed ground axes N.x, N.y, not along the heading (see HEADING_COLUMNS).
 COORDINATE_COLUMNS = {
     "q1": ("x_rear", "m"), "q2": ("y_rear", "m"), "q3": ("yaw", "rad"), "q4": ("roll", "rad"),
-    "q5": ("pitch", "rad"), "q6": ("rear_wheel_angle", "rad"), "q7": ("steer", "rad"),
+    "q5": ("frame_pitch", "rad"), "q6": ("rear_wheel_angle", "rad"), "q7": ("steer", "rad"),
     "q8": ("front_wheel_angle", "rad"), "q9": ("compression_rear", "m"),
     "q10": ("compression_front", "m"),
 }
 SPEED_COLUMNS = {
-    "u1": ("u1", "m/s"), "u2": ("u2", "m/s"), "u3": ("yaw_rate", "rad/s"), "u4": ("roll_rate", "rad/s"),
-    "u5": ("pitch_rate", "rad/s"), "u6": ("rear_wheel_rate", "rad/s"), "u7": ("steer_rate", "rad/s"),
+    "u1": ("velocity_x_fixed", "m/s"), "u2": ("velocity_y_fixed", "m/s"), "u3": ("yaw_rate", "rad/s"),
+    "u4": ("roll_rate", "rad/s"), "u5": ("frame_pitch_rate", "rad/s"), "u6": ("rear_wheel_rate", "rad/s"), "u7": ("steer_rate", "rad/s"),
     "u8": ("front_wheel_rate", "rad/s"), "u9": ("compression_rate_rear", "m/s"),
     "u10": ("compression_rate_front", "m/s"),
 }
+#: The rear contact's velocity along the heading (yaw q3) [m/s]: forward and lateral (the drift).
+HEADING_COLUMNS = {"forward_speed": "m/s", "lateral_speed": "m/s"}
 #: The force and moment each tyre applies to the bicycle (in every transient form): output -> column.
 APPLIED_COLUMNS = {"fy_r": "fy_rear", "fy_f": "fy_front", "mz_r": "mz_rear", "mz_f": "mz_front"}
 #: The other named outputs of the compiled model: output -> column (units: :data:`whipple_kick.slip.OUTPUTS`).
@@ -52,7 +57,7 @@ PATCH_STATE_COLUMNS = {"slip_patch_r": "slip_patch_rear", "slip_patch_f": "slip_
 #: Energy balance residual column [J] (:func:`whipple_kick.energy.balance_residual`).
 BALANCE_COLUMN = "energy_balance_residual"
 #: Unit of every trajectory column (from the symbol registry and :data:`whipple_kick.slip.OUTPUTS`).
-UNITS = {"time": "s", **dict(COORDINATE_COLUMNS.values()), **dict(SPEED_COLUMNS.values()),
+UNITS = {"time": "s", **dict(COORDINATE_COLUMNS.values()), **dict(SPEED_COLUMNS.values()), **HEADING_COLUMNS,
          **dict.fromkeys(PATCH_STATE_COLUMNS.values(), "rad"),
          **{c: slip.OUTPUTS[o][0] for o, c in {**APPLIED_COLUMNS, **OUTPUT_COLUMNS}.items()},
          **dict(energy.COLUMNS.values()), BALANCE_COLUMN: "J"}
@@ -101,6 +106,9 @@ def trajectory_frame(solution, tyre_transient="contact_patch"):
         cols[name] = traj.x[:, slip.X[q]]
     for u, (name, _) in SPEED_COLUMNS.items():
         cols[name] = outs[:, slip.OUT[u]]   # includes the dependent speeds u5 u6 u8
+    yaw, vx_fixed, vy_fixed = cols["yaw"], cols["velocity_x_fixed"], cols["velocity_y_fixed"]
+    cols["forward_speed"] = np.cos(yaw) * vx_fixed + np.sin(yaw) * vy_fixed
+    cols["lateral_speed"] = -np.sin(yaw) * vx_fixed + np.cos(yaw) * vy_fixed
     for o, name in APPLIED_COLUMNS.items():
         cols[name] = outs[:, slip.OUT[o]]
     if tyre_transient != "force_lag":
@@ -115,6 +123,29 @@ def trajectory_frame(solution, tyre_transient="contact_patch"):
     if not np.all(np.isfinite(frame.to_numpy())):
         raise SimulationError("non-finite values in the trajectory")
     return frame
+
+
+def with_units(frame):
+    """``frame`` with each column named ``"<name> [<unit>]"`` (units from :data:`UNITS`), as in trajectory.csv.
+
+    Example
+    -------
+    >>> import pandas as pd
+    >>> list(with_units(pd.DataFrame({"time": [0.0], "roll": [0.1]})).columns)
+    ['time [s]', 'roll [rad]']
+    """
+    return frame.rename(columns={c: f"{c} [{UNITS[c]}]" for c in frame.columns})
+
+
+def read_trajectory(path):
+    """trajectory.csv as a DataFrame with the plain column names of :attr:`Result.trajectory` (units dropped).
+
+    ``pandas.read_csv(path)`` reads the same file with the units in the names (``"roll [rad]"``).
+    """
+    from . import fileio
+
+    frame = fileio.read_csv(path, "trajectory")
+    return frame.rename(columns=lambda c: c.split(" [", 1)[0])
 
 
 def response_metrics(df, baseline, x0, scenario, traj):
