@@ -83,8 +83,15 @@ def test_kick_baseline_and_gain_scale_are_said(recovers):
     lines = [line for line in fig.axes[0].lines if line.get_gid() == "baseline"]
     assert len(lines) == 1 and tuple(lines[0].get_ydata()) == (baseline, baseline)
     assert not any(line.get_gid() == "fall" for ax in fig.axes for line in ax.lines)
-    assert "gains scaled by 1" in fig._suptitle.get_text()
-    assert " x1" not in fig._suptitle.get_text()
+    title = fig._suptitle.get_text().replace("\n", " ")   # wrapped to the figure's width
+    assert "gains scaled by 1" in title
+    assert " x1" not in title
+    # The whole title is inside the figure (it was once one 150-character line, clipped at both ends),
+    # and above the first panel.
+    renderer = fig.canvas.get_renderer()
+    box, panel = fig._suptitle.get_window_extent(renderer), fig.axes[0].get_window_extent(renderer)
+    assert box.x0 >= 0.0 and box.x1 <= fig.bbox.width and box.y1 <= fig.bbox.height
+    assert box.y0 >= panel.y1
 
 
 def test_several_runs_name_their_fall_in_the_legend(fall, recovers):
