@@ -90,11 +90,6 @@ def tyre_state_names(name=transient.DEFAULT_TRANSIENT):
     return transient.STATES[name]
 
 
-def state_names(name=transient.DEFAULT_TRANSIENT):
-    """All state names (:data:`STATE_NAMES` layout) with the tyre slots named for the form ``name``."""
-    return COORDINATES + INDEPENDENT + tyre_state_names(name) + QUADRATURE_STATES
-
-
 def _compiler():
     """Path of the C compiler: $CC if set (must exist), else cc, gcc or clang on PATH."""
     requested = os.environ.get("CC")
@@ -254,7 +249,7 @@ class CompiledRHS:
                               limit2)
         fn, p_ptr, dx_ptr, dx = self.lib.wk_slip_rhs, self._p_ptr, self._dx_ptr, self._dx
         if exception is None:
-            index, limit = 0, math.inf
+            limit = limit2 = math.inf
 
         def f(t, x):
             if abs(x[index]) > limit or abs(x[index2]) > limit2:
@@ -420,7 +415,7 @@ def model_parameters(moore, rear_tyre, front_tyre, gains=None, kick=None,
         ``profile`` (0 constant acceleration, 1 minimum jerk, 2 one cubic
         segment ``c0 + c1 tau + c2 tau^2 + c3 tau^3`` with ``tau = t - t0``,
         given as ``coefficients`` = (c0, c1, c2, c3) in m, m/s, m/s^2, m/s^3;
-        see :func:`cubic_segments`). Default: no kick.
+        see :func:`whipple_kick.inputs.cubic_segments`). Default: no kick.
     symmetric, lateral, reverse_camber : bool
         See :func:`tyre_parameters`.
     drive_torque : float
@@ -984,38 +979,3 @@ def linear_state_space(params, x, step=1e-7):
     for gain, state in (("kq4", "q4"), ("kq7", "q7"), ("ku3", "u3"), ("ku4", "u4"), ("ku7", "u7")):
         K[0, LINEAR_STATES.index(state)] = params[gain]
     return A_cl + B @ K, B, K
-
-
-def cubic_segments(times, displacements):
-    """Cubic-spline segments through a tabulated plate displacement y(t).
-
-    The spline is clamped (zero plate velocity at both ends, so the plate
-    starts from rest and is held afterwards) and passes through every table
-    point; y, y' and y'' are continuous.
-
-    Parameters
-    ----------
-    times : array_like
-        Strictly increasing times [s], at least 2.
-    displacements : array_like
-        Plate displacement [m] at those times (positive to the right).
-
-    Returns
-    -------
-    list of (t_start, t_end, (c0, c1, c2, c3))
-        One entry per table interval; ``kick=dict(profile=2, t0=t_start,
-        coefficients=...)`` reproduces the segment.
-    """
-    from scipy.interpolate import CubicSpline
-    t = np.asarray(times, dtype=float)
-    y = np.asarray(displacements, dtype=float)
-    if t.ndim != 1 or t.shape != y.shape or t.size < 2:
-        raise InputError(f"a kick table needs matching time and displacement columns with at least 2 rows, "
-                         f"got {t.size} times and {y.size} displacements")
-    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(y))):
-        raise InputError("the kick table has non-finite entries")
-    if np.any(np.diff(t) <= 0):
-        raise InputError("kick table times must increase strictly (s)")
-    spline = CubicSpline(t, y, bc_type="clamped")
-    # CubicSpline stores c[m, k] for (x - t_k)^(3 - m).
-    return [(t[k], t[k + 1], tuple(float(spline.c[3 - m, k]) for m in range(4))) for k in range(t.size - 1)]
