@@ -231,23 +231,29 @@ class _PastTheLimit(Exception):
     """Raised inside the fast path once the roll limit is passed."""
 
 
-def _fast_chunk(rhs, x, times, rtol, atol, roll_index, fall_angle, mxstep, jac=None,
-                steer_index=0, steer_limit=np.inf):
-    """Integrate one chunk with odeint's LSODA (the step loop stays in Fortran).
+def _guarded(rhs, roll_index, fall_angle, steer_index, steer_limit):
+    """``f(t, x)`` that raises :class:`_PastTheLimit` once |roll| or |steer| passes its limit.
 
-    Returns ``(states, (nfev, njev, evaluations))``, or ``None`` if the roll limit was passed or
+    Odeint has no events, and integrating a fallen bicycle onwards is wasted
+    work, so the fast path stops as soon as a limit is passed.
+    """
+    if hasattr(rhs, "guarded"):   # the compiled model: the limits are checked in C
+        return rhs.guarded(roll_index, fall_angle, _PastTheLimit, steer_index, steer_limit)
+
+    def guarded(t, x):   # any f(t, x), e.g. the NumPy oracle
+        if abs(x[roll_index]) > fall_angle or abs(x[steer_index]) > steer_limit:
+            raise _PastTheLimit
+        return rhs(t, x)
+    return guarded
+
+
+def _fast_chunk(guarded, x, times, rtol, atol, mxstep, jac=None):
+    """Integrate one chunk of ``guarded`` (:func:`_guarded`) with odeint's LSODA (the step loop stays in Fortran).
+
+    Returns ``(states, (nfev, njev, evaluations))``, or ``None`` if a limit was passed or
     LSODA reported trouble, e.g. more than ``mxstep`` steps between two
     samples (the caller then integrates the chunk carefully).
     """
-    # Stop as soon as the bicycle is past the limit: odeint has no events,
-    # and integrating a fallen bicycle onwards is wasted work.
-    if hasattr(rhs, "guarded"):
-        guarded = rhs.guarded(roll_index, fall_angle, _PastTheLimit, steer_index, steer_limit)
-    else:   # any f(t, x), e.g. the NumPy oracle
-        def guarded(t, x):
-            if abs(x[roll_index]) > fall_angle or abs(x[steer_index]) > steer_limit:
-                raise _PastTheLimit
-            return rhs(t, x)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
@@ -361,6 +367,7 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
         return min(fall_angle - abs(x[roll]), steer_limit - abs(x[steer]))
     fall.terminal = True
     fall.direction = -1
+    guarded = _guarded(rhs, roll, fall_angle, steer, steer_limit)   # once per integration, not per chunk
 
     ts, xs = [], []
     nfev = njev = spent = 0   # LSODA's evaluations, Jacobians, all evaluations (the budget's count)
@@ -401,7 +408,7 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
             times = grid[i0:i1 + 1]
             # A sample at the piece's end is emitted after the jump map (below).
             last = -1 if i1 == len(grid) - 1 else None
-            fast = _fast_chunk(rhs, x, times, rtol, atol, roll, fall_angle, mxstep, jac, steer, steer_limit)
+            fast = _fast_chunk(guarded, x, times, rtol, atol, mxstep, jac)
             if fast is not None and spent + fast[1][2] <= budget.limit(times[-1] - t_start):
                 y, (n, nj, used) = fast
                 nfev, njev, spent = nfev + n, njev + nj, spent + used
