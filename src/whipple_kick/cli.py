@@ -37,6 +37,9 @@ def _run(main, argv, prog="whipple_kick", kept="no results were kept"):
     except KeyboardInterrupt:
         print(f"{prog}: interrupted; {kept}", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except OSError as exc:   # an unwritable output folder or a full disk: the user's to fix
+        print(f"{prog}: cannot write the results: {exc}", file=sys.stderr)
+        return 2
 
 
 def _benchmark(argv):
@@ -534,9 +537,6 @@ def simulate_main(argv=None):
     except SimulationError as exc:
         print(f"simulate: numerical failure: {exc}", file=sys.stderr)
         status = 1
-    except OSError as exc:
-        print(f"simulate: cannot write the results: {exc}", file=sys.stderr)
-        status = 2
     sys.exit(status)
 
 
@@ -602,10 +602,9 @@ def recommend_main(argv=None):
     try:
         status = _run(_recommend, argv, "recommend-pressure",
                       "finished cases are kept in the --out folder (if given); run again on it to resume")
-    except (SweepInterrupted, OSError) as exc:
-        # An unwritable --out folder is the user's to fix (2); lost worker processes are not (1).
+    except SweepInterrupted as exc:   # lost worker processes: not the user's to fix
         print(f"recommend-pressure: {exc}", file=sys.stderr)
-        status = 2 if isinstance(exc, OSError) else 1
+        status = 1
     except SweepTerminated:
         print("recommend-pressure: terminated (SIGTERM); finished cases are kept in the --out folder, "
               "run again on it to resume", file=sys.stderr)
@@ -683,9 +682,4 @@ def _stability(argv):
 
 def stability_main(argv=None):
     """Console script ``stability``: eigenvalues of the slip model against speed (see ``stability --help``)."""
-    try:
-        status = _run(_stability, argv, "stability")
-    except OSError as exc:
-        print(f"stability: cannot write the results: {exc}", file=sys.stderr)
-        status = 2
-    sys.exit(status)
+    sys.exit(_run(_stability, argv, "stability"))
