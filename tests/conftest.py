@@ -1,6 +1,7 @@
 """Fixtures shared by several test files."""
 import pytest
 
+import whipple_kick as wk
 from whipple_kick.scenario import Scenario
 from whipple_kick.simulation import run
 
@@ -9,3 +10,37 @@ from whipple_kick.simulation import run
 def base():
     """The main job's run: 400 kPa, 635 N, thesis defaults (``simulate --pressure 400 --fz 635``)."""
     return run(Scenario(pressure_kpa=400.0, fz_n=635.0))
+
+
+# The bicycle with a rider for 635 N at the rear, its LQR rider at 3 m/s and T03 at 400 kPa: the slip
+# model's own tests and the call-path tests build their model from these.
+@pytest.fixture(scope="module")
+def rider_bike():
+    bike = wk.bicycles.load("balanceassist_v1")
+    combined, _ = wk.riders.for_rear_load(bike, fz_n=635.0)
+    return combined
+
+
+@pytest.fixture(scope="module")
+def gains(rider_bike):
+    K, _ = wk.control.lqr_gains(rider_bike, 3.0)
+    return wk.control.gains_dict(K)
+
+
+@pytest.fixture(scope="module")
+def t03():
+    return wk.tyres.load("T03", pressure_kpa=400)
+
+
+# Sweeps: short runs, since the sweep machinery, not the physics, is under test there.
+SWEEP_BASE = Scenario(duration=3.0, settle=0.1, output_rate=200.0, fz_n=635.0)
+# 600 kPa is outside T03's measured 300-500 kPa: that case fails with an InputError.
+SWEEP_GRID = {"pressure_kpa": [300, 400, 500, 600]}
+
+
+@pytest.fixture(scope="module")
+def default_run(tmp_path_factory):
+    """A four-case pressure sweep in its own folder (one case fails): ``(folder, table)``."""
+    folder = tmp_path_factory.mktemp("sweep") / "grid"
+    table = wk.sweep(SWEEP_GRID, base=SWEEP_BASE, folder=folder, progress=False)
+    return folder, table

@@ -5,18 +5,12 @@ import math
 import numpy as np
 import pytest
 
-import whipple_kick as wk
 from whipple_kick import lsoda, rhs_call, slip
 
 
 @pytest.fixture(scope="module")
-def steady():
-    bike = wk.bicycles.load("balanceassist_v1")
-    combined, _ = wk.riders.for_rear_load(bike, fz_n=635.0)
-    K, _ = wk.control.lqr_gains(combined, 3.0)
-    tyre = wk.tyres.load("T03", pressure_kpa=400)
-    par = slip.model_parameters(combined, tyre, tyre, gains=wk.control.gains_dict(K),
-                                kick=dict(t0=0.0, duration=0.15, displacement=0.15))
+def steady(rider_bike, gains, t03):
+    par = slip.model_parameters(rider_bike, t03, t03, gains=gains, kick=dict(t0=0.0, duration=0.15, displacement=0.15))
     return slip.steady_state(par, 3.0)
 
 

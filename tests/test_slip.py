@@ -7,24 +7,6 @@ import whipple_kick as wk
 from whipple_kick import benchmark, classic, lsoda, slip, slip_build
 
 
-@pytest.fixture(scope="module")
-def rider_bike():
-    bike = wk.bicycles.load("balanceassist_v1")
-    combined, _ = wk.riders.for_rear_load(bike, fz_n=635.0)
-    return combined
-
-
-@pytest.fixture(scope="module")
-def gains(rider_bike):
-    K, _ = wk.control.lqr_gains(rider_bike, 3.0)
-    return wk.control.gains_dict(K)
-
-
-@pytest.fixture(scope="module")
-def t03():
-    return wk.tyres.load("T03", pressure_kpa=400)
-
-
 def _outputs(rhs, trajectory):
     return np.array([rhs.outputs(t, x)[1] for t, x in zip(trajectory.t, trajectory.x, strict=True)])
 

@@ -7,25 +7,6 @@ import pytest
 import whipple_kick as wk
 from whipple_kick import cache, slip, slip_build
 
-
-@pytest.fixture(scope="module")
-def rider_bike():
-    bike = wk.bicycles.load("balanceassist_v1")
-    combined, _ = wk.riders.for_rear_load(bike, fz_n=635.0)
-    return combined
-
-
-@pytest.fixture(scope="module")
-def gains(rider_bike):
-    K, _ = wk.control.lqr_gains(rider_bike, 3.0)
-    return wk.control.gains_dict(K)
-
-
-@pytest.fixture(scope="module")
-def t03():
-    return wk.tyres.load("T03", pressure_kpa=400)
-
-
 # Spread of the random tyre states: forces [N] and moments [N m] for the
 # thesis' form, patch slip and camber angles [rad] for the contact forms.
 _TYRE_SPREAD = {"force_lag": (200.0, 200.0, 5.0, 5.0), "contact_patch": (0.6, 0.6, 0.3, 0.3),

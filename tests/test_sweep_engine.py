@@ -1,6 +1,8 @@
 """Sweeps: cases, parallel runs, the table of results, executors, saved trajectories."""
 import json
 
+from conftest import SWEEP_BASE as BASE
+from conftest import SWEEP_GRID as GRID
 import numpy as np
 import pandas as pd
 import pytest
@@ -8,18 +10,6 @@ import pytest
 import whipple_kick as wk
 from whipple_kick.errors import InputError
 from whipple_kick.scenario import Scenario
-
-# Short runs: the sweep machinery, not the physics, is under test here.
-BASE = Scenario(duration=3.0, settle=0.1, output_rate=200.0, fz_n=635.0)
-# 600 kPa is outside T03's measured 300-500 kPa: that case fails with an InputError.
-GRID = {"pressure_kpa": [300, 400, 500, 600]}
-
-
-@pytest.fixture(scope="module")
-def default_run(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("sweep") / "grid"
-    table = wk.sweep(GRID, base=BASE, folder=folder, progress=False)
-    return folder, table
 
 
 def test_table_has_one_row_per_case_with_inputs_and_metrics(default_run):
