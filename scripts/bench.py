@@ -161,6 +161,28 @@ print(json.dumps(stages))
 """
 
 
+def time_against_baseline(command, baseline, repeats, each=None):
+    """Wall times [s] of ``command`` and of ``baseline``, each run in a fresh process, interleaved.
+
+    ``command`` gets a new ``--out`` folder every time; one untimed run first
+    warms the cache. After each timed run ``baseline`` is timed, then
+    ``each(folder, k)`` is called if given. Returns ``(times, baseline_times)``.
+    """
+    times, base = [], []
+    with tempfile.TemporaryDirectory() as tmp:
+        for k in range(repeats + 1):
+            t0 = time.perf_counter()
+            subprocess.run(command + ["--out", os.path.join(tmp, f"run{k}")], check=True)
+            if k:   # the first run only warms the cache
+                times.append(time.perf_counter() - t0)
+                t0 = time.perf_counter()
+                subprocess.run(baseline, check=True)
+                base.append(time.perf_counter() - t0)
+                if each is not None:
+                    each(tmp, k)
+    return times, base
+
+
 def bench_cli(repeats):
     """Wall time of the whole command, each run in a fresh process writing into a new folder.
 
@@ -172,22 +194,15 @@ def bench_cli(repeats):
     """
     import json
     command = _simulate_command() + ["--pressure", "400", "--fz", "635", "--quiet"]
-    times, base, stages = [], [], []
-    with tempfile.TemporaryDirectory() as tmp:
-        for k in range(repeats + 1):
-            out = os.path.join(tmp, f"run{k}")
-            t0 = time.perf_counter()
-            subprocess.run(command + ["--out", out], check=True)
-            if k:   # the first run only warms the cache
-                times.append(time.perf_counter() - t0)
-                t0 = time.perf_counter()
-                subprocess.run([sys.executable, "-c", _BASELINE], check=True)
-                base.append(time.perf_counter() - t0)
-                staged = os.path.join(tmp, f"staged{k}")
-                os.mkdir(staged)
-                done = subprocess.run([sys.executable, "-c", _STAGES, staged], check=True, capture_output=True,
-                                      text=True)
-                stages.append(json.loads(done.stdout.splitlines()[-1]))
+    stages = []
+
+    def staged_run(tmp, k):
+        staged = os.path.join(tmp, f"staged{k}")
+        os.mkdir(staged)
+        done = subprocess.run([sys.executable, "-c", _STAGES, staged], check=True, capture_output=True, text=True)
+        stages.append(json.loads(done.stdout.splitlines()[-1]))
+
+    times, base = time_against_baseline(command, [sys.executable, "-c", _BASELINE], repeats, staged_run)
     median, baseline = statistics.median(times), statistics.median(base)
     print(f"simulate --pressure 400 --fz 635 --quiet (warm cache, fresh process): "
           f"median {median:.2f} s  runs {[round(v, 2) for v in times]}")
