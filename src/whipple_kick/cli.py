@@ -72,6 +72,16 @@ def benchmark_main(argv=None):
 
 # ----------------------------------------------------------------- simulate
 
+def _output_options(group, figure):
+    """--out, --force, --no-plot and --quiet, the same for every command that writes a folder."""
+    group.add_argument("--out", metavar="DIR",
+                       help="output folder (default: a new folder under the current directory)")
+    group.add_argument("--force", action="store_true",
+                       help="write into an existing non-empty output folder, overwriting the files written")
+    group.add_argument("--no-plot", action="store_true", help=f"do not write {figure}")
+    group.add_argument("--quiet", action="store_true", help="print nothing on success")
+
+
 class _OneLineParser(argparse.ArgumentParser):
     """Argument parser whose usage errors are one line on stderr (exit status 2)."""
 
@@ -214,12 +224,7 @@ def _simulate_parser():
                    help="steady running shown before the kick in s (default 0.5)")
     g.add_argument("--rtol", type=_number("relative"), default=1e-10, metavar="RTOL",
                    help="LSODA relative tolerance (default 1e-10; the thesis used 1e-12)")
-    g.add_argument("--out", metavar="DIR",
-                   help="output folder (default: a new folder under the current directory)")
-    g.add_argument("--force", action="store_true",
-                   help="write into an existing non-empty output folder, overwriting the files written")
-    g.add_argument("--no-plot", action="store_true", help="do not write response.png")
-    g.add_argument("--quiet", action="store_true", help="print nothing on success")
+    _output_options(g, "response.png")
     g = p.add_argument_group("animation")
     g.add_argument("--animate", action="store_true",
                    help="also write animation.mp4 (animation.gif when no video encoder is installed: "
@@ -638,12 +643,7 @@ def _stability_parser():
                         "the steady motion is upright straight running; measured: about the steady motion with "
                         "the offsets (a turn, large where a real eigenvalue is near zero)")
     g = p.add_argument_group("output")
-    g.add_argument("--out", metavar="DIR",
-                   help="output folder (default: a new folder under the current directory)")
-    g.add_argument("--force", action="store_true",
-                   help="write into an existing non-empty output folder, overwriting the files written")
-    g.add_argument("--no-plot", action="store_true", help="do not write stability.png")
-    g.add_argument("--quiet", action="store_true", help="print nothing on success")
+    _output_options(g, "stability.png")
     return p
 
 
