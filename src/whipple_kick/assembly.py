@@ -117,7 +117,9 @@ def assemble(scenario, kick, *, tyres=None, gains=None) -> Assembly:
         gains, poles, controller = custom, None, "custom gains"
     params = slip.model_parameters(moore, rear, front, gains=gains, symmetric=scenario.symmetric_tyres,
                                    kick=kick.model_kick(), tyre_transient=scenario.tyre_transient,
-                                   reverse_camber=scenario.camber_sign == "reversed")
+                                   reverse_camber=scenario.camber_sign == "reversed",
+                                   carcass_sliding=scenario.carcass_sliding, carcass_damping=scenario.carcass_damping,
+                                   carcass_viscosity=scenario.carcass_viscosity)
     found, start = start_state(params, scenario, controller)
     stability = linear_stability(scenario, moore, gains, found, controller)
     steady_yaw_rate = float(start.x[slip.X["u3"]])

@@ -111,7 +111,9 @@ def _model_options(p, symmetric_flag=True, design_default="the run's --speed"):
     control" group, for the caller's speed option.
     """
     from . import tyres
+    from .carcass import SLIDING_LAWS
     from .scenario import CAMBER_SIGNS, CONTROLLERS, TYRE_TRANSIENTS
+    from .transient import DEFAULT_TRANSIENT
     g = p.add_argument_group("tyres")
     g.add_argument("--pressure", type=_number("kPa"), metavar="KPA",
                    help="inflation pressure of both tyres in kPa (default 400)")
@@ -130,10 +132,16 @@ def _model_options(p, symmetric_flag=True, design_default="the run's --speed"):
     if symmetric_flag:
         g.add_argument("--symmetric-tyres", action="store_true",
                        help="zero the tyres' zero-slip offsets (exactly upright steady running)")
-    g.add_argument("--tyre-transient", choices=TYRE_TRANSIENTS, default="contact_patch",
-                   help="how the tyre forces build up: contact_patch (default: lagged contact-patch slip and "
-                        "camber, relaxation length shortening as the force saturates; passive, friction-limited), "
-                        "slip_lag (the same with a constant relaxation length) or force_lag (the thesis' lagged force)")
+    g.add_argument("--tyre-transient", choices=TYRE_TRANSIENTS, default=DEFAULT_TRANSIENT,
+                   help="how the tyre forces build up: carcass (default: a lateral carcass spring in series with a "
+                        "sliding contact patch; passive, friction-limited, the force lag at small slip), "
+                        "contact_patch (lagged patch slip and camber), slip_lag (the same with a constant "
+                        "relaxation length) or force_lag (the thesis' lagged force)")
+    g.add_argument("--carcass-sliding", choices=SLIDING_LAWS, default="peak",
+                   help="carcass tyre past the curve's peak: peak (default: the force stays at the peak) or curve "
+                        "(it follows the steady curve at the kinematic slip: the fit's falling branch)")
+    g.add_argument("--carcass-damping", type=_number("N s/m"), default=0.0, metavar="N_S_PER_M",
+                   help="lateral damping of each carcass, parallel to its stiffness (default 0: pure relaxation)")
     g.add_argument("--camber-sign", choices=CAMBER_SIGNS, default="physical",
                    help="physical (default: a leaning wheel is pushed toward the lean) or reversed (away from it, "
                         "as the thesis authors' published code; not physical)")
@@ -285,6 +293,7 @@ def _model_fields(args):
         coefficient_set=args.coefficient_set, friction=args.friction, controller=args.controller,
         design_speed=args.design_speed, thesis_load_n=args.thesis_load, gain_scale=args.gain_scale,
         low_inertia=args.low_inertia, tyre_transient=args.tyre_transient, camber_sign=args.camber_sign,
+        carcass_sliding=args.carcass_sliding, carcass_damping=args.carcass_damping,
     )
 
 
@@ -384,6 +393,7 @@ def _prepare_out(path, force, previous=()):
 
 
 def _print_summary(result, out, files):
+    from . import results
     s = result.summary
     sc, bike, ctl, kick, st = s["scenario"], s["bicycle"], s["controller"], s["kick"], s["steady_state"]
     deg = 180.0 / np.pi
@@ -438,6 +448,9 @@ def _print_summary(result, out, files):
     print(f"  energy after the kick: plate work {e['plate_work_j']:+.2f} J, sliding {e['sliding_dissipation_j']:.2f} J, "
           f"dampers {e['damper_dissipation_j']:.2f} J{jumps}; balance residual {e['balance_residual_max_abs_j']:.1e} J")
     n = s["numerics"]
+    extrapolated = results.extrapolation_line(s)
+    if extrapolated:
+        print(f"  {extrapolated}")
     print(f"  numerics: LSODA rtol {n['rtol']:g}, {n['evaluations']} evaluations ({n['njev']} Jacobians), "
           f"integration {n['integration_wall_s']:.2f} s, "
           f"run {n['wall_s']:.2f} s")

@@ -1,15 +1,17 @@
 """Energy accounting of the slip model: cumulative works and dissipations.
 
-The compiled model integrates, beside the dynamic states, nine pure
-quadratures (:data:`QUADRATURE_STATES`, all zero at the start of a run):
-the work done on the bicycle by the kick plate, the steer torque, the
-rear-wheel torque, the tyres' zero-slip forces and their aligning moments;
-the dissipation of the contact patches' sliding and of the vertical tyre
-dampers; and the energy stored in each tyre's lateral carcass compliance.
+The compiled model integrates, beside the dynamic states, ten pure
+quadratures (:data:`QUADRATURE_STATES`, zero at the start of a run except
+the carcass tyre's stored energy, which starts at c y^2/2): the work done on
+the bicycle by the kick plate, the steer torque, the rear-wheel torque, the
+tyres' zero-slip forces and their aligning moments; the dissipation of the
+contact patches' sliding, of the vertical tyre dampers and of the carcass
+tyre's lateral dampers; and the energy stored in each tyre's lateral
+carcass compliance.
 They obey, at every instant,
 
     d(KE + PE + tyre springs + carcass_r + carcass_f)/dt
-        = plate + steer + wheel + zero-slip + moment - sliding - dampers,
+        = plate + steer + wheel + zero-slip + moment - sliding - dampers - carcass dampers,
 
 so :func:`balance_residual` of a trajectory stays at integration accuracy
 (the plate stop's impulse adds its work to the plate's column; see
@@ -19,7 +21,7 @@ the argument and the measured sizes.
 """
 #: Quadrature states appended to the dynamic states, in this order.
 QUADRATURE_STATES = ("W_plate", "W_steer", "W_wheel", "W_zero_slip", "W_moment", "D_slide", "D_damper",
-                     "E_carcass_r", "E_carcass_f")
+                     "E_carcass_r", "E_carcass_f", "D_carcass")
 #: Trajectory column and unit of each quadrature state.
 COLUMNS = {
     "W_plate": ("plate_work", "J"), "W_steer": ("steer_work", "J"),
@@ -27,12 +29,17 @@ COLUMNS = {
     "W_moment": ("aligning_moment_work", "J"), "D_slide": ("sliding_dissipation", "J"),
     "D_damper": ("damper_dissipation", "J"), "E_carcass_r": ("carcass_energy_rear", "J"),
     "E_carcass_f": ("carcass_energy_front", "J"),
+    "D_carcass": ("carcass_damper_dissipation", "J"),
 }
+#: Quadratures that are stored energies (the carcass tyre's start at c y^2/2 and equal it throughout);
+#: the others are works and dissipations, counted from the kick start.
+STORED_QUADRATURES = ("E_carcass_r", "E_carcass_f")
+CUMULATIVE = tuple(n for n in QUADRATURE_STATES if n not in STORED_QUADRATURES)
 #: Stored energies (trajectory columns) on the left of the balance.
 STORED = ("kinetic_energy", "potential_energy", "spring_energy", "carcass_energy_rear", "carcass_energy_front")
 #: Works (+) and dissipations (-) on its right.
 SUPPLIED = ("plate_work", "steer_work", "rear_wheel_torque_work", "zero_slip_force_work", "aligning_moment_work")
-DISSIPATED = ("sliding_dissipation", "damper_dissipation")
+DISSIPATED = ("sliding_dissipation", "damper_dissipation", "carcass_damper_dissipation")
 
 
 def common_rates(extra, u, t6):

@@ -19,7 +19,7 @@ import time
 
 import numpy as np
 
-from . import inputs, lsoda, slip
+from . import energy, inputs, lsoda, slip
 from .errors import SimulationError
 
 
@@ -131,7 +131,8 @@ def _integrate(steady, scenario, kick):
     or from ``steady.x`` with ``kick_heading="settled"``) in one LSODA run.
     The constant-acceleration profile's plate stop is a velocity jump
     (:func:`whipple_kick.slip.velocity_jump`) in piecewise runs. The
-    quadratures are shifted to be 0 at the kick start.
+    works and dissipations are shifted to be 0 at the kick start (the
+    carcass energies stay what the carcasses hold).
 
     Returns
     -------
@@ -184,7 +185,7 @@ def _integrate(steady, scenario, kick):
         return _from_kick_start(traj, kick_start), rhs_out, owner, breakpoints, jumps
     settle = lsoda.integrate(rhs, x_start, kick_start, t_start=t_start, rtol=scenario.rtol, **limits,
                                  chunk=chunk, samples=samples[samples < kick_start])
-    quad = [slip.X[n] for n in slip.QUADRATURE_STATES]
+    quad = [slip.X[n] for n in energy.CUMULATIVE]
     settle_x = settle.x.copy()
     settle_x[:, quad] -= settle.end_state[quad]   # cumulative from the kick start
     if settle.fell or settle.failed:
@@ -247,7 +248,7 @@ def _from_kick_start(traj, kick_start):
     if traj.t.size == 0:
         return traj
     x = traj.x.copy()
-    for name in slip.QUADRATURE_STATES:
+    for name in energy.CUMULATIVE:
         j = slip.X[name]
         x[:, j] -= np.interp(kick_start, traj.t, traj.x[:, j])
     return replace(traj, x=x)

@@ -74,10 +74,12 @@ __all__ = [
     "camber_reversed",
     "cornering_stiffness_model",
     "cornering_stiffness_numpy",
+    "inner_function",
     "lateral_force_factors",
     "lateral_force_factors_numpy",
     "lateral_force_formula",
     "lateral_force_model",
+    "lateral_force_model_factors",
     "lateral_force_numpy",
     "lateral_secant_model",
     "lateral_secant_numpy",
@@ -225,7 +227,7 @@ def _curve(alpha_deg, factors):
 
     b, c, d, e = factors["B"], factors["C"], factors["D"], factors["E"]
     bx = b * (sm.sympify(alpha_deg) + factors["Sh"])
-    return d * sm.sin(c * sm.atan(bx - e * (bx - sm.atan(bx)))) + factors["Sv"]
+    return d * sm.sin(c * sm.atan(inner_function(bx, e))) + factors["Sv"]
 
 
 def lateral_force_formula(alpha_deg, gamma_deg, fz_kn, a):
@@ -310,19 +312,62 @@ def offset_fade(fz_n):
     return sm.Piecewise((1, fz_n >= OFFSET_FADE_LOAD), (smooth, True))
 
 
-def _model_curve(factor_builder, count, slip_rad, camber_rad, fz_n, coefficients, friction_scale):
-    """Shared body of the ``*_model`` builders: map inputs, fade the constant shift, scale, flip sign, gate on load."""
+def _model_factors(factor_builder, count, camber_rad, fz_n, coefficients, friction_scale):
+    """Factors at model inputs (rad, N): the constant shift faded with the load, friction scaled; formula units."""
     coefficients = _coefficients(coefficients, count, factor_builder.__name__)
     k = _CONSTANT_SHIFT[factor_builder.__name__]
     coefficients[k] = coefficients[k] * offset_fade(fz_n)
-    alpha, gamma, fz_kn = _formula_inputs(slip_rad, camber_rad, fz_n)
+    _, gamma, fz_kn = _formula_inputs(0, camber_rad, fz_n)
+    return _scale_friction(factor_builder(gamma, fz_kn, coefficients), friction_scale)
+
+
+def _model_curve(factor_builder, count, slip_rad, camber_rad, fz_n, coefficients, friction_scale):
+    """Shared body of the ``*_model`` builders: map inputs, fade the constant shift, scale, flip sign, gate on load."""
+    alpha, _, _ = _formula_inputs(slip_rad, 0, fz_n)
 
     def value():
-        factors = _scale_friction(factor_builder(gamma, fz_kn, coefficients), friction_scale)
+        factors = _model_factors(factor_builder, count, camber_rad, fz_n, coefficients, friction_scale)
         # Minus: the formula's y axis points left and its z axis up (module notes).
         return -_curve(alpha, factors)
 
     return _loaded_only(value, fz_n)
+
+
+def lateral_force_model_factors(camber_rad, fz_n, a, friction_scale=1):
+    """The factors :func:`lateral_force_model` evaluates its curve with, at model inputs.
+
+    ``F_y,model(slip) = -(D sin(C atan(B x - E (B x - atan(B x)))) + Sv)`` with
+    ``x = slip [deg] + Sh``: the formula's units (B 1/deg, D and Sv N, Sh
+    deg), the constant shift faded with the load (:func:`offset_fade`) and
+    the friction scale applied. The carcass tyre's compiled inverse and
+    friction limit (:mod:`whipple_kick.transient`) start from these.
+
+    Parameters
+    ----------
+    camber_rad, fz_n : sympy.Expr or float
+        Camber [rad, model sign] and normal load [N, > 0].
+    a : sequence of 14
+        Coefficients a0..a13.
+    friction_scale : sympy.Expr or float
+
+    Returns
+    -------
+    dict
+        ``B C D E Sh Sv``.
+    """
+    return _model_factors(lateral_force_factors, N_FY_COEFFICIENTS, camber_rad, fz_n, a, friction_scale)
+
+
+def inner_function(u, e):
+    """The Magic Formula's inner function ``(1 - E) u + E atan(u)`` of ``u = B x``.
+
+    The curve is ``D sin(C atan(inner(B x))) + Sv``; the carcass tyre inverts
+    the curve through it (closed form for the sine and arctangent, Newton
+    for this function, which rises monotonically for E <= 1).
+    """
+    import sympy as sm
+
+    return (1 - e) * u + e * sm.atan(u)
 
 
 def lateral_force_model(slip_rad, camber_rad, fz_n, a, friction_scale=1):

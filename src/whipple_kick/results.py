@@ -50,15 +50,21 @@ OUTPUT_COLUMNS = {
     "ap": "plate_acceleration", "kinetic_energy": "kinetic_energy", "potential_energy": "potential_energy",
     "spring_energy": "spring_energy", "sliding_power": "sliding_power", "holonomic": "holonomic_residual",
     "sigma_r": "relaxation_length_rear", "sigma_f": "relaxation_length_front",
+    "fy_limit_r": "fy_limit_rear", "fy_limit_f": "fy_limit_front",
 }
-#: Contact-patch states (transient forms contact_patch and slip_lag only): state -> column.
+#: Contact-patch states (transient forms contact_patch and slip_lag; the carcass has the camber ones
+#: and its patch slip as the output ``patch_slip_*``): state -> column.
 PATCH_STATE_COLUMNS = {"slip_patch_r": "slip_patch_rear", "slip_patch_f": "slip_patch_front",
                        "camber_patch_r": "camber_patch_rear", "camber_patch_f": "camber_patch_front"}
+#: The slip the steady curves are evaluated at (contact-patch and carcass forms): output -> column.
+PATCH_OUTPUT_COLUMNS = {"patch_slip_r": "slip_patch_rear", "patch_slip_f": "slip_patch_front"}
+#: The carcass tyre's deflection states (transient carcass only): state -> column.
+CARCASS_STATE_COLUMNS = {"carcass_y_r": "carcass_deflection_rear", "carcass_y_f": "carcass_deflection_front"}
 #: Energy balance residual column [J] (:func:`whipple_kick.energy.balance_residual`).
 BALANCE_COLUMN = "energy_balance_residual"
 #: Unit of every trajectory column (from the symbol registry and :data:`whipple_kick.slip.OUTPUTS`).
 UNITS = {"time": "s", **dict(COORDINATE_COLUMNS.values()), **dict(SPEED_COLUMNS.values()), **HEADING_COLUMNS,
-         **dict.fromkeys(PATCH_STATE_COLUMNS.values(), "rad"),
+         **dict.fromkeys(PATCH_STATE_COLUMNS.values(), "rad"), **dict.fromkeys(CARCASS_STATE_COLUMNS.values(), "m"),
          **{c: slip.OUTPUTS[o][0] for o, c in {**APPLIED_COLUMNS, **OUTPUT_COLUMNS}.items()},
          **dict(energy.COLUMNS.values()), BALANCE_COLUMN: "J"}
 #: Columns whose peaks after the kick the summary lists (``max_abs_<column>``).
@@ -85,12 +91,12 @@ class Result:
     summary: dict = field(default_factory=dict)
 
 
-def trajectory_frame(solution, tyre_transient="contact_patch"):
+def trajectory_frame(solution, tyre_transient="carcass"):
     """DataFrame of states and named outputs at every sample of a :class:`~whipple_kick.integration.Solution`.
 
-    The patch states are columns in the contact-patch forms only; the
-    energy columns and the balance residual (:mod:`whipple_kick.energy`) in
-    every form.
+    The patch slip and camber are columns in the contact-patch and carcass
+    forms, the carcass deflections in the carcass form; the energy columns
+    and the balance residual (:mod:`whipple_kick.energy`) in every form.
 
     Raises
     ------
@@ -112,7 +118,12 @@ def trajectory_frame(solution, tyre_transient="contact_patch"):
     for o, name in APPLIED_COLUMNS.items():
         cols[name] = outs[:, slip.OUT[o]]
     if tyre_transient != "force_lag":
-        for state, name in PATCH_STATE_COLUMNS.items():
+        for o, name in PATCH_OUTPUT_COLUMNS.items():   # the state itself in the contact forms
+            cols[name] = outs[:, slip.OUT[o]]
+        cols["camber_patch_rear"] = traj.x[:, slip.X["camber_patch_r"]]
+        cols["camber_patch_front"] = traj.x[:, slip.X["camber_patch_f"]]
+    if tyre_transient == "carcass":
+        for state, name in CARCASS_STATE_COLUMNS.items():
             cols[name] = traj.x[:, slip.X[state]]
     for o, name in OUTPUT_COLUMNS.items():
         cols[name] = outs[:, slip.OUT[o]]
@@ -270,7 +281,9 @@ def summarise(scenario, kick, assembly, solution, frame, *, custom_tyres=False) 
         "end_time_s": float(frame["time"].iloc[-1]),
         "message": traj.message,
         "bicycle": assembly.bicycle,
-        "tyres": _tyres_section(scenario, assembly, custom_tyres),
+        "tyres": {**_tyres_section(scenario, assembly, custom_tyres),
+                  "carcass": _carcass_section(scenario, assembly, frame),
+                  "extrapolation": extrapolation(frame, assembly.rear, assembly.front)},
         "controller": _controller_section(scenario, assembly),
         "linear_stability": assembly.stability,
         "kick": kick.summary(scenario.kick_direction),
@@ -301,6 +314,90 @@ def _tyres_section(scenario, assembly, custom_tyres):
         "data_warnings": sorted({w for w in (getattr(assembly.rear, "data_warning", None),
                                              getattr(assembly.front, "data_warning", None)) if w}),
     }
+
+
+def _carcass_section(scenario, assembly, frame):
+    """The carcass tyre's stiffness, the load it is taken at (the run's start) and its options; None otherwise."""
+    if scenario.tyre_transient != "carcass":
+        return None
+    # The loads the stiffness was taken at: those of the state the run starts from (the kick start).
+    from . import carcass, slip
+    _, out = slip.CompiledRHS(assembly.start.params).outputs(0.0, assembly.start.x)
+    params = assembly.params
+    return {
+        "stiffness_rear_n_per_m": params["ccr"], "stiffness_front_n_per_m": params["ccf"],
+        "reference_load_rear_n": float(out[slip.OUT["fz_r"]]), "reference_load_front_n": float(out[slip.OUT["fz_f"]]),
+        "reference_load_is": "each wheel's normal load in the steady motion the run starts from: "
+                             "stiffness = cornering stiffness there / relaxation length",
+        "sliding": scenario.carcass_sliding, "damping_n_s_per_m": scenario.carcass_damping,
+        "sliding_viscosity_n_s_per_m": params["carcass_viscosity"],
+        "patch_slip_cap_deg": carcass.PATCH_SLIP_CAP_DEG,
+    }
+
+
+def extrapolation(frame, rear, front):
+    """Where a run leaves the ranges its tyre fits were measured over (after the kick start).
+
+    Per wheel: the measured |slip| and load range (the tyre file's
+    ``[measured]`` table, None when it has none) and the time [s] the patch
+    slip (the slip the steady curve is evaluated at), the kinematic slip and
+    the normal load spend outside them, with their extremes.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        A trajectory table (:func:`trajectory_frame`).
+    rear, front : whipple_kick.tyres.Tyre
+
+    Returns
+    -------
+    dict
+        ``rear`` and ``front``.
+    """
+    after = frame[frame["time"] >= 0.0]
+    t = after["time"].to_numpy()
+    dt = np.diff(t, append=t[-1]) if t.size else t
+
+    def seconds(mask):
+        return float(np.sum(dt[mask]))
+
+    out = {}
+    for wheel, tyre in (("rear", rear), ("front", front)):
+        measured = getattr(tyre, "measured", None)
+        patch_column = f"slip_patch_{wheel}" if f"slip_patch_{wheel}" in after else f"slip_{wheel}"
+        patch = np.degrees(np.abs(after[patch_column].to_numpy()))
+        kinematic = np.degrees(np.abs(after[f"slip_{wheel}"].to_numpy()))
+        load = after[f"fz_{wheel}"].to_numpy()
+        entry = {"max_abs_patch_slip_deg": float(patch.max(initial=0.0)),
+                 "max_abs_kinematic_slip_deg": float(kinematic.max(initial=0.0)),
+                 "max_load_n": float(load.max(initial=0.0)), "min_load_n": float(load.min(initial=0.0))}
+        if measured is None:
+            entry["measured"] = None
+        else:
+            entry.update({
+                "measured": {"slip_deg": measured["slip_deg"], "load_n": [measured["load_min"], measured["load_max"]]},
+                "patch_slip_beyond_s": seconds(patch > measured["slip_deg"]),
+                "kinematic_slip_beyond_s": seconds(kinematic > measured["slip_deg"]),
+                "load_outside_s": seconds((load < measured["load_min"]) | (load > measured["load_max"])),
+                "duration_s": float(t[-1] - t[0]) if t.size else 0.0,
+            })
+        out[wheel] = entry
+    return out
+
+
+def extrapolation_line(summary):
+    """One line saying where the run's tyre data were extrapolated (None when nothing is known)."""
+    parts = []
+    for wheel, e in (summary["tyres"].get("extrapolation") or {}).items():
+        m = e.get("measured")
+        if not m:
+            continue
+        parts.append(f"{wheel}: patch slip beyond +-{m['slip_deg']:g} deg for {e['patch_slip_beyond_s']:.2f} s "
+                     f"(max {e['max_abs_patch_slip_deg']:.0f} deg; kinematic slip max "
+                     f"{e['max_abs_kinematic_slip_deg']:.0f} deg), load outside {m['load_n'][0]:g}-"
+                     f"{m['load_n'][1]:g} N for {e['load_outside_s']:.2f} of {e['duration_s']:.2f} s "
+                     f"(max {e['max_load_n']:.0f} N)")
+    return "tyre fits extrapolated: " + "; ".join(parts) if parts else None
 
 
 def _controller_section(scenario, assembly):

@@ -17,7 +17,7 @@ Example
 """
 from dataclasses import asdict, dataclass, replace
 
-from . import inputs, transient
+from . import carcass, inputs, transient
 from .errors import InputError, check_range
 
 #: Rider models: the LQR designed on the linearised classic model, the thesis' Table 8.4 gains, or none.
@@ -142,11 +142,30 @@ class Scenario:
         integrates from -settle across the kick and the plate stop in one
         LSODA run, without the plate stop's impulse (for comparison only;
         not with a table, whose every interval is its own parameter set).
-    tyre_transient : {"contact_patch", "slip_lag", "force_lag"}
-        How the tyre forces build up (:mod:`whipple_kick.transient`):
-        lagged contact-patch slip and camber with a slip-dependent
-        relaxation length (default, passive and friction-limited); the same
+    tyre_transient : {"carcass", "contact_patch", "slip_lag", "force_lag"}
+        How the tyre forces build up (:mod:`whipple_kick.transient`): a
+        lateral carcass spring in series with a sliding contact patch
+        (default: passive and friction-limited whatever the load does; the
+        force lag at small slip, :mod:`whipple_kick.carcass`); lagged
+        contact-patch slip and camber with a slip-dependent relaxation
+        length (friction-limited, not passive under load changes); the same
         with a constant relaxation length; or the thesis' lagged force.
+    carcass_sliding : {"peak", "curve"}
+        The carcass tyre's friction limit once the patch slides past the
+        curve's peak: the peak itself (default, a Coulomb plateau that uses
+        nothing of the fit past the peak) or the steady curve at the
+        wheel's kinematic slip (steady sliding follows the fit's falling
+        branch). Carcass transient only.
+    carcass_damping : float
+        Lateral damping of each carcass [N s/m], parallel to its stiffness
+        (default 0: the thesis' pure relaxation). Carcass transient only.
+    carcass_viscosity : float
+        Numerics: the sliding viscosity [N s/m] that regularises an
+        undamped carcass' friction limit (a patch past the limit slides
+        faster by the excess force over it;
+        :data:`whipple_kick.carcass.SLIDING_VISCOSITY`). Smaller is closer
+        to the Coulomb plateau and stiffer (at least 1e-3 N s/m: below,
+        LSODA stalls); docs/validation.md shows the results converged.
     plate_stop : {"impulse", "resolve"}
         Speeds across the constant-acceleration profile's instant plate
         stop: the rear no-slip constraint's impulse (default) or a re-solve
@@ -206,7 +225,10 @@ class Scenario:
     fall_angle_deg: float = 45.0
     steer_limit_deg: float | None = 90.0
     piecewise: bool = True
-    tyre_transient: str = "contact_patch"
+    tyre_transient: str = transient.DEFAULT_TRANSIENT
+    carcass_sliding: str = carcass.DEFAULT_SLIDING
+    carcass_damping: float = 0.0
+    carcass_viscosity: float = carcass.SLIDING_VISCOSITY
     plate_stop: str = "impulse"
     kick_heading: str = "fixed"
     camber_sign: str = "physical"
@@ -282,7 +304,11 @@ class Scenario:
         check_range("gain scale", self.gain_scale, 0.0, 10.0, "(factor)")
         if self.controller not in CONTROLLERS:
             raise InputError(f"controller {self.controller!r} is unknown; choose one of {', '.join(CONTROLLERS)}")
+        check_range("carcass damping", self.carcass_damping, 0.0, 1e4, "N s/m")
+        # Below 1e-3 N s/m the plateau is so stiff that LSODA stalls at the plate stop (measured 5e-4).
+        check_range("carcass sliding viscosity", self.carcass_viscosity, 1e-3, 10.0, "N s/m")
         for label, value, choices in (("tyre transient", self.tyre_transient, TYRE_TRANSIENTS),
+                                      ("carcass sliding law", self.carcass_sliding, carcass.SLIDING_LAWS),
                                       ("plate stop", self.plate_stop, PLATE_STOPS),
                                       ("kick heading", self.kick_heading, KICK_HEADINGS),
                                       ("camber sign", self.camber_sign, CAMBER_SIGNS),

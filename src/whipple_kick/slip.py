@@ -25,7 +25,7 @@ import shutil
 
 import numpy as np
 
-from . import cache, energy, kane, magic_formula, rhs_call, transient
+from . import cache, carcass, energy, kane, magic_formula, rhs_call, transient
 from . import symbols as S
 from .errors import InputError
 
@@ -70,17 +70,27 @@ OUTPUTS = {
     "mz_f": ("N m", "aligning moment the front tyre applies to the bicycle"),
     "sigma_r": ("m", "rear relaxation length in use"),
     "sigma_f": ("m", "front relaxation length in use"),
+    "patch_slip_r": ("rad", "slip angle the rear steady curve is evaluated at: the contact patch's (the kinematic "
+                            "slip in force_lag)"),
+    "patch_slip_f": ("rad", "slip angle the front steady curve is evaluated at: the contact patch's (the kinematic "
+                            "slip in force_lag)"),
+    "fy_limit_r": ("N", "rear friction limit on the side of its force: the steady curve's extreme at the current "
+                        "load and camber (patch slip within the carcass tyre's cap)"),
+    "fy_limit_f": ("N", "front friction limit on the side of its force: the steady curve's extreme at the current "
+                        "load and camber (patch slip within the carcass tyre's cap)"),
 }
 #: Every output by position: the ten speeds (dependent ones included), then :data:`OUTPUTS`.
 OUTPUT_NAMES = SPEEDS + tuple(OUTPUTS)
 PARAMETER_NAMES = S.SLIP_CONSTANTS
 X = {n: i for i, n in enumerate(STATE_NAMES)}
 X.update({n: X[m] for n, m in zip(TYRE_STATES, PATCH_STATES, strict=True)})
+X.update({n: X[m] for n, m in zip(transient.STATES["carcass"], PATCH_STATES, strict=True)})
 OUT = {n: i for i, n in enumerate(OUTPUT_NAMES)}
 P = {n: i for i, n in enumerate(PARAMETER_NAMES)}
 
 #: Package modules the compiled library is generated from (its cache key hashes them).
-_SOURCES = ("symbols", "derivation", "codegen", "magic_formula", "transient", "energy", "slip", "slip_build")
+_SOURCES = ("symbols", "derivation", "codegen", "magic_formula", "transient", "carcass", "energy", "slip",
+            "slip_build")
 _PARTITION = kane.ConstraintPartition(SPEEDS, DEPENDENT)
 
 
@@ -174,6 +184,8 @@ def library():
     lib.wk_slip_jacobian.argtypes = [ctypes.c_double, pointer, pointer, pointer, pointer]
     lib.wk_slip_impulse_terms.restype = ctypes.c_int
     lib.wk_slip_impulse_terms.argtypes = [ctypes.c_double, pointer, pointer, pointer, pointer, pointer]
+    lib.wk_slip_cornering_stiffness.restype = ctypes.c_int
+    lib.wk_slip_cornering_stiffness.argtypes = [ctypes.c_double, ctypes.c_double, pointer, pointer]
     sizes = (ctypes.c_int * 4)()
     lib.wk_slip_sizes(sizes)
     if tuple(sizes) != (len(STATE_NAMES), len(PARAMETER_NAMES), len(OUTPUT_NAMES), len(DYNAMIC_STATES)):
@@ -398,7 +410,9 @@ def tyre_parameters(tyre, wheel, symmetric=False, lateral=True, reverse_camber=F
 
 def model_parameters(moore, rear_tyre, front_tyre, gains=None, kick=None,
                      symmetric=False, lateral=True, drive_torque=0.0,
-                     tyre_transient=transient.DEFAULT_TRANSIENT, reverse_camber=False):
+                     tyre_transient=transient.DEFAULT_TRANSIENT, reverse_camber=False,
+                     carcass_sliding=carcass.DEFAULT_SLIDING, carcass_damping=0.0,
+                     carcass_viscosity=carcass.SLIDING_VISCOSITY):
     """Assemble the slip model's parameters by name.
 
     Parameters
@@ -422,7 +436,17 @@ def model_parameters(moore, rear_tyre, front_tyre, gains=None, kick=None,
         Constant rear-wheel torque T6c [N m] about the rear frame's C.y axis
         (+ opposes forward rolling); the steady-state solver sets it.
     tyre_transient : str
-        One of :data:`whipple_kick.transient.TRANSIENTS` (default ``contact_patch``).
+        One of :data:`whipple_kick.transient.TRANSIENTS` (default ``carcass``).
+    carcass_sliding : {"peak", "curve"}
+        The carcass tyre's friction limit past the peak (:mod:`whipple_kick.carcass`).
+    carcass_damping : float
+        Lateral damping of both carcasses [N s/m], parallel to their stiffness
+        (default 0).
+    carcass_viscosity : float
+        :data:`whipple_kick.carcass.SLIDING_VISCOSITY` [N s/m]: the
+        regularisation of an undamped carcass' Coulomb plateau. The stiffnesses ``ccr``/``ccf`` are set by
+        :func:`steady_state` (or :func:`upright_state`) from the loads of the
+        state found: ``C_Fa(F_z0) / sigma0``.
     """
     params = {n: float(moore[n]) for n in S.CLASSIC_CONSTANTS}
     params.update(tyre_parameters(rear_tyre, "r", symmetric, lateral, reverse_camber))
@@ -442,8 +466,17 @@ def model_parameters(moore, rear_tyre, front_tyre, gains=None, kick=None,
         "T6c": float(drive_torque),
         "tyre_transient": float(transient.check(tyre_transient)),
         "vsx_r": 0.0,
+        "ccr": 0.0, "ccf": 0.0,   # set from the steady loads (_steady_tyre_states)
+        "dcr": float(carcass_damping), "dcf": float(carcass_damping),
+        "carcass_sliding": float(carcass.check_sliding(carcass_sliding)),
+        "carcass_viscosity": float(carcass_viscosity),
     })
     return params
+
+
+#: Parameters the steady solve sets (:func:`steady_state`): the rear-wheel torque holding the speed and the
+#: carcass stiffnesses at the steady loads.
+STEADY_PARAMETERS = ("T6c", "ccr", "ccf")
 
 
 class SteadyState:
@@ -530,23 +563,51 @@ def steady_state(params, speed, tol=1e-13, guess=None):
     xs = state(z)
     out_params = dict(params)
     out_params["T6c"] = float(z[-1])
+    out_params["ccr"], out_params["ccf"] = float(rhs.p[P["ccr"]]), float(rhs.p[P["ccf"]])
     return SteadyState(xs, out_params, res, dict(zip(names, z, strict=True)))
 
 
 def _steady_tyre_states(rhs, x):
     """``x`` with the tyre slots at their steady values for its kinematics.
 
-    The relaxed forces and moments at the steady curves (``force_lag``), or
-    the patch slip and camber at the kinematic ones (contact forms), both at
-    the state's own slip, camber and load.
+    The relaxed forces and moments at the steady curves (``force_lag``), the
+    patch slip and camber at the kinematic ones (contact forms), or the
+    carcass deflection carrying the steady force and the camber (carcass),
+    all at the state's own slip, camber and load. For the carcass tyre the
+    stiffnesses ``ccr``/``ccf`` of ``rhs`` are set first from the state's
+    loads (:func:`carcass_stiffness`), and its stored-energy quadratures to
+    ``c y^2 / 2`` (what the carcass holds at the start).
     """
-    names = (("fy_ss_r", "fy_ss_f", "mz_ss_r", "mz_ss_f") if rhs.transient == "force_lag"
-             else ("slip_r", "slip_f", "camber_r", "camber_f"))
+    form = rhs.transient
     x = np.array(x, dtype=float)
     _, out = rhs.outputs(0.0, x)
+    if form == "carcass":
+        stiffness = carcass_stiffness(rhs, out[OUT["fz_r"]], out[OUT["fz_f"]])
+        rhs.p[P["ccr"]], rhs.p[P["ccf"]] = stiffness
+        for k, wheel in enumerate("rf"):
+            c = stiffness[k]
+            y = out[OUT[f"fy_ss_{wheel}"]] / c if c > 0.0 else 0.0
+            x[X[f"carcass_y_{wheel}"]] = y
+            x[X[f"camber_patch_{wheel}"]] = out[OUT[f"camber_{wheel}"]]
+            x[X[f"E_carcass_{wheel}"]] = 0.5 * c * y * y
+        return x
+    names = (("fy_ss_r", "fy_ss_f", "mz_ss_r", "mz_ss_f") if form == "force_lag"
+             else ("slip_r", "slip_f", "camber_r", "camber_f"))
     for slot, out_name in zip(PATCH_STATES, names, strict=True):
         x[X[slot]] = out[OUT[out_name]]
     return x
+
+
+def carcass_stiffness(rhs, fz_rear, fz_front):
+    """Carcass lateral stiffnesses (rear, front) [N/m]: ``C_Fa(F_z0) / sigma0`` at the given loads [N].
+
+    ``C_Fa`` is the cornering stiffness ``-dF_y/dslip`` at zero slip and
+    camber (of the blended, scaled curve the model evaluates), computed by
+    the compiled model.
+    """
+    out = np.empty(2)
+    rhs.lib.wk_slip_cornering_stiffness(float(fz_rear), float(fz_front), rhs.p.ctypes.data, out.ctypes.data)
+    return out / np.array([rhs.p[P["sigr"]], rhs.p[P["sigf"]]])
 
 
 def upright_state(params, speed, tol=1e-13):
@@ -612,6 +673,7 @@ def upright_state(params, speed, tol=1e-13):
     dx = rhs(0.0, xs)
     unknowns = dict(zip(names, (float(v) for v in sol.x), strict=True))
     unknowns["largest_rate"] = float(max(abs(dx[X[n]]) for n in ("u2", "u3", "u4", "u7")))
+    out_params["ccr"], out_params["ccf"] = float(rhs.p[P["ccr"]]), float(rhs.p[P["ccf"]])
     return SteadyState(xs, out_params, res, unknowns)
 
 
@@ -863,6 +925,8 @@ def _difference_scales(form):
         scale[X[name]] = 1e-3
     if form == "force_lag":
         scale[[X[s] for s in TYRE_STATES]] = 1e2
+    if form == "carcass":   # deflections ~1e-2 m at the friction limit
+        scale[[X["carcass_y_r"], X["carcass_y_f"]]] = 1e-2
     scale.flags.writeable = False
     return scale
 

@@ -28,7 +28,7 @@ import numpy as np
 import sympy as sm
 from sympy.printing.c import C99CodePrinter
 
-from . import cache, codegen, energy, fileio, kane, magic_formula, transient
+from . import cache, carcass, codegen, energy, fileio, kane, magic_formula, transient
 from . import symbols as S
 from .errors import BuildError
 from .slip import (
@@ -54,10 +54,14 @@ _KINEMATICS = ("vsy_r", "vsy_f", "vx_r", "vx_f", "camber_r", "camber_f", "fz_r",
 _APPLIED = ("Fy_r", "Fy_f", "Mz_r", "Mz_f")
 #: What each tyre block returns, in order (beyond the applied loads): the four
 #: state rates, then the form-dependent quadrature rates and relaxation lengths.
-_BLOCK_EXTRAS = ("W0", "D_slide", "P_carcass_r", "P_carcass_f", "sigma_r", "sigma_f")
+_BLOCK_EXTRAS = ("W0", "D_slide", "P_carcass_r", "P_carcass_f", "D_carcass", "sigma_r", "sigma_f",
+                 "patch_slip_r", "patch_slip_f")
 #: Output names the C code copies from the tyre block rather than computing.
 _BLOCK_OUTPUTS = {"fy_r": "Fy_r", "fy_f": "Fy_f", "mz_r": "Mz_r", "mz_f": "Mz_f",
-                  "sigma_r": "sigma_r", "sigma_f": "sigma_f"}
+                  "sigma_r": "sigma_r", "sigma_f": "sigma_f", "patch_slip_r": "patch_slip_r",
+                  "patch_slip_f": "patch_slip_f"}
+#: Outputs computed by a compiled helper for every form: the friction limit on the force's side.
+_LIMIT_OUTPUTS = ("fy_limit_r", "fy_limit_f")
 
 
 # ------------------------------------------------------------ tyre curves
@@ -107,6 +111,78 @@ def _called_curves():
     return {"fy": call("fy"), "mz": call("mz"), "secant": call("sec")}
 
 
+def _factor_symbols():
+    """Symbols printing as ``f[0]`` .. ``f[5]``: the factors B C D E Sh Sv in the generic C curve."""
+    return [sm.Symbol(f"f[{i}]", real=True) for i in range(6)]
+
+
+def _c_carcass_curves():
+    """C of the Magic-Formula pieces the carcass tyre needs, generated from :mod:`magic_formula`.
+
+    ``wk_mf_y``/``wk_mf_dy``: the formula-convention curve of given factors
+    and its slope per degree; per wheel and set, ``wk_fyfac_<w>_<k>`` (the
+    factors at a camber and load, as :func:`magic_formula.lateral_force_model_factors`)
+    and ``wk_fyg_<w>_<k>`` (the set's model force and its derivatives in
+    slip, camber and load); per wheel the blend ``wk_fyg_<w>`` and the
+    friction limit on a force's side ``wk_fylim_<w>`` (an output).
+    """
+    a_deg = sm.Symbol("a_deg", real=True)
+    f = _factor_symbols()
+    factors = dict(zip(("B", "C", "D", "E", "Sh", "Sv"), f, strict=True))
+    y = magic_formula._curve(a_deg, factors)
+    printer = _Printer()
+    mf_y = ("static double wk_mf_y(double a_deg, const double *f)\n{\n"
+            f"    return {printer.doprint(y)};\n}}")
+    mf_dy = ("static double wk_mf_dy(double a_deg, const double *f)\n{\n"
+             f"    return {printer.doprint(sm.diff(y, a_deg))};\n}}")
+    slip, camber, fz = sm.symbols("slip camber fz", real=True)
+    lines = []
+    for wheel in "rf":
+        for k in (1, 2):
+            sets, _, mu, _ = _wheel_parameters(wheel, "a")
+            fac = magic_formula.lateral_force_model_factors(camber, fz, sets[k - 1], friction_scale=mu)
+            exprs = [fac[n] for n in ("B", "C", "D", "E", "Sh", "Sv")]
+            lines += [f"static void wk_fyfac_{wheel}_{k}(double camber, double fz, const double *p, double *fac)",
+                      "{", *_parameter_locals(exprs), _c_block(exprs, [f"fac[{i}]" for i in range(6)]), "}"]
+            # The factors at two cambers in one CSE'd block (the load terms shared).
+            lagged = sm.Symbol("gl", real=True)
+            fac2 = magic_formula.lateral_force_model_factors(lagged, fz, sets[k - 1], friction_scale=mu)
+            both = exprs + [fac2[n] for n in ("B", "C", "D", "E", "Sh", "Sv")]
+            lines += [f"static void wk_fyfac2_{wheel}_{k}(double camber, double gl, double fz, const double *p, "
+                      "double *fac, double *fac2)", "{", *_parameter_locals(both),
+                      _c_block(both, [f"fac[{i}]" for i in range(6)] + [f"fac2[{i}]" for i in range(6)]), "}"]
+            e = _set_curve("fy", wheel, k, slip, camber, fz)
+            grad = [e, sm.diff(e, slip), sm.diff(e, camber), sm.diff(e, fz)]
+            lines += [f"static void wk_fyg_{wheel}_{k}(double slip, double camber, double fz, const double *p, "
+                      "double *g)", "{", *_parameter_locals(grad), _c_block(grad, [f"g[{i}]" for i in range(4)]),
+                      "}"]
+        lines += [f"static void wk_fyg_{wheel}(double slip, double camber, double fz, const double *p, double *g)",
+                  "{", f"    const double w = p[{P['w' + wheel]}], lam = p[{P['lam' + wheel]}];",
+                  "    double g2[4];",
+                  f"    wk_fyg_{wheel}_1(slip, camber, fz, p, g);",
+                  "    for (int i = 0; i < 4; i++) g[i] *= (1.0 - w);",
+                  f"    if (w != 0.0) {{ wk_fyg_{wheel}_2(slip, camber, fz, p, g2); "
+                  "for (int i = 0; i < 4; i++) g[i] += w * g2[i]; }",
+                  "    for (int i = 0; i < 4; i++) g[i] *= lam;", "}"]
+    return mf_y, mf_dy, lines
+
+
+def _c_limit_functions():
+    """Per wheel ``wk_fylim_<w>(camber, fz, F, p)``: the friction limit on the side of ``F`` [N] (an output)."""
+    lines = []
+    for wheel in "rf":
+        lines += [f"static double wk_fylim_{wheel}(double camber, double fz, double F, const double *p)", "{",
+                  "    if (!(fz > 0.0)) return 0.0;",
+                  "    wk_curve c; double lo, hi;",
+                  f"    c.w = p[{P['w' + wheel]}]; c.lam = p[{P['lam' + wheel]}]; c.two = c.w != 0.0;",
+                  f"    wk_fyfac_{wheel}_1(camber, fmax(fz, {carcass.FZ_SHAPE_FLOOR!r}), p, c.f1);",
+                  f"    if (c.two) wk_fyfac_{wheel}_2(camber, fmax(fz, {carcass.FZ_SHAPE_FLOOR!r}), p, c.f2);",
+                  "    if (!(c.f1[2] > 0.0) || (c.two && !(c.f2[2] > 0.0))) return 0.0;   /* no grip in the fit */",
+                  "    wk_curve_branch(&c, &lo, &hi);",
+                  "    return F >= 0.0 ? wk_curve_F(&c, lo) : -wk_curve_F(&c, hi);", "}"]
+    return lines
+
+
 # ---------------------------------------------------------------- expressions
 
 @functools.cache
@@ -144,7 +220,7 @@ def _expressions():
     kin = {name: plain(ex[name]) for name in _KINEMATICS}
     u = {f"u{i + 1}": codegen.plain_symbol(s) for i, s in enumerate(eom.u)}
     sigma0 = {"r": S.sym("sigr"), "f": S.sym("sigf")}
-    blocks = {style: {name: transient.tyre_block(name, curves(), sigma0) for name in transient.TRANSIENTS}
+    blocks = {style: {name: transient.tyre_block(name, curves(), sigma0) for name in transient.SYMBOLIC}
               for style, curves in (("inline", _inline_curves), ("called", _called_curves))}
     common = {k: plain(v) for k, v in energy.common_rates(ex, u, S.sym("T6c")).items()}
     k_sym = {name: S.sym(name) for name in _KINEMATICS + _APPLIED}
@@ -194,6 +270,11 @@ def _output_list(ex, style):
     for name in OUTPUT_NAMES[len(SPEEDS):]:
         if name in _BLOCK_OUTPUTS:
             out.append(sm.Symbol(_BLOCK_OUTPUTS[name], real=True))
+        elif name in _LIMIT_OUTPUTS:
+            w = name[-1]
+            args = [sm.Symbol(f"camber_{w}", real=True), sm.Symbol(f"fz_{w}", real=True),
+                    sm.Symbol(f"Fy_{w}", real=True)]
+            out.append(sm.Function(f"wk_fylim_{w}")(*args) if style == "called" else sm.Symbol(name, real=True))
         else:
             out.append(steady[name] if name in steady else ex["outputs"][name])
     return out
@@ -308,6 +389,11 @@ def _c_curve_functions():
     return lines
 
 
+#: Quadrature states whose rates the tyre block gives, and the block's local names for them.
+_BLOCK_QUADRATURES = (("W_zero_slip", "W0"), ("D_slide", "D_slide"), ("E_carcass_r", "P_carcass_r"),
+                      ("E_carcass_f", "P_carcass_f"), ("D_carcass", "D_carcass"))
+
+
 def c_source():
     """Full C source of the slip model: right-hand side, outputs, Jacobian, impulse terms."""
     ex = _expressions()
@@ -318,15 +404,19 @@ def c_source():
     no = len(OUTPUT_NAMES) - n
     dep = [SPEEDS.index(x) for x in DEPENDENT]
     ind = [SPEEDS.index(x) for x in INDEPENDENT]
-    lines = [_C_HELPERS, "/* Generated by whipple_kick.slip; do not edit. */", *_c_curve_functions()]
+    mf_y, mf_dy, carcass_curves = _c_carcass_curves()
+    lines = [_C_HELPERS, "/* Generated by whipple_kick.slip; do not edit. */", *_c_curve_functions(),
+             *carcass_curves, carcass.c_source(P, mf_y, mf_dy), *_c_limit_functions()]
     lines += ["int wk_slip_rhs(double t, const double *x, const double *p, double *dx, double *out)", "{"]
     for i, s in enumerate(sy["p"]):
         lines.append(f"    const double {s.name} = p[{i}];")
     for i, s in enumerate(sy["q"]):
         lines.append(f"    const double {s.name} = x[{i}];")
+    declared = set()   # forms share slot names (slip_lag's are contact_patch's, the carcass' camber too)
     for name in transient.TRANSIENTS:
         for slot, s in enumerate(sy["s"][name]):
-            if name != "slip_lag":   # slip_lag shares contact_patch's names
+            if s.name not in declared:
+                declared.add(s.name)
                 lines.append(f"    const double {s.name} = x[{len(COORDINATES) + k + slot}];")
     lines.append(f"    double A[{m * n}], a0[{m}];")
     stage1 = ex["stage1"]
@@ -364,11 +454,23 @@ def c_source():
     block_targets = list(_APPLIED) + [f"trate[{i}]" for i in range(nt)] + list(_BLOCK_EXTRAS)
     lines.append(f"    double {', '.join(_APPLIED)}, trate[{nt}], {', '.join(_BLOCK_EXTRAS)};")
     lines.append("    const int mode = (int)tyre_transient;")
-    for code, name in enumerate(transient.TRANSIENTS):
+    lines.append("    wk_carcass_state cr, cf;")
+    for code, name in enumerate(transient.SYMBOLIC):
         head = "if" if code == 0 else "else if"
-        cond = f"(mode == {code})" if code < len(transient.TRANSIENTS) - 1 else "(1)"
-        lines += [f"    {head} {cond} {{", _c_block(_block_list(ex["blocks"]["called"][name]), block_targets, "        "),
-                  "    }"]
+        lines += [f"    {head} (mode == {transient.TRANSIENTS.index(name)}) {{",
+                  _c_block(_block_list(ex["blocks"]["called"][name]), block_targets, "        "), "    }"]
+    # The carcass tyre (whipple_kick.carcass): written in C, not a SymPy expression.
+    lines += ["    else {",
+              "        wk_carcass_r(vsy_r, vx_r, camber_r, fz_r, carcass_y_r, camber_patch_r, p, &cr);",
+              "        wk_carcass_f(vsy_f, vx_f, camber_f, fz_f, carcass_y_f, camber_patch_f, p, &cf);",
+              "        Fy_r = cr.F; Fy_f = cf.F; Mz_r = cr.M; Mz_f = cf.M;",
+              "        trate[0] = cr.rate; trate[1] = cf.rate; trate[2] = cr.gl_rate; trate[3] = cf.gl_rate;",
+              "        W0 = cr.F0 * cr.vslide + cf.F0 * cf.vslide;",
+              "        D_slide = -(cr.F - cr.F0) * cr.vslide - (cf.F - cf.F0) * cf.vslide;",
+              "        P_carcass_r = cr.cc * cr.y * cr.rate; P_carcass_f = cf.cc * cf.y * cf.rate;",
+              "        D_carcass = cr.dc * cr.rate * cr.rate + cf.dc * cf.rate * cf.rate;",
+              "        sigma_r = sigr; sigma_f = sigf; patch_slip_r = cr.slip; patch_slip_f = cf.slip;",
+              "    }"]
     lines.append(f"    for (int i = 0; i < {n}; i++) f[i] += G[i * 4] * Fy_r + G[i * 4 + 1] * Fy_f"
                  " + G[i * 4 + 2] * Mz_r + G[i * 4 + 3] * Mz_f;")
     # Kane's reduced equations: T = [I; C], C = -A_dep^-1 A_ind, t0 = [0; d], d = -A_dep^-1 b.
@@ -408,8 +510,7 @@ def c_source():
                                  [f"dx[{q0 + QUADRATURE_STATES.index(nm)}]"
                                   for nm in ("W_plate", "W_steer", "W_wheel", "W_moment", "D_damper")], "        "),
               "    }"]
-    for nm, local in (("W_zero_slip", "W0"), ("D_slide", "D_slide"), ("E_carcass_r", "P_carcass_r"),
-                      ("E_carcass_f", "P_carcass_f")):
+    for nm, local in _BLOCK_QUADRATURES:
         lines.append(f"    dx[{q0 + QUADRATURE_STATES.index(nm)}] = {local};")
     # Work of the rear no-slip constraint's force while the plate moves:
     # u . (M du/dt - f) = -lambda . a0 (zero when a0 = 0, so skipped then).
@@ -457,6 +558,10 @@ def c_source():
                                  [f"A[{i}]" for i in range(m * n)] + [f"a0[{i}]" for i in range(m)], "        "), "    }",
               "    {", _c_block(mass, [f"M[{i}]" for i in range(n * n)], "        "), "    }",
               "    return 0;", "}"]
+    # Cornering stiffness -dF/dslip at zero slip and camber per wheel (the carcass stiffness' numerator).
+    lines += ["int wk_slip_cornering_stiffness(double fzr, double fzf, const double *p, double *out)", "{",
+              "    double g[4];", "    wk_fyg_r(0.0, 0.0, fzr, p, g); out[0] = -g[1];",
+              "    wk_fyg_f(0.0, 0.0, fzf, p, g); out[1] = -g[1];", "    return 0;", "}"]
     lines.append(f"int wk_slip_sizes(int *sizes) {{ sizes[0] = {ns}; sizes[1] = {len(PARAMETER_NAMES)}; "
                  f"sizes[2] = {len(OUTPUT_NAMES)}; sizes[3] = {nd}; return 0; }}")
     return "\n".join(lines) + "\n"
@@ -480,7 +585,7 @@ def numpy_source():
                                doc="Mass matrix, forcing without tyre loads, its tyre-load derivative, "
                                    "constraint remainder, tyre-block inputs."),
     ]
-    for name in transient.TRANSIENTS:
+    for name in transient.SYMBOLIC:
         parts.append(codegen.numpy_function(
             f"tyre_{name}", [("t", t), ("k", sy["kinematics"]), ("s", sy["s"][name]), ("p", sy["p"])],
             [sm.Matrix(_block_list(ex["blocks"]["inline"][name]))], doc=f"Tyre block of {name}."))
@@ -490,7 +595,7 @@ def numpy_source():
                    ("p", sy["p"])],
         [sm.Matrix([common[nm] for nm in ("W_plate", "W_steer", "W_wheel", "W_moment", "D_damper")])],
         doc="Form-independent quadrature rates."))
-    block_symbols = [sm.Symbol(n, real=True) for n in _BLOCK_EXTRAS]
+    block_symbols = [sm.Symbol(n, real=True) for n in _BLOCK_EXTRAS + _LIMIT_OUTPUTS]
     parts.append(codegen.numpy_function(
         "outputs", [("t", t), ("q", sy["q"]), ("u", sy["u"]), ("k", sy["kinematics"]), ("a", sy["applied"]),
                     ("e", block_symbols), ("p", sy["p"])],
@@ -520,7 +625,7 @@ def numpy_rhs(t, x, p, with_outputs=False):
         A, a0 = mod.stage1([t], q, p)
         u = _PARTITION.dependent_speeds(A, a0, u_ind)
         M, f0, G, b, kin = mod.stage2([t], q, u, p)
-        block = getattr(mod, f"tyre_{name}")([t], kin, s, p)[0]
+        block = _carcass_block(kin, s, p) if name == "carcass" else getattr(mod, f"tyre_{name}")([t], kin, s, p)[0]
         applied = block[:4]
         f = f0 + G @ applied
         udot = _PARTITION.accelerations(M, f, A, b)
@@ -529,16 +634,79 @@ def numpy_rhs(t, x, p, with_outputs=False):
         for value, nm in zip(common, ("W_plate", "W_steer", "W_wheel", "W_moment", "D_damper"), strict=True):
             rates[QUADRATURE_STATES.index(nm)] = value
         extras = dict(zip(_BLOCK_EXTRAS, block[8:], strict=True))
-        for nm, local in (("W_zero_slip", "W0"), ("D_slide", "D_slide"), ("E_carcass_r", "P_carcass_r"),
-                          ("E_carcass_f", "P_carcass_f")):
+        for nm, local in _BLOCK_QUADRATURES:
             rates[QUADRATURE_STATES.index(nm)] = extras[local]
         if np.any(a0 != 0.0):
             rates[QUADRATURE_STATES.index("W_plate")] += kane.constraint_power(M, f, u, udot)
         dx = np.concatenate([u, udot[_PARTITION.ind], block[4:8], rates])
         if with_outputs:
-            outputs = mod.outputs([t], q, u, kin, applied, block[8:], p)[0]
+            limits = [_reference_limit(p, w, kin, applied[k]) for k, w in enumerate("rf")]
+            outputs = mod.outputs([t], q, u, kin, applied, np.concatenate([block[8:], limits]), p)[0]
             return dx, np.concatenate([u, outputs])
     return dx
+
+
+def _reference_curves(p, wheel):
+    """(F_ss, M_ss) of one wheel from a parameter array, by the NumPy Magic Formula (blend and scale applied)."""
+    w, mu, lam = p[P[f"w{wheel}"]], p[P[f"mu{wheel}"]], p[P[f"lam{wheel}"]]
+    sets = [(1.0 - w, [p[P[f"a{wheel}{k}_{i}"]] for i in range(14)], [p[P[f"c{wheel}{k}_{i}"]] for i in range(18)])
+            for k in (1, 2)]
+    sets[1] = (w, *sets[1][1:])
+
+    def fy(slip, camber, fz):
+        return lam * sum(wt * magic_formula.lateral_force_numpy(slip, camber, fz, a, mu) for wt, a, _ in sets if wt)
+
+    def mz(slip, camber, fz):
+        return lam * sum(wt * magic_formula.aligning_moment_numpy(slip, camber, fz, c, mu) for wt, _, c in sets if wt)
+    return fy, mz
+
+
+def _grip(p, wheel, camber, fz):
+    """Whether every coefficient set of a wheel has a positive peak factor D at this load (NumPy factors)."""
+    w, mu = p[P[f"w{wheel}"]], p[P[f"mu{wheel}"]]
+    sets = [k for k, weight in ((1, 1.0 - w), (2, w)) if weight]
+    return all(magic_formula.lateral_force_factors_numpy(camber, max(fz, carcass.FZ_SHAPE_FLOOR),
+                                                         [p[P[f"a{wheel}{k}_{i}"]] for i in range(14)], mu)["D"] > 0
+               for k in sets)
+
+
+def _kin_of(kin, wheel):
+    return tuple(float(kin[_KINEMATICS.index(f"{n}_{wheel}")]) for n in ("vsy", "vx", "camber", "fz"))
+
+
+def _carcass_block(kin, s, p):
+    """Both wheels' carcass blocks by :func:`whipple_kick.carcass.reference_block`, in the C block's layout."""
+    sliding = carcass.SLIDING_LAWS[int(p[P["carcass_sliding"]])]
+    extras = dict.fromkeys(_BLOCK_EXTRAS, 0.0)
+    out = {}
+    for k, wheel in enumerate("rf"):
+        fy, mz = _reference_curves(p, wheel)
+        vsy, vx, camber, fz = _kin_of(kin, wheel)
+        cc, dc = p[P[f"cc{wheel}"]], p[P[f"dc{wheel}"]]
+        o = carcass.reference_block(fy, mz, vsy, vx, camber, fz, s[k], s[k + 2], cc, dc, p[P[f"sig{wheel}"]],
+                                    sliding, viscosity=p[P["carcass_viscosity"]], grip=_grip(p, wheel, camber, fz))
+        out[wheel] = o
+        f0 = float(fy(0.0, camber, fz)) if fz > 0 else 0.0
+        vslide = vsy + o["rate"]
+        extras["W0"] += f0 * vslide
+        extras["D_slide"] += -(o["F"] - f0) * vslide
+        extras[f"P_carcass_{wheel}"] = cc * s[k] * o["rate"]
+        extras["D_carcass"] += dc * o["rate"] ** 2
+        extras[f"sigma_{wheel}"] = p[P[f"sig{wheel}"]]
+        extras[f"patch_slip_{wheel}"] = o["slip"]
+    r, f = out["r"], out["f"]
+    return np.array([r["F"], f["F"], r["M"], f["M"], r["rate"], f["rate"], r["gl_rate"], f["gl_rate"],
+                     *(extras[n] for n in _BLOCK_EXTRAS)])
+
+
+def _reference_limit(p, wheel, kin, force):
+    """The friction limit [N] on the side of ``force`` by the reference block's scan (an output)."""
+    fy, _ = _reference_curves(p, wheel)
+    vsy, vx, camber, fz = _kin_of(kin, wheel)
+    if fz <= 0 or not _grip(p, wheel, camber, fz):
+        return 0.0
+    ref = carcass.reference_block(fy, lambda *a: 0.0, vsy, vx, camber, fz, 0.0, camber, 1.0, 0.0, 1.0)
+    return ref["fmax"] if force >= 0 else -ref["fmin"]
 
 
 # ------------------------------------------------------------------ the build

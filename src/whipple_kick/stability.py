@@ -91,12 +91,13 @@ _LABELS = {
     **{q: col for q, col in results.COORDINATE_COLUMNS.items()},
     **{u: col for u, col in results.SPEED_COLUMNS.items()},
     **{state: (col, "rad") for state, col in results.PATCH_STATE_COLUMNS.items()},
+    **{state: (col, "m") for state, col in results.CARCASS_STATE_COLUMNS.items()},
     "v_fwd": ("forward_velocity", "m/s"), "v_lat": ("lateral_velocity", "m/s"),
     "fyr": ("fy_rear", "N"), "fyf": ("fy_front", "N"), "mzr": ("mz_rear", "N m"), "mzf": ("mz_front", "N m"),
 }
 
 
-def state_labels(transient="contact_patch", constant_speed=True):
+def state_labels(transient=slip.transient.DEFAULT_TRANSIENT, constant_speed=True):
     """(name, unit) of each state of the linear model, in order.
 
     Parameters
@@ -390,7 +391,8 @@ def mode_content(model, eigenvalue, vector, wheelbase):
     for name in model.states[-4:]:   # tyre slots: rear, front, rear, front
         i = idx[name]
         gain = 1.0
-        if name in slip.TYRE_STATES:   # force-lag forces and moments: per radian of slip
+        if name in slip.TYRE_STATES or name in results.CARCASS_STATE_COLUMNS:
+            # force-lag forces and moments, carcass deflections: per radian of slip
             gain = abs(M[i, idx["v_lat"]]) * speed / abs(M[i, i])
         lag.append(lam * vec[i] / (-M[i, i]) / gain)
     scaled = np.array([
@@ -634,8 +636,8 @@ class _Loop:
         """
         params = _loop_params(self.setup, speed, self.loop, self.base)
         if other is not None:
-            shared = slip.SteadyState(other.x, {**params, "T6c": other.params["T6c"]}, other.residual,
-                                      other.unknowns)
+            shared = slip.SteadyState(other.x, {**params, **{n: other.params[n] for n in slip.STEADY_PARAMETERS}},
+                                      other.residual, other.unknowns)
             rhs = slip.CompiledRHS(shared.params)
             if abs(rhs.outputs(0.0, shared.x)[1][slip.OUT["T7"]]) < ZERO_TORQUE_N_M:
                 return linearise(params, shared, self.loop, "the other loop's (no steer torque)")
@@ -1267,7 +1269,7 @@ def free_response(model, vector, amplitude=1e-4, duration=2.0, rate=500.0, rtol=
     traj = lsoda.integrate(rhs, x0, duration, rtol=rtol, output_rate=rate)
     if traj.failed or traj.fell:
         raise FloatingPointError(f"the free response did not complete: {traj.message}")
-    keep = [slip.LINEAR_STATES.index(n) for n in model.states]
+    keep = [slip.linear_states(rhs.transient).index(n) for n in model.states]
     z_ref = slip.heading_state(model.steady.x)[keep]
     deviation = np.array([slip.heading_state(x)[keep] for x in traj.x]) - z_ref
     return traj.t, deviation

@@ -105,6 +105,11 @@ def _entries():
         ("slip_patch_f", "front tyre contact-patch (lagged) slip angle, + = patch sliding right", "rad", s),
         ("camber_patch_r", "rear tyre contact-patch (lagged) camber angle, + = top leaning right", "rad", s),
         ("camber_patch_f", "front tyre contact-patch (lagged) camber angle, + = top leaning right", "rad", s),
+        # --- carcass tyre states (transient carcass; its lagged camber is camber_patch_*) --
+        ("carcass_y_r", "rear tyre lateral carcass deflection: contact patch relative to the rim, along A.y "
+                        "(the carcass force on the wheel is ccr times it)", "m", s),
+        ("carcass_y_f", "front tyre lateral carcass deflection: contact patch relative to the rim, along the "
+                        "front lateral axis", "m", s),
         # --- cumulative work and dissipation (quadrature states, from 0 at the start) --
         ("W_plate", "cumulative work of the kick plate on the bicycle (tyre force and rear no-slip constraint)", "J", s),
         ("W_steer", "cumulative work of the steer torque T7 (T7 u7)", "J", s),
@@ -115,6 +120,7 @@ def _entries():
         ("D_damper", "cumulative dissipation of the vertical tyre dampers", "J", s),
         ("E_carcass_r", "rear tyre carcass energy: integral of the power into the lateral carcass compliance", "J", s),
         ("E_carcass_f", "front tyre carcass energy: integral of the power into the lateral carcass compliance", "J", s),
+        ("D_carcass", "cumulative dissipation of the carcass tyres' lateral dampers, d (dy/dt)^2", "J", s),
         # --- tyre block: applied loads and its kinematic inputs (plain symbols) --
         ("Fy_r", "lateral force the rear tyre applies to the wheel (along A.y), from the active transient form", "N", i),
         ("Fy_f", "lateral force the front tyre applies to the wheel (along the front lateral axis)", "N", i),
@@ -159,7 +165,16 @@ def _entries():
                   "it non-zero)", "m/s", c),
         ("T6c", "constant rear-wheel torque holding the steady speed, about C.y (the rear frame's right-pointing "
                 "axis) on the wheel: + opposes forward rolling (a brake), - drives", "N m", c),
-        ("tyre_transient", "tyre transient form: 0 contact_patch (default), 1 slip_lag, 2 force_lag (thesis)", "-", c),
+        ("tyre_transient", "tyre transient form: 0 contact_patch, 1 slip_lag, 2 force_lag (thesis), "
+                           "3 carcass (default)", "-", c),
+        ("ccr", "rear carcass lateral stiffness C_Fa(F_z0)/sigma0 (carcass transient)", "N/m", c),
+        ("ccf", "front carcass lateral stiffness C_Fa(F_z0)/sigma0 (carcass transient)", "N/m", c),
+        ("dcr", "rear carcass lateral damping, parallel to its stiffness (carcass transient)", "N s/m", c),
+        ("dcf", "front carcass lateral damping, parallel to its stiffness (carcass transient)", "N s/m", c),
+        ("carcass_sliding", "carcass friction limit past the peak: 0 the peak (Coulomb plateau), 1 the steady "
+                            "curve at the kinematic slip", "-", c),
+        ("carcass_viscosity", "sliding viscosity of an undamped carcass tyre's patch past its friction limit "
+                              "(regularises the Coulomb plateau)", "N s/m", c),
     ]
     fy_units = ["-", "N/kN^2", "N/kN", "N/deg", "kN", "1/deg", "1/kN", "-", "deg/deg", "deg/kN",
                 "deg", "N/(kN deg)", "N/kN", "N"]
@@ -195,6 +210,7 @@ SLIP_CONSTANTS = CLASSIC_CONSTANTS + (
     "wr", "wf", "mur", "muf", "lamr", "lamf",
     "kick_t0", "kick_T", "kick_D", "kick_profile", "kick_c0", "kick_c1", "kick_c2", "kick_c3",
     "kq3", "kq4", "kq7", "ku3", "ku4", "ku7", "T6c", "tyre_transient", "vsx_r",
+    "ccr", "ccf", "dcr", "dcf", "carcass_sliding", "carcass_viscosity",
 ) + tuple(f"{kind}{wheel}{k}_{i}" for wheel in "rf" for k in (1, 2)
           for kind, n in (("a", 14), ("c", 18)) for i in range(n))
 

@@ -74,8 +74,14 @@ _FRICTION_QUANTITIES = {
     "mu_rig": ("-", 0.0, True),
     "thesis_curve_scale": ("-", 0.0, True),
 }
+#: The optional ``[measured]`` table: the ranges the fits were measured over (what lies outside is extrapolation).
+_MEASURED_QUANTITIES = {
+    "slip_deg": ("deg", 0.0, True),
+    "load_min": ("N", 0.0, True),
+    "load_max": ("N", 0.0, True),
+}
 _TOP_KEYS = {"name", "description", "size", "source", "warning", "formula", "friction",
-             "pressure", "coefficients"}
+             "pressure", "coefficients", "measured"}
 _SET_ENTRY_KEYS = {"fy", "fy_source", "mz", "mz_source", "mz_from"}
 
 
@@ -176,8 +182,21 @@ def read_tyre_file(path):
         _fail(path, "pressure", "needs at least one pressure table, e.g. [pressure.400]")
 
     sets = _read_sets(path, _table(path, "coefficients", data["coefficients"]), properties)
-    return TyreFile(path, name, _text(path, "description", data["description"]),
-                    data.get("size", ""), warning, friction, properties, sets)
+    measured = None
+    if "measured" in data:
+        table = _table(path, "measured", data["measured"])
+        extra = set(table) - set(_MEASURED_QUANTITIES)
+        if extra:
+            _fail(path, f"measured.{sorted(extra)[0]}", f"unknown key; allowed: {', '.join(_MEASURED_QUANTITIES)}")
+        measured = {key: _quantity(path, f"measured.{key}", table.get(key), *spec)
+                    for key, spec in _MEASURED_QUANTITIES.items()}
+        if measured["load_min"] > measured["load_max"]:
+            _fail(path, "measured.load_min", f"{measured['load_min']:g} N exceeds load_max "
+                                             f"{measured['load_max']:g} N")
+    tyre_file = TyreFile(path, name, _text(path, "description", data["description"]),
+                         data.get("size", ""), warning, friction, properties, sets)
+    tyre_file.measured = measured
+    return tyre_file
 
 
 def _read_sets(path, table, properties):
@@ -342,6 +361,9 @@ class Tyre:
         Whether published M_z coefficients exist for this tyre.
     data_warning : str or None
         The tyre file's warning about its data.
+    measured : dict or None
+        The ranges the fits were measured over, from the file's ``[measured]``
+        table: ``slip_deg`` (|slip|, deg), ``load_min``, ``load_max`` (N).
     """
 
     def __init__(self, data, pressure_kpa, coefficient_set, friction, missing_moment):
@@ -365,6 +387,8 @@ class Tyre:
         self.curve_scale = data.friction["thesis_curve_scale"] if friction == "thesis" else 1.0
         self._sets = [(w, coefficients[p][0], coefficients[p][1]) for w, p in self._weights]
         self.has_aligning_moment = all(mz is not None for _, _, mz in self._sets)
+        #: Measured ranges of the fits (``slip_deg``, ``load_min``, ``load_max``; deg, N), or None.
+        self.measured = getattr(data, "measured", None)
 
     def __repr__(self):
         return (f"Tyre({self.name!r}, pressure_kpa={self.pressure_kpa:g}, "
