@@ -6,6 +6,7 @@ Usage:
     python scripts/bench.py build      # cold build (derive + generate + compile) and warm start, fresh processes
     python scripts/bench.py run        # the 6 s kick-plate base case at rtol 1e-12 and 1e-8, C vs NumPy RHS
     python scripts/bench.py cli        # end to end: `simulate --pressure 400 --fz 635 --out NEW --quiet`, warm cache
+    python scripts/bench.py transient  # each tyre transient form against contact_patch: RHS call and 6 s run
     python scripts/bench.py all
     python scripts/bench.py compare --against DIR [--against-cache DIR]
                                        # this checkout against another one (e.g. main) in the same session:
@@ -114,6 +115,48 @@ def bench_run(repeats):
                             breakpoints=(0.15,), rtol=rtol)
         n = time.perf_counter() - t0
         print(f"6 s base case, NumPy RHS, rtol {rtol:g}: {n:.2f} s (one run); C is {n / c_med:.0f}x faster")
+
+
+def bench_transient(repeats):
+    """Each tyre transient form against the contact-patch form, in one process, interleaved rounds.
+
+    The RHS call from Python (20 000 calls at a perturbed steady state) and
+    the 6 s default run (``wk.run``, its integration wall time and whole),
+    medians over ``repeats`` rounds and the ratio to the contact-patch form.
+    """
+    import whipple_kick as wk
+    from whipple_kick import slip
+    forms = ("contact_patch", "carcass", "slip_lag", "force_lag")
+    calls, runs, integration = ({f: [] for f in forms} for _ in range(3))
+    fast = {}
+    base = _base_case()
+    for form in forms:
+        params = dict(base.params, tyre_transient=float(wk.transient.TRANSIENTS.index(form)))
+        ss = slip.steady_state(params, 3.0)
+        x = ss.x.copy()
+        x[slip.X["u4"]] = 0.1
+        fast[form] = (slip.CompiledRHS(ss.params).fast, x)
+        wk.run(wk.Scenario(pressure_kpa=400.0, fz_n=635.0, tyre_transient=form))   # warm
+    for _ in range(repeats):
+        for form in forms:
+            f, x = fast[form]
+            t0 = time.perf_counter()
+            for _ in range(20000):
+                f(0.05, x)
+            calls[form].append((time.perf_counter() - t0) / 20000)
+            t0 = time.perf_counter()
+            r = wk.run(wk.Scenario(pressure_kpa=400.0, fz_n=635.0, tyre_transient=form))
+            runs[form].append(time.perf_counter() - t0)
+            integration[form].append(r.summary["numerics"]["integration_wall_s"])
+    ref = {k: statistics.median(v["contact_patch"]) for k, v in (("call", calls), ("run", runs),
+                                                                  ("integration", integration))}
+    print(f"medians of {repeats} interleaved rounds; ratio to contact_patch")
+    print("| form | RHS call [us] | ratio | 6 s run: integration [s] | ratio | whole wk.run [s] | ratio |")
+    print("|---|---|---|---|---|---|---|")
+    for form in forms:
+        c, i, w = (statistics.median(v[form]) for v in (calls, integration, runs))
+        print(f"| {form} | {c * 1e6:.2f} | {c / ref['call']:.2f} | {i:.4f} | {i / ref['integration']:.2f} | "
+              f"{w:.3f} | {w / ref['run']:.2f} |")
 
 
 def _simulate_command():
@@ -336,7 +379,7 @@ def bench_compare(args):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("what", choices=("rhs", "build", "run", "cli", "all", "compare"))
+    parser.add_argument("what", choices=("rhs", "build", "run", "cli", "all", "compare", "transient"))
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--against", metavar="DIR", help="checkout to compare with (its src/ is imported)")
     parser.add_argument("--against-cache", metavar="DIR", help="model cache of that checkout (default: a temp dir)")
@@ -346,6 +389,9 @@ def main():
         if not args.against:
             parser.error("compare needs --against DIR")
         bench_compare(args)
+        return
+    if args.what == "transient":
+        bench_transient(args.repeats)
         return
     for name, fn in (("rhs", bench_rhs), ("build", bench_build), ("run", bench_run), ("cli", bench_cli)):
         if args.what in (name, "all"):

@@ -3,11 +3,17 @@
 Usage:
     python scripts/regenerate_regression.py --reason "why the reference runs changed"
     python scripts/regenerate_regression.py --thesis-form NAME [NAME ...] --reason "why"
+    python scripts/regenerate_regression.py --contact-patch NAME [NAME ...] --reason "why"
 
 Writes ``tests/data/regression/<name>.npz`` for the cases in :func:`cases`
 (the project's default model) and appends a line (date, model hash, reason)
 to ``tests/data/regression/CHANGELOG.md``. ``tests/test_regression.py``
 reruns each stored scenario and compares.
+
+``tests/data/regression/contact_patch/`` holds the references of the
+contact-patch tyre transient, the default before the carcass tyre: the same
+cases with ``tyre_transient="contact_patch"`` in their stored scenarios,
+pinned like the thesis' form (``--contact-patch`` reruns named ones).
 
 ``tests/data/regression/thesis_form/`` holds the references made with the
 thesis' tyre transient before the contact-patch form, the plate stop's
@@ -41,12 +47,17 @@ import whipple_kick as wk
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 OUT = ROOT / "tests" / "data" / "regression"
 THESIS_FORM = OUT / "thesis_form"
+#: References of the contact-patch tyre transient, the default before the carcass tyre (pinned like thesis_form).
+CONTACT_PATCH = OUT / "contact_patch"
+#: Pinned reference folders by option name.
+PINNED = {"thesis_form": THESIS_FORM, "contact_patch": CONTACT_PATCH}
 CHANGELOG = OUT / "CHANGELOG.md"
 #: Stored columns (those the run has): the thesis' response signals, both tyres' loads, slips and the
 #: energy accounting's main terms, so a swapped label or a changed tyre shows.
 COLUMNS = ("time", "yaw_rate", "roll_rate", "steer_rate", "roll", "steer", "yaw", "y_rear",
            "fy_rear", "fy_front", "mz_rear", "mz_front", "fz_rear", "fz_front", "slip_rear", "slip_front",
-           "slip_patch_rear", "slip_patch_front", "steer_torque", "plate_work", "sliding_dissipation")
+           "slip_patch_rear", "slip_patch_front", "carcass_deflection_rear", "carcass_deflection_front",
+           "steer_torque", "plate_work", "sliding_dissipation")
 RATE_HZ = 200.0
 #: Kick table of the tabulated case (minimum-jerk 150 mm in 150 ms, rows every 10 ms), in :data:`OUT`.
 KICK_TABLE = "kick_table_smooth_10ms.csv"
@@ -103,16 +114,16 @@ def write_case(name, scenario, path):
     return result
 
 
-def rewrite_thesis_form(name):
-    """Rerun the stored scenario of ``thesis_form/<name>.npz`` and rewrite it (its columns and scenario kept)."""
+def rewrite_pinned(name, folder=THESIS_FORM):
+    """Rerun the stored scenario of ``<folder>/<name>.npz`` and rewrite it (its columns and scenario kept)."""
     from whipple_kick import simulation
-    path = THESIS_FORM / f"{name}.npz"
+    path = folder / f"{name}.npz"
     if not path.exists():
-        raise SystemExit(f"no thesis-form reference {name!r} in {THESIS_FORM}")
+        raise SystemExit(f"no pinned reference {name!r} in {folder}")
     with np.load(path) as data:
         scenario = simulation.Scenario(**json.loads(str(data["scenario_json"])))
         columns = [c for c in data.files if c not in ("name", "scenario_json", "model_hash", "generated")]
-    result = simulation.run(runnable(scenario, THESIS_FORM))
+    result = simulation.run(runnable(scenario, folder))
     df = result.trajectory
     arrays = {c: df[c].to_numpy(dtype=np.float32) for c in columns}
     np.savez_compressed(path, **arrays, name=np.array(name),
@@ -131,16 +142,22 @@ def main(argv=None):
                         help="why the references change (written to the changelog)")
     parser.add_argument("--thesis-form", nargs="+", metavar="NAME",
                         help="rewrite only these references of thesis_form/ (their stored scenarios)")
+    parser.add_argument("--contact-patch", nargs="+", metavar="NAME",
+                        help="rewrite only these references of contact_patch/ (their stored scenarios)")
     args = parser.parse_args(argv)
     reason = " ".join(args.reason.split())
     if not reason:
         parser.error("--reason must not be empty")
-    if args.thesis_form:
-        for name in args.thesis_form:
-            s = rewrite_thesis_form(name).summary
-            end = f"fell at {s['fall_time_s']:.3f} s ({s['fall_reason']})" if s["fell"] else f"{s['end_time_s']:g} s"
-            print(f"{name:22s} {end:18s} -> thesis_form/{name}.npz")
-        reason = f"thesis_form/ {', '.join(args.thesis_form)} only: {reason}"
+    pinned = [(key, names) for key, names in (("thesis_form", args.thesis_form),
+                                               ("contact_patch", args.contact_patch)) if names]
+    if pinned:
+        for key, names in pinned:
+            for name in names:
+                s = rewrite_pinned(name, PINNED[key]).summary
+                end = (f"fell at {s['fall_time_s']:.3f} s ({s['fall_reason']})" if s["fell"]
+                       else f"{s['end_time_s']:g} s")
+                print(f"{name:22s} {end:18s} -> {key}/{name}.npz")
+        reason = "; ".join(f"{key}/ {', '.join(names)} only" for key, names in pinned) + f": {reason}"
     else:
         OUT.mkdir(parents=True, exist_ok=True)
         _write_kick_table(OUT / KICK_TABLE)

@@ -37,6 +37,8 @@ def test_main_job_writes_the_three_files(tmp_path, capsys):
     roll = summary["recovery"]["signals"]["roll_rate"]["time_s"]
     assert f"roll rate {roll:.2f} s" in stdout
     assert stderr == ""
+    # One line says where the tyre fits are extrapolated (T03 was measured to 6 deg and 488 N).
+    assert sum(line.strip().startswith("tyre fits extrapolated: rear: patch slip") for line in stdout.splitlines()) == 1
 
 
 _WARM_PROBE = """

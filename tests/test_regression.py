@@ -43,12 +43,14 @@ from whipple_kick import simulation
 
 DATA = pathlib.Path(__file__).parent / "data" / "regression"
 THESIS_FORM = DATA / "thesis_form"
+CONTACT_PATCH = DATA / "contact_patch"
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "scripts"))
 import regenerate_regression
 
 TOLERANCE = 1e-4      # of each column's largest |reference value|
 TIME_TOLERANCE = 1e-6  # s
 EXPECTED = sorted(regenerate_regression.cases())
+EXPECTED_CONTACT_PATCH = sorted(n for n in EXPECTED if n != "thesis_400kPa")
 EXPECTED_THESIS_FORM = sorted([f"lqr_{p}kPa_{fz}N" for fz in (570, 635, 701) for p in (300, 400, 500)]
                               + ["off_400kPa_635N", "kick40_400kPa_635N"])
 _META = ("name", "scenario_json", "model_hash", "generated")
@@ -94,6 +96,7 @@ def failures(dev):
 def test_every_reference_is_stored():
     assert sorted(p.stem for p in DATA.glob("*.npz")) == EXPECTED
     assert sorted(p.stem for p in THESIS_FORM.glob("*.npz")) == EXPECTED_THESIS_FORM
+    assert sorted(p.stem for p in CONTACT_PATCH.glob("*.npz")) == EXPECTED_CONTACT_PATCH
     log = (DATA / "CHANGELOG.md").read_text().strip().splitlines()
     assert log[-1].startswith("- ") and log[-1].count(" | ") == 2
     # More than the thesis' six signals: both tyres and the energy terms.
@@ -115,6 +118,15 @@ def test_thesis_form_reproduces_its_references(name):
     scenario, ref = load_reference(name, THESIS_FORM)
     assert (scenario.tyre_transient, scenario.plate_stop, scenario.kick_heading) == ("force_lag", "resolve",
                                                                                       "settled")
+    dev = deviations(trajectory(scenario, ref), ref)
+    assert failures(dev) == [], f"{name}: relative deviations {dev} (tolerance {TOLERANCE:g})"
+
+
+@pytest.mark.parametrize("name", EXPECTED_CONTACT_PATCH)
+def test_contact_patch_form_reproduces_its_references(name):
+    """The contact-patch tyre transient (the default before the carcass tyre) keeps its references."""
+    scenario, ref = load_reference(name, CONTACT_PATCH)
+    assert scenario.tyre_transient == "contact_patch"
     dev = deviations(trajectory(scenario, ref), ref)
     assert failures(dev) == [], f"{name}: relative deviations {dev} (tolerance {TOLERANCE:g})"
 

@@ -605,15 +605,23 @@ def _steady_curve_peaks(tyre, camber, fz):
 
 
 def _force_bound_ratios(result):
-    """max over samples of |F|/peak and |M|/peak per wheel (patch camber), and the unloaded samples' loads."""
+    """max over samples of |F|/peak and |M|/peak per wheel, and the unloaded samples' loads.
+
+    The curves are taken at the camber each form evaluates them at: the patch's (lagged) camber in the
+    contact-patch forms; in the carcass form the force's limit at the wheel's camber and the moment at
+    the lagged one.
+    """
     rear, front, _ = wk.assembly.build_tyres(result.scenario)
     df = result.trajectory
+    carcass = result.scenario.tyre_transient == "carcass"
     out = {}
     for wheel, tyre in (("rear", rear), ("front", front)):
         fz = df[f"fz_{wheel}"].to_numpy()
         force, moment = df[f"fy_{wheel}"].to_numpy(), df[f"mz_{wheel}"].to_numpy()
-        camber = df[f"camber_patch_{wheel}"].to_numpy()
-        peak_f, peak_m = _steady_curve_peaks(tyre, camber, fz)
+        patch = df[f"camber_patch_{wheel}"].to_numpy()
+        peak_f, peak_m = _steady_curve_peaks(tyre, df[f"camber_{wheel}"].to_numpy() if carcass else patch, fz)
+        if carcass:
+            _, peak_m = _steady_curve_peaks(tyre, patch, fz)
         loaded = fz > 0.0
         out[wheel] = (np.max(np.abs(force[loaded]) / peak_f[loaded]), np.max(np.abs(moment[loaded]) / peak_m[loaded]),
                       np.abs(force[~loaded]).tolist() + np.abs(moment[~loaded]).tolist())
@@ -626,9 +634,13 @@ def test_tyre_loads_never_exceed_the_steady_curve(base, kicks, case):
     that sample's load and patch camber, |M_z| likewise, and an unloaded tyre carries nothing. The contact-
     patch form applies the steady curve of its own patch slip, so the measured ratio is <= 1 to round-off."""
     result = base if case == "default" else kicks[case]
+    # The carcass form (default): a lifted tyre's carcass force relaxes through the sliding viscosity in
+    # ~1e-7 s, so at the samples it is what the integration leaves of it: measured 1.1e-8 N (atol 1e-12 m
+    # of the deflection at 4e4 N/m is 4e-8 N); its moment is exactly 0. The contact-patch form: exactly 0.
+    zero = 1e-7 if result.scenario.tyre_transient == "carcass" else 0.0
     for wheel, (ratio_f, ratio_m, unloaded) in _force_bound_ratios(result).items():
         assert ratio_f <= 1.001 and ratio_m <= 1.001, (wheel, ratio_f, ratio_m)
-        assert all(v == 0.0 for v in unloaded), wheel
+        assert all(v <= zero for v in unloaded), wheel
     if case == "controller off":
         # The front wheel really does lift off in this fall (so the zero-load check is not empty).
         assert np.any(result.trajectory["fz_front"] == 0.0)

@@ -181,8 +181,14 @@ def test_a_lifted_wheel_closing_on_the_ground_carries_no_force(rider_bike, t03, 
     # The spring-damper alone would push: kz q + cz dq/dt = 5 kN at 400 kPa.
     assert ss.params[f"kz{wheel}"] * x[slip.X[q]] + ss.params[f"cz{wheel}"] * x[slip.X[u]] > 4e3
     dx, out = rhs.outputs(0.0, x)
-    for name in ("fz", "fy", "mz", "fy_ss", "mz_ss"):
+    for name in ("fz", "mz", "fy_ss", "mz_ss", "fy_limit"):
         assert out[slip.OUT[f"{name}_{wheel}"]] == 0.0, name
+    # The carcass (default transient) still holds the deflection it had in contact; with no grip its patch
+    # slides with the wheel and the force relaxes through the sliding viscosity alone, in ~1e-7 s.
+    force = out[slip.OUT[f"fy_{wheel}"]]
+    assert force == pytest.approx(ss.params[f"cc{wheel}"] * x[slip.X[f"carcass_y_{wheel}"]], rel=1e-15)
+    assert ss.params[f"cc{wheel}"] * dx[slip.X[f"carcass_y_{wheel}"]] == pytest.approx(
+        -ss.params[f"cc{wheel}"] * force / ss.params["carcass_viscosity"], rel=1e-9)
     assert np.all(np.isfinite(dx))
     assert dx[slip.X["D_damper"]] == pytest.approx(0.0, abs=1e-9)   # the other tyre is at rest vertically
     oracle, oracle_out = slip_build.numpy_rhs(0.0, x, slip.parameter_vector(ss.params), with_outputs=True)
@@ -324,8 +330,8 @@ def test_secant_series_joins_the_quotient():
 def test_patch_states_stay_finite_as_the_rolling_speed_vanishes(rider_bike, t03):
     """A wheel turned sideways (|vx| -> 0) while its contact slides: the patch slip turns toward
     +-90 deg at a finite rate, the camber lag stops, force and moment follow the steady curve; unloaded,
-    they are exactly zero."""
-    par = slip.model_parameters(rider_bike, t03, t03, symmetric=True)
+    they are exactly zero (the contact-patch form; the carcass' own case is in test_carcass.py)."""
+    par = slip.model_parameters(rider_bike, t03, t03, symmetric=True, tyre_transient="contact_patch")
     ss = slip.steady_state(par, 3.0)
     rhs = slip.CompiledRHS(ss.params)
     x = ss.x.copy()

@@ -8,9 +8,10 @@ import whipple_kick as wk
 from whipple_kick import cache, slip, slip_build
 
 # Spread of the random tyre states: forces [N] and moments [N m] for the
-# thesis' form, patch slip and camber angles [rad] for the contact forms.
+# thesis' form, patch slip and camber angles [rad] for the contact forms, carcass
+# deflections [m] (up to 620 N rear: on and past the friction limit) and lagged cambers.
 _TYRE_SPREAD = {"force_lag": (200.0, 200.0, 5.0, 5.0), "contact_patch": (0.6, 0.6, 0.3, 0.3),
-                "slip_lag": (0.6, 0.6, 0.3, 0.3)}
+                "slip_lag": (0.6, 0.6, 0.3, 0.3), "carcass": (0.015, 0.015, 0.3, 0.3)}
 
 
 @pytest.mark.parametrize("transient", wk.transient.TRANSIENTS)
@@ -29,6 +30,10 @@ def test_c_agrees_with_numpy_oracle(rider_bike, gains, t03, transient):
     p = slip.parameter_vector(params)
     rng = np.random.default_rng(1)
     worst = 0.0
+    # The carcass' patch slip inverts the steady curve, ill-conditioned near its peak (dF/da -> 0): two exact
+    # inversions of one force (closed form + Newton in C, bracketed root finding in Python) agree there only to
+    # ~eps F / (dF/da); measured 1.6e-9 relative on these states (the symbolic forms: ~1e-14).
+    tol = 1e-8 if transient == "carcass" else 1e-10
     for _ in range(100):
         x = ss.x.copy()
         for name, spread in (("q3", 0.5), ("q4", 0.3), ("q7", 0.3), ("q5", 0.01), ("u1", 1.0), ("u2", 0.5),
@@ -42,10 +47,10 @@ def test_c_agrees_with_numpy_oracle(rider_bike, gains, t03, transient):
         dx_n, out_n = slip_build.numpy_rhs(t, x, p, with_outputs=True)
         # Same expressions, different evaluation order: agreement is limited
         # by the conditioning of the two small linear solves, ~1e-14 here.
-        np.testing.assert_allclose(dx_c, dx_n, rtol=1e-10, atol=1e-10 * np.abs(dx_n).max())
-        np.testing.assert_allclose(out_c, out_n, rtol=1e-10, atol=1e-10 * np.abs(out_n).max())
+        np.testing.assert_allclose(dx_c, dx_n, rtol=tol, atol=tol * np.abs(dx_n).max())
+        np.testing.assert_allclose(out_c, out_n, rtol=tol, atol=tol * np.abs(out_n).max())
         worst = max(worst, np.abs(dx_c - dx_n).max() / np.abs(dx_n).max())
-    assert worst < 1e-10
+    assert worst < tol
 
 
 def test_metadata_beside_the_library_describes_its_layouts():

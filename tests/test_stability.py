@@ -312,7 +312,7 @@ def test_state_space_has_named_states_and_the_loops_poles():
     sys_cl = model.state_space()
     sys_ol = model.state_space(closed=False)
     assert sys_cl.nstates == 14 and sys_cl.input_labels == ["steer_torque"]
-    assert sys_cl.state_labels[:2] == ["roll", "steer"] and "slip_patch_front" in sys_cl.state_labels
+    assert sys_cl.state_labels[:2] == ["roll", "steer"] and "carcass_deflection_front" in sys_cl.state_labels
     assert sys_cl.output_labels == sys_cl.state_labels
     ref = np.sort_complex(np.linalg.eigvals(model.A - model.B @ model.K))
     assert np.allclose(np.sort_complex(sys_cl.poles()), ref)
