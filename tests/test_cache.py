@@ -6,7 +6,7 @@ import sys
 import pytest
 
 from whipple_kick import cache, slip
-from whipple_kick.errors import InputError
+from whipple_kick.errors import CacheError, InputError
 
 
 def test_cache_folder_is_private(tmp_path, monkeypatch):
@@ -20,7 +20,7 @@ def test_cache_folder_writable_by_others_is_refused(tmp_path, monkeypatch):
     folder.mkdir()
     folder.chmod(0o777)
     monkeypatch.setenv("WHIPPLE_KICK_CACHE", str(folder))
-    with pytest.raises(PermissionError, match="not private"):
+    with pytest.raises(CacheError, match="not private"):
         cache.cache_dir()
 
 
@@ -28,7 +28,7 @@ def test_cached_file_writable_by_others_is_not_loaded(tmp_path):
     path = tmp_path / "x.py"
     path.write_text("")
     path.chmod(0o666)
-    with pytest.raises(PermissionError, match="writable by others"):
+    with pytest.raises(CacheError, match="writable by others"):
         cache.check_private_file(path)
 
 

@@ -2,41 +2,53 @@
 
 Every failure prints one line on stderr, without a traceback, and exits
 with a status that says whose it is: 2 the user's input (an
-:class:`~whipple_kick.errors.InputError`, an unwritable output folder),
-1 the machine's set-up or the numerics (a C compiler that fails, a run
-that fails numerically), 130 interrupted (Ctrl-C, as shells report
-SIGINT). An output folder a command created and did not fill is removed.
+:class:`~whipple_kick.errors.InputError`, an unwritable output folder, an
+output folder in use by another run), 1 the machine's set-up or the
+numerics (a C compiler that fails, an unusable cache folder, a run that
+fails numerically), 130 interrupted (Ctrl-C, as shells report SIGINT),
+143 terminated (SIGTERM, as schedulers and ``timeout`` send). An output
+folder a command created and did not fill is removed, and no temporary
+file is left behind.
 """
 import argparse
+import contextlib
 import math
 import sys
 
 import numpy as np
 
-from .errors import BuildError, InputError, SimulationError
+from . import fileio
+from .errors import BuildError, CacheError, InputError, SimulationError, Terminated, terminate_raises
 
 #: Exit status of a command interrupted by Ctrl-C (128 + SIGINT, as shells report it).
 EXIT_INTERRUPTED = 130
-#: Exit status of a sweep ended by SIGTERM (128 + SIGTERM).
+#: Exit status of a command ended by SIGTERM (128 + SIGTERM).
 EXIT_TERMINATED = 143
 
 
 def _run(main, argv, prog="whipple_kick", kept="no results were kept"):
     """Run a command's ``main(argv)``, turning each kind of failure into one line and its exit status.
 
-    ``kept`` says what an interrupted command leaves behind.
+    ``kept`` says what an interrupted (Ctrl-C) or terminated (SIGTERM) command leaves behind.
     """
     try:
-        return main(argv)
+        with terminate_raises():
+            return main(argv)
     except InputError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     except BuildError as exc:
         print(f"{prog}: cannot build the compiled model: {exc}", file=sys.stderr)
         return 1
+    except CacheError as exc:   # the machine's set-up, before "cannot write the results" below
+        print(f"{prog}: cache error: {exc}", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         print(f"{prog}: interrupted; {kept}", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except Terminated:
+        print(f"{prog}: terminated (SIGTERM); {kept}", file=sys.stderr)
+        return EXIT_TERMINATED
     except OSError as exc:   # an unwritable output folder or a full disk: the user's to fix
         print(f"{prog}: cannot write the results: {exc}", file=sys.stderr)
         return 2
@@ -350,37 +362,56 @@ def _default_out(scenario, prefix="kick"):
     return out
 
 
-def _prepare_out(path, force, previous=()):
-    """Create/check the output folder before the (longer) run. Returns (path, created).
+#: Held (flock, :func:`whipple_kick.fileio.take_lock`) by the command writing into an output folder; holds its pid.
+OUT_LOCK_FILE = ".whipple_kick.lock"
 
-    With ``force``, the files named in ``previous`` (what the command
-    writes) are removed first, so no file of an earlier run (say its
-    response.png beside a new ``--no-plot`` summary) is left to contradict
-    the new one.
+
+@contextlib.contextmanager
+def _output_folder(path, force, previous=()):
+    """Create/check the output folder before the (longer) run and hold its lock; yields (path, created).
+
+    The lock (:data:`OUT_LOCK_FILE`) keeps a second command from writing
+    into the same folder at the same time (it gets one line, exit status
+    2); a lock left by a killed command is taken over. Hidden temporaries
+    of ``previous`` left by a killed writer are removed. With ``force``,
+    the files named in ``previous`` (what the command writes) are removed
+    first, so no file of an earlier run (say its response.png beside a new
+    ``--no-plot`` summary) is left to contradict the new one.
     """
-    import os
     import pathlib
     out = pathlib.Path(path)
     if out.exists() and not out.is_dir():
         raise InputError(f"output folder {str(out)!r} exists and is not a folder")
-    if out.is_dir() and any(out.iterdir()) and not force:
-        raise InputError(f"output folder {str(out)!r} exists and is not empty; "
-                         "use --force to overwrite its files or choose another --out")
-    created = not out.exists()
-    if force and not created:
-        for name in previous:
-            try:
-                (out / name).unlink(missing_ok=True)
-            except OSError as exc:
-                raise InputError(f"--force cannot remove {str(out / name)!r}: {exc.strerror or exc}") from None
     try:
-        out.mkdir(parents=True, exist_ok=True)
-        probe = out / f".simulate-probe-{os.getpid()}"
-        probe.write_text("")
-        probe.unlink()
+        out.mkdir(parents=True)
+        created = True
+    except FileExistsError:
+        created = False
     except OSError as exc:
         raise InputError(f"output folder {str(out)!r} is not writable: {exc.strerror or exc}") from None
-    return out, created
+    try:
+        lock = fileio.take_lock(out / OUT_LOCK_FILE,
+                                f"output folder {str(out)!r} is in use by another run (process {{pid}}); "
+                                "wait for it to finish or choose another --out")
+    except OSError as exc:
+        raise InputError(f"output folder {str(out)!r} is not writable: {exc.strerror or exc}") from None
+    try:
+        # Holding the lock, any temporary of ours here is a killed writer's.
+        for stale in fileio.stale_temporaries(out, previous):
+            stale.unlink(missing_ok=True)
+        if not force and any(p.name != OUT_LOCK_FILE for p in out.iterdir()):
+            raise InputError(f"output folder {str(out)!r} exists and is not empty; "
+                             "use --force to overwrite its files or choose another --out")
+        if force and not created:
+            for name in previous:
+                try:
+                    (out / name).unlink(missing_ok=True)
+                except OSError as exc:
+                    raise InputError(f"--force cannot remove {str(out / name)!r}: {exc.strerror or exc}") from None
+        yield out, created
+    finally:
+        # The lock file goes with the lock, so that the folder holds only the results.
+        fileio.release_lock(lock, out / OUT_LOCK_FILE)
 
 
 def _print_summary(result, out, files):
@@ -479,22 +510,22 @@ def _simulate(argv):
     given = _flags_given(argv) if args.compat is not None else ()
     scenario = assembly.preflight(_scenario_from_args(args, given))
     movie_options = _animation_options(args)
-    out, created = _prepare_out(args.out or _default_out(scenario), args.force, _OUTPUT_FILES)
-    written = []
-    try:
-        result, files, note = _simulate_into(args, scenario, movie_options, out, written)
-    except SimulationError as exc:
-        if exc.partial is None:
+    with _output_folder(args.out or _default_out(scenario), args.force, _OUTPUT_FILES) as (out, created):
+        written = []
+        try:
+            result, files, note = _simulate_into(args, scenario, movie_options, out, written)
+        except SimulationError as exc:
+            if exc.partial is None:
+                _discard(out, created, written)
+                raise
+            # What ran before the failure is kept for the user to inspect.
+            _write_results(exc.partial, out)
+            raise SimulationError(
+                f"{exc}; the run up to t = {exc.partial.summary['end_time_s']:g} s is in {out}") from None
+        except BaseException:
+            # A failure, Ctrl-C or SIGTERM before every file is written: leave nothing half done.
             _discard(out, created, written)
             raise
-        # What ran before the failure is kept for the user to inspect.
-        _write_results(exc.partial, out)
-        raise SimulationError(
-            f"{exc}; the run up to t = {exc.partial.summary['end_time_s']:g} s is in {out}") from None
-    except BaseException:
-        # A failure or Ctrl-C before every file is written: leave nothing half done.
-        _discard(out, created, written)
-        raise
     report_data_warnings(result.summary)
     if not args.quiet:
         _print_summary(result, out, files)
@@ -603,17 +634,13 @@ def _recommend(argv):
 
 def recommend_main(argv=None):
     """Console script ``recommend-pressure`` (see ``recommend-pressure --help``)."""
-    from .sweep_engine import SweepInterrupted, SweepTerminated
+    from .sweep_engine import SweepInterrupted
     try:
         status = _run(_recommend, argv, "recommend-pressure",
                       "finished cases are kept in the --out folder (if given); run again on it to resume")
     except SweepInterrupted as exc:   # lost worker processes: not the user's to fix
         print(f"recommend-pressure: {exc}", file=sys.stderr)
         status = 1
-    except SweepTerminated:
-        print("recommend-pressure: terminated (SIGTERM); finished cases are kept in the --out folder, "
-              "run again on it to resume", file=sys.stderr)
-        status = EXIT_TERMINATED
     sys.exit(status)
 
 
@@ -658,15 +685,16 @@ def _stability(argv):
     scenario = Scenario(**_model_fields(args), symmetric_tyres=args.tyre_offsets == "zero",
                                    speed=float(speeds[0]))
     assembly.preflight(scenario)
-    out, created = _prepare_out(args.out or _default_out(scenario, "stability"), args.force, _STABILITY_FILES)
-    try:
-        result = stability.analyse(scenario, speeds)
-        result.summary["numerics"] = {"wall_s": time.perf_counter() - started}
-        files = stability.write(result, out, plot=not args.no_plot)
-    except BaseException:
-        # A failure or Ctrl-C before every file is written: leave nothing half done.
-        _discard(out, created, _STABILITY_FILES)
-        raise
+    with _output_folder(args.out or _default_out(scenario, "stability"), args.force,
+                        _STABILITY_FILES) as (out, created):
+        try:
+            result = stability.analyse(scenario, speeds)
+            result.summary["numerics"] = {"wall_s": time.perf_counter() - started}
+            files = stability.write(result, out, plot=not args.no_plot)
+        except BaseException:
+            # A failure, Ctrl-C or SIGTERM before every file is written: leave nothing half done.
+            _discard(out, created, _STABILITY_FILES)
+            raise
     missing = {loop: m["speeds_without_steady_motion"] for loop, m in result.summary["steady_motion"].items()
                if m["speeds_without_steady_motion"]}
     for loop, count in missing.items():

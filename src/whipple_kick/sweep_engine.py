@@ -18,7 +18,6 @@ Example
 """
 import atexit
 import concurrent.futures as cf
-import contextlib
 import dataclasses
 import datetime
 import itertools
@@ -27,13 +26,12 @@ import os
 import signal
 import socket
 import sys
-import threading
 import time
 
 import numpy as np
 
 from . import simulation, slip
-from .errors import InputError
+from .errors import InputError, Terminated, terminate_raises
 from .scenario import Scenario
 from .sweep_store import Folder, canonical, case_id, slim, table, trajectory_path
 
@@ -54,26 +52,8 @@ VOLATILE_COLUMNS = ("run.started", "run.finished", "run.wall_s", "run.cpu_s", "r
                     "numerics.wall_s", "numerics.integration_wall_s")
 
 
-class SweepTerminated(BaseException):
-    """SIGTERM reached the process running a sweep (a BaseException, like KeyboardInterrupt,
-    so that no ``except Exception`` of a case swallows it)."""
-
-
-def _raise_terminated(signum, frame):
-    raise SweepTerminated("terminated (SIGTERM)")
-
-
-@contextlib.contextmanager
-def _terminate_raises():
-    """Within the block, SIGTERM raises :class:`SweepTerminated` (main thread only; elsewhere a no-op)."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = signal.signal(signal.SIGTERM, _raise_terminated)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, previous)
+#: SIGTERM reached the process running a sweep (the package's :class:`~whipple_kick.errors.Terminated`).
+SweepTerminated = Terminated
 
 
 class SweepInterrupted(RuntimeError):
@@ -392,7 +372,7 @@ def sweep(grid=None, cases=None, *, base=None, folder=None, executor=None, worke
     todo = [(cid, sc) for cid, sc in unique if not finished(cid)]
     lost, interrupted, own = [], False, False
     try:
-        with _terminate_raises():
+        with terminate_raises():
             if store is not None:
                 store.write_manifest("running", n_cases=len(unique), n_done=len(unique) - len(todo))
             own = executor is None and todo

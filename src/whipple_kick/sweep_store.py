@@ -13,10 +13,8 @@ Example
 >>> from whipple_kick import sweep_store
 >>> frame, summary = sweep_store.load_trajectory("thesis_grid", case_id)   # doctest: +SKIP
 """
-import contextlib
 import dataclasses
 import datetime
-import fcntl
 import hashlib
 import json
 import os
@@ -173,36 +171,16 @@ def slim(record):
 
 
 def _lock(folder):
-    """Take the folder's sweep lock (an exclusive ``flock`` on :data:`LOCK_FILE`) and write our pid into it.
-
-    The operating system drops the lock when its holder dies, so a lock
-    left by a killed sweep is simply taken over. Returns the open file
-    descriptor (:func:`_unlock` releases it).
+    """Take the folder's sweep lock (:func:`whipple_kick.fileio.take_lock` on :data:`LOCK_FILE`).
 
     Raises
     ------
     InputError
         Another process holds the lock (one line naming its pid).
     """
-    path = pathlib.Path(folder) / LOCK_FILE
-    fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
-    try:
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except BlockingIOError:
-        holder = os.pread(fd, 32, 0).decode(errors="replace").strip() or "unknown"
-        os.close(fd)
-        raise InputError(f"sweep folder {str(folder)!r} is in use by another sweep (process {holder}, "
-                         f"{LOCK_FILE}); wait for it to finish, then run again to resume") from None
-    os.ftruncate(fd, 0)
-    os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
-    return fd
-
-
-def _unlock(fd):
-    # LOCK_UN releases the lock even where forked pool workers still hold the descriptor.
-    with contextlib.suppress(OSError):
-        fcntl.flock(fd, fcntl.LOCK_UN)
-        os.close(fd)
+    return fileio.take_lock(pathlib.Path(folder) / LOCK_FILE,
+                            f"sweep folder {str(folder)!r} is in use by another sweep (process {{pid}}, "
+                            f"{LOCK_FILE}); wait for it to finish, then run again to resume")
 
 
 class Folder:
@@ -226,7 +204,7 @@ class Folder:
     def close(self):
         """Release the folder's lock (idempotent)."""
         if self._lock_fd is not None:
-            _unlock(self._lock_fd)
+            fileio.release_lock(self._lock_fd)
             self._lock_fd = None
 
     def _open(self, case_list, base, extend, trajectory):
