@@ -290,6 +290,7 @@ def _model_fields(args):
         raise InputError("--pressure sets both tyres; do not combine it with --pressure-front/--pressure-rear")
     if (fronts[0] is None) != (fronts[1] is None):
         raise InputError("give both --pressure-front KPA and --pressure-rear KPA (or --pressure KPA for both)")
+    _check_loads(args.bicycle, [args.fz] if args.fz is not None else [])
     return dict(
         bicycle=args.bicycle, fz_n=args.fz, rider_mass_kg=args.rider_mass, tyre=args.tyre,
         pressure_kpa=400.0 if args.pressure is None else args.pressure,
@@ -298,6 +299,22 @@ def _model_fields(args):
         design_speed=args.design_speed, thesis_load_n=args.thesis_load, gain_scale=args.gain_scale,
         low_inertia=args.low_inertia, tyre_transient=args.tyre_transient, camber_sign=args.camber_sign,
     )
+
+
+def _check_loads(bicycle, loads):
+    """Refuse a ``--fz`` no rider can put on ``bicycle``'s rear tyre, naming the real range in N.
+
+    Checked here, before the scenario's own check (a load above 0 N), so that
+    0 N and 10 N get the same message: the loads between the bicycle's own
+    rear load and that with the heaviest rider.
+    """
+    from . import bicycles, riders
+    bike = bicycles.load(bicycle)
+    if bike.includes_rider:
+        return   # refused later in one line (the preset already includes its rider)
+    low, high, _ = riders.rear_load_range(bike)
+    for fz in loads:
+        riders.within_rear_load_range(bike, fz, low, high)
 
 
 def _scenario_from_args(args, given=()):
@@ -621,6 +638,7 @@ def _recommend(argv):
     from .scenario import Scenario
     base = Scenario(duration=args.duration)
     base.validate()
+    _check_loads(base.bicycle, args.fz)
     recs = recommend.recommend_pressures(
         args.fz, tyre=args.tyre, pressures=args.pressures, fine=args.fine, step_kpa=args.step,
         base=base, criterion=args.criterion, workers=args.workers, folder=args.out, extend=args.extend,
