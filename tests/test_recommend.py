@@ -168,3 +168,9 @@ def test_recommend_pressure_cli_criterion_and_extend(tmp_path):
                     "--no-progress")
     assert extended.returncode == 0, extended.stderr
     assert len(wk.sweep_store.read_log(folder)) == 3
+
+
+def test_recommend_pressure_help_prints_single_percent_signs():
+    """argparse formats help strings with %, not the description: "5 %%" there was printed as is."""
+    proc = _cli("--help")
+    assert proc.returncode == 0 and "%%" not in proc.stdout and "within 5 % of their first peaks" in proc.stdout

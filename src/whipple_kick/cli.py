@@ -602,7 +602,7 @@ def _recommend(argv):
         description="Recommend the tyre inflation pressure with the fastest recovery after a "
                     "kick-plate kick (Dell'Orto 2025, Section 8.3 and Table 8.9): runs the kick at each "
                     "pressure for each rear load, ranks the runs by the recovery time (yaw, roll and "
-                    "steer rates all back within 5 %% of their first peaks) and says by how much the "
+                    "steer rates all back within 5 % of their first peaks) and says by how much the "
                     "best beats the second best, against the spread of the model itself.",
         epilog="Both tyres get the same pressure, as in the experiment. Every other setting is the "
                "simulate default (3 m/s, LQR rider designed at that speed, 150 mm kick in 0.150 s, 6 s). "
