@@ -21,7 +21,7 @@ faster than any step can follow) ends as a reported failure with the samples
 it produced so far, in bounded time.
 """
 import collections
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 import itertools
 import warnings
 
@@ -50,6 +50,20 @@ class Trajectory:
     def state(self, name):
         """Time history of one state by name."""
         return self.x[:, slip.X[name]]
+
+
+def join(pieces):
+    """One trajectory of consecutive pieces (each starting where the previous ended).
+
+    The samples are concatenated and the work counters (``nfev``, ``njev``,
+    ``evaluations``) summed; how the run ended (fall, failure, message, end
+    state) is the last piece's. The one place pieces are merged, so that no
+    counter is lost (a hand-made Trajectory once reported 0 Jacobians).
+    """
+    pieces = list(pieces)
+    return replace(pieces[-1], t=np.concatenate([p.t for p in pieces]), x=np.concatenate([p.x for p in pieces]),
+                   nfev=sum(p.nfev for p in pieces), njev=sum(p.njev for p in pieces),
+                   evaluations=sum(p.evaluations for p in pieces))
 
 
 #: Fast-path chunk length [s]: each chunk is one odeint (LSODA restarted), and
