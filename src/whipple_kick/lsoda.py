@@ -183,6 +183,9 @@ def _careful_chunk(rhs, x, times, rtol, atol, fall, spent, budget, t_start, jac=
         return solver.nfev, solver.njev, _evaluations(jac, solver.nfev, solver.njev)
     out_t, out_x = [times[:1]], [np.asarray(x, dtype=float)[None, :]]
     nxt, g_old = 1, fall(times[0], x)
+    if g_old <= 0.0:   # already at or past a limit where the chunk starts: that is the fall
+        return times[:1], np.asarray(x, dtype=float)[None, :], (times[0], np.asarray(x, dtype=float)), "fell", \
+            None, (0, 0, 0)
     recent = collections.deque([(0, times[0])])   # (evaluations, time) after the steps of the last window
     while True:
         try:
@@ -259,6 +262,11 @@ def _guarded(rhs, roll_index, fall_angle, steer_index, steer_limit):
             raise _PastTheLimit
         return rhs(t, x)
     return guarded
+
+
+def _within_limits(states, roll_index, fall_angle, steer_index, steer_limit):
+    """Whether every row of ``states`` has |roll| and |steer| inside their limits."""
+    return bool(np.all(np.abs(states[:, roll_index]) < fall_angle) and np.all(np.abs(states[:, steer_index]) < steer_limit))
 
 
 def _fast_chunk(guarded, x, times, rtol, atol, mxstep, jac=None):
@@ -423,7 +431,10 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
             # A sample at the piece's end is emitted after the jump map (below).
             last = -1 if i1 == len(grid) - 1 else None
             fast = _fast_chunk(guarded, x, times, rtol, atol, mxstep, jac)
-            if fast is not None and spent + fast[1][2] <= budget.limit(times[-1] - t_start):
+            # The guard sees only the states LSODA evaluates; a sample (the chunk's end above all)
+            # interpolated past a limit must still go to the careful path, or the fall is missed.
+            if fast is not None and spent + fast[1][2] <= budget.limit(times[-1] - t_start) \
+                    and _within_limits(fast[0], roll, fall_angle, steer, steer_limit):
                 y, (n, nj, used) = fast
                 nfev, njev, spent = nfev + n, njev + nj, spent + used
                 emit(times[:last], y[:last])
