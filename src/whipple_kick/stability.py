@@ -956,14 +956,24 @@ def _refiners(contexts, setup, result):
 
 
 def _root(fun, a, b):
-    """Root of ``fun`` in [a, b] by Brent's method (to 1e-9 m/s), or the linear estimate if that fails."""
+    """Root of ``fun`` in [a, b] by Brent's method (to 1e-9 m/s): ``(speed, None)``, or ``(None, reason)``.
+
+    The sweep's samples say a sign changes between ``a`` and ``b``; the fresh
+    linearisations at the ends may disagree (a mode matched to another
+    eigenvalue, a steady motion continued to another branch). Then there is
+    no bracket and no root is claimed: an estimate outside [a, b] would be a
+    number without meaning.
+    """
     from scipy.optimize import brentq
     fa, fb = fun(a), fun(b)
     if fa == 0.0:
-        return a
-    if fa * fb > 0:
-        return a + (b - a) * fa / (fa - fb)
-    return float(brentq(fun, a, b, xtol=1e-9, rtol=1e-12))
+        return a, None
+    if fb == 0.0:
+        return b, None
+    if not (np.isfinite(fa) and np.isfinite(fb)) or fa * fb > 0:
+        return None, (f"the real part does not change sign between {a:g} and {b:g} m/s on fresh "
+                      f"linearisations ({fa:+.3g} and {fb:+.3g} 1/s), although the sweep's samples do")
+    return float(brentq(fun, a, b, xtol=1e-9, rtol=1e-12)), None
 
 
 class _Sweep:
@@ -1058,14 +1068,21 @@ def _weave_speed(sweep):
             nxt = sweep.eigenvalue(k + 1, t)
             if lam.real <= 0 or nxt is None:
                 continue
-            crossing = _root(sweep.tracked_real_part(k, t), sweep.speeds[k], sweep.speeds[k + 1])
+            crossing, why = _root(sweep.tracked_real_part(k, t), sweep.speeds[k], sweep.speeds[k + 1])
             if sweep.name[k + 1, t] == "weave" and nxt.imag != 0.0:
-                return crossing, "the weave's real part crosses zero"
+                return (crossing, "the weave's real part crosses zero") if why is None else (None, why)
             # The pair split between the two speeds: still unstable then if a root stays positive.
             pair = [complex(l) for l in sweep.lams[k + 1] if l.imag == 0.0 and abs(l - nxt) < 4 * abs(lam.imag)]
+            if not pair:
+                return None, (f"the weave pair stops being the weave between {sweep.speeds[k]:g} and "
+                              f"{sweep.speeds[k + 1]:g} m/s without turning into two real eigenvalues "
+                              f"near it (it continues as {nxt.real:+.3g}{nxt.imag:+.3g}j 1/s, "
+                              f"{sweep.name[k + 1, t]}); refine the speed grid there")
             if max(l.real for l in pair) > 0:
                 return sweep.split_speed(k, t), ("the weave pair splits into two real eigenvalues while "
                                                  "unstable (one stays unstable)")
+            if why is not None:
+                return None, why
             return crossing, "the weave's real part crosses zero just before the pair splits"
     return None, "the weave is unstable up to the end of the sweep"
 
@@ -1079,7 +1096,7 @@ def _capsize_speed(sweep, above=None):
     the split, else at the split.
     """
     n = len(sweep.speeds)
-    found = []
+    found, unlocated = [], []
     for k in range(n - 1):
         if not (sweep.present(k) and sweep.present(k + 1)):
             continue
@@ -1089,15 +1106,18 @@ def _capsize_speed(sweep, above=None):
                 continue
             same_branch = sweep.name[k, t] == "capsize" and before.imag == 0.0
             if before.real <= 0:
-                found.append((_root(sweep.tracked_real_part(k, t), sweep.speeds[k], sweep.speeds[k + 1]),
-                              "the capsize eigenvalue crosses zero" + ("" if same_branch else
-                                                                        " just after the weave pair splits")))
+                crossing, why = _root(sweep.tracked_real_part(k, t), sweep.speeds[k], sweep.speeds[k + 1])
+                if why is not None:
+                    unlocated.append(why)
+                    continue
+                found.append((crossing, "the capsize eigenvalue crosses zero" + ("" if same_branch else
+                                                                                   " just after the weave pair splits")))
             elif not same_branch:
                 found.append((sweep.split_speed(k, t), "the capsize eigenvalue is born unstable where the "
                                                        "weave pair splits"))
     found = [f for f in found if above is None or f[0] >= above - 1e-9]
     if not found:
-        return None, "no capsize eigenvalue becomes unstable within the sweep"
+        return None, unlocated[0] if unlocated else "no capsize eigenvalue becomes unstable within the sweep"
     return min(found)
 
 
@@ -1114,13 +1134,18 @@ def _stable_ranges(sweep):
     for start, stop in _segments(stable):
         if not stable[start]:
             continue
-        lo, hi = sweep.speeds[start], sweep.speeds[stop - 1]
+        lo, hi, notes = sweep.speeds[start], sweep.speeds[stop - 1], []
+        # A boundary that cannot be located stays at the last stable sweep speed, and says so.
         if start > 0 and sweep.present(start - 1):
-            lo = _root(lambda v, k=start: sweep.largest_real_part(v, k), sweep.speeds[start - 1], lo)
+            root, why = _root(lambda v, k=start: sweep.largest_real_part(v, k), sweep.speeds[start - 1], lo)
+            lo = lo if why is not None else root
+            notes += [f"lower end not located, the sweep speed is given: {why}"] if why is not None else []
         if stop < n and sweep.present(stop):
-            hi = _root(lambda v, k=stop - 1: sweep.largest_real_part(v, k), hi, sweep.speeds[stop])
+            root, why = _root(lambda v, k=stop - 1: sweep.largest_real_part(v, k), hi, sweep.speeds[stop])
+            hi = hi if why is not None else root
+            notes += [f"upper end not located, the sweep speed is given: {why}"] if why is not None else []
         ranges.append({"from_m_s": float(lo), "to_m_s": float(hi), "lower_open": start == 0,
-                       "upper_open": stop == n})
+                       "upper_open": stop == n, **({"note": "; ".join(notes)} if notes else {})})
     return ranges
 
 
@@ -1403,7 +1428,7 @@ def range_text(interval):
     """
     lo = f"{interval['from_m_s']:.2f}" + (" (sweep start)" if interval["lower_open"] else "")
     hi = f"{interval['to_m_s']:.2f}" + (" (sweep end)" if interval["upper_open"] else "")
-    return f"{lo}-{hi}"
+    return f"{lo}-{hi}" + (" (an end not located: at a sweep speed)" if "note" in interval else "")
 
 
 def speeds_text(summary, loop):
