@@ -69,3 +69,12 @@ def test_concurrent_builds_share_one_library(tmp_path):
     assert len(libraries) == 1, libraries
     leftovers = [f.name for f in (tmp_path / "cache").iterdir() if f.name.endswith(".tmp")]
     assert not leftovers
+
+
+def test_every_generator_is_part_of_its_own_cache_key():
+    """A module that writes generated code is hashed into that code's key: editing what it writes
+    rebuilds the entry (classic.py was not in its own key, so a change to _generate_source reused the
+    stale module unless someone remembered to bump a layout string)."""
+    from whipple_kick import classic, geometry
+    for module, name in ((classic, "classic"), (geometry, "geometry"), (slip, "slip"), (slip, "slip_build")):
+        assert name in module._SOURCES, (module.__name__, name)
