@@ -652,11 +652,11 @@ def _recommend(argv):
 
 def recommend_main(argv=None):
     """Console script ``recommend-pressure`` (see ``recommend-pressure --help``)."""
-    from .sweep_engine import SweepInterrupted
+    from .sweep_engine import SweepFailed, SweepInterrupted
     try:
         status = _run(_recommend, argv, "recommend-pressure",
                       "finished cases are kept in the --out folder (if given); run again on it to resume")
-    except SweepInterrupted as exc:   # lost worker processes: not the user's to fix
+    except (SweepInterrupted, SweepFailed) as exc:   # lost workers, or every case failed: not the user's to fix
         print(f"recommend-pressure: {exc}", file=sys.stderr)
         status = 1
     sys.exit(status)

@@ -56,6 +56,23 @@ VOLATILE_COLUMNS = ("run.started", "run.finished", "run.wall_s", "run.cpu_s", "r
 SweepTerminated = Terminated
 
 
+class SweepFailed(RuntimeError):
+    """Every case of a sweep failed: no result to rank or tabulate, so a bug or a broken set-up, not a verdict.
+
+    The message names how many cases failed and the first one's error; a
+    sweep folder keeps every case's error in its table and log.
+    """
+
+
+def check_some_ok(table):
+    """Raise :class:`SweepFailed` if every case of a sweep's ``table`` failed (one line, the first error)."""
+    failed = table["status"] == "failed"
+    if len(table) and bool(failed.all()):
+        first = table.loc[failed.idxmax()]
+        raise SweepFailed(f"all {len(table)} cases failed (a bug or a broken set-up, not a result); the first, "
+                          f"case {first['case_id']}, with {first['error']}")
+
+
 class SweepInterrupted(RuntimeError):
     """Some cases were not run because the executor failed (e.g. its workers died).
 
