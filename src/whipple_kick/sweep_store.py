@@ -6,7 +6,8 @@ sweep resumes where it stopped; docs/sweeps.md describes the folder and its
 rules. A case is identified by a hash of its full scenario (:func:`case_id`),
 whatever overrides produced it. Files are written atomically
 (:mod:`whipple_kick.fileio`); the log is appended one line per case and a
-truncated last line (a crash while writing) is ignored when read back.
+truncated last line (a crash while writing) is ignored when read back, and
+ended with a newline when the folder is opened again.
 
 Example
 -------
@@ -242,6 +243,7 @@ class Folder:
             "cases": [{"case_id": cid, "overrides": ov, "scenario": scenario_dict(sc)}
                       for ov, sc, cid in self.case_list],
         }
+        _terminate_last_line(self.path / LOG_FILE)
         self.records = read_log(self.path)
         self._next_table = 0.0
 
@@ -271,6 +273,20 @@ class Folder:
             rows.to_csv(tmp, index=False, float_format="%.12g")
         end = time.monotonic()
         self._next_table = end + max(interval, 20.0 * (end - start))
+
+
+def _terminate_last_line(path):
+    """End a log cut short mid-line (a crash while appending) with a newline.
+
+    The cut line stays unreadable (and is ignored); without the newline the
+    next record appended would be glued to it and lost with it.
+    """
+    if not path.exists() or path.stat().st_size == 0:
+        return
+    with path.open("rb+") as fh:
+        fh.seek(-1, os.SEEK_END)
+        if fh.read(1) != b"\n":
+            fh.write(b"\n")
 
 
 def _now():
