@@ -269,8 +269,7 @@ class Folder:
         if not force and start < self._next_table:
             return
         rows = table(self.case_list, self.records)
-        with fileio.atomic_path(self.path / TABLE_FILE) as tmp:
-            rows.to_csv(tmp, index=False, float_format="%.12g")
+        fileio.write_csv(rows, self.path / TABLE_FILE, significant_digits=12)
         end = time.monotonic()
         self._next_table = end + max(interval, 20.0 * (end - start))
 
