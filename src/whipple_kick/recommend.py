@@ -9,6 +9,9 @@ best and whether that margin is clear of the model's own spread. The
 
 Example
 -------
+Skipped as a doctest: three 6 s kick runs in a process pool, several seconds
+(``tests/test_recommend.py`` runs it).
+
 >>> from whipple_kick import recommend
 >>> rec = recommend.recommend_pressure(635)              # doctest: +SKIP
 >>> rec.best_pressure_kpa, rec.margin_s, rec.verdict     # doctest: +SKIP
@@ -270,6 +273,8 @@ def recommend_pressure(fz_n, tyre="T03", pressures=None, fine=False, step_kpa=10
 
     Example
     -------
+    Skipped as a doctest: three 6 s kick runs in a process pool, several seconds.
+
     >>> from whipple_kick import recommend
     >>> rec = recommend.recommend_pressure(635)              # doctest: +SKIP
     >>> rec.best_pressure_kpa, rec.margin_s, rec.verdict     # doctest: +SKIP

@@ -11,6 +11,9 @@ folder and the rules. The pressure recommender on top of it is
 
 Example
 -------
+Skipped as a doctest: nine 6 s kick runs, and the folder ``thesis_grid`` written
+into the current folder.
+
 >>> import whipple_kick as wk
 >>> table = wk.sweep({"pressure_kpa": [300, 400, 500], "fz_n": [570, 635, 701]},
 ...                  folder="thesis_grid")                    # doctest: +SKIP

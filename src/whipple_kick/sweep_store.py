@@ -11,6 +11,9 @@ ended with a newline when the folder is opened again.
 
 Example
 -------
+Skipped as a doctest: it needs the sweep folder of :mod:`whipple_kick.sweep_engine`'s
+example and one of its case ids.
+
 >>> from whipple_kick import sweep_store
 >>> frame, summary = sweep_store.load_trajectory("thesis_grid", case_id)   # doctest: +SKIP
 """
