@@ -132,6 +132,17 @@ def test_the_compiled_model_in_use_is_checked_against_its_manifest():
 
 # ------------------------------------------------------------ Ctrl-C
 
+def _signal_ends_the_run(tmp_path, signum, status, what):
+    """Send ``signum`` to a long run once its folder exists: one line, ``status`` (128 + signal), no folder."""
+    out = tmp_path / "run"
+    proc = _start_long_run(out)
+    proc.send_signal(signum)
+    stdout, stderr = proc.communicate(timeout=120)
+    assert proc.returncode == status == 128 + signum
+    assert stdout == "" and stderr == f"simulate: {what}; no results were kept\n"
+    assert not out.exists()
+
+
 def test_ctrl_c_during_a_run_is_status_130_and_leaves_no_folder(tmp_path):
     """SIGINT once the output folder exists: one line, status 130, the folder removed.
 
@@ -140,26 +151,14 @@ def test_ctrl_c_during_a_run_is_status_130_and_leaves_no_folder(tmp_path):
     folder, not for a fixed time. The child gets the default SIGINT handling
     whatever the test runner was started with (nohup, &).
     """
-    out = tmp_path / "run"
-    proc = _start_long_run(out)
-    proc.send_signal(signal.SIGINT)
-    stdout, stderr = proc.communicate(timeout=120)
-    assert proc.returncode == cli.EXIT_INTERRUPTED == 130
-    assert stdout == "" and stderr == "simulate: interrupted; no results were kept\n"
-    assert not out.exists()
+    _signal_ends_the_run(tmp_path, signal.SIGINT, cli.EXIT_INTERRUPTED, "interrupted")
 
 
 # ------------------------------------------------------------ SIGTERM
 
 def test_sigterm_during_a_run_is_status_143_and_leaves_no_folder(tmp_path):
     """SIGTERM (schedulers, ``timeout``) as Ctrl-C: one line, status 143, the folder removed (before: silent death)."""
-    out = tmp_path / "run"
-    proc = _start_long_run(out)
-    proc.send_signal(signal.SIGTERM)
-    stdout, stderr = proc.communicate(timeout=120)
-    assert proc.returncode == cli.EXIT_TERMINATED == 143
-    assert stdout == "" and stderr == "simulate: terminated (SIGTERM); no results were kept\n"
-    assert not out.exists()
+    _signal_ends_the_run(tmp_path, signal.SIGTERM, cli.EXIT_TERMINATED, "terminated (SIGTERM)")
 
 
 def test_sigterm_while_writing_the_trajectory_leaves_no_temporary(tmp_path):
