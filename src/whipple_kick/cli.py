@@ -363,6 +363,17 @@ def _discard(out, created, written):
         (out / name).unlink(missing_ok=True)
 
 
+class _Output:
+    """The output folder a command writes into (:func:`_output_folder`).
+
+    ``written`` lists the files written so far (removed if the command
+    fails); ``keep`` set to True keeps them (a partial result for the user).
+    """
+
+    def __init__(self, out, created):
+        self.out, self.created, self.written, self.keep, self.lock = out, created, [], False, None
+
+
 def _default_out(scenario, prefix="kick"):
     """A new folder name under the current directory (never an existing one)."""
     import datetime
@@ -385,7 +396,7 @@ OUT_LOCK_FILE = ".whipple_kick.lock"
 
 @contextlib.contextmanager
 def _output_folder(path, force, previous=()):
-    """Create/check the output folder before the (longer) run and hold its lock; yields (path, created).
+    """Create/check the output folder before the (longer) run and hold its lock; yields an :class:`_Output`.
 
     The lock (:data:`OUT_LOCK_FILE`) keeps a second command from writing
     into the same folder at the same time (it gets one line, exit status
@@ -394,41 +405,57 @@ def _output_folder(path, force, previous=()):
     the files named in ``previous`` (what the command writes) are removed
     first, so no file of an earlier run (say its response.png beside a new
     ``--no-plot`` summary) is left to contradict the new one.
+
+    Whatever ends the command before it finishes (a failure, Ctrl-C,
+    SIGTERM, from the folder's creation on) removes the folder it created,
+    else the files it wrote, unless ``keep`` was set.
     """
     import pathlib
     out = pathlib.Path(path)
     if out.exists() and not out.is_dir():
         raise InputError(f"output folder {str(out)!r} exists and is not a folder")
+    job = _Output(out, created=not out.exists())
     try:
-        out.mkdir(parents=True)
-        created = True
-    except FileExistsError:
-        created = False
-    except OSError as exc:
-        raise InputError(f"output folder {str(out)!r} is not writable: {exc.strerror or exc}") from None
-    try:
-        lock = fileio.take_lock(out / OUT_LOCK_FILE,
-                                f"output folder {str(out)!r} is in use by another run (process {{pid}}); "
-                                "wait for it to finish or choose another --out")
-    except OSError as exc:
-        raise InputError(f"output folder {str(out)!r} is not writable: {exc.strerror or exc}") from None
-    try:
-        # Holding the lock, any temporary of ours here is a killed writer's.
-        for stale in fileio.stale_temporaries(out, previous):
-            stale.unlink(missing_ok=True)
-        if not force and any(p.name != OUT_LOCK_FILE for p in out.iterdir()):
-            raise InputError(f"output folder {str(out)!r} exists and is not empty; "
-                             "use --force to overwrite its files or choose another --out")
-        if force and not created:
-            for name in previous:
-                try:
-                    (out / name).unlink(missing_ok=True)
-                except OSError as exc:
-                    raise InputError(f"--force cannot remove {str(out / name)!r}: {exc.strerror or exc}") from None
-        yield out, created
+        _claim(job, force, previous)
+        yield job
+    except BaseException:
+        if not job.keep:
+            _discard(out, job.created, job.written)
+        raise
     finally:
-        # The lock file goes with the lock, so that the folder holds only the results.
-        fileio.release_lock(lock, out / OUT_LOCK_FILE)
+        if job.lock is not None:
+            # The lock file goes with the lock, so that the folder holds only the results.
+            fileio.release_lock(job.lock, out / OUT_LOCK_FILE)
+
+
+def _claim(job, force, previous):
+    """Create ``job.out``, take its lock (into ``job.lock``) and clear it for the command (:func:`_output_folder`)."""
+    out = job.out
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise InputError(f"output folder {str(out)!r} is not writable: {exc.strerror or exc}") from None
+    try:
+        job.lock = fileio.take_lock(out / OUT_LOCK_FILE,
+                                    f"output folder {str(out)!r} is in use by another run (process {{pid}}); "
+                                    "wait for it to finish or choose another --out")
+    except InputError:
+        job.keep = True   # the folder is the other run's: touch nothing
+        raise
+    except OSError as exc:
+        raise InputError(f"output folder {str(out)!r} is not writable: {exc.strerror or exc}") from None
+    # Holding the lock, any temporary of ours here is a killed writer's.
+    for stale in fileio.stale_temporaries(out, previous):
+        stale.unlink(missing_ok=True)
+    if not force and any(p.name != OUT_LOCK_FILE for p in out.iterdir()):
+        raise InputError(f"output folder {str(out)!r} exists and is not empty; "
+                         "use --force to overwrite its files or choose another --out")
+    if force and not job.created:
+        for name in previous:
+            try:
+                (out / name).unlink(missing_ok=True)
+            except OSError as exc:
+                raise InputError(f"--force cannot remove {str(out / name)!r}: {exc.strerror or exc}") from None
 
 
 def _print_summary(result, out, files):
@@ -527,22 +554,18 @@ def _simulate(argv):
     given = _flags_given(argv) if args.compat is not None else ()
     scenario = assembly.preflight(_scenario_from_args(args, given))
     movie_options = _animation_options(args)
-    with _output_folder(args.out or _default_out(scenario), args.force, _OUTPUT_FILES) as (out, created):
-        written = []
+    with _output_folder(args.out or _default_out(scenario), args.force, _OUTPUT_FILES) as job:
+        out = job.out
         try:
-            result, files, note = _simulate_into(args, scenario, movie_options, out, written)
+            result, files, note = _simulate_into(args, scenario, movie_options, out, job.written)
         except SimulationError as exc:
             if exc.partial is None:
-                _discard(out, created, written)
                 raise
             # What ran before the failure is kept for the user to inspect.
             _write_results(exc.partial, out)
+            job.keep = True
             raise SimulationError(
                 f"{exc}; the run up to t = {exc.partial.summary['end_time_s']:g} s is in {out}") from None
-        except BaseException:
-            # A failure, Ctrl-C or SIGTERM before every file is written: leave nothing half done.
-            _discard(out, created, written)
-            raise
     report_data_warnings(result.summary)
     if not args.quiet:
         _print_summary(result, out, files)
@@ -703,16 +726,12 @@ def _stability(argv):
     scenario = Scenario(**_model_fields(args), symmetric_tyres=args.tyre_offsets == "zero",
                                    speed=float(speeds[0]))
     assembly.preflight(scenario)
-    with _output_folder(args.out or _default_out(scenario, "stability"), args.force,
-                        _STABILITY_FILES) as (out, created):
-        try:
-            result = stability.analyse(scenario, speeds)
-            result.summary["numerics"] = {"wall_s": time.perf_counter() - started}
-            files = stability.write(result, out, plot=not args.no_plot)
-        except BaseException:
-            # A failure, Ctrl-C or SIGTERM before every file is written: leave nothing half done.
-            _discard(out, created, _STABILITY_FILES)
-            raise
+    with _output_folder(args.out or _default_out(scenario, "stability"), args.force, _STABILITY_FILES) as job:
+        out = job.out
+        job.written.extend(_STABILITY_FILES)   # written together at the end: any of them may be there
+        result = stability.analyse(scenario, speeds)
+        result.summary["numerics"] = {"wall_s": time.perf_counter() - started}
+        files = stability.write(result, out, plot=not args.no_plot)
     missing = {loop: m["speeds_without_steady_motion"] for loop, m in result.summary["steady_motion"].items()
                if m["speeds_without_steady_motion"]}
     for loop, count in missing.items():
