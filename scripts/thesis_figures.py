@@ -37,6 +37,14 @@ def _scenario(args, **changes):
     return Scenario.thesis(**{"rtol": args.rtol, **changes})
 
 
+def run_line(s):
+    """How a run ended and when it recovered, from its summary ``s``, for the progress lines."""
+    outcome = f"fell at {s['fall_time_s']:.3f} s ({s['fall_reason']})" if s["fell"] else "no fall"
+    time_s = s["recovery"]["time_s"]
+    recovery = "not recovered within the run" if time_s is None else f"{time_s:.3f} s"
+    return f"{outcome}; recovery (yaw, roll, steer rates within 5 %) {recovery}"
+
+
 def _figure(args, name, runs, title):
     path = pathlib.Path(args.out_dir) / f"{name}.png"
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -44,10 +52,7 @@ def _figure(args, name, runs, title):
     for label, scenario in runs:
         t = time.perf_counter()
         result = run(scenario)
-        s = result.summary
-        outcome = f"fell at {s['fall_time_s']:.3f} s ({s['fall_reason']})" if s["fell"] else "no fall"
-        print(f"  {name}: {label}: {outcome}; recovery (yaw, roll, steer rates within 5 %) "
-              f"{s['recovery']['time_s']} s; {time.perf_counter() - t:.2f} s", file=sys.stderr)
+        print(f"  {name}: {label}: {run_line(result.summary)}; {time.perf_counter() - t:.2f} s", file=sys.stderr)
         results.append((label, result))
     first = results[0][1].summary["kick"]
     wk.plotting.response_figure(results, path, title=title, time_range=tuple(args.time_range),

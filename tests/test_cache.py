@@ -6,7 +6,7 @@ import sys
 import pytest
 
 from whipple_kick import cache, slip
-from whipple_kick.errors import InputError
+from whipple_kick.errors import CacheError, InputError
 
 
 def test_cache_folder_is_private(tmp_path, monkeypatch):
@@ -20,7 +20,7 @@ def test_cache_folder_writable_by_others_is_refused(tmp_path, monkeypatch):
     folder.mkdir()
     folder.chmod(0o777)
     monkeypatch.setenv("WHIPPLE_KICK_CACHE", str(folder))
-    with pytest.raises(PermissionError, match="not private"):
+    with pytest.raises(CacheError, match="not private"):
         cache.cache_dir()
 
 
@@ -28,7 +28,7 @@ def test_cached_file_writable_by_others_is_not_loaded(tmp_path):
     path = tmp_path / "x.py"
     path.write_text("")
     path.chmod(0o666)
-    with pytest.raises(PermissionError, match="writable by others"):
+    with pytest.raises(CacheError, match="writable by others"):
         cache.check_private_file(path)
 
 
@@ -69,3 +69,12 @@ def test_concurrent_builds_share_one_library(tmp_path):
     assert len(libraries) == 1, libraries
     leftovers = [f.name for f in (tmp_path / "cache").iterdir() if f.name.endswith(".tmp")]
     assert not leftovers
+
+
+def test_every_generator_is_part_of_its_own_cache_key():
+    """A module that writes generated code is hashed into that code's key: editing what it writes
+    rebuilds the entry (classic.py was not in its own key, so a change to _generate_source reused the
+    stale module unless someone remembered to bump a layout string)."""
+    from whipple_kick import classic, geometry
+    for module, name in ((classic, "classic"), (geometry, "geometry"), (slip, "slip"), (slip, "slip_build")):
+        assert name in module._SOURCES, (module.__name__, name)

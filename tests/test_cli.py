@@ -158,6 +158,11 @@ BAD_INPUTS = {
     "pressure-negative": (["--pressure", "-5"], ["-5", "kPa"]),
     "front-pressure-out-of-range": (["--pressure-front", "250", "--pressure-rear", "400"], ["250", "kPa"]),
     "negative-load": (["--fz", "-100"], ["-100", "N", "range"]),
+    # 0 N and 10 N state the same, real range: the loads a rider can put on this bicycle
+    # (before: "(0, inf] N" for 0 N, "(165.09, 1535.65] N" for 10 N).
+    "zero-load": (["--fz", "0"], ["fz = 0.0 N", "allowed range (165.09, 1535.65] N for 'balanceassist_v1'"]),
+    "load-below-the-bicycle's-own": (["--fz", "10"], ["fz = 10.0 N",
+                                                      "allowed range (165.09, 1535.65] N for 'balanceassist_v1'"]),
     "load-too-large": (["--fz", "5000"], ["5000", "N", "range"]),
     "negative-rider-mass": (["--rider-mass", "-3"], ["-3", "kg", "(0, 200]"]),
     "unknown-tyre": (["--tyre", "T99"], ["T99", "T01", "T05"]),

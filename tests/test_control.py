@@ -18,8 +18,8 @@ from whipple_kick.errors import InputError
 DESIGN_SPEED = 3.0  # m/s, the thesis' design speed
 THESIS_LOADS = (570, 635, 701)  # N, Table 8.3 rear-tyre loads
 
-# ../shared/data/benchmarks.md, "LQR gains published with the authors'
-# kick-plate model": lqr(A, B, I, 1) for `browser_with_rider`, [kq4, kq7, ku4, ku7].
+# LQR gains published with the authors' kick-plate model (mechmotum/bicycle-kickplate-model
+# on GitHub, October 2024): lqr(A, B, I, 1) for `browser_with_rider`, [kq4, kq7, ku4, ku7].
 PUBLISHED_GAINS = {
     6.0: [-2.23409174, 4.90641021, -0.59393849, 0.43409879],
     3.0: [-23.18340061, 17.08640989, -7.99985294, 1.86343941],
@@ -66,9 +66,9 @@ def test_feedback_indices_match_model_ordering():
 
 @pytest.mark.parametrize("speed", sorted(PUBLISHED_GAINS))
 def test_published_gains_browser_with_rider(speed):
-    # Issue 5 asks for 0.5 % per gain. benchmarks.md says the published gains
-    # come from a slightly different model build and a faithful linearisation
-    # lands within about 0.3 %; we measure at most 0.26 % (ku4 at 3 m/s).
+    # Issue 5 asks for 0.5 % per gain. The published gains came from a slightly
+    # different build of the authors' model, so a faithful linearisation lands
+    # within a few tenths of a per cent; we measure at most 0.26 % (ku4 at 3 m/s).
     K, poles = control.lqr_gains(wk.bicycles.load("browser_with_rider"), speed)
     np.testing.assert_allclose(K, PUBLISHED_GAINS[speed], rtol=5e-3)
     assert np.all(poles.real < 0)
@@ -173,13 +173,22 @@ def test_linear_and_nonlinear_closed_loop_agree(combined, load):
 
 # --- (5) presets, scaling, configurability, errors --------------------------
 
-def test_thesis_gains_table():
-    assert control.thesis_gains(635) == control.THESIS_GAINS[635]
-    assert control.thesis_gains(701.0)["ku7"] == 1.600
-    # The result is a copy: editing it must not change the preset.
-    g = control.thesis_gains(570)
+@pytest.mark.parametrize("load", THESIS_LOADS)
+def test_thesis_gains_stabilise_the_bicycle_of_their_load(combined, load):
+    """Table 8.4's gains for a load balance the bicycle with that load's rider at the 3 m/s design speed.
+
+    Open loop the weave is unstable there (Re about +1.1 to +1.2 1/s); with T7 = -K x every
+    closed-loop mode decays (slowest about -0.58, -0.60, -0.61 1/s for 570, 635, 701 N).
+    """
+    moore = combined[load]
+    A, _ = classic.linear_state_space(moore, DESIGN_SPEED)
+    assert np.max(np.linalg.eigvals(A).real) > 1.0
+    closed = np.linalg.eigvals(control.closed_loop_matrix(moore, DESIGN_SPEED, _thesis_K(load)))
+    assert np.max(closed.real) < -0.5
+    # A float load selects the same row; the result is a copy the caller may change.
+    g = control.thesis_gains(float(load))
     g["kq4"] = 0.0
-    assert control.THESIS_GAINS[570]["kq4"] == -18.619
+    assert control.thesis_gains(load)["kq4"] == control.THESIS_GAINS[load]["kq4"] < 0
 
 
 @pytest.mark.parametrize("load", [600, 635.5, 634.6, 0, -635])

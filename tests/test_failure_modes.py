@@ -1,8 +1,8 @@
 """Failure modes a user meets: one line on stderr, the right exit status, nothing half-written left.
 
 Exit statuses: 2 the user's input, 1 the machine's set-up (a C compiler that
-fails) or the numerics, 130 Ctrl-C. Subprocess tests run the installed
-console script as a user would.
+fails, an unusable cache folder) or the numerics, 130 Ctrl-C, 143 SIGTERM.
+Subprocess tests run the installed console script as a user would.
 """
 import json
 import os
@@ -16,7 +16,7 @@ import time
 import numpy as np
 import pytest
 
-from whipple_kick import cache, cli, inputs, slip, slip_build
+from whipple_kick import cache, cli, fileio, inputs, slip, slip_build
 from whipple_kick.cli import simulate_main
 from whipple_kick.errors import BuildError, InputError
 
@@ -33,6 +33,30 @@ def _console_script(name):
     exe = pathlib.Path(sys.executable).with_name(name)
     assert exe.exists(), f"console script {name} not installed (pip install -e .)"
     return str(exe)
+
+
+#: Python code that resets SIGINT and SIGTERM to their default actions, then runs ``argv[1:]`` in its place
+#: (same pid). A test runner started with SIGINT ignored (``nohup``, ``&`` in a non-interactive shell)
+#: passes that on to its children, and Python then installs no KeyboardInterrupt handler.
+_DEFAULT_SIGNALS = ("import os, signal, sys; signal.signal(signal.SIGINT, signal.SIG_DFL); "
+                    "signal.signal(signal.SIGTERM, signal.SIG_DFL); os.execv(sys.argv[1], sys.argv[1:])")
+
+
+def _with_default_signals(argv):
+    """``argv`` run with SIGINT and SIGTERM at their default actions, whatever this process ignores."""
+    return [sys.executable, "-c", _DEFAULT_SIGNALS, *argv]
+
+
+def _start_long_run(out, *extra):
+    """``simulate`` of 120 s at rtol 1e-12 (far longer than a test waits) on ``out``, once ``out`` exists."""
+    proc = subprocess.Popen(_with_default_signals([_console_script("simulate"), "--duration", "120", "--rtol",
+                                                   "1e-12", "--no-plot", "--out", str(out), *extra]),
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while not out.exists() and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert proc.poll() is None, proc.communicate()
+    return proc
 
 
 # ------------------------------------------------------------ C compiler
@@ -108,25 +132,140 @@ def test_the_compiled_model_in_use_is_checked_against_its_manifest():
 
 # ------------------------------------------------------------ Ctrl-C
 
+def _signal_ends_the_run(tmp_path, signum, status, what):
+    """Send ``signum`` to a long run once its folder exists: one line, ``status`` (128 + signal), no folder."""
+    out = tmp_path / "run"
+    proc = _start_long_run(out)
+    proc.send_signal(signum)
+    stdout, stderr = proc.communicate(timeout=120)
+    assert proc.returncode == status == 128 + signum
+    assert stdout == "" and stderr == f"simulate: {what}; no results were kept\n"
+    assert not out.exists()
+
+
 def test_ctrl_c_during_a_run_is_status_130_and_leaves_no_folder(tmp_path):
     """SIGINT once the output folder exists: one line, status 130, the folder removed.
 
     The run (120 s simulated at rtol 1e-12, several seconds of work) is far
     longer than the time the signal takes to arrive; the test waits for the
-    folder, not for a fixed time.
+    folder, not for a fixed time. The child gets the default SIGINT handling
+    whatever the test runner was started with (nohup, &).
     """
+    _signal_ends_the_run(tmp_path, signal.SIGINT, cli.EXIT_INTERRUPTED, "interrupted")
+
+
+# ------------------------------------------------------------ SIGTERM
+
+def test_sigterm_during_a_run_is_status_143_and_leaves_no_folder(tmp_path):
+    """SIGTERM (schedulers, ``timeout``) as Ctrl-C: one line, status 143, the folder removed (before: silent death)."""
+    _signal_ends_the_run(tmp_path, signal.SIGTERM, cli.EXIT_TERMINATED, "terminated (SIGTERM)")
+
+
+def test_sigterm_while_writing_the_trajectory_leaves_no_temporary(tmp_path):
+    """SIGTERM in the middle of writing trajectory.csv: the hidden temporary is removed with the run's files."""
     out = tmp_path / "run"
-    proc = subprocess.Popen([_console_script("simulate"), "--duration", "120", "--rtol", "1e-12", "--no-plot",
-                             "--out", str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    deadline = time.monotonic() + 120
-    while not out.exists() and proc.poll() is None and time.monotonic() < deadline:
-        time.sleep(0.01)
-    assert proc.poll() is None, proc.communicate()
-    proc.send_signal(signal.SIGINT)
-    stdout, stderr = proc.communicate(timeout=120)
-    assert proc.returncode == cli.EXIT_INTERRUPTED == 130
-    assert stdout == "" and stderr == "simulate: interrupted; no results were kept\n"
-    assert not out.exists()
+    out.mkdir()
+    (out / "notes.txt").write_text("mine\n")
+    code = f"""
+import os, signal
+from whipple_kick import cli, fileio
+rows = fileio.csv_text_rows
+def killed_midway(*args, **kwargs):
+    for k, text in enumerate(rows(*args, **kwargs)):
+        if k == 0:
+            os.kill(os.getpid(), signal.SIGTERM)
+        yield text
+fileio.csv_text_rows = killed_midway
+cli.simulate_main(["--duration", "0.6", "--no-plot", "--force", "--out", {str(out)!r}])
+"""
+    proc = subprocess.run(_with_default_signals([sys.executable, "-c", code]), capture_output=True, text=True,
+                          timeout=300)
+    assert proc.returncode == 143 and proc.stderr == "simulate: terminated (SIGTERM); no results were kept\n"
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
+
+
+def test_stale_hidden_temporaries_do_not_make_the_folder_busy_and_are_removed(tmp_path, capsys):
+    """A killed writer's ``.trajectory.csv.<pid>.tmp`` is invisible to ``ls``: it neither blocks nor stays."""
+    out = tmp_path / "run"
+    out.mkdir()
+    (out / ".trajectory.csv.99999999.tmp").write_text("half a trajectory")
+    status, _, err = _simulate(["--duration", "0.6", "--no-plot", "--quiet", "--out", str(out)], capsys)
+    assert status == 0, err
+    assert sorted(p.name for p in out.iterdir()) == ["summary.json", "trajectory.csv"]
+    (out / ".summary.json.99999999.tmp").write_text("{")
+    (out / ".notes.txt.99999999.tmp").write_text("not ours: kept")
+    status, _, err = _simulate(["--duration", "0.6", "--no-plot", "--quiet", "--force", "--out", str(out)], capsys)
+    assert status == 0, err
+    assert sorted(p.name for p in out.iterdir()) == [".notes.txt.99999999.tmp", "summary.json", "trajectory.csv"]
+
+
+# ------------------------------------------------------------ one run per output folder
+
+def test_second_run_on_the_same_out_is_refused_in_one_line(tmp_path):
+    """Two runs on one --out: the second gets one line and status 2, the first finishes (before: both wrote)."""
+    out = tmp_path / "run"
+    first = _start_long_run(out)
+    try:
+        second = subprocess.run([_console_script("simulate"), "--duration", "0.6", "--no-plot", "--force",
+                                 "--out", str(out)], capture_output=True, text=True, timeout=300)
+    finally:
+        first.send_signal(signal.SIGINT)
+        first.communicate(timeout=120)
+    assert second.returncode == 2 and second.stderr.count("\n") == 1, second.stderr
+    assert f"output folder {str(out)!r} is in use by another run (process {first.pid})" in second.stderr
+    assert not out.exists()           # the first run, interrupted, removed the folder it made
+
+
+def test_lock_of_a_killed_run_is_taken_over_and_not_left_behind(tmp_path, capsys):
+    out = tmp_path / "run"
+    out.mkdir()
+    (out / cli.OUT_LOCK_FILE).write_text("99999999\n")      # a run killed by SIGKILL
+    status, _, err = _simulate(["--duration", "0.6", "--no-plot", "--quiet", "--out", str(out)], capsys)
+    assert status == 0, err
+    assert sorted(p.name for p in out.iterdir()) == ["summary.json", "trajectory.csv"]
+
+
+# ------------------------------------------------------------ cache folder
+
+def test_cache_folder_others_can_write_is_a_cache_error(tmp_path):
+    """Named as the cache's problem, with the folder and the fix (before: "cannot write the results", status 2)."""
+    shared = tmp_path / "cache"
+    shared.mkdir()
+    shared.chmod(0o777)
+    proc = subprocess.run([_console_script("simulate"), "--duration", "0.6", "--no-plot", "--out",
+                           str(tmp_path / "run")], env=dict(os.environ, WHIPPLE_KICK_CACHE=str(shared)),
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 1 and proc.stderr.count("\n") == 1, proc.stderr
+    assert proc.stderr.startswith(f"simulate: cache error: cache folder {shared} is not private")
+    assert "mode 0o777" in proc.stderr and "WHIPPLE_KICK_CACHE" in proc.stderr
+    assert not (tmp_path / "run").exists()
+
+
+def test_cache_folder_that_cannot_be_created_is_a_cache_error(tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    proc = subprocess.run([_console_script("stability"), "--speeds", "3", "--no-plot", "--out", str(tmp_path / "run")],
+                          env=dict(os.environ, WHIPPLE_KICK_CACHE=str(blocker / "cache")),
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 1 and proc.stderr.count("\n") == 1, proc.stderr
+    assert proc.stderr.startswith(f"stability: cache error: cache folder {blocker / 'cache'} cannot be created")
+
+
+def test_read_only_cache_folder_is_a_cache_error(tmp_path, monkeypatch):
+    """A cache folder the build cannot write into (read-only, full): CacheError naming the folder and the fix."""
+    import errno
+
+    from whipple_kick.errors import CacheError
+    monkeypatch.setenv("WHIPPLE_KICK_CACHE", str(tmp_path / "cache"))
+
+    def read_only(path):
+        raise PermissionError(errno.EROFS, "Read-only file system", str(path) + ".lock")
+    monkeypatch.setattr(cache, "locked", read_only)
+    with pytest.raises(CacheError) as info:
+        cache.build_once("x.py", lambda tmp: tmp.write_text(""))
+    message = str(info.value)
+    assert message.startswith(f"cache folder {tmp_path / 'cache'} cannot be written (Read-only file system)")
+    assert "WHIPPLE_KICK_CACHE" in message and "\n" not in message
 
 
 def test_interrupted_run_in_an_existing_folder_removes_only_its_own_files(tmp_path, capsys, monkeypatch):
@@ -279,7 +418,8 @@ def test_sigterm_ends_the_sweeps_workers_and_records_interrupted(tmp_path):
     finally:
         proc.kill()
     assert proc.returncode == cli.EXIT_TERMINATED == 143
-    assert stderr.startswith("recommend-pressure: terminated (SIGTERM)") and stderr.count("\n") == 1, stderr
+    assert stderr.startswith("recommend-pressure: terminated (SIGTERM); finished cases are kept") \
+        and stderr.count("\n") == 1, stderr
     manifest = json.loads((folder / "manifest.json").read_text())
     assert manifest["status"] == "interrupted" and manifest["n_done"] < manifest["n_cases"] == 201
     assert workers and not any(_alive(pid) for pid in workers)
@@ -315,7 +455,7 @@ def test_lock_of_a_dead_process_is_taken_over(tmp_path):
                               capture_output=True, text=True, timeout=120)
         assert held.returncode == 1 and f"in use by another sweep (process {os.getpid()}," in held.stderr
     finally:
-        sweep_store._unlock(fd)
+        fileio.release_lock(fd)
 
 
 def test_progress_bar_only_on_a_terminal_unless_asked(tmp_path):

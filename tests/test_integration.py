@@ -171,3 +171,44 @@ def test_kept_speeds_plate_stop_keeps_the_speeds_and_the_energy_balance():
     assert 0.01 < abs(jump["rear_slide_m_s"]) < 2.0
     assert np.max(np.abs(r.trajectory[wk.results.BALANCE_COLUMN])) < 1e-3
     assert r.summary["numerics"]["plate_stop"] == "keep_speeds"
+
+
+@pytest.mark.parametrize("changes", [
+    dict(),                                                          # settle, then the kick with a jump
+    dict(plate_stop="keep_speeds"),                                  # Scenario.authors_code()'s stop
+    dict(settle=0.0, start="upright", camber_sign="reversed", plate_stop="keep_speeds"),
+    dict(kick_profile="smooth", piecewise=False),                    # one LSODA run
+], ids=["settle-and-kick", "keep-speeds", "authors-code-like", "one-piece"])
+def test_work_counters_are_the_sum_over_the_pieces(changes, monkeypatch):
+    """The summary's nfev, njev and evaluations count every LSODA piece of the run.
+
+    keep_speeds runs reported njev = 0 and evaluations = 0: their two pieces were
+    merged by hand without those counters (now lsoda.join merges every run's pieces).
+    """
+    from whipple_kick import lsoda
+    pieces = []
+    integrate = lsoda.integrate
+
+    def counted(*args, **kwargs):
+        traj = integrate(*args, **kwargs)
+        pieces.append(traj)
+        return traj
+    monkeypatch.setattr(lsoda, "integrate", counted)
+    numerics = run(Scenario(duration=0.4, **changes)).summary["numerics"]
+    # (A piece LSODA ran with the Adams method alone, as a short settle, needs no Jacobian.)
+    assert pieces and all(p.evaluations >= p.nfev > 0 for p in pieces)
+    for name in ("nfev", "njev", "evaluations"):
+        assert numerics[name] == sum(getattr(p, name) for p in pieces), name
+
+
+def test_join_concatenates_samples_sums_counters_and_ends_as_the_last_piece():
+    from whipple_kick import lsoda
+    n = len(wk.slip.STATE_NAMES)
+    a = lsoda.Trajectory(np.array([0.0, 1.0]), np.zeros((2, n)), False, None, 10, "a", end_state=np.zeros(n),
+                         njev=2, evaluations=30)
+    b = lsoda.Trajectory(np.array([2.0]), np.ones((1, n)), True, 2.0, 5, "fell", end_state=np.ones(n),
+                         njev=1, evaluations=12, fall_reason="steer")
+    c = lsoda.join([a, b])
+    assert c.t.tolist() == [0.0, 1.0, 2.0] and c.x.shape == (3, n) and c.x[2, 0] == 1.0
+    assert (c.nfev, c.njev, c.evaluations) == (15, 3, 42)
+    assert c.fell and c.fall_time == 2.0 and c.message == "fell" and c.fall_reason == "steer" and c.end_state[0] == 1.0

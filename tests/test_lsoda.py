@@ -172,3 +172,33 @@ def test_the_budget_counts_the_evaluations_inside_the_jacobian():
     costly = lsoda.integrate(Model(1000), _start(), 1.0, output_rate=100.0, budget=budget)
     assert costly.failed and "more than the budget 2000 + 2000/s" in costly.message
     assert costly.evaluations == costly.nfev + 1000 * costly.njev
+
+
+@pytest.mark.parametrize("limit", ["roll", "steer"])
+def test_a_fast_chunk_ending_past_a_limit_is_a_fall(limit, monkeypatch):
+    """The fast path's guard sees only the states LSODA evaluates; a chunk whose samples (its end
+    above all) lie past a limit although no evaluation did must still end the run as a fall.
+
+    Modelled by a guard that never fires: roll (or steer) = 0.01 cosh t passes 0.3 rad at
+    acosh(30) = 4.0941 s, inside the chunk 4.0-4.5 s. Before, the run went on to 10 s "no fall".
+    """
+    monkeypatch.setattr(lsoda, "_guarded", lambda rhs, *limits: rhs)
+    index = ROLL if limit == "roll" else slip.X["q7"]
+    rate = ROLL_RATE if limit == "roll" else slip.X["u7"]
+
+    def grow(t, x):
+        dx = -x.copy()
+        dx[index], dx[rate] = x[rate], x[index]
+        return dx
+    x0 = np.full(N, 1e-3)
+    x0[index], x0[rate] = 0.01, 0.0
+    limits = dict(fall_angle=0.3 if limit == "roll" else 1.0, steer_limit=0.3 if limit == "steer" else None)
+    traj = lsoda.integrate(grow, x0, 10.0, rtol=1e-10, output_rate=100.0, **limits)
+    assert traj.fell and traj.fall_reason == limit
+    assert traj.fall_time == pytest.approx(math.acosh(30.0), abs=1e-7)
+
+
+def test_a_chunk_starting_past_the_limit_falls_at_its_start():
+    x0 = _start(roll=0.5)
+    traj = lsoda.integrate(capsize, x0, 1.0, rtol=1e-10, output_rate=100.0, fall_angle=0.3)
+    assert traj.fell and traj.fall_time == 0.0 and traj.t.tolist() == [0.0]

@@ -34,7 +34,8 @@ def test_recommend_pressure_prints_table_and_recommendation_for_thesis_loads():
 
 
 @pytest.mark.parametrize("args, message", [
-    (("--fz", "-3"), "rear-tyre load fz = -3.0 N is outside"),
+    (("--fz", "-3"), "rear-tyre load fz = -3.0 N is outside the allowed range (165.09, 1535.65] N"),
+    (("--fz", "635", "10"), "rear-tyre load fz = 10.0 N is outside the allowed range (165.09, 1535.65] N"),
     (("--fz", "635", "--pressures", "700"), "700.0 kPa is outside the allowed range [300, 500] kPa"),
     (("--fz", "635", "--tyre", "T99"), "tyre = 'T99' is unknown"),
     (("--fz", "x"), "'x' is not a number (N)"),
@@ -167,3 +168,40 @@ def test_recommend_pressure_cli_criterion_and_extend(tmp_path):
                     "--no-progress")
     assert extended.returncode == 0, extended.stderr
     assert len(wk.sweep_store.read_log(folder)) == 3
+
+
+def test_recommend_pressure_help_prints_single_percent_signs():
+    """argparse formats help strings with %, not the description: "5 %%" there was printed as is."""
+    proc = _cli("--help")
+    assert proc.returncode == 0 and "%%" not in proc.stdout and "within 5 % of their first peaks" in proc.stdout
+
+
+def test_a_sweep_whose_every_case_fails_is_an_error_not_a_verdict(monkeypatch):
+    """Before: the verdict "none recovered" and, from the command line, exit status 0."""
+    import concurrent.futures as cf
+
+    from whipple_kick import simulation
+    from whipple_kick.sweep_engine import SweepFailed
+
+    def broken(scenario):
+        raise ZeroDivisionError("a bug")
+    monkeypatch.setattr(simulation, "run", broken)
+    with cf.ThreadPoolExecutor(1) as pool, pytest.raises(SweepFailed) as info:
+        wk.recommend.recommend_pressures([635.0], pressures=[300, 400], base=BASE, executor=pool)
+    message = str(info.value)
+    assert message.startswith("all 2 cases failed (a bug or a broken set-up, not a result); the first, case ")
+    assert message.endswith("with ZeroDivisionError: a bug") and "\n" not in message
+
+
+def test_recommend_pressure_reports_a_sweep_whose_every_case_failed_in_one_line_exit_1(monkeypatch, capsys):
+    from whipple_kick import cli
+    from whipple_kick.sweep_engine import SweepFailed
+
+    def failed(*args, **kwargs):
+        raise SweepFailed("all 3 cases failed (...); the first, case 0123, with ZeroDivisionError: a bug")
+    monkeypatch.setattr(wk.recommend, "recommend_pressures", failed)
+    with pytest.raises(SystemExit) as info:
+        cli.recommend_main(["--fz", "635", "--pressures", "300", "400", "500"])
+    out, err = capsys.readouterr()
+    assert info.value.code == 1 and out == ""
+    assert err == "recommend-pressure: all 3 cases failed (...); the first, case 0123, with ZeroDivisionError: a bug\n"

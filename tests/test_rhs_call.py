@@ -137,3 +137,27 @@ def test_integration_is_the_same_on_either_path(steady, monkeypatch):
     slow = lsoda.integrate(slow_rhs, steady.x, 1.0, breakpoints=(0.15,), rtol=1e-10)
     assert fast.nfev == slow.nfev and fast.njev == slow.njev
     np.testing.assert_array_equal(fast.x, slow.x)
+
+
+@pytest.mark.parametrize("cause", ["headers", "compiler"])
+def test_falling_back_to_ctypes_is_one_warning_line_once_per_process(cause, tmp_path, monkeypatch, capsys):
+    """Before, the slower ctypes path was taken silently (about 1.9 times the cost per evaluation)."""
+    import shutil
+    import sysconfig
+    monkeypatch.setattr(rhs_call, "_warned", False)
+    if cause == "headers":
+        monkeypatch.setattr(sysconfig, "get_paths", lambda: {"include": str(tmp_path)})
+        compilers = ["cc-a", "cc-b"]
+    else:
+        monkeypatch.setenv("WHIPPLE_KICK_CACHE", str(tmp_path / "cache"))
+        compilers = [shutil.which("false"), shutil.which("true") + "-not-there"]
+    rhs_call.module.cache_clear()
+    try:
+        assert [rhs_call.module(c) for c in compilers] == [None, None]
+    finally:
+        rhs_call.module.cache_clear()
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("whipple_kick: warning: the fast call into the compiled model "
+                                                   "is not available: ")
+    assert ("Python headers are missing" if cause == "headers" else f"building it with {compilers[0]} failed") in err
+    assert "about 1.9 times as costly" in err

@@ -8,7 +8,7 @@ from whipple_kick.benchmark import from_moore
 from whipple_kick.errors import InputError
 
 # Jason seated on the balance-assist bicycle v1 as computed by Moore's
-# BicycleParameters (shared/data/bicycleparameters/JasonBalanceassistv1Benchmark.txt).
+# BicycleParameters (file JasonBalanceassistv1Benchmark.txt, github.com/moorepants/BicycleParameters).
 # These are the RIDER ALONE (mB = 83.5 kg is Jason's mass), benchmark frame.
 BP_JASON = {"mB": 83.50000000000001, "xB": 0.3352609184222891, "zB": -1.1408922158792676,
             "IBxx": 11.738504483083279, "IByy": 12.110105514155187,

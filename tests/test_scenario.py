@@ -9,12 +9,23 @@ from whipple_kick.scenario import Scenario
 
 
 def test_defaults_are_the_thesis_settings_and_validate_returns_the_scenario():
+    """What the defaults do, not what they are: the thesis' kick (150 mm in 0.150 s at a constant
+    13.3 m/s^2, Dell'Orto 2025, Section 8.2), a rider seated for 635 N on the rear tyre, the LQR rider
+    designed at the run's speed, T03 at 400 kPa on both wheels."""
+    from whipple_kick import assembly, inputs
     sc = Scenario()
     assert sc.validate() is sc
-    assert (sc.tyre, sc.pressure_kpa, sc.speed, sc.kick_displacement, sc.rtol) == ("T03", 400.0, 3.0, 0.150, 1e-10)
-    assert sc.pressures == (400.0, 400.0) and sc.lqr_design_speed == 3.0
+    kick = inputs.kick_of(sc)
+    assert (kick.profile, kick.displacement, kick.duration) == ("constant", 0.150, 0.150)
+    assert kick.peak_acceleration == pytest.approx(2 * 0.150 / 0.150 ** 2)      # 13.3 m/s^2
+    rear, front, notes = assembly.build_tyres(sc)
+    assert (rear.name, rear.pressure_kpa, front.pressure_kpa, notes) == ("T03", 400.0, 400.0, [])
+    assert sc.lqr_design_speed == sc.speed == 3.0
+    from whipple_kick.simulation import run
+    bike = run(sc.with_changes(duration=0.2)).summary["bicycle"]
+    assert bike["bicycle"] == "balanceassist_v1" and bike["static_load_rear_n"] == pytest.approx(635.0, abs=1e-6)
+    assert Scenario(speed=5.0).lqr_design_speed == 5.0 and Scenario(design_speed=3.0, speed=5.0).lqr_design_speed == 3.0
     assert Scenario(pressure_front_kpa=300.0, pressure_rear_kpa=500.0).pressures == (500.0, 300.0)
-    assert Scenario(design_speed=3.0, speed=5.0).lqr_design_speed == 3.0
     json.dumps(sc.to_dict(), allow_nan=False)
 
 

@@ -36,18 +36,32 @@ def test_symmetric_tyres_run_upright():
     assert abs(st["roll_rad"]) < 1e-12 and abs(st["yaw_rate_rad_s"]) < 1e-12
 
 
-def test_thesis_preset_runs():
+def test_thesis_preset_runs_its_table_8_4_rider():
+    """The thesis preset recovers at 400 kPa with the Table 8.4 rider for 635 N actually applied:
+    the steer torque at every sample is -K x with those gains (to round-off)."""
     r = run(Scenario.thesis(pressure_kpa=400.0, duration=2.0))
     s = r.summary
-    assert s["bicycle"]["bicycle"] == "balanceassist_635N" and s["bicycle"]["rider_mass_kg"] is None
-    assert s["controller"]["gains"]["kq7"] == pytest.approx(15.4934)
-    assert s["tyres"]["coefficient_set"] == "chapter8" and s["tyres"]["friction"] == "thesis"
-    assert s["numerics"]["rtol"] == 1e-12 and not s["fell"]
+    assert s["bicycle"]["bicycle"] == "balanceassist_635N" and not s["fell"]
+    gains = wk.control.thesis_gains(635)
+    x = r.trajectory[["roll", "steer", "roll_rate", "steer_rate"]].to_numpy()
+    K = np.array([gains[name] for name in wk.control.GAIN_ORDER])
+    torque = r.trajectory["steer_torque"].to_numpy()
+    assert np.max(np.abs(torque)) > 1.0     # the kick makes the rider steer
+    np.testing.assert_allclose(torque, -x @ K, rtol=0, atol=1e-12)
 
 
 def test_front_and_rear_pressures_may_differ():
-    r = run(Scenario(pressure_front_kpa=300.0, pressure_rear_kpa=500.0, duration=0.3))
-    assert (r.summary["tyres"]["pressure_rear_kpa"], r.summary["tyres"]["pressure_front_kpa"]) == (500.0, 300.0)
+    """Each wheel gets the tyre of its own pressure: the assembled rear tyre is the 500 kPa one, the
+    front the 300 kPa one, and the run differs from both runs at one pressure."""
+    mixed = Scenario(pressure_front_kpa=300.0, pressure_rear_kpa=500.0, duration=0.3)
+    rear, front, _ = wk.assembly.build_tyres(mixed)
+    force = lambda tyre: tyre.lateral_force(slip=0.02, camber=0.05, fz=600.0)
+    assert force(rear) == force(wk.tyres.load("T03", 500.0)) != force(wk.tyres.load("T03", 300.0)) == force(front)
+    r = run(mixed)
+    for same in (300.0, 500.0):
+        other = run(Scenario(pressure_kpa=same, duration=0.3))
+        assert not np.allclose(r.trajectory["fy_front"], other.trajectory["fy_front"]) \
+            or not np.allclose(r.trajectory["fy_rear"], other.trajectory["fy_rear"]), same
 
 
 def test_tyre_without_moment_data_runs_with_zero_moment():

@@ -404,3 +404,47 @@ def test_cli_controller_off_has_the_open_loop_only(tmp_path, capsys):
     assert exc.value.code == 0 and capsys.readouterr().out == ""
     assert set(pd.read_csv(out / "eigenvalues.csv")["loop"]) == {"open"}
     assert not (out / "stability.png").exists()
+
+
+# ------------------------------------------------------------------ root finding that may fail
+
+def test_root_without_a_bracket_is_not_found_with_a_reason():
+    """Before, _root extrapolated linearly outside [a, b] and returned that as the crossing speed."""
+    speed, why = stability._root(lambda v: v + 1.0, 2.0, 3.0)     # +3 and +4: no sign change
+    assert speed is None and "does not change sign between 2 and 3 m/s" in why
+    speed, why = stability._root(lambda v: v - 2.5, 2.0, 3.0)
+    assert speed == pytest.approx(2.5, abs=1e-9) and why is None
+
+
+class _WeaveTurnsIntoAnotherPair:
+    """A stand-in sweep: the unstable weave at 1 m/s continues at 2 m/s as a stable oscillatory
+    eigenvalue of another name, with no real eigenvalue near it (no split)."""
+
+    def __init__(self):
+        self.speeds = np.array([1.0, 2.0])
+        self.lams = [np.array([0.5 + 2j]), np.array([-1.0 + 5j])]
+        self.name = {(0, 7): "weave", (1, 7): "wobble"}
+
+    def present(self, k):
+        return True
+
+    def values(self, k, mode):
+        return [(complex(self.lams[k][0]), 7)] if self.name[k, 7] == mode else []
+
+    def eigenvalue(self, k, track_id):
+        return complex(self.lams[k][0])
+
+    def tracked_real_part(self, k, track_id):
+        return lambda v: 0.5 - 1.5 * (v - 1.0)
+
+
+def test_weave_pair_that_neither_stays_nor_splits_is_not_found_with_a_reason():
+    """Before, ``max`` over the empty list of split partners raised ValueError."""
+    speed, why = stability._weave_speed(_WeaveTurnsIntoAnotherPair())
+    assert speed is None and "without turning into two real eigenvalues" in why and "wobble" in why
+
+
+def test_stable_range_with_an_end_not_located_says_so():
+    text = stability.range_text({"from_m_s": 2.0, "to_m_s": 4.33, "lower_open": False, "upper_open": False,
+                                 "note": "lower end not located, ..."})
+    assert text == "2.00-4.33 (an end not located: at a sweep speed)"

@@ -90,6 +90,10 @@ def test_truncated_log_line_is_ignored_and_the_case_rerun(tmp_path):
     log.write_text(lines[0] + "\n" + lines[1][: len(lines[1]) // 2])   # a crash mid-write
     table = wk.sweep(grid, base=BASE, folder=folder, progress=False, trajectory_columns=None)
     assert (table["status"] == "ok").all()
+    # The rerun case's record is on its own line, not glued to the cut one (before, that swallowed
+    # it: the log then held one case, and every later run of the sweep ran the other again).
+    assert set(wk.sweep_store.read_log(folder)) == set(table["case_id"])
+    assert log.read_text().endswith("\n") and len(log.read_text().splitlines()) == 3
 
 
 def test_folder_of_another_sweep_is_refused_unless_extended(default_run, tmp_path):

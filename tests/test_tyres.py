@@ -325,3 +325,24 @@ def test_linear_tyre_is_linear_without_camber_force_or_moment():
         assert np.all(magic_formula.aligning_moment_numpy(slip, 0.1, fz, mz) == 0.0)
     with pytest.raises(InputError, match="cornering coefficient"):
         tyres.linear_tyre(-1.0, 0.05, 2e5)
+
+
+def test_a_tyre_without_moment_data_is_told_by_its_flag_not_by_a_message(monkeypatch):
+    """assembly.build_tyres decided "no M_z data" by finding "aligning-moment" in an error's text:
+    any rewording of that message made T04 runs fail. It now reads Tyre.has_aligning_moment."""
+    from whipple_kick import assembly, tyres
+    from whipple_kick.errors import InputError
+    from whipple_kick.scenario import Scenario
+
+    def reworded(self, mz):
+        if mz is not None:
+            return mz
+        if self.missing_moment == "zero":
+            return tyres.ZERO_MOMENT_COEFFICIENTS
+        raise InputError(f"tyre {self.name}: no M_z fit")
+    monkeypatch.setattr(tyres.Tyre, "_moment_coefficients", reworded)
+    rear, front, notes = assembly.build_tyres(Scenario(tyre="T04"))
+    assert not rear.has_aligning_moment and notes == ["T04 has no published aligning-moment data: M_z = 0"]
+    assert all((mz == tyres.ZERO_MOMENT_COEFFICIENTS).all() for _, _, mz in rear.blend)
+    rear, _, notes = assembly.build_tyres(Scenario(tyre="T03"))
+    assert rear.has_aligning_moment and notes == []

@@ -32,9 +32,7 @@ import functools
 import itertools
 import math
 import pathlib
-import shutil
 import subprocess
-import tempfile
 import time
 
 import numpy as np
@@ -884,16 +882,18 @@ class _Frames:
 
 @functools.cache
 def video_encoder():
-    """Path of an ffmpeg executable, or None.
+    """Path of the ffmpeg executable the ``video`` extra's imageio-ffmpeg uses, or None without it.
 
-    The ``video`` extra's imageio-ffmpeg ships one; otherwise an ``ffmpeg``
-    on PATH is used.
+    imageio-ffmpeg ships an ffmpeg (``IMAGEIO_FFMPEG_EXE`` points it at
+    another, e.g. the system's) and writes the frames through it
+    (:func:`imageio_ffmpeg.write_frames`), so an ``ffmpeg`` on PATH alone is
+    not enough: without the extra, animations are GIFs.
     """
     try:
         import imageio_ffmpeg
         return imageio_ffmpeg.get_ffmpeg_exe()
     except (ImportError, RuntimeError):
-        return shutil.which("ffmpeg")
+        return None
 
 
 @functools.cache
@@ -904,39 +904,27 @@ def _h264_codec(exe):
 
 
 class _FfmpegWriter:
-    """Raw RGBA frames piped into ffmpeg, encoded as H.264 mp4."""
+    """RGBA frames encoded as H.264 mp4 by ffmpeg, through :func:`imageio_ffmpeg.write_frames`."""
 
     def __init__(self, path, size, fps):
         exe = video_encoder()
         if exe is None:
             raise InputError(f"cannot write {path}: no video encoder; install the 'video' extra "
                              "(pip install 'whipple_kick[video]') or write a .gif")
+        import imageio_ffmpeg
         codec = _h264_codec(exe)
-        args = list(FFMPEG_OUTPUT_ARGS) if codec == "libx264" else ["-pix_fmt", "yuv420p", "-q:v", "4"]
-        self._log = tempfile.TemporaryFile()
-        self._proc = subprocess.Popen(
-            [exe, "-y", "-loglevel", "error", "-f", "rawvideo", "-vcodec", "rawvideo", "-s", f"{size[0]}x{size[1]}",
-             "-pix_fmt", "rgba", "-framerate", repr(float(fps)), "-i", "pipe:", "-an", "-vcodec", codec, *args,
-             str(path)], stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=self._log)
+        # write_frames sets the input format, the codec and -pix_fmt; the rest of the output options are ours.
+        options = list(FFMPEG_OUTPUT_ARGS[2:]) if codec == "libx264" else ["-q:v", "4"]
+        self._frames = imageio_ffmpeg.write_frames(
+            str(path), tuple(size), pix_fmt_in="rgba", pix_fmt_out="yuv420p", fps=float(fps), codec=codec,
+            quality=None, macro_block_size=1, ffmpeg_log_level="error", output_params=options)
+        self._frames.send(None)   # starts ffmpeg
 
     def write(self, rgba):
-        try:
-            self._proc.stdin.write(memoryview(rgba).cast("B"))
-        except BrokenPipeError:
-            self.close()
+        self._frames.send(np.ascontiguousarray(rgba))
 
     def close(self):
-        if self._proc.stdin and not self._proc.stdin.closed:
-            try:
-                self._proc.stdin.close()
-            except BrokenPipeError:
-                pass
-        status = self._proc.wait()
-        self._log.seek(0)
-        message = self._log.read().decode(errors="replace").strip()
-        self._log.close()
-        if status != 0:
-            raise OSError(f"ffmpeg failed (status {status}): {message[-800:]}")
+        self._frames.close()   # ends the input, waits for ffmpeg; raises with its message if it failed
 
 
 class _GifWriter:

@@ -45,8 +45,8 @@ MOORE_NAMES = (
 def meijaard2007_parameters():
     """Return the benchmark bicycle's parameters (exact values, SI units).
 
-    Source: Meijaard et al. (2007) Table 1, as transcribed in
-    ``shared/data/benchmarks.md``. ``lam`` is exactly pi/10 rad.
+    Source: Meijaard, Papadopoulos, Ruina & Schwab (2007), Proc. R. Soc. A
+    463:1955-1982, Table 1. ``lam`` is exactly pi/10 rad.
 
     Returns
     -------
@@ -188,8 +188,8 @@ def from_moore(moore):
 def canonical_matrices():
     """Published canonical matrices of the benchmark bicycle.
 
-    Source: Meijaard et al. (2007) eqs. (A 21)-(A 24) as printed in
-    ``shared/data/benchmarks.md``; ``M qdd + v C1 qd + (g K0 + v^2 K2) q = f``
+    Source: Meijaard et al. (2007), Proc. R. Soc. A 463:1955-1982, eqs.
+    (A 21)-(A 24); ``M qdd + v C1 qd + (g K0 + v^2 K2) q = f``
     with ``q = [roll, steer]``.
 
     Returns
@@ -206,7 +206,7 @@ def canonical_matrices():
 
 
 #: Published eigenvalues (Meijaard et al. 2007 Table 2) at v = 0..10 m/s.
-#: Each row: (v, weave/real pair, capsize, castor) as listed in benchmarks.md;
+#: Each row: (v, weave/real pair, capsize, castor) as listed in that table;
 #: at v = 0 both pairs are real (+-).
 PUBLISHED_EIGENVALUES = {
     0: (3.13164324790656, -3.13164324790656, 5.53094371765393, -5.53094371765393),

@@ -5,13 +5,17 @@ Generated code is a build artefact. It lives in ``$WHIPPLE_KICK_CACHE`` or
 folder created with private permissions (0700) and refused if another user
 can write to it. Several processes may build the same entry at once: a file
 lock serialises the builders and each entry is written to a temporary name
-and renamed into place, so a reader never sees a half-written file.
+and renamed into place, so a reader never sees a half-written file. A cache
+folder that cannot be created, written or trusted is a one-line
+:class:`~whipple_kick.errors.CacheError` naming the folder, what is wrong and
+how to fix it.
 
 Nothing here imports SymPy: the cache key names the SymPy version the entry
 was generated with through :mod:`importlib.metadata`, so a warm run finds
 its entries without loading the derivation's libraries.
 """
 import contextlib
+import errno
 import fcntl
 import functools
 import hashlib
@@ -24,6 +28,7 @@ import stat
 import sys
 
 from . import fileio
+from .errors import CacheError
 
 _PACKAGE_DIR = pathlib.Path(__file__).resolve().parent
 
@@ -33,8 +38,9 @@ def cache_dir():
 
     Raises
     ------
-    PermissionError
-        If the folder is not owned by this user or is writable by others.
+    CacheError
+        The folder cannot be created, is not owned by this user or is
+        writable by others.
     """
     root = os.environ.get("WHIPPLE_KICK_CACHE")
     if root:
@@ -42,14 +48,26 @@ def cache_dir():
     else:
         base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
         path = pathlib.Path(base) / "whipple_kick"
-    path.mkdir(mode=0o700, parents=True, exist_ok=True)
-    info = path.stat()
+    try:
+        path.mkdir(mode=0o700, parents=True, exist_ok=True)
+        info = path.stat()
+    except OSError as exc:
+        raise CacheError(f"cache folder {path} cannot be created: {exc.strerror or exc}; "
+                         f"{_FIX}") from None
     if info.st_uid != os.getuid() or info.st_mode & (stat.S_IWGRP | stat.S_IWOTH):
-        raise PermissionError(
+        # Another user could plant code there that this process would load and run.
+        raise CacheError(
             f"cache folder {path} is not private to this user (owner uid {info.st_uid}, "
-            f"mode {oct(info.st_mode & 0o777)}); remove it or set WHIPPLE_KICK_CACHE"
+            f"mode {oct(info.st_mode & 0o777)}): others could change the code it holds; "
+            f"chmod 700 it, remove it, or {_FIX}"
         )
     return path
+
+
+#: How to fix an unusable cache folder, the end of every CacheError message.
+_FIX = "set WHIPPLE_KICK_CACHE to a private writable folder (e.g. export WHIPPLE_KICK_CACHE=$HOME/.whipple_kick_cache)"
+#: Errors of writing a cache entry that are the folder's, not the build's.
+_FOLDER_ERRORS = (errno.EACCES, errno.EPERM, errno.EROFS, errno.ENOSPC, errno.EDQUOT)
 
 
 def source_hash(module_names, extra=""):
@@ -97,7 +115,8 @@ def check_private_file(path):
     """Refuse to load a cached file another user could have written."""
     info = pathlib.Path(path).stat()
     if info.st_uid != os.getuid() or info.st_mode & (stat.S_IWGRP | stat.S_IWOTH):
-        raise PermissionError(f"cached file {path} is writable by others; refusing to load it")
+        raise CacheError(f"cached file {path} is writable by others; refusing to load it; remove it, "
+                         f"or {_FIX}")
 
 
 def _manifest_path(path):
@@ -137,12 +156,20 @@ def build_once(name, build):
     """
     path = cache_dir() / name
     if not intact(path):
-        with locked(path):
-            if not intact(path):
-                _manifest_path(path).unlink(missing_ok=True)
-                with fileio.atomic_path(path, private=True) as tmp:
-                    build(tmp)
-                fileio.write_atomic(_manifest_path(path), _fingerprint(path) + "\n", private=True)
+        try:
+            with locked(path):
+                if not intact(path):
+                    _manifest_path(path).unlink(missing_ok=True)
+                    with fileio.atomic_path(path, private=True) as tmp:
+                        build(tmp)
+                    fileio.write_atomic(_manifest_path(path), _fingerprint(path) + "\n", private=True)
+        except CacheError:
+            raise
+        except OSError as exc:
+            if exc.errno not in _FOLDER_ERRORS:
+                raise
+            raise CacheError(f"cache folder {path.parent} cannot be written ({exc.strerror or exc}) to build "
+                             f"{name}; make it writable, or {_FIX}") from None
     check_private_file(path)
     return path
 

@@ -2,41 +2,53 @@
 
 Every failure prints one line on stderr, without a traceback, and exits
 with a status that says whose it is: 2 the user's input (an
-:class:`~whipple_kick.errors.InputError`, an unwritable output folder),
-1 the machine's set-up or the numerics (a C compiler that fails, a run
-that fails numerically), 130 interrupted (Ctrl-C, as shells report
-SIGINT). An output folder a command created and did not fill is removed.
+:class:`~whipple_kick.errors.InputError`, an unwritable output folder, an
+output folder in use by another run), 1 the machine's set-up or the
+numerics (a C compiler that fails, an unusable cache folder, a run that
+fails numerically), 130 interrupted (Ctrl-C, as shells report SIGINT),
+143 terminated (SIGTERM, as schedulers and ``timeout`` send). An output
+folder a command created and did not fill is removed, and no temporary
+file is left behind.
 """
 import argparse
+import contextlib
 import math
 import sys
 
 import numpy as np
 
-from .errors import BuildError, InputError, SimulationError
+from . import fileio
+from .errors import BuildError, CacheError, InputError, SimulationError, Terminated, terminate_raises
 
 #: Exit status of a command interrupted by Ctrl-C (128 + SIGINT, as shells report it).
 EXIT_INTERRUPTED = 130
-#: Exit status of a sweep ended by SIGTERM (128 + SIGTERM).
+#: Exit status of a command ended by SIGTERM (128 + SIGTERM).
 EXIT_TERMINATED = 143
 
 
 def _run(main, argv, prog="whipple_kick", kept="no results were kept"):
     """Run a command's ``main(argv)``, turning each kind of failure into one line and its exit status.
 
-    ``kept`` says what an interrupted command leaves behind.
+    ``kept`` says what an interrupted (Ctrl-C) or terminated (SIGTERM) command leaves behind.
     """
     try:
-        return main(argv)
+        with terminate_raises():
+            return main(argv)
     except InputError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     except BuildError as exc:
         print(f"{prog}: cannot build the compiled model: {exc}", file=sys.stderr)
         return 1
+    except CacheError as exc:   # the machine's set-up, before "cannot write the results" below
+        print(f"{prog}: cache error: {exc}", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         print(f"{prog}: interrupted; {kept}", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except Terminated:
+        print(f"{prog}: terminated (SIGTERM); {kept}", file=sys.stderr)
+        return EXIT_TERMINATED
     except OSError as exc:   # an unwritable output folder or a full disk: the user's to fix
         print(f"{prog}: cannot write the results: {exc}", file=sys.stderr)
         return 2
@@ -286,6 +298,7 @@ def _model_fields(args):
         raise InputError("--pressure sets both tyres; do not combine it with --pressure-front/--pressure-rear")
     if (fronts[0] is None) != (fronts[1] is None):
         raise InputError("give both --pressure-front KPA and --pressure-rear KPA (or --pressure KPA for both)")
+    _check_loads(args.bicycle, [args.fz] if args.fz is not None else [])
     return dict(
         bicycle=args.bicycle, fz_n=args.fz, rider_mass_kg=args.rider_mass, tyre=args.tyre,
         pressure_kpa=400.0 if args.pressure is None else args.pressure,
@@ -295,6 +308,22 @@ def _model_fields(args):
         low_inertia=args.low_inertia, tyre_transient=args.tyre_transient, camber_sign=args.camber_sign,
         carcass_sliding=args.carcass_sliding, carcass_damping=args.carcass_damping,
     )
+
+
+def _check_loads(bicycle, loads):
+    """Refuse a ``--fz`` no rider can put on ``bicycle``'s rear tyre, naming the real range in N.
+
+    Checked here, before the scenario's own check (a load above 0 N), so that
+    0 N and 10 N get the same message: the loads between the bicycle's own
+    rear load and that with the heaviest rider.
+    """
+    from . import bicycles, riders
+    bike = bicycles.load(bicycle)
+    if bike.includes_rider:
+        return   # refused later in one line (the preset already includes its rider)
+    low, high, _ = riders.rear_load_range(bike)
+    for fz in loads:
+        riders.within_rear_load_range(bike, fz, low, high)
 
 
 def _scenario_from_args(args, given=()):
@@ -343,6 +372,17 @@ def _discard(out, created, written):
         (out / name).unlink(missing_ok=True)
 
 
+class _Output:
+    """The output folder a command writes into (:func:`_output_folder`).
+
+    ``written`` lists the files written so far (removed if the command
+    fails); ``keep`` set to True keeps them (a partial result for the user).
+    """
+
+    def __init__(self, out, created):
+        self.out, self.created, self.written, self.keep, self.lock = out, created, [], False, None
+
+
 def _default_out(scenario, prefix="kick"):
     """A new folder name under the current directory (never an existing one)."""
     import datetime
@@ -359,37 +399,72 @@ def _default_out(scenario, prefix="kick"):
     return out
 
 
-def _prepare_out(path, force, previous=()):
-    """Create/check the output folder before the (longer) run. Returns (path, created).
+#: Held (flock, :func:`whipple_kick.fileio.take_lock`) by the command writing into an output folder; holds its pid.
+OUT_LOCK_FILE = ".whipple_kick.lock"
 
-    With ``force``, the files named in ``previous`` (what the command
-    writes) are removed first, so no file of an earlier run (say its
-    response.png beside a new ``--no-plot`` summary) is left to contradict
-    the new one.
+
+@contextlib.contextmanager
+def _output_folder(path, force, previous=()):
+    """Create/check the output folder before the (longer) run and hold its lock; yields an :class:`_Output`.
+
+    The lock (:data:`OUT_LOCK_FILE`) keeps a second command from writing
+    into the same folder at the same time (it gets one line, exit status
+    2); a lock left by a killed command is taken over. Hidden temporaries
+    of ``previous`` left by a killed writer are removed. With ``force``,
+    the files named in ``previous`` (what the command writes) are removed
+    first, so no file of an earlier run (say its response.png beside a new
+    ``--no-plot`` summary) is left to contradict the new one.
+
+    Whatever ends the command before it finishes (a failure, Ctrl-C,
+    SIGTERM, from the folder's creation on) removes the folder it created,
+    else the files it wrote, unless ``keep`` was set.
     """
-    import os
     import pathlib
     out = pathlib.Path(path)
     if out.exists() and not out.is_dir():
         raise InputError(f"output folder {str(out)!r} exists and is not a folder")
-    if out.is_dir() and any(out.iterdir()) and not force:
+    job = _Output(out, created=not out.exists())
+    try:
+        _claim(job, force, previous)
+        yield job
+    except BaseException:
+        if not job.keep:
+            _discard(out, job.created, job.written)
+        raise
+    finally:
+        if job.lock is not None:
+            # The lock file goes with the lock, so that the folder holds only the results.
+            fileio.release_lock(job.lock, out / OUT_LOCK_FILE)
+
+
+def _claim(job, force, previous):
+    """Create ``job.out``, take its lock (into ``job.lock``) and clear it for the command (:func:`_output_folder`)."""
+    out = job.out
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise InputError(f"output folder {str(out)!r} is not writable: {exc.strerror or exc}") from None
+    try:
+        job.lock = fileio.take_lock(out / OUT_LOCK_FILE,
+                                    f"output folder {str(out)!r} is in use by another run (process {{pid}}); "
+                                    "wait for it to finish or choose another --out")
+    except InputError:
+        job.keep = True   # the folder is the other run's: touch nothing
+        raise
+    except OSError as exc:
+        raise InputError(f"output folder {str(out)!r} is not writable: {exc.strerror or exc}") from None
+    # Holding the lock, any temporary of ours here is a killed writer's.
+    for stale in fileio.stale_temporaries(out, previous):
+        stale.unlink(missing_ok=True)
+    if not force and any(p.name != OUT_LOCK_FILE for p in out.iterdir()):
         raise InputError(f"output folder {str(out)!r} exists and is not empty; "
                          "use --force to overwrite its files or choose another --out")
-    created = not out.exists()
-    if force and not created:
+    if force and not job.created:
         for name in previous:
             try:
                 (out / name).unlink(missing_ok=True)
             except OSError as exc:
                 raise InputError(f"--force cannot remove {str(out / name)!r}: {exc.strerror or exc}") from None
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-        probe = out / f".simulate-probe-{os.getpid()}"
-        probe.write_text("")
-        probe.unlink()
-    except OSError as exc:
-        raise InputError(f"output folder {str(out)!r} is not writable: {exc.strerror or exc}") from None
-    return out, created
 
 
 def _print_summary(result, out, files):
@@ -492,22 +567,18 @@ def _simulate(argv):
     given = _flags_given(argv) if args.compat is not None else ()
     scenario = assembly.preflight(_scenario_from_args(args, given))
     movie_options = _animation_options(args)
-    out, created = _prepare_out(args.out or _default_out(scenario), args.force, _OUTPUT_FILES)
-    written = []
-    try:
-        result, files, note = _simulate_into(args, scenario, movie_options, out, written)
-    except SimulationError as exc:
-        if exc.partial is None:
-            _discard(out, created, written)
-            raise
-        # What ran before the failure is kept for the user to inspect.
-        _write_results(exc.partial, out)
-        raise SimulationError(
-            f"{exc}; the run up to t = {exc.partial.summary['end_time_s']:g} s is in {out}") from None
-    except BaseException:
-        # A failure or Ctrl-C before every file is written: leave nothing half done.
-        _discard(out, created, written)
-        raise
+    with _output_folder(args.out or _default_out(scenario), args.force, _OUTPUT_FILES) as job:
+        out = job.out
+        try:
+            result, files, note = _simulate_into(args, scenario, movie_options, out, job.written)
+        except SimulationError as exc:
+            if exc.partial is None:
+                raise
+            # What ran before the failure is kept for the user to inspect.
+            _write_results(exc.partial, out)
+            job.keep = True
+            raise SimulationError(
+                f"{exc}; the run up to t = {exc.partial.summary['end_time_s']:g} s is in {out}") from None
     report_data_warnings(result.summary)
     if not args.quiet:
         _print_summary(result, out, files)
@@ -567,7 +638,7 @@ def _recommend(argv):
         description="Recommend the tyre inflation pressure with the fastest recovery after a "
                     "kick-plate kick (Dell'Orto 2025, Section 8.3 and Table 8.9): runs the kick at each "
                     "pressure for each rear load, ranks the runs by the recovery time (yaw, roll and "
-                    "steer rates all back within 5 %% of their first peaks) and says by how much the "
+                    "steer rates all back within 5 % of their first peaks) and says by how much the "
                     "best beats the second best, against the spread of the model itself.",
         epilog="Both tyres get the same pressure, as in the experiment. Every other setting is the "
                "simulate default (3 m/s, LQR rider designed at that speed, 150 mm kick in 0.150 s, 6 s). "
@@ -603,6 +674,7 @@ def _recommend(argv):
     from .scenario import Scenario
     base = Scenario(duration=args.duration)
     base.validate()
+    _check_loads(base.bicycle, args.fz)
     recs = recommend.recommend_pressures(
         args.fz, tyre=args.tyre, pressures=args.pressures, fine=args.fine, step_kpa=args.step,
         base=base, criterion=args.criterion, workers=args.workers, folder=args.out, extend=args.extend,
@@ -616,17 +688,13 @@ def _recommend(argv):
 
 def recommend_main(argv=None):
     """Console script ``recommend-pressure`` (see ``recommend-pressure --help``)."""
-    from .sweep_engine import SweepInterrupted, SweepTerminated
+    from .sweep_engine import SweepFailed, SweepInterrupted
     try:
         status = _run(_recommend, argv, "recommend-pressure",
                       "finished cases are kept in the --out folder (if given); run again on it to resume")
-    except SweepInterrupted as exc:   # lost worker processes: not the user's to fix
+    except (SweepInterrupted, SweepFailed) as exc:   # lost workers, or every case failed: not the user's to fix
         print(f"recommend-pressure: {exc}", file=sys.stderr)
         status = 1
-    except SweepTerminated:
-        print("recommend-pressure: terminated (SIGTERM); finished cases are kept in the --out folder, "
-              "run again on it to resume", file=sys.stderr)
-        status = EXIT_TERMINATED
     sys.exit(status)
 
 
@@ -671,15 +739,12 @@ def _stability(argv):
     scenario = Scenario(**_model_fields(args), symmetric_tyres=args.tyre_offsets == "zero",
                                    speed=float(speeds[0]))
     assembly.preflight(scenario)
-    out, created = _prepare_out(args.out or _default_out(scenario, "stability"), args.force, _STABILITY_FILES)
-    try:
+    with _output_folder(args.out or _default_out(scenario, "stability"), args.force, _STABILITY_FILES) as job:
+        out = job.out
+        job.written.extend(_STABILITY_FILES)   # written together at the end: any of them may be there
         result = stability.analyse(scenario, speeds)
         result.summary["numerics"] = {"wall_s": time.perf_counter() - started}
         files = stability.write(result, out, plot=not args.no_plot)
-    except BaseException:
-        # A failure or Ctrl-C before every file is written: leave nothing half done.
-        _discard(out, created, _STABILITY_FILES)
-        raise
     missing = {loop: m["speeds_without_steady_motion"] for loop, m in result.summary["steady_motion"].items()
                if m["speeds_without_steady_motion"]}
     for loop, count in missing.items():

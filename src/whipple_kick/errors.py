@@ -7,9 +7,15 @@ malformed parameter file. Numerical trouble is *not* an InputError: a run
 that fails numerically raises :class:`SimulationError`, carrying what was
 computed before the failure. A C compiler that cannot build the model is
 :class:`BuildError` (the machine's set-up, not the user's input: exit
-status 1).
+status 1). A cache folder that cannot be used is :class:`CacheError` (also
+the machine's set-up: exit status 1). SIGTERM inside :func:`terminate_raises`
+raises :class:`Terminated`, which the command-line entry points turn into one
+line and exit status 143, as Ctrl-C's KeyboardInterrupt into 130.
 """
+import contextlib
 import math
+import signal
+import threading
 
 
 class InputError(ValueError):
@@ -74,3 +80,41 @@ class BuildError(RuntimeError):
     The message is one line naming the compiler and where its full output
     was saved.
     """
+
+
+class CacheError(OSError):
+    """The cache of generated code cannot be used (:mod:`whipple_kick.cache`).
+
+    The message is one line naming the folder, what is wrong with it and how
+    to fix it (e.g. set ``WHIPPLE_KICK_CACHE`` to a private writable folder).
+    """
+
+
+class Terminated(BaseException):
+    """SIGTERM reached the process (within :func:`terminate_raises`).
+
+    A BaseException, like KeyboardInterrupt, so that no ``except Exception``
+    (say a sweep recording a failing case) swallows it, and every ``finally``
+    on the way out (temporary files, folder locks) still runs.
+    """
+
+
+def _raise_terminated(signum, frame):
+    raise Terminated("terminated (SIGTERM)")
+
+
+@contextlib.contextmanager
+def terminate_raises():
+    """Within the block, SIGTERM raises :class:`Terminated` (main thread only; elsewhere a no-op).
+
+    Schedulers and ``timeout`` send SIGTERM; its default action kills the
+    process at once, leaving temporary files and printing nothing.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _raise_terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)

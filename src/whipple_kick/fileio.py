@@ -1,4 +1,4 @@
-"""File input and output, one way each: atomic writes, and CSV through pandas.
+"""File input and output, one way each: atomic writes, folder locks, and CSV through pandas.
 
 Every file the package writes (cache entries, sweep folders, the results of
 ``simulate`` and ``stability``) is written to a temporary name in the same
@@ -8,9 +8,18 @@ are CSV as pandas writes and reads them: :func:`write_csv` writes exactly
 the text of ``DataFrame.to_csv(index=False)`` (faster for the all-float
 trajectory), :func:`read_csv` reads with ``pandas.read_csv`` and turns a
 file that cannot be read into a one-line :class:`~whipple_kick.errors.InputError`.
+A folder a command writes into is held by one process at a time
+(:func:`take_lock`).
+
+The locks are ``fcntl.flock`` (POSIX), as is the rest of the package (the
+compiled model is a shared library built by the C compiler and loaded with
+ctypes). The ``filelock`` package was not used: it truncates the lock file
+on every attempt to take it, which would erase the holder's pid that the
+refusal message names.
 """
 from collections.abc import Iterator
 import contextlib
+import fcntl
 import os
 import pathlib
 
@@ -52,6 +61,67 @@ def atomic_path(path, *, private: bool = False) -> Iterator[pathlib.Path]:
     finally:
         with contextlib.suppress(FileNotFoundError):
             tmp.unlink()
+
+
+def stale_temporaries(folder, names) -> list[pathlib.Path]:
+    """Hidden temporaries (:func:`temporary_name`) of the files ``names`` in ``folder``, of any process.
+
+    Whoever holds the folder's lock (:func:`take_lock`) knows them to be
+    left by a writer that was killed (SIGKILL, power loss) before it could
+    remove them.
+    """
+    folder = pathlib.Path(folder)
+    return [p for name in names for p in folder.glob(f".{name}.*.tmp") if p.name[len(name) + 2:-4].isdigit()]
+
+
+def take_lock(path, busy: str) -> int:
+    """Take an exclusive lock (``flock``) on the file ``path`` and write our pid into it.
+
+    The operating system drops the lock when its holder dies, so a lock
+    left by a killed process is simply taken over. Returns the open file
+    descriptor (:func:`release_lock` releases it).
+
+    Parameters
+    ----------
+    path : path-like
+        The lock file (created if absent).
+    busy : str
+        The refusal message; ``{pid}`` is replaced by the holder's pid.
+
+    Raises
+    ------
+    InputError
+        Another process holds the lock (``busy``).
+    """
+    while True:
+        fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            holder = os.pread(fd, 32, 0).decode(errors="replace").strip() or "unknown"
+            os.close(fd)
+            raise InputError(busy.replace("{pid}", holder)) from None
+        # A holder that removes the file on release (release_lock with a path) may have
+        # removed the one we opened just before we locked it: then take the new one.
+        with contextlib.suppress(FileNotFoundError):
+            if os.stat(path).st_ino == os.fstat(fd).st_ino:
+                break
+        os.close(fd)
+    os.ftruncate(fd, 0)
+    os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+    return fd
+
+
+def release_lock(fd: int, path=None) -> None:
+    """Release a lock of :func:`take_lock` and close its descriptor; with ``path``, remove the lock file first."""
+    if path is not None:
+        # Removed while still held, so nobody takes the lock on a file about to vanish.
+        with contextlib.suppress(OSError):
+            os.unlink(path)
+    # LOCK_UN releases the lock even where forked processes (pool workers) still hold the descriptor.
+    with contextlib.suppress(OSError):
+        fcntl.flock(fd, fcntl.LOCK_UN)
+        os.close(fd)
 
 
 def write_atomic(path, data: str | bytes, *, private: bool = False) -> None:

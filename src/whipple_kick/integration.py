@@ -193,10 +193,7 @@ def _integrate(steady, scenario, kick):
         # the kick): that is the run's outcome, and there is no kick to integrate.
         return replace(settle, x=settle_x), rhs, None, breakpoints, jumps
     post, rhs_out, owner = run_from(steady.x, kick_start, samples[samples >= kick_start])
-    traj = lsoda.Trajectory(np.concatenate([settle.t, post.t]), np.concatenate([settle_x, post.x]),
-                                post.fell, post.fall_time, settle.nfev + post.nfev, post.message,
-                                end_state=post.end_state, failed=post.failed, njev=settle.njev + post.njev,
-                                evaluations=settle.evaluations + post.evaluations, fall_reason=post.fall_reason)
+    traj = lsoda.join([replace(settle, x=settle_x), post])
     if owner is not None:
         # The settle's samples belong to the model of the plate at rest before the table.
         rhs_out = [rhs] + list(rhs_out)
@@ -237,10 +234,7 @@ def _integrate_kept_speeds(rhs, params, x, span, rows, stop, scenario, chunk, ju
                   "constraint_impulse_n_s": None, "rear_slide_m_s": slide})
     second = lsoda.integrate(after, x_stop, scenario.duration, t_start=stop, rtol=scenario.rtol,
                                  **limits, chunk=chunk, samples=rows[rows >= stop])
-    traj = lsoda.Trajectory(np.concatenate([first.t, second.t]), np.concatenate([first.x, second.x]),
-                                second.fell, second.fall_time, first.nfev + second.nfev, second.message,
-                                end_state=second.end_state, failed=second.failed, fall_reason=second.fall_reason)
-    return traj, [rhs, after], np.concatenate([np.zeros(first.t.size, dtype=int), np.ones(second.t.size, dtype=int)])
+    return lsoda.join([first, second]), [rhs, after], np.concatenate([np.zeros(first.t.size, dtype=int), np.ones(second.t.size, dtype=int)])
 
 
 def _from_kick_start(traj, kick_start):
@@ -276,25 +270,18 @@ def _integrate_table(params, x0, table, scenario, chunk, t_start=None):
     t_start = pending[0] if t_start is None else t_start
     pending = pending[pending >= t_start]
     limits = end_limits(scenario)
-    ts, xs, owner, rhss = [], [], [], []
-    nfev = njev = evaluations = 0
+    trajs, owner, rhss = [], [], []
     x = np.asarray(x0, dtype=float)
-    traj = None
     for k, (a, b, t0, coefficients) in enumerate(table.pieces(t_start, t_end)):
         rhs = slip.CompiledRHS(inputs.segment_parameters(params, t0, coefficients))
         rhss.append(rhs)
         traj = lsoda.integrate(rhs, x, b, t_start=a, rtol=scenario.rtol, **limits,
                                    chunk=chunk, samples=pending)
-        nfev, njev, evaluations = nfev + traj.nfev, njev + traj.njev, evaluations + traj.evaluations
-        ts.append(traj.t)
-        xs.append(traj.x)
+        trajs.append(traj)
         owner.append(np.full(traj.t.size, k))
         if traj.t.size:
             pending = pending[pending > traj.t[-1]]
         x = traj.end_state
         if traj.fell or traj.failed:
             break
-    trajectory = lsoda.Trajectory(np.concatenate(ts), np.concatenate(xs), traj.fell, traj.fall_time,
-                                      nfev, traj.message, end_state=x, failed=traj.failed, njev=njev,
-                                      evaluations=evaluations, fall_reason=traj.fall_reason)
-    return trajectory, rhss, np.concatenate(owner).astype(int)
+    return lsoda.join(trajs), rhss, np.concatenate(owner).astype(int)

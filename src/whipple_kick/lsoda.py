@@ -21,7 +21,7 @@ faster than any step can follow) ends as a reported failure with the samples
 it produced so far, in bounded time.
 """
 import collections
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 import itertools
 import warnings
 
@@ -50,6 +50,20 @@ class Trajectory:
     def state(self, name):
         """Time history of one state by name."""
         return self.x[:, slip.X[name]]
+
+
+def join(pieces):
+    """One trajectory of consecutive pieces (each starting where the previous ended).
+
+    The samples are concatenated and the work counters (``nfev``, ``njev``,
+    ``evaluations``) summed; how the run ended (fall, failure, message, end
+    state) is the last piece's. The one place pieces are merged, so that no
+    counter is lost (a hand-made Trajectory once reported 0 Jacobians).
+    """
+    pieces = list(pieces)
+    return replace(pieces[-1], t=np.concatenate([p.t for p in pieces]), x=np.concatenate([p.x for p in pieces]),
+                   nfev=sum(p.nfev for p in pieces), njev=sum(p.njev for p in pieces),
+                   evaluations=sum(p.evaluations for p in pieces))
 
 
 #: Fast-path chunk length [s]: each chunk is one odeint (LSODA restarted), and
@@ -169,6 +183,9 @@ def _careful_chunk(rhs, x, times, rtol, atol, fall, spent, budget, t_start, jac=
         return solver.nfev, solver.njev, _evaluations(jac, solver.nfev, solver.njev)
     out_t, out_x = [times[:1]], [np.asarray(x, dtype=float)[None, :]]
     nxt, g_old = 1, fall(times[0], x)
+    if g_old <= 0.0:   # already at or past a limit where the chunk starts: that is the fall
+        return times[:1], np.asarray(x, dtype=float)[None, :], (times[0], np.asarray(x, dtype=float)), "fell", \
+            None, (0, 0, 0)
     recent = collections.deque([(0, times[0])])   # (evaluations, time) after the steps of the last window
     while True:
         try:
@@ -245,6 +262,11 @@ def _guarded(rhs, roll_index, fall_angle, steer_index, steer_limit):
             raise _PastTheLimit
         return rhs(t, x)
     return guarded
+
+
+def _within_limits(states, roll_index, fall_angle, steer_index, steer_limit):
+    """Whether every row of ``states`` has |roll| and |steer| inside their limits."""
+    return bool(np.all(np.abs(states[:, roll_index]) < fall_angle) and np.all(np.abs(states[:, steer_index]) < steer_limit))
 
 
 def _fast_chunk(guarded, x, times, rtol, atol, mxstep, jac=None):
@@ -409,7 +431,10 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
             # A sample at the piece's end is emitted after the jump map (below).
             last = -1 if i1 == len(grid) - 1 else None
             fast = _fast_chunk(guarded, x, times, rtol, atol, mxstep, jac)
-            if fast is not None and spent + fast[1][2] <= budget.limit(times[-1] - t_start):
+            # The guard sees only the states LSODA evaluates; a sample (the chunk's end above all)
+            # interpolated past a limit must still go to the careful path, or the fall is missed.
+            if fast is not None and spent + fast[1][2] <= budget.limit(times[-1] - t_start) \
+                    and _within_limits(fast[0], roll, fall_angle, steer, steer_limit):
                 y, (n, nj, used) = fast
                 nfev, njev, spent = nfev + n, njev + nj, spent + used
                 emit(times[:last], y[:last])

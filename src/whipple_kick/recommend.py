@@ -9,6 +9,9 @@ best and whether that margin is clear of the model's own spread. The
 
 Example
 -------
+Skipped as a doctest: three 6 s kick runs in a process pool, several seconds
+(``tests/test_recommend.py`` runs it).
+
 >>> from whipple_kick import recommend
 >>> rec = recommend.recommend_pressure(635)              # doctest: +SKIP
 >>> rec.best_pressure_kpa, rec.margin_s, rec.verdict     # doctest: +SKIP
@@ -20,7 +23,7 @@ import numpy as np
 
 from .errors import InputError, check_range
 from .scenario import Scenario
-from .sweep_engine import sweep
+from .sweep_engine import check_some_ok, sweep
 
 # --------------------------------------------------------------- the pressure recommender
 
@@ -192,6 +195,11 @@ def recommend_pressures(loads, tyre="T03", pressures=None, fine=False, step_kpa=
     -------
     list of Recommendation
         In the order of ``loads``.
+
+    Raises
+    ------
+    whipple_kick.sweep_engine.SweepFailed
+        Every case failed (then there is nothing to recommend from).
     """
     base = Scenario() if base is None else base
     criterion = criterion_key(criterion)
@@ -202,6 +210,7 @@ def recommend_pressures(loads, tyre="T03", pressures=None, fine=False, step_kpa=
     sweep_options.setdefault("progress", False)
     table = sweep({"fz_n": loads, "pressure_kpa": grid}, base=dataclasses.replace(base, tyre=tyre),
                   **sweep_options)
+    check_some_ok(table)   # "none recovered" would be a verdict on a sweep that never ran a case
     out = []
     for fz in loads:
         rows = table[table["fz_n"] == fz].copy()
@@ -264,6 +273,8 @@ def recommend_pressure(fz_n, tyre="T03", pressures=None, fine=False, step_kpa=10
 
     Example
     -------
+    Skipped as a doctest: three 6 s kick runs in a process pool, several seconds.
+
     >>> from whipple_kick import recommend
     >>> rec = recommend.recommend_pressure(635)              # doctest: +SKIP
     >>> rec.best_pressure_kpa, rec.margin_s, rec.verdict     # doctest: +SKIP

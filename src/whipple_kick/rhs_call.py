@@ -13,7 +13,8 @@ call.
 It needs the Python headers (``Python.h``) beside the interpreter; where they
 are missing, or the compiler fails on them, :func:`module` returns None and
 :class:`whipple_kick.slip.CompiledRHS` keeps its ctypes call (the same
-numbers, slower: ``scripts/bench.py rhs`` shows which path is in use).
+numbers, slower: ``scripts/bench.py rhs`` shows which path is in use), and
+one warning line on stderr says so, once per process (:func:`_fall_back`).
 """
 import functools
 import hashlib
@@ -27,6 +28,7 @@ import sysconfig
 import numpy as np
 
 from . import cache
+from .errors import CacheError
 
 _NAME = "whipple_kick_rhs_call"
 
@@ -240,7 +242,9 @@ def module(compiler):
         i1=0, lim1=inf, i2=0, lim2=inf)``, a callable ``f(t, x)``.
     """
     import pathlib
-    if not pathlib.Path(sysconfig.get_paths()["include"], "Python.h").exists():
+    headers = pathlib.Path(sysconfig.get_paths()["include"], "Python.h")
+    if not headers.exists():
+        _fall_back(f"the Python headers are missing ({headers}; install the python3-dev package of this Python)")
         return None
     folder = cache.cache_dir()
 
@@ -259,6 +263,26 @@ def module(compiler):
             _NAME, path, loader=importlib.machinery.ExtensionFileLoader(_NAME, str(path)))
         mod = importlib.util.module_from_spec(spec)
         spec.loader.exec_module(mod)
-    except (RuntimeError, OSError, ImportError):
+    except CacheError:
+        raise   # the model itself cannot be cached either: one error, not a warning
+    except (RuntimeError, OSError, ImportError) as exc:
+        first = (str(exc).strip().splitlines() or [type(exc).__name__])[-1][:200]
+        _fall_back(f"building it with {compiler} failed ({first})")
         return None
     return mod
+
+
+#: Cost of a right-hand-side call through ctypes against the extension (2.07 against 1.10 of the
+#: C function alone, docs/simulate.md "LSODA calls the compiled model").
+CTYPES_COST = 1.9
+_warned = False
+
+
+def _fall_back(why):
+    """Say once per process why the extension is not used and what it costs."""
+    global _warned
+    if not _warned:
+        _warned = True
+        print(f"whipple_kick: warning: the fast call into the compiled model is not available: {why}; "
+              f"using ctypes instead (same results, each model evaluation about {CTYPES_COST:g} times "
+              "as costly)", file=sys.stderr)

@@ -532,6 +532,46 @@ class RearLoadSolution(NamedTuple):
         return static_loads(self.combined)[1]
 
 
+def rear_load_range(bike, rider="jason", height_m=None):
+    """Static rear-tyre loads a rider can produce on ``bike``: (low, high, per_kg).
+
+    ``low`` is the bicycle's own rear load [N] (a rider of no mass, excluded),
+    ``high`` that with a :data:`MAX_RIDER_MASS_KG` rider [N], ``per_kg`` the
+    rear load one kilogram of rider adds [N/kg] (the seated posture, hence
+    the rider's mass centre, does not depend on the mass).
+    """
+    probe = yeadon_rider(rider, height_m=height_m)
+    x_rider = place(bike, probe).com[0]
+    bench = bike.benchmark
+    rear_bike, _ = static_loads(bike)
+    per_kg = bench["g"] * (bench["w"] - x_rider) / bench["w"]
+    return rear_bike, rear_bike + MAX_RIDER_MASS_KG * per_kg, per_kg
+
+
+def check_rear_load(bike, fz_n, rider="jason", height_m=None):
+    """Return ``float(fz_n)`` if a rider can put it on ``bike``'s rear tyre (:func:`rear_load_range`).
+
+    Raises
+    ------
+    InputError
+        One line naming the load, the range ``(low, high]`` in N on this
+        bicycle and where its ends come from.
+    """
+    low, high, _ = rear_load_range(bike, rider, height_m)
+    return within_rear_load_range(bike, fz_n, low, high)
+
+
+def within_rear_load_range(bike, fz_n, low, high):
+    """``float(fz_n)`` if ``low < fz_n <= high`` (the :func:`rear_load_range` of ``bike``), else one-line InputError."""
+    fz = check_range("rear-tyre load fz", fz_n, None, None, "N")  # a finite number
+    if not low < fz <= high:
+        raise InputError(f"rear-tyre load fz = {fz_n!r} N is outside the allowed range "
+                         f"({low:.2f}, {high:.2f}] N for {bike.name!r}: the bicycle alone puts "
+                         f"{low:.2f} N on its rear tyre and a {MAX_RIDER_MASS_KG:g} kg "
+                         f"rider {high:.2f} N")
+    return fz
+
+
 def for_rear_load(bike, fz_n, rider="jason", height_m=None):
     """Seat the rider whose mass gives the bicycle a static rear-tyre load ``fz_n``.
 
@@ -547,7 +587,7 @@ def for_rear_load(bike, fz_n, rider="jason", height_m=None):
         m/s^2 for ``balanceassist_v1``, the value of its source).
     fz_n : float
         Required static rear-tyre normal force [N]; between the bicycle's own
-        rear load (exclusive) and that with a 200 kg rider.
+        rear load (exclusive) and that with a 200 kg rider (:func:`check_rear_load`).
     rider : str
         Rider file name.
     height_m : float, optional
@@ -559,18 +599,8 @@ def for_rear_load(bike, fz_n, rider="jason", height_m=None):
         ``combined, rider_mass = for_rear_load(...)``; ``.front_n`` and
         ``.rear_n`` give the static loads [N].
     """
-    probe = yeadon_rider(rider, height_m=height_m)
-    x_rider = place(bike, probe).com[0]
-    bench = bike.benchmark
-    rear_bike, _ = static_loads(bike)
-    per_kg = bench["g"] * (bench["w"] - x_rider) / bench["w"]
-    high = rear_bike + MAX_RIDER_MASS_KG * per_kg
-    fz = check_range("rear-tyre load fz", fz_n, None, None, "N")  # a finite number
-    if not rear_bike < fz <= high:
-        raise InputError(f"rear-tyre load fz = {fz_n!r} N is outside the allowed range "
-                         f"({rear_bike:.2f}, {high:.2f}] N for {bike.name!r}: the bicycle alone puts "
-                         f"{rear_bike:.2f} N on its rear tyre and a {MAX_RIDER_MASS_KG:g} kg "
-                         f"rider {high:.2f} N")
+    rear_bike, high, per_kg = rear_load_range(bike, rider, height_m)
+    fz = within_rear_load_range(bike, fz_n, rear_bike, high)
     mass = (fz - rear_bike) / per_kg
     combined = seat(bike, yeadon_rider(rider, mass_kg=mass, height_m=height_m))
     achieved = static_loads(combined)[0]

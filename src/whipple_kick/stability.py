@@ -32,8 +32,9 @@ Example
 >>> from whipple_kick import stability
 >>> from whipple_kick import Scenario
 >>> result = stability.analyse(Scenario(symmetric_tyres=True), np.arange(2.0, 6.01, 0.5),
-...                            loops=("open",))                      # doctest: +SKIP
->>> result.summary["open"]["weave_speed_m_s"]                       # doctest: +SKIP
+...                            loops=("open",))
+>>> round(result.summary["slip"]["open"]["weave_speed_m_s"], 2)
+3.82
 """
 from dataclasses import dataclass, field
 import math
@@ -175,8 +176,8 @@ class LinearModel:
 
         Example
         -------
-        >>> sys = linear_model(Scenario(symmetric_tyres=True), 4.0).state_space()   # doctest: +SKIP
-        >>> sys.input_labels                                                      # doctest: +SKIP
+        >>> sys = linear_model(Scenario(symmetric_tyres=True), 4.0).state_space()
+        >>> sys.input_labels
         ['steer_torque']
         """
         import control as ct  # slow import: only when asked for
@@ -224,6 +225,10 @@ def linearise(params, steady_state, loop, found_by="direct", constant_speed=True
 
     Example
     -------
+    Skipped as a doctest: a fragment, ``moore``, ``rear`` and ``front`` being a
+    bicycle's Moore parameters and two tyres (:func:`linear_model` does all of
+    this from a Scenario).
+
     >>> params = slip.model_parameters(moore, rear, front)              # doctest: +SKIP
     >>> model = linearise(params, slip.steady_state(params, 4.0), "open")   # doctest: +SKIP
     """
@@ -316,8 +321,8 @@ def linear_model(scenario, speed, loop="open", *, tyres=None):
     Example
     -------
     >>> from whipple_kick import Scenario
-    >>> model = linear_model(Scenario(symmetric_tyres=True), 4.0)    # doctest: +SKIP
-    >>> model.state_space().nstates                                   # doctest: +SKIP
+    >>> model = linear_model(Scenario(symmetric_tyres=True), 4.0)
+    >>> model.state_space().nstates
     14
     """
     _check_loop(loop)
@@ -377,8 +382,12 @@ def mode_content(model, eigenvalue, vector, wheelbase):
 
     Example
     -------
-    >>> lam, vec = np.linalg.eig(model.matrix)                          # doctest: +SKIP
-    >>> shares, scaled = mode_content(model, lam, vec, wheelbase=1.113)  # doctest: +SKIP
+    >>> from whipple_kick import Scenario
+    >>> model = linear_model(Scenario(symmetric_tyres=True), 4.0)
+    >>> lam, vec = np.linalg.eig(model.matrix)
+    >>> shares, scaled = mode_content(model, lam, vec, wheelbase=1.113)
+    >>> shares.shape        # one row per eigenvalue, one column per kind of motion
+    (14, 6)
     """
     single = np.ndim(eigenvalue) == 0
     lam = np.atleast_1d(np.asarray(eigenvalue, dtype=complex))
@@ -804,8 +813,9 @@ def analyse(scenario, speeds, *, loops=None, tyres=None):
     Example
     -------
     >>> from whipple_kick import Scenario
-    >>> res = analyse(Scenario(symmetric_tyres=True), [3.0, 4.0, 5.0], loops=("open",))   # doctest: +SKIP
-    >>> sorted(set(res.eigenvalues["mode"]))                                             # doctest: +SKIP
+    >>> res = analyse(Scenario(symmetric_tyres=True), [3.0, 4.0, 5.0], loops=("open",))
+    >>> sorted(set(res.eigenvalues["mode"]))
+    ['capsize', 'caster', 'lateral_rear', 'relaxation_front', 'relaxation_rear', 'vertical', 'weave', 'wobble']
     """
     import pandas as pd
 
@@ -958,14 +968,24 @@ def _refiners(contexts, setup, result):
 
 
 def _root(fun, a, b):
-    """Root of ``fun`` in [a, b] by Brent's method (to 1e-9 m/s), or the linear estimate if that fails."""
+    """Root of ``fun`` in [a, b] by Brent's method (to 1e-9 m/s): ``(speed, None)``, or ``(None, reason)``.
+
+    The sweep's samples say a sign changes between ``a`` and ``b``; the fresh
+    linearisations at the ends may disagree (a mode matched to another
+    eigenvalue, a steady motion continued to another branch). Then there is
+    no bracket and no root is claimed: an estimate outside [a, b] would be a
+    number without meaning.
+    """
     from scipy.optimize import brentq
     fa, fb = fun(a), fun(b)
     if fa == 0.0:
-        return a
-    if fa * fb > 0:
-        return a + (b - a) * fa / (fa - fb)
-    return float(brentq(fun, a, b, xtol=1e-9, rtol=1e-12))
+        return a, None
+    if fb == 0.0:
+        return b, None
+    if not (np.isfinite(fa) and np.isfinite(fb)) or fa * fb > 0:
+        return None, (f"the real part does not change sign between {a:g} and {b:g} m/s on fresh "
+                      f"linearisations ({fa:+.3g} and {fb:+.3g} 1/s), although the sweep's samples do")
+    return float(brentq(fun, a, b, xtol=1e-9, rtol=1e-12)), None
 
 
 class _Sweep:
@@ -1060,14 +1080,21 @@ def _weave_speed(sweep):
             nxt = sweep.eigenvalue(k + 1, t)
             if lam.real <= 0 or nxt is None:
                 continue
-            crossing = _root(sweep.tracked_real_part(k, t), sweep.speeds[k], sweep.speeds[k + 1])
+            crossing, why = _root(sweep.tracked_real_part(k, t), sweep.speeds[k], sweep.speeds[k + 1])
             if sweep.name[k + 1, t] == "weave" and nxt.imag != 0.0:
-                return crossing, "the weave's real part crosses zero"
+                return (crossing, "the weave's real part crosses zero") if why is None else (None, why)
             # The pair split between the two speeds: still unstable then if a root stays positive.
             pair = [complex(l) for l in sweep.lams[k + 1] if l.imag == 0.0 and abs(l - nxt) < 4 * abs(lam.imag)]
+            if not pair:
+                return None, (f"the weave pair stops being the weave between {sweep.speeds[k]:g} and "
+                              f"{sweep.speeds[k + 1]:g} m/s without turning into two real eigenvalues "
+                              f"near it (it continues as {nxt.real:+.3g}{nxt.imag:+.3g}j 1/s, "
+                              f"{sweep.name[k + 1, t]}); refine the speed grid there")
             if max(l.real for l in pair) > 0:
                 return sweep.split_speed(k, t), ("the weave pair splits into two real eigenvalues while "
                                                  "unstable (one stays unstable)")
+            if why is not None:
+                return None, why
             return crossing, "the weave's real part crosses zero just before the pair splits"
     return None, "the weave is unstable up to the end of the sweep"
 
@@ -1081,7 +1108,7 @@ def _capsize_speed(sweep, above=None):
     the split, else at the split.
     """
     n = len(sweep.speeds)
-    found = []
+    found, unlocated = [], []
     for k in range(n - 1):
         if not (sweep.present(k) and sweep.present(k + 1)):
             continue
@@ -1091,15 +1118,18 @@ def _capsize_speed(sweep, above=None):
                 continue
             same_branch = sweep.name[k, t] == "capsize" and before.imag == 0.0
             if before.real <= 0:
-                found.append((_root(sweep.tracked_real_part(k, t), sweep.speeds[k], sweep.speeds[k + 1]),
-                              "the capsize eigenvalue crosses zero" + ("" if same_branch else
-                                                                        " just after the weave pair splits")))
+                crossing, why = _root(sweep.tracked_real_part(k, t), sweep.speeds[k], sweep.speeds[k + 1])
+                if why is not None:
+                    unlocated.append(why)
+                    continue
+                found.append((crossing, "the capsize eigenvalue crosses zero" + ("" if same_branch else
+                                                                                   " just after the weave pair splits")))
             elif not same_branch:
                 found.append((sweep.split_speed(k, t), "the capsize eigenvalue is born unstable where the "
                                                        "weave pair splits"))
     found = [f for f in found if above is None or f[0] >= above - 1e-9]
     if not found:
-        return None, "no capsize eigenvalue becomes unstable within the sweep"
+        return None, unlocated[0] if unlocated else "no capsize eigenvalue becomes unstable within the sweep"
     return min(found)
 
 
@@ -1116,13 +1146,18 @@ def _stable_ranges(sweep):
     for start, stop in _segments(stable):
         if not stable[start]:
             continue
-        lo, hi = sweep.speeds[start], sweep.speeds[stop - 1]
+        lo, hi, notes = sweep.speeds[start], sweep.speeds[stop - 1], []
+        # A boundary that cannot be located stays at the last stable sweep speed, and says so.
         if start > 0 and sweep.present(start - 1):
-            lo = _root(lambda v, k=start: sweep.largest_real_part(v, k), sweep.speeds[start - 1], lo)
+            root, why = _root(lambda v, k=start: sweep.largest_real_part(v, k), sweep.speeds[start - 1], lo)
+            lo = lo if why is not None else root
+            notes += [f"lower end not located, the sweep speed is given: {why}"] if why is not None else []
         if stop < n and sweep.present(stop):
-            hi = _root(lambda v, k=stop - 1: sweep.largest_real_part(v, k), hi, sweep.speeds[stop])
+            root, why = _root(lambda v, k=stop - 1: sweep.largest_real_part(v, k), hi, sweep.speeds[stop])
+            hi = hi if why is not None else root
+            notes += [f"upper end not located, the sweep speed is given: {why}"] if why is not None else []
         ranges.append({"from_m_s": float(lo), "to_m_s": float(hi), "lower_open": start == 0,
-                       "upper_open": stop == n})
+                       "upper_open": stop == n, **({"note": "; ".join(notes)} if notes else {})})
     return ranges
 
 
@@ -1218,8 +1253,12 @@ def perturbed_state(model, vector, amplitude):
 
     Example
     -------
-    >>> lam, vec = np.linalg.eig(model.matrix)                    # doctest: +SKIP
-    >>> x0 = perturbed_state(model, vec[:, 0], 1e-4)              # doctest: +SKIP
+    >>> from whipple_kick import Scenario
+    >>> model = linear_model(Scenario(symmetric_tyres=True), 4.0)
+    >>> lam, vec = np.linalg.eig(model.matrix)
+    >>> x0 = perturbed_state(model, vec[:, 0], 1e-4)
+    >>> x0.shape == model.steady.x.shape
+    True
     """
     idx = {n: i for i, n in enumerate(model.states)}
     # Rotate the eigenvector so its largest roll/steer entry is real and positive.
@@ -1256,12 +1295,15 @@ def free_response(model, vector, amplitude=1e-4, duration=2.0, rate=500.0, rtol=
 
     Example
     -------
-    >>> model = linear_model(Scenario(symmetric_tyres=True), 3.0, "closed")   # doctest: +SKIP
-    >>> lam, vec = np.linalg.eig(model.matrix)                                 # doctest: +SKIP
-    >>> k = int(np.argmax(lam.imag))                                           # doctest: +SKIP
-    >>> t, dev = free_response(model, vec[:, k], duration=1.0, rate=2000.0)    # doctest: +SKIP
-    >>> fit_eigenvalue(t, np.column_stack([modal_coordinate(model, k, dev).real,
-    ...                                    modal_coordinate(model, k, dev).imag]))  # doctest: +SKIP
+    >>> from whipple_kick import Scenario
+    >>> model = linear_model(Scenario(symmetric_tyres=True), 3.0, "closed")
+    >>> lam, vec = np.linalg.eig(model.matrix)
+    >>> k = int(np.argmax(lam.imag))
+    >>> t, dev = free_response(model, vec[:, k], duration=1.0, rate=2000.0)
+    >>> fit = fit_eigenvalue(t, np.column_stack([modal_coordinate(model, k, dev).real,
+    ...                                          modal_coordinate(model, k, dev).imag]))
+    >>> bool(abs(fit - lam[k]) < 1e-3 * abs(lam[k]))    # the nonlinear response decays at the eigenvalue
+    True
     """
     from . import lsoda
     rhs = slip.CompiledRHS(model.steady.params)
@@ -1296,6 +1338,8 @@ def modal_coordinate(model, index, deviation):
 
     Example
     -------
+    Skipped as a doctest: a fragment of :func:`free_response`'s example, which runs it.
+
     >>> eta = modal_coordinate(model, k, dev)     # see free_response    # doctest: +SKIP
     """
     _, V = np.linalg.eig(model.matrix)
@@ -1405,7 +1449,7 @@ def range_text(interval):
     """
     lo = f"{interval['from_m_s']:.2f}" + (" (sweep start)" if interval["lower_open"] else "")
     hi = f"{interval['to_m_s']:.2f}" + (" (sweep end)" if interval["upper_open"] else "")
-    return f"{lo}-{hi}"
+    return f"{lo}-{hi}" + (" (an end not located: at a sweep speed)" if "note" in interval else "")
 
 
 def speeds_text(summary, loop):
@@ -1413,9 +1457,11 @@ def speeds_text(summary, loop):
 
     Example
     -------
-    >>> print(speeds_text(result.summary, "open"))      # doctest: +SKIP
-    slip: weave 3.82 m/s, capsize 3.88 m/s; stable 3.82-3.88 m/s
-    no-slip: weave 3.97 m/s, capsize 5.93 m/s; stable 3.97-5.93 m/s
+    >>> from whipple_kick import Scenario
+    >>> result = analyse(Scenario(symmetric_tyres=True), [3.0, 4.0, 5.0], loops=("open",))
+    >>> print(speeds_text(result.summary, "open"))
+    slip: weave 3.82 m/s, capsize none; stable none
+    no-slip: weave 3.97 m/s, capsize none; stable 3.97-5.00 (sweep end) m/s
     """
     lines = []
     for model in ("slip", "no-slip"):
@@ -1450,7 +1496,8 @@ def figure(result, path, title=None):
 
     Example
     -------
-    >>> figure(analyse(Scenario(symmetric_tyres=True), [3.0, 4.0, 5.0]), "stability.png")   # doctest: +SKIP
+    >>> from whipple_kick import Scenario
+    >>> _ = figure(analyse(Scenario(symmetric_tyres=True), [3.0, 4.0, 5.0]), "stability.png")
     """
     import pathlib
 
@@ -1550,7 +1597,9 @@ def case_row(result, at_speed=3.0):
 
     Example
     -------
-    >>> case_row(analyse(Scenario(symmetric_tyres=True), parse_speeds("2:6:0.1")))["weave_speed_m_s"]   # doctest: +SKIP
+    >>> from whipple_kick import Scenario
+    >>> round(case_row(analyse(Scenario(symmetric_tyres=True), parse_speeds("2:6:0.1")))["weave_speed_m_s"], 2)
+    3.86
     """
     sc, s, table = result.scenario, result.summary, result.eigenvalues
     speed = float(result.speeds[np.argmin(np.abs(result.speeds - at_speed))])
@@ -1605,6 +1654,9 @@ def pressure_load_table(pressures=THESIS_PRESSURES_KPA, loads=THESIS_LOADS_N, *,
 
     Example
     -------
+    Skipped as a doctest: one full speed sweep (0.5-10 m/s every 0.05 m/s) per case,
+    several seconds each (``scripts/stability_study.py`` runs the whole table).
+
     >>> table = pressure_load_table(pressures=(400.0,), loads=(635.0,))   # doctest: +SKIP
     >>> table[["pressure_kpa", "weave_speed_m_s", "capsize_speed_m_s"]]   # doctest: +SKIP
     """
@@ -1657,7 +1709,10 @@ def write(result, out, plot=True):
 
     Example
     -------
-    >>> write(analyse(Scenario(symmetric_tyres=True), [3.0, 4.0]), "out")   # doctest: +SKIP
+    >>> from whipple_kick import Scenario
+    >>> import os
+    >>> os.mkdir("out")
+    >>> write(analyse(Scenario(symmetric_tyres=True), [3.0, 4.0]), "out")
     ['eigenvalues.csv', 'summary.json', 'stability.png']
     """
     import json
@@ -1678,7 +1733,14 @@ def report_lines(summary):
 
     Example
     -------
-    >>> print("\\n".join(report_lines(result.summary)))     # doctest: +SKIP
+    >>> from whipple_kick import Scenario
+    >>> result = analyse(Scenario(symmetric_tyres=True), [3.0, 4.0, 5.0], loops=("open",))
+    >>> print("\\n".join(report_lines(result.summary)))
+      open loop (no rider control):
+        slip: weave 3.82 m/s, capsize none; stable none
+        no-slip: weave 3.97 m/s, capsize none; stable 3.97-5.00 (sweep end) m/s
+        wobble 9.2-9.4 Hz, damping ratio 0.063-0.102 (least damped at 3.00 m/s), stable
+        modes: weave, capsize, caster, wobble, lateral rear, relaxation rear, relaxation front, vertical
     """
     lines = []
     for loop in LOOPS:
@@ -1717,6 +1779,9 @@ def pressure_load_figure(table, path):
 
     Example
     -------
+    Skipped as a doctest: the whole pressure-load table (a minute or more) and a PNG
+    written into the current folder.
+
     >>> pressure_load_figure(pressure_load_table(), "stability_pressure_load.png")   # doctest: +SKIP
     """
     import pathlib

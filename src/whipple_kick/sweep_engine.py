@@ -11,6 +11,9 @@ folder and the rules. The pressure recommender on top of it is
 
 Example
 -------
+Skipped as a doctest: nine 6 s kick runs, and the folder ``thesis_grid`` written
+into the current folder.
+
 >>> import whipple_kick as wk
 >>> table = wk.sweep({"pressure_kpa": [300, 400, 500], "fz_n": [570, 635, 701]},
 ...                  folder="thesis_grid")                    # doctest: +SKIP
@@ -18,7 +21,6 @@ Example
 """
 import atexit
 import concurrent.futures as cf
-import contextlib
 import dataclasses
 import datetime
 import itertools
@@ -27,13 +29,12 @@ import os
 import signal
 import socket
 import sys
-import threading
 import time
 
 import numpy as np
 
 from . import simulation, slip
-from .errors import InputError
+from .errors import InputError, Terminated, terminate_raises
 from .scenario import Scenario
 from .sweep_store import Folder, canonical, case_id, slim, table, trajectory_path
 
@@ -54,26 +55,25 @@ VOLATILE_COLUMNS = ("run.started", "run.finished", "run.wall_s", "run.cpu_s", "r
                     "numerics.wall_s", "numerics.integration_wall_s")
 
 
-class SweepTerminated(BaseException):
-    """SIGTERM reached the process running a sweep (a BaseException, like KeyboardInterrupt,
-    so that no ``except Exception`` of a case swallows it)."""
+#: SIGTERM reached the process running a sweep (the package's :class:`~whipple_kick.errors.Terminated`).
+SweepTerminated = Terminated
 
 
-def _raise_terminated(signum, frame):
-    raise SweepTerminated("terminated (SIGTERM)")
+class SweepFailed(RuntimeError):
+    """Every case of a sweep failed: no result to rank or tabulate, so a bug or a broken set-up, not a verdict.
+
+    The message names how many cases failed and the first one's error; a
+    sweep folder keeps every case's error in its table and log.
+    """
 
 
-@contextlib.contextmanager
-def _terminate_raises():
-    """Within the block, SIGTERM raises :class:`SweepTerminated` (main thread only; elsewhere a no-op)."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = signal.signal(signal.SIGTERM, _raise_terminated)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, previous)
+def check_some_ok(table):
+    """Raise :class:`SweepFailed` if every case of a sweep's ``table`` failed (one line, the first error)."""
+    failed = table["status"] == "failed"
+    if len(table) and bool(failed.all()):
+        first = table.loc[failed.idxmax()]
+        raise SweepFailed(f"all {len(table)} cases failed (a bug or a broken set-up, not a result); the first, "
+                          f"case {first['case_id']}, with {first['error']}")
 
 
 class SweepInterrupted(RuntimeError):
@@ -392,7 +392,7 @@ def sweep(grid=None, cases=None, *, base=None, folder=None, executor=None, worke
     todo = [(cid, sc) for cid, sc in unique if not finished(cid)]
     lost, interrupted, own = [], False, False
     try:
-        with _terminate_raises():
+        with terminate_raises():
             if store is not None:
                 store.write_manifest("running", n_cases=len(unique), n_done=len(unique) - len(todo))
             own = executor is None and todo

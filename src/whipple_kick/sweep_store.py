@@ -6,17 +6,19 @@ sweep resumes where it stopped; docs/sweeps.md describes the folder and its
 rules. A case is identified by a hash of its full scenario (:func:`case_id`),
 whatever overrides produced it. Files are written atomically
 (:mod:`whipple_kick.fileio`); the log is appended one line per case and a
-truncated last line (a crash while writing) is ignored when read back.
+truncated last line (a crash while writing) is ignored when read back, and
+ended with a newline when the folder is opened again.
 
 Example
 -------
+Skipped as a doctest: it needs the sweep folder of :mod:`whipple_kick.sweep_engine`'s
+example and one of its case ids.
+
 >>> from whipple_kick import sweep_store
 >>> frame, summary = sweep_store.load_trajectory("thesis_grid", case_id)   # doctest: +SKIP
 """
-import contextlib
 import dataclasses
 import datetime
-import fcntl
 import hashlib
 import json
 import os
@@ -173,36 +175,16 @@ def slim(record):
 
 
 def _lock(folder):
-    """Take the folder's sweep lock (an exclusive ``flock`` on :data:`LOCK_FILE`) and write our pid into it.
-
-    The operating system drops the lock when its holder dies, so a lock
-    left by a killed sweep is simply taken over. Returns the open file
-    descriptor (:func:`_unlock` releases it).
+    """Take the folder's sweep lock (:func:`whipple_kick.fileio.take_lock` on :data:`LOCK_FILE`).
 
     Raises
     ------
     InputError
         Another process holds the lock (one line naming its pid).
     """
-    path = pathlib.Path(folder) / LOCK_FILE
-    fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
-    try:
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except BlockingIOError:
-        holder = os.pread(fd, 32, 0).decode(errors="replace").strip() or "unknown"
-        os.close(fd)
-        raise InputError(f"sweep folder {str(folder)!r} is in use by another sweep (process {holder}, "
-                         f"{LOCK_FILE}); wait for it to finish, then run again to resume") from None
-    os.ftruncate(fd, 0)
-    os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
-    return fd
-
-
-def _unlock(fd):
-    # LOCK_UN releases the lock even where forked pool workers still hold the descriptor.
-    with contextlib.suppress(OSError):
-        fcntl.flock(fd, fcntl.LOCK_UN)
-        os.close(fd)
+    return fileio.take_lock(pathlib.Path(folder) / LOCK_FILE,
+                            f"sweep folder {str(folder)!r} is in use by another sweep (process {{pid}}, "
+                            f"{LOCK_FILE}); wait for it to finish, then run again to resume")
 
 
 class Folder:
@@ -226,7 +208,7 @@ class Folder:
     def close(self):
         """Release the folder's lock (idempotent)."""
         if self._lock_fd is not None:
-            _unlock(self._lock_fd)
+            fileio.release_lock(self._lock_fd)
             self._lock_fd = None
 
     def _open(self, case_list, base, extend, trajectory):
@@ -264,6 +246,7 @@ class Folder:
             "cases": [{"case_id": cid, "overrides": ov, "scenario": scenario_dict(sc)}
                       for ov, sc, cid in self.case_list],
         }
+        _terminate_last_line(self.path / LOG_FILE)
         self.records = read_log(self.path)
         self._next_table = 0.0
 
@@ -289,10 +272,23 @@ class Folder:
         if not force and start < self._next_table:
             return
         rows = table(self.case_list, self.records)
-        with fileio.atomic_path(self.path / TABLE_FILE) as tmp:
-            rows.to_csv(tmp, index=False, float_format="%.12g")
+        fileio.write_csv(rows, self.path / TABLE_FILE, significant_digits=12)
         end = time.monotonic()
         self._next_table = end + max(interval, 20.0 * (end - start))
+
+
+def _terminate_last_line(path):
+    """End a log cut short mid-line (a crash while appending) with a newline.
+
+    The cut line stays unreadable (and is ignored); without the newline the
+    next record appended would be glued to it and lost with it.
+    """
+    if not path.exists() or path.stat().st_size == 0:
+        return
+    with path.open("rb+") as fh:
+        fh.seek(-1, os.SEEK_END)
+        if fh.read(1) != b"\n":
+            fh.write(b"\n")
 
 
 def _now():

@@ -4,7 +4,8 @@ Example
 -------
 >>> import whipple_kick as wk
 >>> tyre = wk.tyres.load("T03", pressure_kpa=400)
->>> tyre.lateral_force(slip=0.02, camber=0.0, fz=600.0)   # N, model convention
+>>> round(float(tyre.lateral_force(slip=0.02, camber=0.0, fz=600.0)), 1)   # N, model convention
+-117.2
 
 Units and signs everywhere in this module: radians, newtons, metres and the
 MODEL convention of :mod:`whipple_kick.magic_formula` (y right, z down;
