@@ -184,3 +184,18 @@ def test_summary_compares_and_gives_verdicts(nine_cases):
     assert summary["mean_abs_error"]["period_s"]["n"] == len(errors)
     assert summary["setup"]["scenario"]["speed"] == 2.0 and summary["setup"]["scenario"]["kick_accel"] == 35.0
     assert summary["setup"]["scenario"]["kick_profile"] == "smooth"
+
+
+def test_recommend_variants_names_answers_within_the_spread(monkeypatch):
+    """The verdict per load across variants, with the best pressures inside the model's spread named."""
+    def fake(loads, base=None, **options):
+        right = base.kick_direction == "right"
+        return [recommend.Recommendation(fz, "T03", 500.0 if right else 300.0, None, "settling", 0.1 if right else 0.5,
+                                         0.218, "no clear optimum" if right else "clear", None) for fz in loads]
+    monkeypatch.setattr(recommend, "recommend_pressures", fake)
+    from whipple_kick.scenario import Scenario
+    variants = {(d, "contact_patch"): Scenario(kick_direction=d) for d in ("right", "left")}
+    recs, verdicts = recommend.recommend_variants([570.0], variants)
+    assert set(recs) == set(variants)
+    assert verdicts == ["570 N, contact_patch transient: 500 kPa for kicks to the right, 300 kPa for kicks to the "
+                        "left: the answer depends on the direction (no clear optimum for kicks to the right)"]

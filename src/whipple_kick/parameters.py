@@ -37,7 +37,7 @@ def shipped(kind: str) -> pathlib.Path:
 
     Parameters
     ----------
-    kind : {"bicycles", "riders", "tyres"}
+    kind : {"bicycles", "experiments", "riders", "tyres"}
 
     Returns
     -------

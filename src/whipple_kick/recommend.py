@@ -385,20 +385,28 @@ def recommend_variants(loads, variants, **options):
     verdicts : list of str
         Per load: how the best pressure changes with the direction (at each
         tyre transient) and with the tyre transient (at each direction),
-        by :func:`dependence`; empty with one variant.
+        by :func:`dependence`; a best pressure within the model's spread is
+        marked "(no clear optimum)"; empty with one variant.
     """
     recs = {key: recommend_pressures(loads, base=base, **options) for key, base in variants.items()}
     directions = list(dict.fromkeys(d for d, _ in variants))
     forms = list(dict.fromkeys(f for _, f in variants))
+
+    def verdict(recs_by_label, what):
+        # A best pressure whose margin is below the model's spread is named, so a "dependence" between
+        # two such answers is not read as more than it is.
+        text = dependence({label: rec.best_pressure_kpa for label, rec in recs_by_label.items()}, what)
+        unsure = [label for label, rec in recs_by_label.items() if rec.verdict == "no clear optimum"]
+        return text + (f" (no clear optimum for {', '.join(unsure)})" if unsure else "")
+
     verdicts = []
-    for k, fz in enumerate(recs[next(iter(recs))]):
-        fz = fz.fz_n
+    for k, rec in enumerate(recs[next(iter(recs))]):
         if len(directions) > 1:
             for form in forms:
-                best = {f"kicks to the {d}": recs[d, form][k].best_pressure_kpa for d in directions}
-                verdicts.append(f"{fz:g} N, {form} transient: {dependence(best, 'direction')}")
+                by = {f"kicks to the {d}": recs[d, form][k] for d in directions}
+                verdicts.append(f"{rec.fz_n:g} N, {form} transient: {verdict(by, 'direction')}")
         if len(forms) > 1:
             for d in directions:
-                best = {f"the {form} form": recs[d, form][k].best_pressure_kpa for form in forms}
-                verdicts.append(f"{fz:g} N, kicks to the {d}: {dependence(best, 'tyre transient')}")
+                by = {f"the {form} form": recs[d, form][k] for form in forms}
+                verdicts.append(f"{rec.fz_n:g} N, kicks to the {d}: {verdict(by, 'tyre transient')}")
     return recs, verdicts
