@@ -4,16 +4,14 @@ import os
 import subprocess
 import sys
 
+from conftest import run_console
 import pytest
 
 from whipple_kick.cli import validate_main
 
 
 def _validate(argv, capsys):
-    with pytest.raises(SystemExit) as info:
-        validate_main(argv)
-    out, err = capsys.readouterr()
-    return info.value.code, out, err
+    return run_console(validate_main, argv, capsys)
 
 
 def test_validate_writes_the_comparison(tmp_path, capsys):

@@ -25,7 +25,6 @@ Example
 (0.36, 500.0)
 """
 from dataclasses import dataclass
-import math
 
 from . import parameters
 from .analysis import damping_ratio
@@ -341,7 +340,3 @@ def mean_reduction(experiment, fz_n):
     others = [exp.case(fz_n, p).values["last_peak_time"] for p in exp.pressures if p != best]
     return sum(100.0 * (t_best / t - 1.0) for t in others) / len(others)
 
-
-def is_finite_metric(value):
-    """True for a number that is finite (a metric the thesis or the model gives)."""
-    return value is not None and isinstance(value, (int, float)) and math.isfinite(value)
