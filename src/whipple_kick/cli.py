@@ -739,7 +739,7 @@ def _validate_parser():
         description="The model against the thesis' kick-plate measurements (Dell'Orto 2025, Section 8.5, "
                     "Tables 8.6-8.9): runs the nine measured cases (rear loads 570/635/701 N x 300/400/500 kPa) "
                     "in both kick directions as the experiments ran, processes the yaw rate as the recordings "
-                    "were (100 Hz, 20 Hz zero-phase low-pass, peaks until one is below 8 %%) and compares. "
+                    "were (100 Hz, 20 Hz zero-phase low-pass, peaks until one is below 8 %) and compares. "
                     "Writes validation.csv, cases/<case>_<direction>/trajectory.csv, validation.png and "
                     "summary.json.",
         epilog="Defaults: 2 m/s, 150 mm smooth kick at 35 m/s^2 (0.157 s), LQR rider designed at the run's speed, "

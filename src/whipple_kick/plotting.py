@@ -310,8 +310,9 @@ def validation_figure(result, path=None, dpi=120):
         ax.set_xticklabels([c.replace("_", "\n") for c in cases], fontsize=6.5)
         ax.tick_params(labelsize=7)
         ax.grid(alpha=0.3)
-        if k == 0:
-            ax.legend(fontsize=7, loc="best")
+        if k == 0:   # one legend for the six metric panels, above them
+            fig.legend(*ax.get_legend_handles_labels(), loc="upper center", ncol=3, fontsize=8,
+                       bbox_to_anchor=(0.5, 0.965), frameon=False)
         if column == "dominant_frequency_hz":
             ax.legend(handles=ax.get_legend_handles_labels()[0][-1:], fontsize=7, loc="best")
     colors = {p: c for p, c in zip((300.0, 400.0, 500.0), ("tab:blue", "tab:red", "tab:olive"), strict=True)}
@@ -322,6 +323,7 @@ def validation_figure(result, path=None, dpi=120):
         ax_f = fig.add_subplot(grid[2 + row, 2])
         if not any(name.endswith(f"_{direction}") for name in result.runs):
             ax_t.text(0.5, 0.5, f"kicks to the {direction} not run", transform=ax_t.transAxes, ha="center")
+            ax_t.set_axis_off()
             ax_f.set_axis_off()
             continue
         for name, run in result.runs.items():
@@ -354,7 +356,7 @@ def validation_figure(result, path=None, dpi=120):
             ax_f.set_xlabel("frequency [Hz] (grey: measured 5-6 Hz band)")
     fig.suptitle("Model against the kick-plate measurements (thesis Section 8.5, Tables 8.6-8.8): "
                  "2 m/s, 150 mm smooth kick at 35 m/s^2", fontsize=10)
-    fig.subplots_adjust(left=0.06, right=0.99, top=0.95, bottom=0.05, hspace=0.45, wspace=0.25)
+    fig.subplots_adjust(left=0.06, right=0.99, top=0.93, bottom=0.05, hspace=0.45, wspace=0.25)
     if path is None:
         return fig
     fig.savefig(path, dpi=dpi, pil_kwargs={"compress_level": PNG_COMPRESS_LEVEL})
