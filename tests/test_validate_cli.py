@@ -43,6 +43,8 @@ def test_validate_writes_the_comparison(tmp_path, capsys):
     (["--workers", "0"], "--workers = 0 must be a whole number >= 1"),
     (["--speed", "fast"], "'fast' is not a number (m/s)"),
     (["--tyre-transient", "x"], "argument --tyre-transient: invalid choice"),
+    (["--bicycle", "balanceassist_635N"], "already includes its rider"),
+    (["--tyre", "T01"], "kPa"),
 ])
 def test_validate_bad_input_is_one_line_exit_2(args, message, tmp_path, capsys):
     status, stdout, stderr = _validate([*args, "--out", str(tmp_path / "v")], capsys)

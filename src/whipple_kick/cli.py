@@ -776,7 +776,7 @@ def _validate_parser():
 def _validate(argv):
     import time
 
-    from . import validation
+    from . import assembly, validation
     args = _validate_parser().parse_args(argv)
     started = time.perf_counter()
     if args.workers is not None and args.workers < 1:
@@ -784,7 +784,8 @@ def _validate(argv):
     base = validation.base_scenario(**_model_fields(args), speed=args.speed, kick_accel=args.kick_accel,
                                     kick_displacement=args.kick_displacement, kick_profile=args.kick_profile,
                                     duration=args.duration, rtol=args.rtol)
-    base.with_changes(fz_n=635.0).validate()   # every flag checked before any run or folder
+    for case in validation.experiments.load().cases.values():   # every flag checked before any run or folder
+        assembly.preflight(base.with_changes(fz_n=case.fz_n, pressure_kpa=case.pressure_kpa))
     out, created = _prepare_out(args.out or _new_folder("validation"), args.force, _VALIDATE_FILES)
     try:
         result = validation.validate(base, directions=args.directions, workers=args.workers,

@@ -226,6 +226,13 @@ def validate(base=None, experiment=None, directions=DIRECTIONS, workers=None, pr
     Returns
     -------
     Validation
+
+    Raises
+    ------
+    InputError
+        A set-up the measured cases cannot run with (checked for every case
+        before any run: e.g. a bicycle preset that includes its rider, a
+        tyre not measured at 300-500 kPa).
     """
     import tempfile
 
@@ -244,6 +251,9 @@ def validate(base=None, experiment=None, directions=DIRECTIONS, workers=None, pr
         raise InputError(f"time origin {time_origin!r} is unknown; choose one of {', '.join(TIME_ORIGINS)}")
     cases = [{"fz_n": c.fz_n, "pressure_kpa": c.pressure_kpa, "kick_direction": d}
              for c in exp.cases.values() for d in directions]
+    from .assembly import preflight
+    for case in cases:   # a set-up no case can run (a preset with its rider, a tyre without these pressures) fails here
+        preflight(base.with_changes(**case))
     with tempfile.TemporaryDirectory(prefix="whipple_kick_validate_") as folder:
         table = sweep(cases=cases, base=base, folder=folder, workers=workers, progress=progress,
                       trajectory_columns=TRAJECTORY_COLUMNS, trajectory_dtype="float64", trajectory_rate=None)
