@@ -428,7 +428,7 @@ def report_lines(result):
                      f"{cell(r['slow_swing_ratio'], '{:.2f}'):>10}")
     s = result.summary
     lines.append("mean |model - measured|: " + ", ".join(
-        f"{k} {v['all']:.3g} {v['unit']}".replace(" -", "") for k, v in s["mean_abs_error"].items()
+        f"{k} {v['all']:.3g}" + ("" if v["unit"] == "-" else f" {v['unit']}") for k, v in s["mean_abs_error"].items()
         if v["all"] is not None))
     sw = s["slow_swing_ratio"]
     if sw["model_mean"] is not None:
