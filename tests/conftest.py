@@ -44,3 +44,11 @@ def default_run(tmp_path_factory):
     folder = tmp_path_factory.mktemp("sweep") / "grid"
     table = wk.sweep(SWEEP_GRID, base=SWEEP_BASE, folder=folder, progress=False)
     return folder, table
+
+
+def run_console(main, argv, capsys):
+    """Run a console script's ``main(argv)`` in-process; return (status, stdout, stderr)."""
+    with pytest.raises(SystemExit) as info:
+        main(argv)
+    out, err = capsys.readouterr()
+    return info.value.code, out, err

@@ -4,6 +4,7 @@ import os
 import subprocess
 import sys
 
+from conftest import run_console
 import pytest
 
 import whipple_kick as wk
@@ -12,10 +13,7 @@ from whipple_kick.cli import simulate_main
 
 def _simulate(argv, capsys):
     """Run ``simulate`` in-process; return (status, stdout, stderr)."""
-    with pytest.raises(SystemExit) as info:
-        simulate_main(argv)
-    out, err = capsys.readouterr()
-    return info.value.code, out, err
+    return run_console(simulate_main, argv, capsys)
 
 
 def test_main_job_writes_the_three_files(tmp_path, capsys):

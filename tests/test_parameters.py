@@ -29,7 +29,7 @@ def test_the_loaders_read_the_shipped_folders():
 
 
 def test_unknown_kind_is_refused():
-    with pytest.raises(ValueError, match="kind must be one of bicycles, riders, tyres"):
+    with pytest.raises(ValueError, match="kind must be one of bicycles, experiments, riders, tyres"):
         parameters.shipped("wheels")
 
 

@@ -615,6 +615,88 @@ def lowpass(t, signal, cutoff_hz=20.0, order=4):
         raise InputError(f"series of {x.size} samples is too short to low-pass filter: {exc}") from None
 
 
+def as_recorded(t, signal, t_kick=0.0, rate_hz=100.0, cutoff_hz=20.0, order=4):
+    """A signal as the thesis' IMU recorded and filtered it (Section 8.3, "Data analysis").
+
+    Sampled at ``rate_hz`` on a grid through ``t_kick`` (linear
+    interpolation, exact to the solution's own accuracy when the input is a
+    fine simulation output), then low-passed at ``cutoff_hz`` without phase
+    shift (:func:`lowpass`, so the peaks stay where they were).
+
+    Parameters
+    ----------
+    t, signal : array_like
+        Strictly increasing time [s] and the signal.
+    t_kick : float
+        A time [s] the grid passes through (the kick start).
+    rate_hz : float
+        Sampling rate [Hz] (thesis: 100 Hz).
+    cutoff_hz : float
+        Low-pass cut-off [Hz] (thesis: 20 Hz), below ``rate_hz / 2``.
+    order : int
+        Butterworth order (the thesis does not say; 4).
+
+    Returns
+    -------
+    t_rec, x_rec : ndarray
+        The recording's time grid [s] and the filtered signal on it.
+    """
+    t, x = _as_series(t, signal)
+    rate_hz = check_range("recording rate", rate_hz, 0.0, None, "Hz", low_open=True)
+    first = math.ceil((t[0] - t_kick) * rate_hz - 1e-9)
+    last = math.floor((t[-1] - t_kick) * rate_hz + 1e-9)
+    if last - first < 2:
+        raise InputError(f"record of {t[-1] - t[0]:g} s is too short to sample at {rate_hz:g} Hz")
+    t_rec = t_kick + np.arange(first, last + 1) / rate_hz
+    x_rec = np.interp(t_rec, t, x)
+    return t_rec, lowpass(t_rec, x_rec, cutoff_hz, order)
+
+
+def dominant_frequency(t, signal, t_start, duration, f_min=0.0, f_max=25.0, *, baseline=0.0):
+    """Frequency [Hz] of the largest local maximum of :func:`amplitude_spectrum` over a window.
+
+    The window is ``[t_start, t_start + duration)`` (1 s gives the thesis'
+    1 Hz bins). Only a bin larger than both its neighbours counts (a local
+    maximum, as the thesis reads its spectra): the spectrum of a decaying
+    pulse falls from 0 Hz without a peak, and its largest bin above
+    ``f_min`` would only be the edge of that fall. Only frequencies in
+    ``[f_min, f_max]`` compete.
+
+    Raises
+    ------
+    MetricUnavailable
+        No local maximum in ``[f_min, f_max]``.
+    """
+    t, x = _as_series(t, signal)
+    window = (t >= t_start - 1e-9) & (t < t_start + duration - 1e-9)   # half-open: N samples, bins of 1/duration
+    freq, amp = amplitude_spectrum(t[window], x[window] - baseline, f_max)
+    inner = np.arange(1, freq.size - 1)
+    peaks = inner[(amp[inner] > amp[inner - 1]) & (amp[inner] >= amp[inner + 1]) & (freq[inner] >= f_min - 1e-9)]
+    if not peaks.size:
+        raise MetricUnavailable(f"the amplitude spectrum over {t_start:g}-{t_start + duration:g} s has no local "
+                                f"maximum between {f_min:g} and {f_max:g} Hz")
+    return float(freq[peaks[np.argmax(amp[peaks])]])
+
+
+def residual_ratio(t, signal, window, reference, baseline=0.0):
+    """Largest ``|signal - baseline|`` within ``window = (t0, t1)`` [s] divided by ``|reference|``.
+
+    E.g. how much of the first yaw-rate peak is left 0.5-1 s after the kick.
+
+    Raises
+    ------
+    MetricUnavailable
+        No sample in the window, or a zero reference.
+    """
+    t, x = _as_series(t, signal)
+    inside = (t >= window[0] - 1e-9) & (t <= window[1] + 1e-9)
+    if not np.any(inside):
+        raise MetricUnavailable(f"no sample between {window[0]:g} and {window[1]:g} s")
+    if reference == 0:
+        raise MetricUnavailable("the reference peak is zero")
+    return float(np.max(np.abs(x[inside] - baseline)) / abs(reference))
+
+
 # --------------------------------------------------------------------------
 # all metrics of one run
 # --------------------------------------------------------------------------

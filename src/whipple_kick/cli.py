@@ -115,24 +115,27 @@ def _number(unit):
     return parse
 
 
-def _model_options(p, symmetric_flag=True, design_default="the run's --speed"):
-    """Add the tyre, bicycle-and-rider and controller options of ``simulate`` (shared with ``stability``).
+def _model_options(p, symmetric_flag=True, design_default="the run's --speed", case_options=True):
+    """Add the tyre, bicycle-and-rider and controller options of ``simulate`` (shared with ``stability``, ``validate``).
 
     ``symmetric_flag`` adds ``--symmetric-tyres``; ``design_default`` says
-    what the LQR design speed is by default. Returns the "riding and
-    control" group, for the caller's speed option.
+    what the LQR design speed is by default; ``case_options`` adds the
+    pressures, the rear load or rider mass and ``--thesis-load`` (not for a
+    command that sets them per case). Returns the "riding and control"
+    group, for the caller's speed option.
     """
     from . import tyres
     from .carcass import SLIDING_LAWS
     from .scenario import CAMBER_SIGNS, CONTROLLERS, TYRE_TRANSIENTS
     from .transient import DEFAULT_TRANSIENT
     g = p.add_argument_group("tyres")
-    g.add_argument("--pressure", type=_number("kPa"), metavar="KPA",
-                   help="inflation pressure of both tyres in kPa (default 400)")
-    g.add_argument("--pressure-front", type=_number("kPa"), metavar="KPA",
-                   help="front tyre pressure in kPa (with --pressure-rear, instead of --pressure)")
-    g.add_argument("--pressure-rear", type=_number("kPa"), metavar="KPA",
-                   help="rear tyre pressure in kPa (with --pressure-front, instead of --pressure)")
+    if case_options:
+        g.add_argument("--pressure", type=_number("kPa"), metavar="KPA",
+                       help="inflation pressure of both tyres in kPa (default 400)")
+        g.add_argument("--pressure-front", type=_number("kPa"), metavar="KPA",
+                       help="front tyre pressure in kPa (with --pressure-rear, instead of --pressure)")
+        g.add_argument("--pressure-rear", type=_number("kPa"), metavar="KPA",
+                       help="rear tyre pressure in kPa (with --pressure-front, instead of --pressure)")
     g.add_argument("--tyre", default="T03", metavar="NAME",
                    help="tyre on both wheels (default T03; available: %s)" % ", ".join(t[0] for t in tyres.available()))
     g.add_argument("--coefficient-set", default="table7_9", metavar="SET",
@@ -161,10 +164,11 @@ def _model_options(p, symmetric_flag=True, design_default="the run's --speed"):
     g.add_argument("--bicycle", default="balanceassist_v1", metavar="NAME",
                    help="bicycle parameter set or .toml path (default balanceassist_v1; presets "
                         "with the rider included: balanceassist_635N, balanceassist_701N, browser_with_rider)")
-    who = g.add_mutually_exclusive_group()
-    who.add_argument("--fz", type=_number("N"), metavar="N",
-                     help="static rear-tyre load in N that the rider's mass is chosen for (default 635)")
-    who.add_argument("--rider-mass", type=_number("kg"), metavar="KG", help="rider mass in kg")
+    if case_options:
+        who = g.add_mutually_exclusive_group()
+        who.add_argument("--fz", type=_number("N"), metavar="N",
+                         help="static rear-tyre load in N that the rider's mass is chosen for (default 635)")
+        who.add_argument("--rider-mass", type=_number("kg"), metavar="KG", help="rider mass in kg")
     g.add_argument("--low-inertia", action="store_true",
                    help="halve the rear frame's inertias and mass-centre height (thesis Figure 8.9)")
     g = p.add_argument_group("riding and control")
@@ -174,9 +178,10 @@ def _model_options(p, symmetric_flag=True, design_default="the run's --speed"):
     g.add_argument("--design-speed", type=_number("m/s"), metavar="M/S",
                    help=f"LQR design speed in m/s (default: {design_default}, as a real rider adapts; "
                         "the thesis fixed it at 3)")
-    g.add_argument("--thesis-load", type=_number("N"), metavar="N",
-                   help="rear load in N whose Table 8.4 gains --controller thesis uses (570, 635 or 701; "
-                        "default --fz, or the load a preset with rider is labelled with)")
+    if case_options:
+        g.add_argument("--thesis-load", type=_number("N"), metavar="N",
+                       help="rear load in N whose Table 8.4 gains --controller thesis uses (570, 635 or 701; "
+                            "default --fz, or the load a preset with rider is labelled with)")
     g.add_argument("--gain-scale", type=_number("factor"), default=1.0, metavar="FACTOR",
                    help="multiply every controller gain (default 1; the thesis also ran 0.5)")
     return g
@@ -291,23 +296,32 @@ def _flags_given(argv):
     return set(vars(parser.parse_args(argv)))
 
 
+#: Scenario fields of the options ``_model_options(case_options=True)`` adds, by option name.
+_CASE_FIELDS = {"pressure_kpa": "pressure", "pressure_front_kpa": "pressure_front",
+                "pressure_rear_kpa": "pressure_rear", "fz_n": "fz", "rider_mass_kg": "rider_mass",
+                "thesis_load_n": "thesis_load"}
+
+
 def _model_fields(args):
-    """Scenario fields of the options added by :func:`_model_options`."""
+    """Scenario fields of the options added by :func:`_model_options` (without the case options if it had none)."""
+    fields = dict(
+        bicycle=args.bicycle, tyre=args.tyre, coefficient_set=args.coefficient_set, friction=args.friction,
+        controller=args.controller, design_speed=args.design_speed, gain_scale=args.gain_scale,
+        low_inertia=args.low_inertia, tyre_transient=args.tyre_transient, camber_sign=args.camber_sign,
+        carcass_sliding=args.carcass_sliding, carcass_damping=args.carcass_damping,
+    )
+    if not hasattr(args, "pressure"):
+        return fields
     fronts = (args.pressure_front, args.pressure_rear)
     if args.pressure is not None and any(v is not None for v in fronts):
         raise InputError("--pressure sets both tyres; do not combine it with --pressure-front/--pressure-rear")
     if (fronts[0] is None) != (fronts[1] is None):
         raise InputError("give both --pressure-front KPA and --pressure-rear KPA (or --pressure KPA for both)")
     _check_loads(args.bicycle, [args.fz] if args.fz is not None else [])
-    return dict(
-        bicycle=args.bicycle, fz_n=args.fz, rider_mass_kg=args.rider_mass, tyre=args.tyre,
-        pressure_kpa=400.0 if args.pressure is None else args.pressure,
-        pressure_front_kpa=args.pressure_front, pressure_rear_kpa=args.pressure_rear,
-        coefficient_set=args.coefficient_set, friction=args.friction, controller=args.controller,
-        design_speed=args.design_speed, thesis_load_n=args.thesis_load, gain_scale=args.gain_scale,
-        low_inertia=args.low_inertia, tyre_transient=args.tyre_transient, camber_sign=args.camber_sign,
-        carcass_sliding=args.carcass_sliding, carcass_damping=args.carcass_damping,
-    )
+    fields.update({field: getattr(args, option) for field, option in _CASE_FIELDS.items()})
+    if args.pressure is None:
+        fields["pressure_kpa"] = 400.0
+    return fields
 
 
 def _check_loads(bicycle, loads):
@@ -385,13 +399,18 @@ class _Output:
 
 def _default_out(scenario, prefix="kick"):
     """A new folder name under the current directory (never an existing one)."""
-    import datetime
-    import pathlib
     rear, front = scenario.pressures
     p = f"{rear:g}kPa" if rear == front else f"{rear:g}-{front:g}kPa"
     load = f"_{scenario.fz_n:g}N" if scenario.fz_n is not None else ""
+    return _new_folder(f"{prefix}_{scenario.tyre}_{p}{load}")
+
+
+def _new_folder(name):
+    """``<cwd>/<name>_<date-time>``, numbered on if it exists."""
+    import datetime
+    import pathlib
     stamp = datetime.datetime.now().strftime("%Y%m%d-%H%M%S")
-    base = pathlib.Path.cwd() / f"{prefix}_{scenario.tyre}_{p}{load}_{stamp}"
+    base = pathlib.Path.cwd() / f"{name}_{stamp}"
     out, k = base, 1
     while out.exists():
         k += 1
@@ -641,8 +660,9 @@ def _recommend(argv):
                     "steer rates all back within 5 % of their first peaks) and says by how much the "
                     "best beats the second best, against the spread of the model itself.",
         epilog="Both tyres get the same pressure, as in the experiment. Every other setting is the "
-               "simulate default (3 m/s, LQR rider designed at that speed, 150 mm kick in 0.150 s, 6 s). "
-               "See docs/sweeps.md.")
+               "simulate default (3 m/s, LQR rider designed at that speed, 150 mm kick to the right in 0.150 s, 6 s). "
+               "The default runs one direction and one tyre transient; --kick-direction both and "
+               "--tyre-transient all say whether the answer depends on them. See docs/sweeps.md.")
     p.add_argument("--fz", type=_number("N"), nargs="+", required=True, metavar="N",
                    help="static rear-tyre load(s) in N, e.g. --fz 570 635 701")
     p.add_argument("--tyre", default="T03", metavar="NAME",
@@ -666,23 +686,44 @@ def _recommend(argv):
                    help="sweep folder keeping every run (re-running with it resumes)")
     p.add_argument("--extend", action="store_true",
                    help="with --out: add these runs to a folder that holds another sweep")
+    from .inputs import DIRECTIONS
+    from .scenario import TYRE_TRANSIENTS, Scenario
+    p.add_argument("--kick-direction", choices=(*DIRECTIONS, "both"), default="right",
+                   help="direction the plate moves (default right); both: run each direction and say whether "
+                        "the best pressure depends on it (twice the runs)")
+    p.add_argument("--tyre-transient", choices=(*TYRE_TRANSIENTS, "all"), default=Scenario.tyre_transient,
+                   help=f"tyre transient form (default {Scenario.tyre_transient}); all: run each form and say "
+                        "whether the best pressure depends on it")
     bar = p.add_mutually_exclusive_group()
     bar.add_argument("--progress", action="store_true", default=None,
                      help="show the progress bar (default: only when stderr is a terminal)")
     bar.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
     args = p.parse_args(argv)
-    from .scenario import Scenario
-    base = Scenario(duration=args.duration)
-    base.validate()
-    _check_loads(base.bicycle, args.fz)
-    recs = recommend.recommend_pressures(
-        args.fz, tyre=args.tyre, pressures=args.pressures, fine=args.fine, step_kpa=args.step,
-        base=base, criterion=args.criterion, workers=args.workers, folder=args.out, extend=args.extend,
+    directions = DIRECTIONS if args.kick_direction == "both" else (args.kick_direction,)
+    forms = TYRE_TRANSIENTS if args.tyre_transient == "all" else (args.tyre_transient,)
+    variants = {(d, f): Scenario(duration=args.duration, kick_direction=d, tyre_transient=f).validate()
+                for d in directions for f in forms}
+    _check_loads(next(iter(variants.values())).bicycle, args.fz)
+    if args.out is not None and len(variants) > 1 and not args.extend:
+        raise InputError("--out with --kick-direction both or --tyre-transient all keeps every variant in one "
+                         "folder: add --extend")
+    recs, verdicts = recommend.recommend_variants(
+        args.fz, variants, tyre=args.tyre, pressures=args.pressures, fine=args.fine, step_kpa=args.step,
+        criterion=args.criterion, workers=args.workers, folder=args.out, extend=args.extend,
         progress=sys.stderr.isatty() if args.progress is None else args.progress)
-    for k, rec in enumerate(recs):
-        if k:
-            print()
-        print(recommend.format_recommendation(rec))
+    first = True
+    for (direction, form), by_load in recs.items():
+        for rec in by_load:
+            if not first:
+                print()
+            first = False
+            if len(variants) > 1:
+                print(f"kicks to the {direction}, {form} tyre transient:")
+            print(recommend.format_recommendation(rec))
+    if verdicts:
+        print("\nwhat the best pressure depends on:")
+        for line in verdicts:
+            print(f"  {line}")
     return 0
 
 
@@ -761,3 +802,94 @@ def _stability(argv):
 def stability_main(argv=None):
     """Console script ``stability``: eigenvalues of the slip model against speed (see ``stability --help``)."""
     sys.exit(_run(_stability, argv, "stability"))
+
+
+# ------------------------------------------------------------------ validate
+
+#: Every file or folder ``validate`` writes (``--force`` removes them first).
+_VALIDATE_FILES = ("validation.csv", "summary.json", "validation.png")
+
+
+def _validate_parser():
+    from . import validation
+    p = _OneLineParser(
+        prog="validate", allow_abbrev=False,
+        description="The model against the thesis' kick-plate measurements (Dell'Orto 2025, Section 8.5, "
+                    "Tables 8.6-8.9): runs the nine measured cases (rear loads 570/635/701 N x 300/400/500 kPa) "
+                    "in both kick directions as the experiments ran, processes the yaw rate as the recordings "
+                    "were (100 Hz, 20 Hz zero-phase low-pass, peaks until one is below 8 %) and compares. "
+                    "Writes validation.csv, cases/<case>_<direction>/trajectory.csv, validation.png and "
+                    "summary.json.",
+        epilog="Defaults: 2 m/s, 150 mm smooth kick at 35 m/s^2 (0.157 s), LQR rider designed at the run's speed, "
+               "both directions, 6 s after the kick; the loads and pressures are the measured ones (no --pressure, "
+               "--fz). See docs/experiments.md.")
+    g = _model_options(p, case_options=False)
+    g.add_argument("--speed", type=_number("m/s"), default=validation.SPEED, metavar="M/S",
+                   help=f"forward speed in m/s (default {validation.SPEED:g}, the measured 1.92-2 m/s)")
+    g = p.add_argument_group("kick")
+    g.add_argument("--kick-accel", type=_number("m/s^2"), default=validation.KICK_ACCEL, metavar="M/S2",
+                   help=f"peak plate acceleration in m/s^2 (default {validation.KICK_ACCEL:g}, measured 30-35)")
+    g.add_argument("--kick-displacement", type=_number("m"), default=validation.KICK_DISPLACEMENT, metavar="M",
+                   help=f"plate travel in m (default {validation.KICK_DISPLACEMENT:g})")
+    g.add_argument("--kick-profile", choices=("smooth", "constant"), default="smooth",
+                   help="smooth (default: minimum jerk) or constant acceleration (the thesis' simulations)")
+    g.add_argument("--directions", nargs="+", choices=validation.DIRECTIONS, default=list(validation.DIRECTIONS),
+                   help="kick directions to run (default both: the thesis does not give one)")
+    g = p.add_argument_group("comparison and output")
+    g.add_argument("--time-origin", choices=validation.TIME_ORIGINS, default="first_peak",
+                   help="origin of the last-peak time: first_peak (default, inferred from the printed times and "
+                        "periods) or kick")
+    g.add_argument("--compare-transients", action="store_true",
+                   help="also run every tyre transient form and say whether the best pressure depends on it "
+                        "(summary.json by_tyre_transient; 3x the runs)")
+    g.add_argument("--duration", type=_number("s"), default=validation.DURATION, metavar="S",
+                   help=f"simulated time after the kick in s (default {validation.DURATION:g})")
+    g.add_argument("--rtol", type=_number("relative"), default=1e-10, metavar="RTOL",
+                   help="LSODA relative tolerance (default 1e-10)")
+    g.add_argument("--workers", type=int, metavar="N", help="worker processes (default: one per CPU core)")
+    _output_options(g, "validation.png")
+    return p
+
+
+def _validate(argv):
+    import time
+
+    from . import assembly, validation
+    args = _validate_parser().parse_args(argv)
+    started = time.perf_counter()
+    if args.workers is not None and args.workers < 1:
+        raise InputError(f"--workers = {args.workers} must be a whole number >= 1")
+    base = validation.base_scenario(**_model_fields(args), speed=args.speed, kick_accel=args.kick_accel,
+                                    kick_displacement=args.kick_displacement, kick_profile=args.kick_profile,
+                                    duration=args.duration, rtol=args.rtol)
+    for case in validation.experiments.load().cases.values():   # every flag checked before any run or folder
+        assembly.preflight(base.with_changes(fz_n=case.fz_n, pressure_kpa=case.pressure_kpa))
+    out, created = _prepare_out(args.out or _new_folder("validation"), args.force, _VALIDATE_FILES)
+    try:
+        result = validation.validate(base, directions=args.directions, workers=args.workers,
+                                     time_origin=args.time_origin)
+        if args.compare_transients:
+            forms, verdicts = validation.compare_transients(base, directions=args.directions, workers=args.workers,
+                                                            time_origin=args.time_origin)
+            result.summary["by_tyre_transient"] = validation.transient_summary(forms, verdicts)
+        result.summary["wall_s"] = time.perf_counter() - started
+        files = validation.write(result, out, plot=not args.no_plot)
+    except BaseException:
+        _discard(out, created, _VALIDATE_FILES)
+        raise
+    if not args.quiet:
+        print(f"validate: {len(result.runs)} model runs against the thesis' kick-plate measurements "
+              f"(tyre transient {base.tyre_transient}, {base.speed:g} m/s, {base.kick_profile} kick at "
+              f"{base.kick_accel:g} m/s^2)")
+        for line in validation.report_lines(result):
+            print("  " + line)
+        for rule, by_direction in result.summary.get("by_tyre_transient", {}).get("verdicts", {}).items():
+            for direction, text in by_direction.items():
+                print(f"  tyre transient, {rule} rule, kicks to the {direction}: {text}")
+        print(f"  wrote {', '.join(files)} in {out} ({time.perf_counter() - started:.1f} s)")
+    return 0
+
+
+def validate_main(argv=None):
+    """Console script ``validate``: the model against the thesis' measurements (see ``validate --help``)."""
+    sys.exit(_run(_validate, argv, "validate"))

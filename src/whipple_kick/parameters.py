@@ -1,6 +1,6 @@
 """Reading and validating the project's TOML parameter files: one reader, one set of rules.
 
-The shipped files (bicycles, riders, tyres) are package data of
+The shipped files (bicycles, experiments, riders, tyres) are package data of
 ``whipple_kick.parameter_files``, which is the repository's top-level
 ``parameters/`` folder: :func:`shipped` finds them with
 :mod:`importlib.resources` wherever the package is installed (a wheel or an
@@ -29,7 +29,7 @@ from .errors import InputError
 #: The package whose data are the shipped parameter files.
 DATA_PACKAGE = "whipple_kick.parameter_files"
 #: Kinds of shipped parameter files (sub-folders of the data package).
-KINDS = ("bicycles", "riders", "tyres")
+KINDS = ("bicycles", "experiments", "riders", "tyres")
 
 
 def shipped(kind: str) -> pathlib.Path:
@@ -37,7 +37,7 @@ def shipped(kind: str) -> pathlib.Path:
 
     Parameters
     ----------
-    kind : {"bicycles", "riders", "tyres"}
+    kind : {"bicycles", "experiments", "riders", "tyres"}
 
     Returns
     -------

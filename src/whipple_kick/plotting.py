@@ -255,3 +255,109 @@ def animate(result, path, **options):
     """
     from .animation import animate as _animate
     return _animate(result, path, **options)
+
+
+#: (validation.csv column, axis label) of the validation figure's metric panels.
+VALIDATION_METRICS = (
+    ("last_peak_time_s", "last-peak time [s]"),
+    ("n_peaks", "peaks above 8 %"),
+    ("period_s", "period, peaks #1-#3 [s]"),
+    ("log_dec_13", "log decrement #1-#3"),
+    ("log_dec_24", "log decrement #2-#4"),
+    ("dominant_frequency_hz", "dominant frequency [Hz]"),
+)
+
+
+def validation_figure(result, path=None, dpi=120):
+    """Model against the thesis' measurements (:func:`whipple_kick.validation.validate`).
+
+    Six metric panels (each case: measured, model with kicks to the right
+    and to the left), the model's processed yaw-rate histories (steady turn
+    removed) and their amplitude spectra over the 1 s after the kick, with
+    the measured 5-6 Hz band shaded; the spectra's 1 s window starts as
+    the wheel leaves the plate (0.2 s), as the dominant frequency's does.
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from . import analysis, experiments
+
+    exp = experiments.load()
+    band = (exp.processing["yaw_band_low"], exp.processing["yaw_band_high"])
+    start = exp.conditions["wheel_on_plate_min"]   # the spectra's window starts as the wheel leaves the plate
+    table = result.table
+    cases = list(dict.fromkeys(table["case"]))
+    x = np.arange(len(cases))
+    fig = Figure(figsize=(13, 11))
+    FigureCanvasAgg(fig)
+    grid = fig.add_gridspec(4, 3, height_ratios=(1, 1, 1.3, 1.3))
+    styles = {("measured", ""): dict(marker="s", color="k", label="measured (thesis Tables 8.6-8.8)"),
+              ("model", "right"): dict(marker="o", color="tab:red", label="model, kick to the right"),
+              ("model", "left"): dict(marker="^", color="tab:blue", label="model, kick to the left")}
+    for k, (column, label) in enumerate(VALIDATION_METRICS):
+        ax = fig.add_subplot(grid[k // 3, k % 3])
+        for (source, direction), style in styles.items():
+            rows = table[(table["source"] == source) & (table["direction"] == direction)].set_index("case")
+            if rows.empty:
+                continue
+            values = [float(rows.loc[c, column]) if c in rows.index and rows.loc[c, column] is not None
+                      and np.isfinite(float(rows.loc[c, column])) else np.nan for c in cases]
+            ax.plot(x, values, linestyle="none", markersize=6, **style)
+        if column == "dominant_frequency_hz":
+            ax.axhspan(*band, color="0.85", zorder=0, label="measured 5-6 Hz band (Section 8.6)")
+        ax.set_ylabel(label, fontsize=8)
+        ax.set_xticks(x)
+        ax.set_xticklabels([c.replace("_", "\n") for c in cases], fontsize=6.5)
+        ax.tick_params(labelsize=7)
+        ax.grid(alpha=0.3)
+        if k == 0:   # one legend for the six metric panels, above them
+            fig.legend(*ax.get_legend_handles_labels(), loc="upper center", ncol=3, fontsize=8,
+                       bbox_to_anchor=(0.5, 0.965), frameon=False)
+        if column == "dominant_frequency_hz":
+            ax.legend(handles=ax.get_legend_handles_labels()[0][-1:], fontsize=7, loc="best")
+    colors = {p: c for p, c in zip((300.0, 400.0, 500.0), ("tab:blue", "tab:red", "tab:olive"), strict=True)}
+    dashes = {570.0: ":", 635.0: "-", 701.0: "--"}
+    legend_drawn = False
+    for row, direction in enumerate(("right", "left")):
+        ax_t = fig.add_subplot(grid[2 + row, 0:2])
+        ax_f = fig.add_subplot(grid[2 + row, 2])
+        if not any(name.endswith(f"_{direction}") for name in result.runs):
+            ax_t.text(0.5, 0.5, f"kicks to the {direction} not run", transform=ax_t.transAxes, ha="center")
+            ax_t.set_axis_off()
+            ax_f.set_axis_off()
+            continue
+        for name, run in result.runs.items():
+            if not name.endswith(f"_{direction}"):
+                continue
+            summary = run["summary"]["scenario"]
+            t, y = run["recording"]
+            style = dict(color=colors.get(summary["pressure_kpa"], "0.4"), linestyle=dashes.get(summary["fz_n"], "-"),
+                         linewidth=1.0)
+            ax_t.plot(t, y - run["steady"], label=name.rsplit("_", 1)[0], **style)
+            after = (t >= start - 1e-9) & (t < start + exp.processing["record_length"] - 1e-9)
+            f, a = analysis.amplitude_spectrum(t[after], y[after] - run["steady"], exp.processing["spectrum_max"])
+            ax_f.plot(f, a, **style)
+        ax_t.axvspan(0.0, 0.5, color="0.93", zorder=0)
+        ax_t.text(0.25, 0.02, "measured peaks end here (< 0.5 s)", transform=ax_t.get_xaxis_transform(),
+                  ha="center", fontsize=7, color="0.3")
+        ax_t.axvline(0.0, color="tab:green", linestyle=":", linewidth=1)
+        ax_t.set_xlim(-0.2, 3.0)   # the slow swing's first half-period; the runs go on to 6 s
+        ax_t.set_ylabel(f"yaw rate - steady [rad/s]\nkick to the {direction}", fontsize=8)
+        ax_t.grid(alpha=0.3)
+        ax_f.axvspan(*band, color="0.85", zorder=0)
+        ax_f.set_xlim(0, exp.processing["spectrum_max"])
+        ax_f.set_ylabel(f"amplitude [rad/s], {start:g}-{start + exp.processing['record_length']:g} s", fontsize=8)
+        ax_f.grid(alpha=0.3)
+        if not legend_drawn:
+            ax_t.legend(fontsize=6, ncol=3, loc="upper right")
+            legend_drawn = True
+        if row == 1:
+            ax_t.set_xlabel("time from kick start [s] (model: 100 Hz, 20 Hz low-pass, as recorded)")
+            ax_f.set_xlabel("frequency [Hz] (grey: measured 5-6 Hz band)")
+    fig.suptitle("Model against the kick-plate measurements (thesis Section 8.5, Tables 8.6-8.8): "
+                 "2 m/s, 150 mm smooth kick at 35 m/s^2", fontsize=10)
+    fig.subplots_adjust(left=0.06, right=0.99, top=0.93, bottom=0.05, hspace=0.45, wspace=0.25)
+    if path is None:
+        return fig
+    fig.savefig(path, dpi=dpi, pil_kwargs={"compress_level": PNG_COMPRESS_LEVEL})
+    return None

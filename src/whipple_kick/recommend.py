@@ -339,3 +339,85 @@ def format_recommendation(rec):
             text += f"; best measured pressure {rec.best_measured_kpa:g} kPa"
         lines.append(head + text)
     return "\n".join(lines)
+
+
+# --------------------------------------------------------------- what the answer depends on
+
+def dependence(best_by_variant, what):
+    """Say whether the best pressure changes between variants of one choice.
+
+    Parameters
+    ----------
+    best_by_variant : dict
+        ``{variant label: best pressure [kPa] or None}``, e.g.
+        ``{"kicks to the right": 500.0, "kicks to the left": 300.0}``.
+    what : str
+        The choice the variants differ in ("direction", "tyre transient").
+
+    Returns
+    -------
+    str
+        E.g. ``"500 kPa for kicks to the right, 300 kPa for kicks to the left: the answer depends on
+        the direction"``, or ``"500 kPa whatever the direction"``.
+
+    Example
+    -------
+    >>> dependence({"kicks to the right": 500.0, "kicks to the left": 500.0}, "direction")
+    '500 kPa whatever the direction'
+    """
+    if not best_by_variant:
+        raise InputError(f"no variants of the {what} to compare")
+    known = {label: p for label, p in best_by_variant.items() if p is not None}
+    if not known:
+        return f"no pressure recovered in any {what}"
+    parts = ", ".join(f"{p:g} kPa for {label}" if p is not None else f"none for {label}"
+                      for label, p in best_by_variant.items())
+    if len(set(known.values())) == 1 and len(known) == len(best_by_variant):
+        return f"{next(iter(known.values())):g} kPa whatever the {what}"
+    return f"{parts}: the answer depends on the {what}"
+
+
+def recommend_variants(loads, variants, **options):
+    """:func:`recommend_pressures` for each variant of the run, and whether the best pressure depends on it.
+
+    Parameters
+    ----------
+    loads : sequence of float
+        Rear loads [N].
+    variants : dict
+        ``{(kick direction, tyre transient): base Scenario}``.
+    **options
+        Passed to :func:`recommend_pressures` (``tyre``, ``pressures``, ``criterion``, sweep options).
+
+    Returns
+    -------
+    recs : dict
+        ``{variant: [Recommendation per load]}``.
+    verdicts : list of str
+        Per load: how the best pressure changes with the direction (at each
+        tyre transient) and with the tyre transient (at each direction),
+        by :func:`dependence`; a best pressure within the model's spread is
+        marked "(no clear optimum)"; empty with one variant.
+    """
+    recs = {key: recommend_pressures(loads, base=base, **options) for key, base in variants.items()}
+    directions = list(dict.fromkeys(d for d, _ in variants))
+    forms = list(dict.fromkeys(f for _, f in variants))
+
+    def verdict(recs_by_label, what):
+        # A best pressure whose margin is below the model's spread is named, so a "dependence" between
+        # two such answers is not read as more than it is.
+        text = dependence({label: rec.best_pressure_kpa for label, rec in recs_by_label.items()}, what)
+        unsure = [label for label, rec in recs_by_label.items() if rec.verdict == "no clear optimum"]
+        return text + (f" (no clear optimum for {', '.join(unsure)})" if unsure else "")
+
+    verdicts = []
+    for k, rec in enumerate(recs[next(iter(recs))]):
+        if len(directions) > 1:
+            for form in forms:
+                by = {f"kicks to the {d}": recs[d, form][k] for d in directions}
+                verdicts.append(f"{rec.fz_n:g} N, {form} transient: {verdict(by, 'direction')}")
+        if len(forms) > 1:
+            for d in directions:
+                by = {f"the {form} form": recs[d, form][k] for form in forms}
+                verdicts.append(f"{rec.fz_n:g} N, kicks to the {d}: {verdict(by, 'tyre transient')}")
+    return recs, verdicts
