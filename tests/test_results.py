@@ -142,3 +142,28 @@ def test_trajectory_csv_names_carry_units_and_read_back(base, tmp_path):
     back = wk.results.read_trajectory(path)
     assert list(back.columns) == list(base.trajectory.columns)
     np.testing.assert_allclose(back.to_numpy(), base.trajectory.to_numpy(), rtol=6e-13, atol=1e-300)
+
+
+def test_save_and_load_round_trip(base, tmp_path):
+    """Result.save writes the three files; Result.load gives the summary back exactly and the trajectory to
+    trajectory.csv's 13 significant digits (relative 5e-13); a loaded result saves the same files again."""
+    assert base.save(tmp_path / "run") == ["trajectory.csv", "summary.json", "scenario.toml"]
+    loaded = wk.Result.load(tmp_path / "run")
+    assert loaded.summary == base.summary and loaded.scenario == base.scenario
+    a, b = loaded.trajectory.to_numpy(), base.trajectory.to_numpy()
+    assert np.all(np.abs(a - b) <= 5e-13 * np.abs(b))
+    loaded.save(tmp_path / "again")
+    for name in ("trajectory.csv", "summary.json", "scenario.toml"):
+        assert (tmp_path / "again" / name).read_bytes() == (tmp_path / "run" / name).read_bytes()
+
+
+def test_load_of_a_folder_that_is_not_a_run_is_one_line(tmp_path):
+    with pytest.raises(wk.InputError, match="does not exist"):
+        wk.Result.load(tmp_path / "missing")
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(wk.InputError, match=r"is not a run folder: it has no summary\.json"):
+        wk.Result.load(tmp_path / "empty")
+    (tmp_path / "empty" / "summary.json").write_text("{not json")
+    (tmp_path / "empty" / "trajectory.csv").write_text("time [s]\n0\n")
+    with pytest.raises(wk.InputError, match="is not a run summary"):
+        wk.Result.load(tmp_path / "empty")

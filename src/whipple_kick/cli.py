@@ -224,6 +224,12 @@ def _simulate_parser():
                    help="steady running shown before the kick in s (default 0.5)")
     g.add_argument("--rtol", type=_number("relative"), default=1e-10, metavar="RTOL",
                    help="LSODA relative tolerance (default 1e-10; the thesis used 1e-12)")
+    g.add_argument("--output-rate", type=_number("Hz"), default=1000.0, metavar="HZ",
+                   help="samples per second written to trajectory.csv (default 1000: about 1 MB per simulated "
+                        "second); the integration's accuracy does not depend on it")
+    g.add_argument("--scenario", metavar="FILE",
+                   help="rerun the scenario of a TOML file (every run folder has scenario.toml); flags given "
+                        "override its values")
     _output_options(g, "response.png")
     g = p.add_argument_group("animation")
     g.add_argument("--animate", action="store_true",
@@ -261,6 +267,11 @@ def _animation_options(args):
 _FIELD_FLAGS = {"fz_n": ("fz",), "rider_mass_kg": ("rider_mass",), "pressure_kpa": ("pressure",),
                 "pressure_front_kpa": ("pressure_front",), "pressure_rear_kpa": ("pressure_rear",),
                 "thesis_load_n": ("thesis_load",), "kick_profile": ("kick_profile", "kick_table")}
+
+
+#: Fields a flag's field replaces in a --scenario file or the --compat preset (their alternatives).
+_REPLACED_FIELDS = {"fz_n": ("rider_mass_kg",), "rider_mass_kg": ("fz_n",), "kick_duration": ("kick_accel",),
+                    "kick_accel": ("kick_duration",), "pressure_kpa": ("pressure_front_kpa", "pressure_rear_kpa")}
 
 
 def _flags_given(argv):
@@ -309,17 +320,23 @@ def _scenario_from_args(args, given=()):
         kick_duration=args.kick_duration, kick_accel=args.kick_accel,
         kick_profile="constant" if profile is None else profile, kick_table=args.kick_table,
         kick_direction=args.kick_direction, settle=args.settle, duration=args.duration, rtol=args.rtol,
-        plate_stop=args.plate_stop, kick_heading=args.kick_heading, start=args.start,
+        plate_stop=args.plate_stop, kick_heading=args.kick_heading, start=args.start, output_rate=args.output_rate,
     )
-    if args.compat is None:
+    if args.compat is None and args.scenario is None:
         return Scenario(**fields)
+    if args.compat is not None and args.scenario is not None:
+        raise InputError("--scenario FILE gives the whole scenario; do not combine it with --compat")
     changes = {name: value for name, value in fields.items()
                if any(flag in given for flag in _FIELD_FLAGS.get(name, (name,)))}
+    for name in [n for n in changes if n in _REPLACED_FIELDS]:
+        changes = {**dict.fromkeys(_REPLACED_FIELDS[name]), **changes}
+    if args.scenario is not None:
+        return Scenario.from_file(args.scenario).with_changes(**changes)
     return Scenario.authors_code(**changes)
 
 
 #: Every file ``simulate`` may write (``--force`` removes them before a run).
-_OUTPUT_FILES = ("trajectory.csv", "summary.json", "response.png", "animation.mp4", "animation.gif")
+_OUTPUT_FILES = ("trajectory.csv", "summary.json", "scenario.toml", "response.png", "animation.mp4", "animation.gif")
 #: Every file ``stability`` may write.
 _STABILITY_FILES = ("eigenvalues.csv", "summary.json", "stability.png")
 
@@ -444,17 +461,6 @@ def _print_summary(result, out, files):
     print(f"  wrote {', '.join(files)} in {out}")
 
 
-def _write_results(result, out):
-    """trajectory.csv and summary.json of ``result`` in ``out`` (each written atomically); returns the file names."""
-    import json
-
-    from . import fileio, results
-    fileio.write_csv(results.with_units(result.trajectory), out / "trajectory.csv",
-                     significant_digits=results.TRAJECTORY_CSV_DIGITS)
-    fileio.write_atomic(out / "summary.json", json.dumps(result.summary, indent=2, allow_nan=False) + "\n")
-    return ["trajectory.csv", "summary.json"]
-
-
 def _data_warnings(prog, quiet):
     """Print each tyre file's data warning once, as one line on stderr (none with ``quiet``; summary.json lists them).
 
@@ -476,7 +482,7 @@ def _simulate(argv):
     from . import assembly
     args = _simulate_parser().parse_args(argv)
     report_data_warnings = _data_warnings("simulate", args.quiet)
-    given = _flags_given(argv) if args.compat is not None else ()
+    given = _flags_given(argv) if args.compat is not None or args.scenario is not None else ()
     scenario = assembly.preflight(_scenario_from_args(args, given))
     movie_options = _animation_options(args)
     out, created = _prepare_out(args.out or _default_out(scenario), args.force, _OUTPUT_FILES)
@@ -488,7 +494,7 @@ def _simulate(argv):
             _discard(out, created, written)
             raise
         # What ran before the failure is kept for the user to inspect.
-        _write_results(exc.partial, out)
+        exc.partial.save(out)
         raise SimulationError(
             f"{exc}; the run up to t = {exc.partial.summary['end_time_s']:g} s is in {out}") from None
     except BaseException:
@@ -511,7 +517,7 @@ def _simulate_into(args, scenario, movie_options, out, written):
     """
     from . import simulation
     result = simulation.run(scenario)
-    files = _write_results(result, out)
+    files = result.save(out)
     written.extend(files)
     if not result.summary["linear_stability"]["stable"]:
         # A warning, not a failure: the run is valid (the bicycle may well fall).

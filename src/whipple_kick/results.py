@@ -84,6 +84,94 @@ class Result:
     trajectory: "object"
     summary: dict = field(default_factory=dict)
 
+    def save(self, folder) -> list:
+        """Write the run into ``folder`` as ``simulate`` does: trajectory.csv, summary.json, scenario.toml.
+
+        Each file is written atomically; the folder is created if needed.
+        trajectory.csv holds every column with its unit in the header
+        (:func:`with_units`), to :data:`TRAJECTORY_CSV_DIGITS` significant
+        digits; scenario.toml reruns the run (``simulate --scenario``,
+        :meth:`whipple_kick.scenario.Scenario.from_file`).
+
+        Returns
+        -------
+        list of str
+            The names of the files written.
+
+        Example
+        -------
+        >>> import whipple_kick as wk
+        >>> result = wk.run(wk.Scenario(duration=1.0))
+        >>> result.save("kick_run")
+        ['trajectory.csv', 'summary.json', 'scenario.toml']
+        """
+        import json
+        import pathlib
+
+        from . import fileio
+        out = pathlib.Path(folder)
+        out.mkdir(parents=True, exist_ok=True)
+        fileio.write_csv(with_units(self.trajectory), out / TRAJECTORY_FILE, significant_digits=TRAJECTORY_CSV_DIGITS)
+        fileio.write_atomic(out / SUMMARY_FILE, json.dumps(self.summary, indent=2, allow_nan=False) + "\n")
+        self.scenario.to_file(out / SCENARIO_FILE, note=_scenario_note(self.summary))
+        return [TRAJECTORY_FILE, SUMMARY_FILE, SCENARIO_FILE]
+
+    @classmethod
+    def load(cls, folder) -> "Result":
+        """The :class:`Result` of a run folder written by :meth:`save` (or ``simulate``).
+
+        The summary is the one written (exactly), the trajectory equals the
+        run's to trajectory.csv's precision (relative 5e-13), the scenario is
+        the summary's; figures, metrics and :meth:`save` work on it as on the
+        result :func:`whipple_kick.run` returned.
+
+        Raises
+        ------
+        InputError
+            ``folder`` is not a run folder (no summary.json or trajectory.csv) or a file in it is unreadable.
+
+        Example
+        -------
+        >>> import whipple_kick as wk
+        >>> result = wk.Result.load("kick_run")        # doctest: +SKIP
+        >>> result.summary["recovered"], result.trajectory["yaw_rate"].iloc[-1]   # doctest: +SKIP
+        (True, 0.0945...)
+        """
+        import json
+        import pathlib
+
+        from .scenario import Scenario
+        path = pathlib.Path(folder)
+        if not path.is_dir():
+            raise InputError(f"run folder {str(path)!r} {'is not a folder' if path.exists() else 'does not exist'}")
+        for name in (SUMMARY_FILE, TRAJECTORY_FILE):
+            if not (path / name).is_file():
+                raise InputError(f"{str(path)!r} is not a run folder: it has no {name} (simulate writes "
+                                 f"{TRAJECTORY_FILE} and {SUMMARY_FILE})")
+        try:
+            summary = json.loads((path / SUMMARY_FILE).read_text(encoding="utf-8"))
+            scenario = Scenario(**summary["scenario"])
+        except (ValueError, KeyError, TypeError) as exc:
+            raise InputError(f"{str(path / SUMMARY_FILE)!r} is not a run summary: {exc}") from None
+        return cls(scenario=scenario, trajectory=read_trajectory(path / TRAJECTORY_FILE), summary=summary)
+
+
+#: The files of a run folder (:meth:`Result.save`).
+TRAJECTORY_FILE = "trajectory.csv"
+SUMMARY_FILE = "summary.json"
+SCENARIO_FILE = "scenario.toml"
+
+
+def _scenario_note(summary):
+    """What scenario.toml cannot rerun of a run made with Python objects (custom tyres or gains), or None."""
+    custom = [what for what, used in (
+        ("tyre objects", str(summary.get("tyres", {}).get("name", "")).startswith("custom")),
+        ("steer-torque gains", summary.get("controller", {}).get("type") == "custom gains")) if used]
+    if not custom:
+        return None
+    return (f"this run used custom {' and '.join(custom)} given in Python (wk.run(..., tyres=, gains=)); "
+            "this file alone does not reproduce them")
+
 
 def trajectory_frame(solution, tyre_transient="contact_patch"):
     """DataFrame of states and named outputs at every sample of a :class:`~whipple_kick.integration.Solution`.
