@@ -49,9 +49,9 @@ def _row(label, result):
     rec = s["recovery"]["signals"]
     patch = (f"{math.degrees(np.max(np.abs(df['slip_patch_rear']))):.1f}" if "slip_patch_rear" in df else "-")
     times = " / ".join("fell" if v["time_s"] is None else f"{v['time_s']:.2f}" for v in rec.values())
-    return (f"| {label} | {s['peaks']['max_abs_yaw_rate']:.3f} | {s['peaks']['max_abs_roll_rate']:.3f} | "
-            f"{s['peaks']['max_abs_steer_rate']:.3f} | {math.degrees(_peak_change(df, 'roll')):.1f} | "
-            f"{s['peaks']['max_abs_fy_rear']:.0f} | {times} | {math.degrees(s['peaks']['max_abs_slip_rear']):.1f} | "
+    return (f"| {label} | {s['peaks']['max_abs_yaw_rate_absolute_rad_s']:.3f} | {s['peaks']['max_abs_roll_rate_absolute_rad_s']:.3f} | "
+            f"{s['peaks']['max_abs_steer_rate_absolute_rad_s']:.3f} | {math.degrees(_peak_change(df, 'roll')):.1f} | "
+            f"{s['peaks']['max_abs_fy_rear_absolute_n']:.0f} | {times} | {math.degrees(s['peaks']['max_abs_slip_rear_absolute_rad']):.1f} | "
             f"{patch} | {e['plate_work_j']:.2f} | {e['sliding_dissipation_j']:.2f} | "
             f"{e['carcass_energy_rear_j']:.2f} | {e['zero_slip_force_work_j']:.2f} | {e['aligning_moment_work_j']:.2f} | "
             f"{e['balance_residual_max_abs_j']:.1e} |")
@@ -83,8 +83,8 @@ def gmin():
         with _secant_floor(value):
             r = run(BASE)
         df = r.trajectory
-        print(f"| {value:g} | {r.summary['peaks']['max_abs_yaw_rate']:.6f} | "
-              f"{math.degrees(_peak_change(df, 'roll')):.4f} | {r.summary['peaks']['max_abs_fy_rear']:.2f} | "
+        print(f"| {value:g} | {r.summary['peaks']['max_abs_yaw_rate_absolute_rad_s']:.6f} | "
+              f"{math.degrees(_peak_change(df, 'roll')):.4f} | {r.summary['peaks']['max_abs_fy_rear_absolute_n']:.2f} | "
               f"{r.summary['recovery']['time_s']} | {df['relaxation_length_rear'].min():.4f} |")
 
 

@@ -273,7 +273,7 @@ def test_kick_table_runs_end_to_end(tmp_path, capsys):
     assert _simulate(["--kick-profile", "smooth", "--duration", "0.6", "--no-plot", "--quiet",
                       "--out", str(out3)], capsys)[0] == 0
     s3 = json.loads((out3 / "summary.json").read_text())
-    assert abs(s3["peaks"]["max_abs_yaw_rate"] - s["peaks"]["max_abs_yaw_rate"]) < 1e-6
+    assert abs(s3["peaks"]["max_abs_yaw_rate_absolute_rad_s"] - s["peaks"]["max_abs_yaw_rate_absolute_rad_s"]) < 1e-6
 
 
 BAD_TABLES = {

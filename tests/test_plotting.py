@@ -136,3 +136,25 @@ def test_axis_limits_stop_where_the_fork_turns_over():
     peak = np.max(np.abs(df["steer_rate"].to_numpy()[before]))
     assert max(-low, high) == pytest.approx(peak * 1.16, rel=0.1)
     assert np.max(np.abs(df["steer_rate"].to_numpy())) > 2.0 * max(-low, high)   # the spin is off the scale
+
+
+def test_recovery_time_and_bands_are_drawn(base, fall):
+    """Issue 25: the recovery time is a vertical line in every panel, labelled "recovered at 2.71 s"; each rate
+    panel has its 5 % band (steady +/- 5 % of the first peak from steady, from the summary) as two lines. A run
+    that falls has its bands but no recovery."""
+    rec = base.summary["recovery"]
+    fig = plotting.response_figure([("", base)], kick=(0.0, 0.15))
+    for ax, (column, _) in zip(fig.axes, plotting.RESPONSE_PANELS, strict=True):
+        marks = [line for line in ax.lines if line.get_gid() == "recovery"]
+        assert len(marks) == 1 and tuple(marks[0].get_xdata()) == (rec["time_s"], rec["time_s"])
+        levels = sorted(line.get_ydata()[0] for line in ax.lines if line.get_gid() == "band")
+        if column in rec["signals"]:
+            entry = rec["signals"][column]
+            assert entry["band_rad_s"] == pytest.approx(0.05 * entry["first_peak_from_steady_rad_s"], rel=1e-15)
+            assert levels == [entry["steady_rad_s"] - entry["band_rad_s"], entry["steady_rad_s"] + entry["band_rad_s"]]
+        else:
+            assert levels == []
+    assert f"recovered at {rec['time_s']:.2f} s" in _texts(fig)
+    fig = plotting.response_figure([("", fall)], kick=(0.0, 0.15))
+    assert not [line for ax in fig.axes for line in ax.lines if line.get_gid() == "recovery"]
+    assert len([line for line in fig.axes[0].lines if line.get_gid() == "band"]) == 2

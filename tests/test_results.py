@@ -1,6 +1,7 @@
 """Results of a run: the trajectory table and its units, the summary, the recovery and the energy balance."""
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -72,7 +73,7 @@ def test_recovery_is_reported_for_yaw_roll_and_steer_rates(base):
     df = base.trajectory
     after = df["time"].to_numpy() >= 0.0
     for name, entry in signals.items():
-        t_rec, peak = entry["time_s"], entry["first_peak_rad_s"]
+        t_rec, peak = entry["time_s"], entry["first_peak_from_steady_rad_s"]
         assert 0.0 < t_rec < 6.0 and peak > 0.0 and entry["reason"] is None
         steady = df[name].iloc[0]
         dev = np.abs(df[name].to_numpy() - steady)
@@ -167,3 +168,43 @@ def test_load_of_a_folder_that_is_not_a_run_is_one_line(tmp_path):
     (tmp_path / "empty" / "trajectory.csv").write_text("time [s]\n0\n")
     with pytest.raises(wk.InputError, match="is not a run summary"):
         wk.Result.load(tmp_path / "empty")
+
+
+#: Unit suffixes of summary keys (results.unit_suffix of the units used): s, rad, rad/s, m, N, N m, J, W, kg, kPa,
+#: m/s, m/s^2, 1/s.
+_UNIT_SUFFIX = re.compile(r"_(s|rad|rad_s|m|n|n_m|j|w|kg|kpa|m_s|m_s2|1_s)$")
+#: Numbers without a unit: counts, ratios and tolerances; the gains' units are in controller.gain_units, the steady
+#: powers' unit in the name of their section (steady_power_w).
+_DIMENSIONLESS = re.compile(r"^(controller\.gain_scale|controller\.gains\..*|steady_state\.steady_power_w\..*|"
+                            r"steady_state\.residual|metrics\.n_peaks|metrics\.(log_decrement|damping_ratio)_\d_\d|"
+                            r"numerics\.(rtol|nfev|njev|evaluations|budget\..*))$")
+
+
+def _numeric_keys(node, prefix=""):
+    for key, value in node.items():
+        if isinstance(value, dict):
+            yield from _numeric_keys(value, f"{prefix}{key}.")
+        elif (isinstance(value, (int, float)) and not isinstance(value, bool)) or (
+                isinstance(value, list) and value and isinstance(value[0], (int, float, list))):
+            yield f"{prefix}{key}"
+
+
+def test_every_number_in_the_summary_has_a_unit_in_its_key(base):
+    """Issue 25: a unit suffix on every key holding a number (dimensionless ones listed above), and the peaks
+    named 'absolute' or 'from steady'."""
+    keys = list(_numeric_keys({k: v for k, v in base.summary.items() if k not in ("scenario", "units")}))
+    assert len(keys) > 80
+    assert [k for k in keys if not (_UNIT_SUFFIX.search(k) or _DIMENSIONLESS.match(k))] == []
+    peaks = [k for k in keys if k.startswith(("peaks.", "metrics.", "recovery.")) and "peak" in k
+             and "time" not in k and not k.startswith("metrics.n_")]   # the response's (not the plate's) peaks
+    assert peaks and all("absolute" in k or "from_steady" in k for k in peaks), peaks
+
+
+def test_recovered_says_whether_all_three_rates_settled(base):
+    s = base.summary
+    assert s["recovered"] is True and s["outcome"] == "completed" and s["recovery"]["time_s"] is not None
+    short = run(Scenario(duration=1.0))          # too short to settle (the default run recovers at 2.7 s)
+    assert short.summary["outcome"] == "completed" and short.summary["recovered"] is False
+    assert short.summary["recovery"]["time_s"] is None
+    fell = run(Scenario(controller="off", duration=3.0))
+    assert fell.summary["fell"] and fell.summary["recovered"] is False

@@ -23,7 +23,7 @@ def test_folder_holds_manifest_table_and_trajectories(default_run):
     assert manifest["cases"][0]["overrides"] == {"pressure_kpa": 300.0}
     on_disk = pd.read_csv(folder / wk.sweep_store.TABLE_FILE)
     assert list(on_disk["case_id"]) == list(table["case_id"])
-    np.testing.assert_allclose(on_disk["last_peak_time"], table["last_peak_time"], rtol=1e-11)
+    np.testing.assert_allclose(on_disk["last_peak_time_s"], table["last_peak_time_s"], rtol=1e-11)
     traj, summary = wk.sweep_store.load_trajectory(folder, table["case_id"].iloc[0])
     assert list(traj.columns) == list(wk.sweep_engine.DEFAULT_TRAJECTORY_COLUMNS)
     assert traj["yaw_rate"].dtype == np.float32

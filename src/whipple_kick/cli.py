@@ -437,8 +437,9 @@ def _print_summary(result, out, files):
     else:
         print(f"  result: no fall in {sc['duration']:g} s")
     m, rec = s["metrics"], s["recovery"]
-    if m["peak_values"]:
-        print(f"  yaw rate: first peak {m['peak_values'][0]:+.3f} rad/s (from steady) at {m['peak_times'][0]:.3f} s")
+    if m["yaw_rate_peaks_from_steady_rad_s"]:
+        print(f"  yaw rate: first peak from steady {m['yaw_rate_peaks_from_steady_rad_s'][0]:+.3f} rad/s "
+              f"at {m['yaw_rate_peak_times_s'][0]:.3f} s")
     if not s["fell"]:
         settled = ", ".join(f"{name.replace('_', ' ')} {sig['time_s']:.2f} s" if sig["time_s"] is not None
                             else f"{name.replace('_', ' ')} not within the run"
@@ -447,8 +448,10 @@ def _print_summary(result, out, files):
         print("  recovery time: " + (f"{rec['time_s']:.3f} s after the kick (all three settled)"
                                      if rec["time_s"] is not None else "none within the run"))
     pk = s["peaks"]
-    print(f"  peaks: |roll rate| {pk['max_abs_roll_rate']:.3f} rad/s, |steer rate| {pk['max_abs_steer_rate']:.3f} rad/s, "
-          f"|Fy rear| {pk['max_abs_fy_rear']:.0f} N, |slip rear| {pk['max_abs_slip_rear'] * deg:.1f} deg")
+    print(f"  largest absolute values after the kick: |yaw rate| {pk['max_abs_yaw_rate_absolute_rad_s']:.3f} rad/s, "
+          f"|roll rate| {pk['max_abs_roll_rate_absolute_rad_s']:.3f} rad/s, "
+          f"|steer rate| {pk['max_abs_steer_rate_absolute_rad_s']:.3f} rad/s, |Fy rear| {pk['max_abs_fy_rear_absolute_n']:.0f} N, "
+          f"|slip rear| {pk['max_abs_slip_rear_absolute_rad'] * deg:.1f} deg")
     e = s["energy"]
     jumps = "".join(f", plate stop ({e['plate_stop']}) {j['kinetic_energy_change_j']:+.3f} J kinetic"
                     for j in e["velocity_jumps"])

@@ -116,6 +116,20 @@ def _outcome(run):
     return fell, summary.get("fall_time_s") if fell else None, baseline, fall_angle, steer_limit
 
 
+def recovery_marks(run):
+    """(recovery time [s] or None, {column: (steady value, half band)}) of a Result; a DataFrame has none.
+
+    The bands are each rate's steady value +/- 5 % of its first peak from
+    steady (``summary["recovery"]["signals"]``): recovered from the time all
+    three rates stay inside theirs.
+    """
+    summary = getattr(run, "summary", None) or {}
+    recovery = summary.get("recovery", {})
+    bands = {name: (entry["steady_rad_s"], entry["band_rad_s"]) for name, entry in recovery.get("signals", {}).items()
+             if entry.get("band_rad_s") is not None}
+    return (recovery.get("time_s") if summary.get("recovered") else None), bands
+
+
 def response_figure(runs, path=None, title=None, kick=None, time_range=None, dpi=150):
     """Plot the response panels for one or more runs.
 
@@ -123,8 +137,8 @@ def response_figure(runs, path=None, title=None, kick=None, time_range=None, dpi
     ----------
     runs : sequence of (label, Result or DataFrame)
         Runs to overlay; DataFrames need the columns of :data:`RESPONSE_PANELS`,
-        ``time`` [s] and ``roll`` [rad]. A Result's fall and steady turn are
-        marked.
+        ``time`` [s] and ``roll`` [rad]. A Result's fall, steady turn, recovery
+        time and 5 % bands (:func:`recovery_marks`) are marked.
     path : str or pathlib.Path, optional
         Write a PNG there.
     title : str, optional
@@ -158,9 +172,11 @@ def response_figure(runs, path=None, title=None, kick=None, time_range=None, dpi
     axes = fig.subplots(len(RESPONSE_PANELS), 1, sharex=True)
     limits = {column: [] for column, _ in RESPONSE_PANELS}
     baselines = []
+    marked = False
     for k, (label, run) in enumerate(runs):
         df = _frame_of(run)
         fell, fall_time, baseline, fall_angle, steer_limit = _outcome(run)
+        recovered_at, bands = recovery_marks(run)
         color = f"C{k}"
         text = f"{label} (fell at {fall_time:.3f} s)" if fell and label else label
         t = df["time"].to_numpy()
@@ -170,6 +186,17 @@ def response_figure(runs, path=None, title=None, kick=None, time_range=None, dpi
                                                 df["steer"] if "steer" in df else None, steer_limit))
             if fell:
                 ax.axvline(fall_time, color=color, lw=1.0, ls="--", gid="fall")
+            if column in bands:
+                steady, band = bands[column]
+                for level in (steady - band, steady + band):
+                    ax.axhline(level, color=color, lw=0.6, ls=(0, (4, 3)), alpha=0.7, gid="band")
+            if recovered_at is not None:
+                ax.axvline(recovered_at, color=color, lw=1.0, ls="-.", gid="recovery")
+        if recovered_at is not None:
+            axes[0].text(recovered_at, 0.97 - 0.09 * k, f"recovered at {recovered_at:.2f} s", color=color, fontsize=8,
+                         ha="left", va="top", gid="recovery", transform=mtransforms.blended_transform_factory(
+                             axes[0].transData, axes[0].transAxes))
+        marked |= bool(bands)
         if fell:
             # Stacked below the top panel's upper edge when several runs fall.
             axes[0].text(fall_time, 0.97 - 0.09 * k, f"fell at {fall_time:.3f} s", color=color, fontsize=8,
@@ -198,6 +225,10 @@ def response_figure(runs, path=None, title=None, kick=None, time_range=None, dpi
         what = "steady motion (the run starts upright)" if upright else "steady turn before the kick"
         axes[0].text(0.01, 0.03, f"dotted: {what}, {value} (the yaw-rate baseline)",
                      fontsize=7.5, color="0.25", transform=axes[0].transAxes, ha="left", va="bottom", gid="baseline")
+    if marked:
+        axes[1].text(0.01, 0.03, "dashed: steady value +/- 5 % of the first peak; dash-dot: recovered (all three "
+                     "rates inside their bands from then on)", fontsize=7.5, color="0.25", transform=axes[1].transAxes,
+                     ha="left", va="bottom", gid="band")
     axes[-1].set_xlabel("time from kick start [s]")
     if time_range is not None:
         axes[-1].set_xlim(*time_range)

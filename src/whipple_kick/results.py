@@ -61,7 +61,7 @@ UNITS = {"time": "s", **dict(COORDINATE_COLUMNS.values()), **dict(SPEED_COLUMNS.
          **dict.fromkeys(PATCH_STATE_COLUMNS.values(), "rad"),
          **{c: slip.OUTPUTS[o][0] for o, c in {**APPLIED_COLUMNS, **OUTPUT_COLUMNS}.items()},
          **dict(energy.COLUMNS.values()), BALANCE_COLUMN: "J"}
-#: Columns whose peaks after the kick the summary lists (``max_abs_<column>``).
+#: Columns whose largest absolute values after the kick the summary lists (``max_abs_<column>_absolute_<unit>``).
 PEAK_COLUMNS = ("yaw_rate", "roll_rate", "steer_rate", "roll", "steer", "slip_rear", "fy_rear", "fy_front",
                 "steer_torque")
 
@@ -249,9 +249,7 @@ def response_metrics(df, baseline, x0, scenario, traj):
     try:
         metrics = analysis.kick_metrics(df, t_kick=0.0, baseline=baseline, include_spectra=False,
                                         fall_roll=fall_roll)
-        rec = analysis.recovery(df, 0.0, {name: float(x0[slip.X[state]]) for name, state in
-                                          (("yaw_rate", "u3"), ("roll_rate", "u4"), ("steer_rate", "u7"))},
-                                ended=ended)
+        rec = analysis.recovery(df, 0.0, rate_baselines(x0), ended=ended)
     except InputError as exc:   # a failure so early that too little of the response exists
         metrics = {"unavailable": {"all": f"no response to analyse: {exc}"}}
         rec = {"time_s": None, "reason": ended or str(exc), "signals": {}}
@@ -265,6 +263,67 @@ def response_metrics(df, baseline, x0, scenario, traj):
         # The last peak above 8 % before a fall or a failure is not the end of the response.
         metrics["last_peak_time"], unavailable["last_peak_time"] = None, ended
     return metrics, rec
+
+
+#: The recovery's signals and the states they are: column -> state.
+RECOVERY_STATES = {"yaw_rate": "u3", "roll_rate": "u4", "steer_rate": "u7"}
+
+
+def rate_baselines(x0):
+    """Steady value [rad/s] of each recovery signal (:data:`RECOVERY_STATES`) in the state ``x0``."""
+    return {name: float(x0[slip.X[state]]) for name, state in RECOVERY_STATES.items()}
+
+
+def unit_suffix(unit):
+    """A unit as a key suffix, as every summary key ends: ``"rad/s"`` -> ``"rad_s"``, ``"N m"`` -> ``"n_m"``.
+
+    Example
+    -------
+    >>> unit_suffix("rad/s"), unit_suffix("N m"), unit_suffix("m/s^2")
+    ('rad_s', 'n_m', 'm_s2')
+    """
+    return unit.lower().replace("/", "_").replace(" ", "_").replace("^", "")
+
+
+#: Summary keys of the :func:`whipple_kick.analysis.kick_metrics` entries renamed to carry their unit and
+#: reference (CHANGELOG.md lists old -> new); the ``period_*`` entries get ``_s``, dimensionless ones
+#: (``n_peaks``, ``log_decrement_*``, ``damping_ratio_*``) keep their names.
+METRIC_KEYS = {"peak_times": "yaw_rate_peak_times_s", "peak_values": "yaw_rate_peaks_from_steady_rad_s",
+               "last_peak_time": "last_peak_time_s"}
+#: kick_metrics entries the summary holds once elsewhere: ``fell``, ``fall_time_s`` at the top, the largest
+#: absolute values in ``peaks``.
+DUPLICATE_METRICS = ("fell", "fall_time", *(f"max_abs_{name}" for name in PEAK_COLUMNS))
+
+
+def metric_key(name):
+    """The summary key of a :func:`whipple_kick.analysis.kick_metrics` entry (:data:`METRIC_KEYS`).
+
+    Example
+    -------
+    >>> metric_key("last_peak_time"), metric_key("period_1_3"), metric_key("damping_ratio_1_3")
+    ('last_peak_time_s', 'period_1_3_s', 'damping_ratio_1_3')
+    """
+    return METRIC_KEYS.get(name, f"{name}_s" if name.startswith("period") else name)
+
+
+def _summary_metrics(metrics):
+    """(metrics, unavailable) of the summary: keys renamed by :func:`metric_key`, duplicates left out."""
+    values = {metric_key(k): v for k, v in metrics.items() if k != "unavailable" and k not in DUPLICATE_METRICS}
+    missing = {metric_key(k): v for k, v in metrics["unavailable"].items() if k not in DUPLICATE_METRICS}
+    return values, missing
+
+
+def _recovery_section(recovery, baselines):
+    """The recovery with each signal's first peak named "from steady", its steady value and its 5 % band."""
+    from . import analysis
+
+    signals = {}
+    for name, entry in recovery["signals"].items():
+        peak = entry["first_peak_rad_s"]
+        signals[name] = {"first_peak_from_steady_rad_s": peak, "steady_rad_s": baselines[name],
+                         "band_rad_s": None if peak is None else analysis.SETTLING_FRACTION * abs(peak),
+                         "time_s": entry["time_s"], "reason": entry["reason"]}
+    return {**recovery, "signals": signals}
 
 
 def clean(value):
@@ -350,8 +409,12 @@ def summarise(scenario, kick, assembly, solution, frame, *, custom_tyres=False) 
     traj = solution.trajectory
     baseline = float(assembly.reference.x[slip.X["u3"]])
     metrics, recovery = response_metrics(frame, baseline, assembly.reference.x, scenario, traj)
+    recovery = _recovery_section(recovery, rate_baselines(assembly.reference.x))
+    metrics, unavailable = _summary_metrics(metrics)
     summary = {
         "outcome": "failed" if traj.failed else "fell" if traj.fell else "completed",
+        # Recovered: yaw, roll and steer rates all settled within 5 % of their first peaks (recovery.time_s).
+        "recovered": not (traj.failed or traj.fell) and recovery["time_s"] is not None,
         "fell": bool(traj.fell),
         "fall_time_s": traj.fall_time,
         "fall_reason": traj.fall_reason,
@@ -366,8 +429,8 @@ def summarise(scenario, kick, assembly, solution, frame, *, custom_tyres=False) 
         "peaks": _peaks(frame),
         "energy": _energy_summary(frame, solution.jumps, scenario),
         "recovery": recovery,
-        "metrics": {k: v for k, v in metrics.items() if k != "unavailable"},
-        "metrics_unavailable": metrics["unavailable"],
+        "metrics": metrics,
+        "metrics_unavailable": unavailable,
         "numerics": _numerics_section(scenario, solution, frame),
         "scenario": scenario.to_dict(),
         "units": {column: UNITS[column] for column in frame.columns},
@@ -405,9 +468,9 @@ def _controller_section(scenario, assembly):
         "gains": gains,
         "gain_units": {name: symbols.info(name).unit for name in gains},
         "law": assembly_module.control_law(gains),
-        # At the run's speed, for the gains used (the LQR design's own poles are at its design speed).
-        "linear_closed_loop_poles": assembly.stability["poles_no_slip_model_1_s"],
-        "design_poles": None if poles is None else [[p.real, p.imag] for p in poles],
+        # The LQR design's own poles, at its design speed (at the run's speed, for the gains used:
+        # linear_stability.poles_no_slip_model_1_s).
+        "design_poles_1_s": None if poles is None else [[p.real, p.imag] for p in poles],
     }
 
 
@@ -437,8 +500,8 @@ def _steady_section(scenario, assembly, baseline):
 
 def _peaks(frame):
     after = frame["time"].to_numpy() >= 0.0
-    return {f"max_abs_{name}": float(np.max(np.abs(frame[name].to_numpy()[after]), initial=0.0))
-            for name in PEAK_COLUMNS}
+    return {f"max_abs_{name}_absolute_{unit_suffix(UNITS[name])}":
+            float(np.max(np.abs(frame[name].to_numpy()[after]), initial=0.0)) for name in PEAK_COLUMNS}
 
 
 def _numerics_section(scenario, solution, frame):
