@@ -17,7 +17,7 @@ def test_folder_holds_manifest_table_and_trajectories(default_run):
     assert manifest["status"] == "complete"
     assert (manifest["n_ok"], manifest["n_failed"]) == (3, 1)
     assert manifest["model_hash"] == wk.slip.model_hash()
-    assert manifest["versions"]["numpy"] == np.__version__
+    assert manifest["provenance"]["versions"]["numpy"] == np.__version__
     assert manifest["base_scenario"]["duration"] == 3.0
     assert [c["case_id"] for c in manifest["cases"]] == list(table["case_id"])
     assert manifest["cases"][0]["overrides"] == {"pressure_kpa": 300.0}

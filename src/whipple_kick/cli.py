@@ -43,7 +43,7 @@ def _run(main, argv, prog="whipple_kick", kept="no results were kept"):
 
 
 def _benchmark(argv):
-    parser = argparse.ArgumentParser(
+    parser = _OneLineParser(
         prog="whipple-benchmark",
         description="Linearise the classic Carvallo-Whipple model of the Meijaard et al. (2007) "
                     "benchmark bicycle and print its eigenvalues [1/s] against forward speed [m/s].")
@@ -83,7 +83,13 @@ def _output_options(group, figure):
 
 
 class _OneLineParser(argparse.ArgumentParser):
-    """Argument parser whose usage errors are one line on stderr (exit status 2)."""
+    """Argument parser whose usage errors are one line on stderr (exit status 2), with ``--version``."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        from . import __version__
+        self.add_argument("--version", action="version", version=f"%(prog)s (whipple_kick {__version__})",
+                          help="print the package version and exit")
 
     def error(self, message):
         print(f"{self.prog}: error: {message} (see {self.prog} --help)", file=sys.stderr)

@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from . import energy, lsoda, slip
+from . import energy, lsoda, provenance, slip
 from .errors import InputError, SimulationError
 
 #: Significant digits of trajectory.csv's floats: a relative round-off of at most 5e-13, far below the
@@ -434,6 +434,7 @@ def summarise(scenario, kick, assembly, solution, frame, *, custom_tyres=False) 
         "numerics": _numerics_section(scenario, solution, frame),
         "scenario": scenario.to_dict(),
         "units": {column: UNITS[column] for column in frame.columns},
+        "provenance": provenance.record(provenance.input_files(scenario, custom_tyres)),
     }
     return clean(summary)
 

@@ -39,7 +39,7 @@ from .sweep_store import Folder, canonical, case_id, slim, table, trajectory_pat
 
 # Summary sections that are not results of the run (the inputs are already
 # columns; the units are documented in whipple_kick.results.UNITS).
-_SKIPPED_SECTIONS = ("scenario", "units")
+_SKIPPED_SECTIONS = ("scenario", "units", "provenance")   # provenance: once, in the manifest
 #: Trajectory columns saved per case by default: what the thesis' figures and
 #: metrics use plus the plate motion and the rear tyre's load, so a case can
 #: be re-analysed or plotted without re-running it.
