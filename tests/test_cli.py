@@ -487,3 +487,32 @@ def test_output_rate_sets_the_rows_of_trajectory_csv(tmp_path, capsys):
     assert json.loads((out / "summary.json").read_text())["scenario"]["output_rate"] == 100.0
     status, _, err = _simulate(["--output-rate", "0.5", "--out", str(tmp_path / "slow")], capsys)
     assert status == 2 and "output rate = 0.5 Hz" in err and "[1, 100000] Hz" in err
+
+
+def test_compare_writes_the_figure_and_the_table(tmp_path, capsys):
+    """Issue 25: ``compare RUN_DIR... --out`` on three run folders (one falls) writes compare.png and compare.csv
+    (one row per quantity, one column per run, named by the folders) and prints the table."""
+    from whipple_kick.cli import compare_main
+
+    folders = []
+    for name, argv in (("p400", []), ("p300", ["--pressure", "300"]), ("off", ["--controller", "off"])):
+        folders.append(str(tmp_path / name))
+        assert _simulate([*argv, "--duration", "3", "--no-plot", "--quiet", "--out", folders[-1]], capsys)[0] == 0
+    out = tmp_path / "cmp"
+    with pytest.raises(SystemExit) as info:
+        compare_main([*folders, "--out", str(out)])
+    stdout, err = capsys.readouterr()
+    assert info.value.code == 0, err
+    assert sorted(p.name for p in out.iterdir()) == ["compare.csv", "compare.png"]
+    assert (out / "compare.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    import pandas as pd
+    table = pd.read_csv(out / "compare.csv", index_col="quantity")
+    assert list(table.columns) == ["p400", "p300", "off"]
+    assert table.loc["outcome"].tolist() == ["completed", "completed", "fell"]
+    assert table.loc["tyres.pressure_rear_kpa"].astype(float).tolist() == [400.0, 300.0, 400.0]
+    assert "fell" in stdout and "compare.png" in stdout
+    with pytest.raises(SystemExit) as info:
+        compare_main([folders[0], str(tmp_path), "--out", str(tmp_path / "cmp2")])
+    stdout, err = capsys.readouterr()
+    assert info.value.code == 2 and err.count("\n") == 1 and "is not a run folder" in err
+    assert not (tmp_path / "cmp2").exists()

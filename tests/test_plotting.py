@@ -4,6 +4,7 @@ import math
 import numpy as np
 import pytest
 
+import whipple_kick as wk
 from whipple_kick import plotting, simulation
 
 
@@ -158,3 +159,43 @@ def test_recovery_time_and_bands_are_drawn(base, fall):
     fig = plotting.response_figure([("", fall)], kick=(0.0, 0.15))
     assert not [line for ax in fig.axes for line in ax.lines if line.get_gid() == "recovery"]
     assert len([line for line in fig.axes[0].lines if line.get_gid() == "band"]) == 2
+
+
+@pytest.fixture(scope="module")
+def three(base):
+    """Three runs to compare: the default run, 300 kPa (both recover), and no control (falls)."""
+    return [base, simulation.run(simulation.Scenario(pressure_kpa=300.0, fz_n=635.0)),
+            simulation.run(simulation.Scenario(controller="off", fz_n=635.0, duration=3.0))]
+
+
+def test_compare_marks_each_runs_fall_recovery_and_bands(three):
+    """Issue 25 acceptance: one figure overlaying the runs; per run its fall or recovery time as a vertical line in
+    every panel, its 5 % bands in each rate panel (the falling run has no steer-rate band: its steer rate has no
+    first peak before the fall), the legend naming the runs by what differs and how each ended."""
+    fig = plotting.compare(three)
+    legend = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    recovered = [r.summary["recovery"]["time_s"] for r in three[:2]]
+    fall_time = three[2].summary["fall_time_s"]
+    assert legend == [f"pressure_kpa=400, controller=lqr, duration=6 (recovered at {recovered[0]:.2f} s)",
+                      f"pressure_kpa=300, controller=lqr, duration=6 (recovered at {recovered[1]:.2f} s)",
+                      f"pressure_kpa=400, controller=off, duration=3 (fell at {fall_time:.3f} s)"]
+    for ax in fig.axes:
+        assert sorted(line.get_xdata()[0] for line in ax.lines if line.get_gid() == "recovery") == sorted(recovered)
+        assert [line.get_xdata()[0] for line in ax.lines if line.get_gid() == "fall"] == [fall_time]
+    bands = [len([line for line in ax.lines if line.get_gid() == "band"]) for ax in fig.axes]
+    assert bands == [6, 6, 4, 0]
+    assert [p.get_gid() for p in fig.axes[0].patches] == [None]   # one shared kick band (the same kick)
+
+
+def test_compare_table_puts_the_runs_side_by_side(three):
+    table = wk.results.compare_table(three, labels=["400 kPa", "300 kPa", "off"])
+    assert list(table.columns) == ["400 kPa", "300 kPa", "off"]
+    assert table.loc["outcome"].tolist() == ["completed", "completed", "fell"]
+    assert table.loc["recovered"].tolist() == [True, True, False]
+    assert table.loc["recovery.time_s"].tolist() == [r.summary["recovery"]["time_s"] for r in three[:2]] + [None]
+    assert table.loc["fall_time_s"].tolist() == [None, None, three[2].summary["fall_time_s"]]
+    assert table.loc["tyres.pressure_rear_kpa"].tolist() == [400.0, 300.0, 400.0]
+    assert table.loc["peaks.max_abs_yaw_rate_absolute_rad_s", "400 kPa"] == \
+        three[0].summary["peaks"]["max_abs_yaw_rate_absolute_rad_s"]
+    with pytest.raises(wk.InputError, match="2 labels for 3 runs"):
+        wk.results.compare_table(three, labels=["a", "b"])

@@ -359,13 +359,18 @@ def _discard(out, created, written):
 
 def _default_out(scenario, prefix="kick"):
     """A new folder name under the current directory (never an existing one)."""
-    import datetime
-    import pathlib
     rear, front = scenario.pressures
     p = f"{rear:g}kPa" if rear == front else f"{rear:g}-{front:g}kPa"
     load = f"_{scenario.fz_n:g}N" if scenario.fz_n is not None else ""
+    return _new_folder(f"{prefix}_{scenario.tyre}_{p}{load}")
+
+
+def _new_folder(name):
+    """``<name>_<date-time>`` under the current directory, numbered if it exists (never an existing folder)."""
+    import datetime
+    import pathlib
     stamp = datetime.datetime.now().strftime("%Y%m%d-%H%M%S")
-    base = pathlib.Path.cwd() / f"{prefix}_{scenario.tyre}_{p}{load}_{stamp}"
+    base = pathlib.Path.cwd() / f"{name}_{stamp}"
     out, k = base, 1
     while out.exists():
         k += 1
@@ -533,9 +538,8 @@ def _simulate_into(args, scenario, movie_options, out, written):
         print(f"simulate: warning: {result.summary['linear_stability']['message']}", file=sys.stderr)
     if not args.no_plot:
         from . import plotting
-        k = result.summary["kick"]
         plotting.response_figure([("", result)], out / "response.png", title=plotting.result_title(result),
-                                 kick=(k["start_s"], k["start_s"] + k["duration_s"]))
+                                 kick=plotting.kick_band(result))
         files.append("response.png")
         written.append("response.png")
     note = None
@@ -630,6 +634,53 @@ def recommend_main(argv=None):
               "run again on it to resume", file=sys.stderr)
         status = EXIT_TERMINATED
     sys.exit(status)
+
+
+# ------------------------------------------------------------------ compare
+
+#: Every file ``compare`` writes.
+_COMPARE_FILES = ("compare.png", "compare.csv")
+
+
+def _compare(argv):
+    import pathlib
+
+    p = _OneLineParser(
+        prog="compare", allow_abbrev=False,
+        description="Overlay kick-plate runs (folders written by simulate or Result.save) in one figure, each "
+                    "run's kick, fall, recovery time and 5 %% bands marked (compare.png), and tabulate their "
+                    "results side by side (compare.csv, printed).",
+        epilog="From Python: wk.plotting.compare(results), wk.results.compare_table(results). See docs/workflow.md.")
+    p.add_argument("runs", nargs="+", metavar="RUN_DIR", help="run folders (each with summary.json and trajectory.csv)")
+    p.add_argument("--labels", nargs="+", metavar="LABEL", help="one legend entry per run (default: the folder names)")
+    _output_options(p.add_argument_group("output"), "compare.png")
+    args = p.parse_args(argv)
+    from . import fileio, plotting, results
+    runs = [results.Result.load(folder) for folder in args.runs]
+    labels = args.labels or [pathlib.Path(folder).resolve().name for folder in args.runs]
+    if args.labels is None and len(set(labels)) < len(labels):
+        labels = results.run_labels(runs)
+    table = results.compare_table(runs, labels)
+    out, created = _prepare_out(args.out or _new_folder("compare"), args.force, _COMPARE_FILES)
+    try:
+        fileio.write_csv(table.reset_index(), out / "compare.csv")
+        if not args.no_plot:
+            plotting.compare(runs, out / "compare.png", labels=labels,
+                             title=f"{len(runs)} runs compared: " + "; ".join(labels))
+    except BaseException:
+        _discard(out, created, _COMPARE_FILES)
+        raise
+    if not args.quiet:
+        import pandas as pd
+        with pd.option_context("display.max_colwidth", 40, "display.width", 200):
+            print(table.to_string(na_rep="-"))
+        print(f"  wrote {', '.join(n for n in _COMPARE_FILES if (out / n).exists())} in {out}")
+    return 0
+
+
+def compare_main(argv=None):
+    """Console script ``compare``: runs overlaid in one figure and their results side by side (``compare --help``)."""
+    sys.exit(_run(_compare, argv, "compare"))
 
 
 # ------------------------------------------------------------------ stability

@@ -178,7 +178,8 @@ def response_figure(runs, path=None, title=None, kick=None, time_range=None, dpi
         fell, fall_time, baseline, fall_angle, steer_limit = _outcome(run)
         recovered_at, bands = recovery_marks(run)
         color = f"C{k}"
-        text = f"{label} (fell at {fall_time:.3f} s)" if fell and label else label
+        text = (f"{label} (fell at {fall_time:.3f} s)" if fell and label else
+                f"{label} (recovered at {recovered_at:.2f} s)" if recovered_at is not None and label else label)
         t = df["time"].to_numpy()
         for ax, (column, _) in zip(axes, RESPONSE_PANELS, strict=True):
             ax.plot(t, df[column], lw=1.2, label=text, color=color)
@@ -239,10 +240,75 @@ def response_figure(runs, path=None, title=None, kick=None, time_range=None, dpi
         fig.suptitle("\n".join(lines), fontsize=10)
     top = RESPONSE_TOP - (RESPONSE_TITLE_LINE * (len(lines) + 1) if lines else 0.0)
     fig.subplots_adjust(top=top, **RESPONSE_MARGINS)
+    return _written(fig, path, dpi)
+
+
+def _written(fig, path, dpi):
+    """``fig``, or None once it is written to ``path`` as PNG (when a path is given)."""
     if path is None:
         return fig
     fig.savefig(path, dpi=dpi, pil_kwargs={"compress_level": PNG_COMPRESS_LEVEL})
     return None
+
+
+def kick_band(result):
+    """(start, end) [s] of a Result's kick, from its summary."""
+    k = result.summary["kick"]
+    return k["start_s"], k["start_s"] + k["duration_s"]
+
+
+def compare(results, path=None, labels=None, title=None, time_range=None, dpi=150):
+    """One figure overlaying runs, each with its kick, fall, recovery time and 5 % bands marked.
+
+    The response panels of :func:`response_figure`, one colour per run; the
+    legend names each run and its fall or recovery time. Runs with different
+    kicks get a band each, in their colour. The table of their metrics side
+    by side is :func:`whipple_kick.results.compare_table`.
+
+    Parameters
+    ----------
+    results : sequence of Result
+        Runs (from :func:`whipple_kick.run` or :meth:`whipple_kick.Result.load`).
+    path : str or pathlib.Path, optional
+        Write a PNG there.
+    labels : sequence of str, optional
+        Legend entries (default :func:`whipple_kick.results.run_labels`: the
+        scenario fields in which the runs differ).
+    title, time_range, dpi
+        As :func:`response_figure`.
+
+    Returns
+    -------
+    matplotlib.figure.Figure or None
+        The figure, or None when it was written to ``path``.
+
+    Example
+    -------
+    >>> import whipple_kick as wk
+    >>> runs = [wk.run(wk.Scenario(pressure_kpa=p, duration=4.0)) for p in (300.0, 500.0)]
+    >>> runs.append(wk.run(wk.Scenario(controller="off", duration=3.0)))
+    >>> fig = wk.plotting.compare(runs)
+    >>> [t.get_text() for t in fig.axes[0].get_legend().get_texts()][2]
+    'pressure_kpa=400, controller=off, duration=3 (fell at 1.585 s)'
+    """
+    from .errors import InputError
+    from .results import run_labels
+
+    results = list(results)
+    if not results:
+        raise InputError("nothing to compare: give at least one run")
+    labels = run_labels(results) if labels is None else list(labels)
+    if len(labels) != len(results):
+        raise InputError(f"{len(labels)} labels for {len(results)} runs; give one label per run")
+    kicks = [kick_band(r) for r in results]
+    same = len(set(kicks)) == 1
+    fig = response_figure(list(zip(labels, results, strict=True)), title=title, time_range=time_range,
+                          kick=kicks[0] if same else None)
+    if not same:
+        for k, (start, end) in enumerate(kicks):
+            for ax in fig.axes:
+                ax.axvspan(start, end, color=f"C{k}", alpha=0.15, zorder=0, gid="kick")
+    return _written(fig, path, dpi)
 
 
 def controller_text(summary):

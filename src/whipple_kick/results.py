@@ -519,3 +519,75 @@ def _numerics_section(scenario, solution, frame):
         "max_abs_holonomic_m": float(np.max(np.abs(frame["holonomic_residual"]))),
         "model_hash": slip.model_hash(),
     }
+
+
+# ------------------------------------------------------------------ comparing runs
+
+#: Rows of :func:`compare_table`: the results by their sweep-table names
+#: (:func:`whipple_kick.sweep_engine.flatten_summary`), then the set-up.
+COMPARE_ROWS = (
+    "outcome", "recovered", "fall_time_s", "fall_reason", "recovery.time_s", "recovery.last_to_settle",
+    *(f"recovery.signals.{name}.time_s" for name in RECOVERY_STATES),
+    *(f"recovery.signals.{name}.first_peak_from_steady_rad_s" for name in RECOVERY_STATES),
+    "last_peak_time_s", "damping_ratio_1_3", "period_s",
+    *(f"peaks.max_abs_{name}_absolute_{unit_suffix(UNITS[name])}" for name in PEAK_COLUMNS),
+    "tyres.name", "tyres.pressure_rear_kpa", "tyres.pressure_front_kpa", "tyres.transient",
+    "bicycle.static_load_rear_n", "steady_state.speed_m_s", "controller.type", "controller.gain_scale",
+    "kick.displacement_m", "kick.duration_s", "kick.direction", "end_time_s",
+)
+
+
+def run_labels(results):
+    """A short label per run: the scenario fields in which the runs differ (``"pressure_kpa=300"``), else "run k".
+
+    Example
+    -------
+    >>> from whipple_kick.scenario import Scenario
+    >>> runs = [Result(Scenario(pressure_kpa=p), None) for p in (300.0, 400.0)]
+    >>> run_labels(runs)
+    ['pressure_kpa=300', 'pressure_kpa=400']
+    """
+    fields = [r.scenario.to_dict() for r in results]
+    differ = [name for name in fields[0] if len({repr(f[name]) for f in fields}) > 1] if fields else []
+    labels = [", ".join(f"{name}={f[name]:g}" if isinstance(f[name], float) else f"{name}={f[name]}"
+                        for name in differ) for f in fields]
+    if not differ or len(set(labels)) < len(labels):
+        return [f"run {k + 1}" for k in range(len(results))]
+    return labels
+
+
+def compare_table(results, labels=None):
+    """The runs' results side by side: one row per quantity (:data:`COMPARE_ROWS`), one column per run.
+
+    Parameters
+    ----------
+    results : sequence of Result
+    labels : sequence of str, optional
+        Column names (default :func:`run_labels`).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Index ``quantity`` (the summary's names, units in them); None where a
+        run has no value (e.g. the fall time of a run that recovered).
+
+    Example
+    -------
+    >>> import whipple_kick as wk
+    >>> runs = [wk.run(wk.Scenario(controller=c, duration=3.0)) for c in ("lqr", "off")]
+    >>> compare_table(runs).loc["outcome"].tolist()
+    ['completed', 'fell']
+    """
+    import pandas as pd
+
+    from .sweep_engine import flatten_summary
+
+    labels = run_labels(results) if labels is None else list(labels)
+    if len(labels) != len(results):
+        raise InputError(f"{len(labels)} labels for {len(results)} runs; give one label per run")
+    columns = {}
+    for label, result in zip(labels, results, strict=True):
+        flat = flatten_summary(result.summary)
+        columns[label] = [flat.get(row) for row in COMPARE_ROWS]
+    frame = pd.DataFrame(columns, index=pd.Index(COMPARE_ROWS, name="quantity"), dtype=object)
+    return frame.where(frame.notna(), None)
