@@ -199,3 +199,46 @@ def test_compare_table_puts_the_runs_side_by_side(three):
         three[0].summary["peaks"]["max_abs_yaw_rate_absolute_rad_s"]
     with pytest.raises(wk.InputError, match="2 labels for 3 runs"):
         wk.results.compare_table(three, labels=["a", "b"])
+
+
+def _sweep_table():
+    """Pressure x load, as a sweep table: at 570 N 300 kPa fell, at 701 N 500 kPa failed."""
+    import pandas as pd
+    return pd.DataFrame({
+        "pressure_kpa": [300.0, 400.0, 500.0] * 2, "fz_n": [570.0] * 3 + [701.0] * 3,
+        "recovery.time_s": [np.nan, 2.5, 2.7, 3.1, 2.9, np.nan], "fell": [True, False, False, False, False, np.nan],
+        "status": ["ok"] * 5 + ["failed"]})
+
+
+def test_sweep_figure_lines_mark_fallen_and_failed_cases():
+    """Issue 25: recovery time against pressure, one line per load; the case that fell is an x at the top of the
+    axes at its pressure, the failed one a hollow square; both have no value on their line (NaN)."""
+    fig = plotting.sweep_figure(_sweep_table(), x="pressure_kpa", y="fz_n", metric="recovery.time_s")
+    ax = fig.axes[0]
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == ["fz_n = 570", "fz_n = 701"]
+    lines = [line for line in ax.lines if line.get_gid() == "metric"]
+    np.testing.assert_array_equal(lines[0].get_ydata(), [np.nan, 2.5, 2.7])
+    np.testing.assert_array_equal(lines[1].get_ydata(), [3.1, 2.9, np.nan])
+    fell = [tuple(line.get_xdata()) for line in ax.lines if line.get_gid() == "fell"]
+    failed = [tuple(line.get_xdata()) for line in ax.lines if line.get_gid() == "failed"]
+    assert fell == [(300.0,), ()] and failed == [(), (500.0,)]
+    assert ax.get_xlabel() == "pressure_kpa" and ax.get_ylabel() == "recovery.time_s"
+
+
+def test_sweep_figure_heatmap_says_each_cells_value():
+    fig = plotting.sweep_figure(_sweep_table(), x="pressure_kpa", y="fz_n", metric="recovery.time_s", kind="heatmap")
+    cells = {(t.get_position(), t.get_text()) for t in fig.axes[0].texts}
+    assert cells == {((0, 0), "fell"), ((1, 0), "2.5"), ((2, 0), "2.7"), ((0, 1), "3.1"), ((1, 1), "2.9"),
+                     ((2, 1), "failed")}
+    assert fig.axes[1].get_ylabel() == "recovery.time_s"           # the colour bar
+
+
+@pytest.mark.parametrize("options, message", [
+    (dict(x="pressure", metric="recovery.time_s"), "column 'pressure' is not in the sweep table"),
+    (dict(x="pressure_kpa", metric="recovery.time_s"), "several cases share the same pressure_kpa"),
+    (dict(x="pressure_kpa", metric="recovery.time_s", kind="heatmap"), "a heat map needs y"),
+    (dict(x="pressure_kpa", y="fz_n", metric="recovery.time_s", kind="bars"), "kind 'bars' is unknown"),
+])
+def test_sweep_figure_mistakes_are_one_line(options, message):
+    with pytest.raises(wk.InputError, match=message):
+        plotting.sweep_figure(_sweep_table(), **options)

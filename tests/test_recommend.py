@@ -160,6 +160,8 @@ def test_recommend_pressure_cli_criterion_and_extend(tmp_path):
                  "--out", str(folder), "--no-progress")
     assert first.returncode == 0, first.stderr
     assert "ranked by the last-peak time" in first.stdout
+    assert (folder / "recommendation.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"   # beside table.csv
+    assert "wrote recommendation.png" in first.stdout
     # Another sweep into the same folder needs --extend.
     refused = _cli("--fz", "701", "--pressures", "300", "--duration", "3", "--out", str(folder), "--no-progress")
     assert refused.returncode == 2 and "extend" in refused.stderr

@@ -617,7 +617,22 @@ def _recommend(argv):
         if k:
             print()
         print(recommend.format_recommendation(rec))
+    if args.out is not None:
+        import pathlib
+
+        import pandas as pd
+
+        from . import plotting
+        metric = recommend.CRITERIA[recommend.criterion_key(args.criterion)][0]
+        plotting.sweep_figure(pd.concat([rec.table.assign(fz_n=rec.fz_n) for rec in recs], ignore_index=True),
+                              x="pressure_kpa", y="fz_n", metric=metric, path=pathlib.Path(args.out) / SWEEP_FIGURE,
+                              title=f"{args.tyre}: {metric} against pressure, one line per rear load")
+        print(f"\nwrote {SWEEP_FIGURE} beside the sweep's table in {args.out}")
     return 0
+
+
+#: The figure ``recommend-pressure --out`` writes into its sweep folder.
+SWEEP_FIGURE = "recommendation.png"
 
 
 def recommend_main(argv=None):

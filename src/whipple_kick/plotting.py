@@ -311,6 +311,131 @@ def compare(results, path=None, labels=None, title=None, time_range=None, dpi=15
     return _written(fig, path, dpi)
 
 
+#: Kinds of :func:`sweep_figure`.
+SWEEP_KINDS = ("lines", "heatmap")
+
+
+def _sweep_cells(table, x, metric, y):
+    """Per case: (x, y or None, metric value or NaN, fell, failed), duplicates of (x, y) refused."""
+    import pandas as pd
+
+    from .errors import InputError
+    for name in (x, metric) + (() if y is None else (y,)):
+        if name not in table.columns:
+            raise InputError(f"column {name!r} is not in the sweep table ({len(table.columns)} columns, e.g. "
+                             "pressure_kpa, fz_n, recovery.time_s, last_peak_time_s; see table.columns)")
+    keys = [x] if y is None else [x, y]
+    if table.duplicated(subset=keys).any():
+        raise InputError(f"several cases share the same {' and '.join(keys)} (the sweep varies other fields too); "
+                         "select the rows of one figure first, e.g. table[table['speed'] == 3.0]")
+    values = pd.to_numeric(table[metric], errors="coerce").to_numpy(dtype=float)
+    fell = (table["fell"] == True).to_numpy() if "fell" in table else np.zeros(len(table), bool)   # noqa: E712
+    failed = (table["status"] != "ok").to_numpy() if "status" in table else np.zeros(len(table), bool)
+    return table[x].to_numpy(dtype=float), None if y is None else table[y].to_numpy(), values, fell, failed
+
+
+def sweep_figure(table, x, metric, y=None, kind="lines", path=None, title=None, dpi=150):
+    """A sweep's ``metric`` against ``x`` (a line per ``y`` value, or a heat map of x by y), fallen cases marked.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        A sweep table (:func:`whipple_kick.sweep`, table.csv of a sweep
+        folder, :attr:`whipple_kick.recommend.Recommendation.table`): one row
+        per case, ``fell`` and ``status`` used when present.
+    x : str
+        Column along the horizontal axis (e.g. ``"pressure_kpa"``).
+    metric : str
+        Column plotted (e.g. ``"recovery.time_s"``, ``"last_peak_time_s"``).
+    y : str, optional
+        Column that tells the lines apart (or, in a heat map, the vertical axis),
+        e.g. ``"fz_n"``.
+    kind : {"lines", "heatmap"}
+        Lines: a case that fell is an x at the top of the axes (it has no
+        recovery time), a failed case a hollow square. Heat map (needs ``y``):
+        each cell says its value, "fell" or "failed".
+    path, title, dpi
+        As :func:`response_figure`.
+
+    Returns
+    -------
+    matplotlib.figure.Figure or None
+        The figure, or None when it was written to ``path``.
+
+    Raises
+    ------
+    InputError
+        A column is missing, ``kind`` is unknown, or several cases share one
+        point (x, y).
+
+    Example
+    -------
+    >>> import whipple_kick as wk
+    >>> table = wk.sweep({"pressure_kpa": [300, 400, 500], "fz_n": [570, 701]}, progress=False)
+    >>> fig = wk.plotting.sweep_figure(table, x="pressure_kpa", y="fz_n", metric="recovery.time_s")
+    >>> [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    ['fz_n = 570', 'fz_n = 701']
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    import matplotlib.transforms as mtransforms
+
+    from .errors import InputError
+    if kind not in SWEEP_KINDS:
+        raise InputError(f"sweep figure kind {kind!r} is unknown; choose one of {', '.join(SWEEP_KINDS)}")
+    if kind == "heatmap" and y is None:
+        raise InputError("a heat map needs y, the column of its vertical axis (e.g. y='fz_n')")
+    xs, ys, values, fell, failed = _sweep_cells(table, x, metric, y)
+    fig = Figure(figsize=(7.0, 4.5))
+    FigureCanvasAgg(fig)
+    ax = fig.subplots()
+    if kind == "lines":
+        groups = [(None, np.ones(xs.size, bool))] if y is None else [(v, ys == v) for v in sorted(set(ys))]
+        top = mtransforms.blended_transform_factory(ax.transData, ax.transAxes)
+        for k, (value, rows) in enumerate(groups):
+            order = np.flatnonzero(rows)[np.argsort(xs[rows], kind="stable")]
+            color = f"C{k}"
+            label = None if y is None else (f"{y} = {value:g}" if isinstance(value, (int, float, np.number))
+                                            else f"{y} = {value}")
+            ax.plot(xs[order], values[order], marker="o", ms=4, color=color, label=label, gid="metric")
+            down = order[fell[order]]
+            ax.plot(xs[down], np.full(down.size, 0.96), ls="none", marker="x", ms=8, mew=2, color=color,
+                    transform=top, gid="fell")
+            broken = order[failed[order] & ~fell[order]]
+            ax.plot(xs[broken], np.full(broken.size, 0.96), ls="none", marker="s", mfc="none", color=color,
+                    transform=top, gid="failed")
+        ax.set_xlabel(x)
+        ax.set_ylabel(metric)
+        ax.grid(True, lw=0.4, alpha=0.5)
+        if y is not None:
+            ax.legend(fontsize=8, loc="best")
+        if fell.any() or failed.any():
+            ax.text(0.01, 0.02, "x at the top: the case fell (no value); hollow square: it failed", fontsize=7.5,
+                    color="0.25", transform=ax.transAxes, gid="fell")
+    else:
+        columns, rows = sorted(set(xs)), sorted(set(ys))
+        grid = np.full((len(rows), len(columns)), np.nan)
+        for xv, yv, v in zip(xs, ys, values, strict=True):
+            grid[rows.index(yv), columns.index(xv)] = v
+        mesh = ax.pcolormesh(np.arange(len(columns) + 1) - 0.5, np.arange(len(rows) + 1) - 0.5,
+                             np.ma.masked_invalid(grid), cmap="viridis", gid="metric")
+        fig.colorbar(mesh, ax=ax, label=metric)
+        for xv, yv, v, down, broken in zip(xs, ys, values, fell, failed, strict=True):
+            text, gid = (("fell", "fell") if down else ("failed", "failed") if broken else
+                         ("-" if not np.isfinite(v) else f"{v:.3g}", "value"))
+            ax.text(columns.index(xv), rows.index(yv), text, ha="center", va="center", fontsize=8, gid=gid,
+                    color="k" if gid != "value" else "w")
+        ax.set_xticks(range(len(columns)), [f"{v:g}" for v in columns])
+        ax.set_yticks(range(len(rows)), [f"{v:g}" if isinstance(v, (int, float, np.number)) else str(v)
+                                         for v in rows])
+        ax.set_xlabel(x)
+        ax.set_ylabel(y)
+    if title:
+        ax.set_title(title, fontsize=10)
+    fig.tight_layout()
+    return _written(fig, path, dpi)
+
+
 def controller_text(summary):
     """The rider model of a run in words, gain scale spelled out (e.g. "LQR rider (designed at 3 m/s), gains x 1")."""
     sc = summary["scenario"]
