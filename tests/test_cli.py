@@ -516,3 +516,17 @@ def test_compare_writes_the_figure_and_the_table(tmp_path, capsys):
     stdout, err = capsys.readouterr()
     assert info.value.code == 2 and err.count("\n") == 1 and "is not a run folder" in err
     assert not (tmp_path / "cmp2").exists()
+
+
+def test_gitignore_covers_the_folders_the_commands_write():
+    """The quick start run from the repository root leaves git status clean: simulate's, stability's and compare's
+    default folders and thesis_figures.py's figures/ are ignored (names as _default_out/_new_folder make them)."""
+    import pathlib
+
+    from whipple_kick.cli import _default_out, _new_folder
+    root = pathlib.Path(__file__).resolve().parent.parent
+    names = [_default_out(wk.Scenario(fz_n=635.0)).name, _default_out(wk.Scenario(), "stability").name,
+             _new_folder("compare").name, "figures"]
+    done = subprocess.run(["git", "-C", str(root), "check-ignore", "--no-index", *(f"{n}/x.csv" for n in names)],
+                          capture_output=True, text=True, check=False)
+    assert done.stdout.split() == [f"{n}/x.csv" for n in names], (names, done.stderr)
