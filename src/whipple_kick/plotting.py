@@ -292,14 +292,12 @@ def compare(results, path=None, labels=None, title=None, time_range=None, dpi=15
     'pressure_kpa=400, controller=off, duration=3 (fell at 1.585 s)'
     """
     from .errors import InputError
-    from .results import run_labels
+    from .results import checked_labels
 
     results = list(results)
     if not results:
         raise InputError("nothing to compare: give at least one run")
-    labels = run_labels(results) if labels is None else list(labels)
-    if len(labels) != len(results):
-        raise InputError(f"{len(labels)} labels for {len(results)} runs; give one label per run")
+    labels = checked_labels(results, labels)
     kicks = [kick_band(r) for r in results]
     same = len(set(kicks)) == 1
     fig = response_figure(list(zip(labels, results, strict=True)), title=title, time_range=time_range,

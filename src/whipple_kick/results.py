@@ -556,6 +556,14 @@ def run_labels(results):
     return labels
 
 
+def checked_labels(results, labels=None):
+    """``labels`` as a list, one per run (default :func:`run_labels`); InputError when the counts differ."""
+    labels = run_labels(results) if labels is None else list(labels)
+    if len(labels) != len(results):
+        raise InputError(f"{len(labels)} labels for {len(results)} runs; give one label per run")
+    return labels
+
+
 def compare_table(results, labels=None):
     """The runs' results side by side: one row per quantity (:data:`COMPARE_ROWS`), one column per run.
 
@@ -582,9 +590,7 @@ def compare_table(results, labels=None):
 
     from .sweep_engine import flatten_summary
 
-    labels = run_labels(results) if labels is None else list(labels)
-    if len(labels) != len(results):
-        raise InputError(f"{len(labels)} labels for {len(results)} runs; give one label per run")
+    labels = checked_labels(results, labels)
     columns = {}
     for label, result in zip(labels, results, strict=True):
         flat = flatten_summary(result.summary)
