@@ -207,6 +207,10 @@ BAD_INPUTS = {
     "unknown-camber-sign": (["--camber-sign", "minus"], ["--camber-sign", "'minus'", "physical", "reversed"]),
     "upright-start-with-settle": (["--start", "upright"], ["settle time = 0.5 s", "start 'upright'", "0 s"]),
     "compat-with-settle": (["--compat", "authors-code", "--settle", "1"], ["settle time = 1 s", "0 s"]),
+    "missing-scenario-file": (["--scenario", "nope.toml"], ["scenario file 'nope.toml' does not exist"]),
+    "scenario-and-compat": (["--scenario", "nope.toml", "--compat", "authors-code"],
+                            ["--scenario FILE", "--compat"]),
+    "malformed-output-rate": (["--output-rate", "fast"], ["--output-rate", "'fast'", "Hz"]),
 }
 
 

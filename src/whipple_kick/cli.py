@@ -731,7 +731,7 @@ def _stability_parser():
 def _stability(argv):
     import time
 
-    from . import assembly, stability
+    from . import assembly, provenance, stability
     from .scenario import Scenario
     args = _stability_parser().parse_args(argv)
     started = time.perf_counter()
@@ -743,6 +743,7 @@ def _stability(argv):
     try:
         result = stability.analyse(scenario, speeds)
         result.summary["numerics"] = {"wall_s": time.perf_counter() - started}
+        result.summary["provenance"] = provenance.record(provenance.input_files(scenario))
         files = stability.write(result, out, plot=not args.no_plot)
     except BaseException:
         # A failure or Ctrl-C before every file is written: leave nothing half done.
