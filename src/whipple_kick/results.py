@@ -253,12 +253,9 @@ def response_metrics(df, baseline, x0, scenario, traj):
     except InputError as exc:   # a failure so early that too little of the response exists
         metrics = {"unavailable": {"all": f"no response to analyse: {exc}"}}
         rec = {"time_s": None, "reason": ended or str(exc), "signals": {}}
-    # The integrator's event is exact; kick_metrics sees |roll| only up to the limit.
-    metrics["fell"] = bool(traj.fell)
-    metrics["fall_time"] = traj.fall_time
+    # The fall is the integrator's exact event (summary fell, fall_time_s): kick_metrics' own estimate of it,
+    # from |roll| up to the limit, is left out of the summary (DUPLICATE_METRICS).
     unavailable = metrics.setdefault("unavailable", {})
-    if traj.fell:
-        unavailable.pop("fall_time", None)
     if ended is not None and metrics.get("last_peak_time") is not None:
         # The last peak above 8 % before a fall or a failure is not the end of the response.
         metrics["last_peak_time"], unavailable["last_peak_time"] = None, ended
