@@ -231,8 +231,9 @@ def _simulate_parser():
     g.add_argument("--rtol", type=_number("relative"), default=1e-10, metavar="RTOL",
                    help="LSODA relative tolerance (default 1e-10; the thesis used 1e-12)")
     g.add_argument("--output-rate", type=_number("Hz"), default=1000.0, metavar="HZ",
-                   help="samples per second written to trajectory.csv (default 1000: about 1 MB per simulated "
-                        "second); the integration's accuracy does not depend on it")
+                   help="samples per second of the run in Hz (default 1000: about 1 MB of trajectory.csv per "
+                        "simulated second); the metrics are computed from these samples, e.g. the recovery time "
+                        "to 1/HZ")
     g.add_argument("--scenario", metavar="FILE",
                    help="rerun the scenario of a TOML file (every run folder has scenario.toml); flags given "
                         "override its values")

@@ -122,8 +122,10 @@ class Result:
 
         The summary is the one written (exactly), the trajectory equals the
         run's to trajectory.csv's precision (relative 5e-13), the scenario is
-        the summary's; figures, metrics and :meth:`save` work on it as on the
-        result :func:`whipple_kick.run` returned.
+        the summary's (file paths in it as the run was given them; the
+        folder's scenario.toml has them absolute, to rerun it from anywhere);
+        figures, metrics and :meth:`save` work on it as on the result
+        :func:`whipple_kick.run` returned. The input files need not exist.
 
         Raises
         ------
