@@ -53,7 +53,7 @@ def test_sweep_manifest_carries_the_provenance(default_run):
     assert "tyre" in rec["input_files"] and rec["date_utc"]
 
 
-@pytest.mark.parametrize("script", ["simulate", "stability", "recommend-pressure", "whipple-benchmark"])
+@pytest.mark.parametrize("script", ["simulate", "stability", "recommend-pressure", "compare", "whipple-benchmark"])
 def test_every_command_has_version(script):
     done = subprocess.run([str(pathlib.Path(sys.executable).parent / script), "--version"], capture_output=True,
                           text=True, timeout=120)
