@@ -209,7 +209,7 @@ def thesis():
                               for n in names)
         half_text = (_outcome(half) if half.summary["fell"]
                      else times(half.summary["recovery"]["signals"], ("roll_rate", "steer_rate")))
-        peak = full.summary["metrics"]["peak_values"][0]
+        peak = full.summary["metrics"]["yaw_rate_peaks_from_steady_rad_s"][0]
         print(f"| {pressure:g} kPa | {peak:+.3f} | "
               f"{times(full.summary['recovery']['signals'], ('yaw_rate', 'roll_rate', 'steer_rate'))} | "
               f"{half_text} | {_outcome(off)} | {_outcome(theirs)} |")

@@ -192,7 +192,7 @@ result = simulation.run(scenario)
 stages["run() total"] = time.perf_counter() - t
 stages["  of which integration"] = result.summary["numerics"]["integration_wall_s"]
 t = time.perf_counter()
-cli._write_results(result, __import__("pathlib").Path(sys.argv[1]))
+result.save(sys.argv[1])
 stages["trajectory.csv + summary.json"] = time.perf_counter() - t
 t = time.perf_counter()
 k = result.summary["kick"]

@@ -31,7 +31,7 @@ from whipple_kick.simulation import Scenario
 PRESSURES = (300.0, 400.0, 500.0)
 LOADS = (570.0, 635.0, 701.0)
 #: summary path of each criterion's value
-VALUES = {"settling": lambda s: s["recovery"]["time_s"], "last_peak": lambda s: s["metrics"]["last_peak_time"]}
+VALUES = {"settling": lambda s: s["recovery"]["time_s"], "last_peak": lambda s: s["metrics"]["last_peak_time_s"]}
 
 
 class PerturbedTyre:

@@ -192,7 +192,7 @@ def nine_case_acceptance(transient):
                         "failed": f"failed {cell(off['end_time_s'])}"}.get(off["outcome"], "no fall")
             print(f"| {pressure:.0f} kPa, {fz:.0f} N | {cell(full['recovery']['time_s'])} "
                   f"({' / '.join(cell(sig[n]) for n in SIGNALS)}) | {half_text} | {off_text} | "
-                  f"{math.degrees(abs(off_df['roll'].iloc[-1])):.1f} | {cell(full['metrics']['last_peak_time'])} |")
+                  f"{math.degrees(abs(off_df['roll'].iloc[-1])):.1f} | {cell(full['metrics']['last_peak_time_s'])} |")
     print()
 
 

@@ -55,9 +55,9 @@ def _row(label, result):
     rec = s["recovery"]["signals"]
     patch = (f"{math.degrees(np.max(np.abs(df['slip_patch_rear']))):.1f}" if "slip_patch_rear" in df else "-")
     times = " / ".join("fell" if v["time_s"] is None else f"{v['time_s']:.2f}" for v in rec.values())
-    return (f"| {label} | {s['peaks']['max_abs_yaw_rate']:.3f} | {s['peaks']['max_abs_roll_rate']:.3f} | "
-            f"{s['peaks']['max_abs_steer_rate']:.3f} | {math.degrees(_peak_change(df, 'roll')):.1f} | "
-            f"{s['peaks']['max_abs_fy_rear']:.0f} | {times} | {math.degrees(s['peaks']['max_abs_slip_rear']):.1f} | "
+    return (f"| {label} | {s['peaks']['max_abs_yaw_rate_absolute_rad_s']:.3f} | {s['peaks']['max_abs_roll_rate_absolute_rad_s']:.3f} | "
+            f"{s['peaks']['max_abs_steer_rate_absolute_rad_s']:.3f} | {math.degrees(_peak_change(df, 'roll')):.1f} | "
+            f"{s['peaks']['max_abs_fy_rear_absolute_n']:.0f} | {times} | {math.degrees(s['peaks']['max_abs_slip_rear_absolute_rad']):.1f} | "
             f"{patch} | {e['plate_work_j']:.2f} | {e['sliding_dissipation_j']:.2f} | "
             f"{e['carcass_energy_rear_j']:.2f} | {e['zero_slip_force_work_j']:.2f} | {e['aligning_moment_work_j']:.2f} | "
             f"{e['balance_residual_max_abs_j']:.1e} |")
@@ -89,8 +89,8 @@ def gmin():
         with _secant_floor(value):
             r = run(BASE)
         df = r.trajectory
-        print(f"| {value:g} | {r.summary['peaks']['max_abs_yaw_rate']:.6f} | "
-              f"{math.degrees(_peak_change(df, 'roll')):.4f} | {r.summary['peaks']['max_abs_fy_rear']:.2f} | "
+        print(f"| {value:g} | {r.summary['peaks']['max_abs_yaw_rate_absolute_rad_s']:.6f} | "
+              f"{math.degrees(_peak_change(df, 'roll')):.4f} | {r.summary['peaks']['max_abs_fy_rear_absolute_n']:.2f} | "
               f"{r.summary['recovery']['time_s']} | {df['relaxation_length_rear'].min():.4f} |")
 
 
@@ -278,8 +278,8 @@ def six_runs():
             if name == "carcass":
                 created = max(0.0, -min(float(df[c].min()) for c in ("carcass_energy_rear", "carcass_energy_front")))
             print(f"| {label} | {name} | {outcome} | {math.degrees(_peak_change(df, 'roll')):.2f} | "
-                  f"{s['peaks']['max_abs_yaw_rate']:.3f} | {s['peaks']['max_abs_steer_rate']:.3f} | "
-                  f"{s['peaks']['max_abs_fy_rear']:.0f} | {times} | {created:.3g} |")
+                  f"{s['peaks']['max_abs_yaw_rate_absolute_rad_s']:.3f} | {s['peaks']['max_abs_steer_rate_absolute_rad_s']:.3f} | "
+                  f"{s['peaks']['max_abs_fy_rear_absolute_n']:.0f} | {times} | {created:.3g} |")
 
 
 def sliding_laws():
@@ -294,15 +294,15 @@ def sliding_laws():
             s, df = r.summary, r.trajectory
             yaw = s["recovery"]["signals"]["yaw_rate"]["time_s"]
             print(f"| {label} | {variant} | {math.degrees(_peak_change(df, 'roll')):.2f} | "
-                  f"{s['peaks']['max_abs_yaw_rate']:.3f} | {s['peaks']['max_abs_fy_rear']:.0f} | "
+                  f"{s['peaks']['max_abs_yaw_rate_absolute_rad_s']:.3f} | {s['peaks']['max_abs_fy_rear_absolute_n']:.0f} | "
                   f"{'-' if yaw is None else f'{yaw:.2f}'} | {df['carcass_damper_dissipation'].iloc[-1]:.2f} |")
 
 
 def peak_slips():
     """T03 table7_9's peak slip and peak force per pressure and load (the carcass tyre's friction limit)."""
     from whipple_kick import carcass as carcass_module
-    print("| pressure [kPa] | C | load [N] | peak slip [deg] | peak \|F_y\| [N] | \|F_y\| at 33 deg / peak "
-          "| \|F_y\| at 80 deg (cap) / at 89.9 deg |")
+    print(r"| pressure [kPa] | C | load [N] | peak slip [deg] | peak \|F_y\| [N] | \|F_y\| at 33 deg / peak "
+          r"| \|F_y\| at 80 deg (cap) / at 89.9 deg |")
     print("|" + "---|" * 7)
     for p in (300, 400, 500):
         tyre = wk.tyres.load("T03", p)

@@ -4,9 +4,10 @@ import os
 import subprocess
 import sys
 
-from conftest import run_console
+import numpy as np
 import pytest
 
+from conftest import run_console
 import whipple_kick as wk
 from whipple_kick.cli import simulate_main
 
@@ -21,7 +22,7 @@ def test_main_job_writes_the_three_files(tmp_path, capsys):
     out = tmp_path / "run"
     status, stdout, stderr = _simulate(["--pressure", "400", "--fz", "635", "--out", str(out)], capsys)
     assert status == 0, stderr
-    assert sorted(p.name for p in out.iterdir()) == ["response.png", "summary.json", "trajectory.csv"]
+    assert sorted(p.name for p in out.iterdir()) == ["response.png", "scenario.toml", "summary.json", "trajectory.csv"]
     assert (out / "response.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert (out / "response.png").stat().st_size > 20_000
     summary = json.loads((out / "summary.json").read_text())
@@ -64,7 +65,7 @@ def test_warm_simulate_imports_neither_sympy_nor_python_control(tmp_path):
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip().splitlines()[-1] == "[]", done.stdout
     assert done.stderr == ""                                   # a warm run builds nothing: not even its one line
-    assert sorted(p.name for p in out.iterdir()) == ["response.png", "summary.json", "trajectory.csv"]
+    assert sorted(p.name for p in out.iterdir()) == ["response.png", "scenario.toml", "summary.json", "trajectory.csv"]
 
 
 def test_default_output_folder_is_new(tmp_path, capsys, monkeypatch):
@@ -75,7 +76,7 @@ def test_default_output_folder_is_new(tmp_path, capsys, monkeypatch):
     folders = sorted(p for p in tmp_path.iterdir() if p.is_dir())
     assert len(folders) == 2      # the second run did not reuse the first one's folder
     for folder in folders:
-        assert sorted(p.name for p in folder.iterdir()) == ["summary.json", "trajectory.csv"]
+        assert sorted(p.name for p in folder.iterdir()) == ["scenario.toml", "summary.json", "trajectory.csv"]
 
 
 def test_existing_folder_needs_force(tmp_path, capsys):
@@ -211,6 +212,10 @@ BAD_INPUTS = {
     "unknown-camber-sign": (["--camber-sign", "minus"], ["--camber-sign", "'minus'", "physical", "reversed"]),
     "upright-start-with-settle": (["--start", "upright"], ["settle time = 0.5 s", "start 'upright'", "0 s"]),
     "compat-with-settle": (["--compat", "authors-code", "--settle", "1"], ["settle time = 1 s", "0 s"]),
+    "missing-scenario-file": (["--scenario", "nope.toml"], ["scenario file 'nope.toml' does not exist"]),
+    "scenario-and-compat": (["--scenario", "nope.toml", "--compat", "authors-code"],
+                            ["--scenario FILE", "--compat"]),
+    "malformed-output-rate": (["--output-rate", "fast"], ["--output-rate", "'fast'", "Hz"]),
 }
 
 
@@ -277,7 +282,7 @@ def test_kick_table_runs_end_to_end(tmp_path, capsys):
     assert _simulate(["--kick-profile", "smooth", "--duration", "0.6", "--no-plot", "--quiet",
                       "--out", str(out3)], capsys)[0] == 0
     s3 = json.loads((out3 / "summary.json").read_text())
-    assert abs(s3["peaks"]["max_abs_yaw_rate"] - s["peaks"]["max_abs_yaw_rate"]) < 1e-6
+    assert abs(s3["peaks"]["max_abs_yaw_rate_absolute_rad_s"] - s["peaks"]["max_abs_yaw_rate_absolute_rad_s"]) < 1e-6
 
 
 BAD_TABLES = {
@@ -320,8 +325,8 @@ def test_animate_writes_a_playable_mp4(tmp_path, capsys):
     out = tmp_path / "run"
     status, stdout, err = _simulate(["--duration", "1.0", "--animate", "--fps", "10", "--out", str(out)], capsys)
     assert status == 0, err
-    assert sorted(p.name for p in out.iterdir()) == ["animation.mp4", "response.png", "summary.json",
-                                                     "trajectory.csv"]
+    assert sorted(p.name for p in out.iterdir()) == ["animation.mp4", "response.png", "scenario.toml",
+                                                     "summary.json", "trajectory.csv"]
     path = str(out / "animation.mp4")
     frames, seconds = imageio_ffmpeg.count_frames_and_secs(path)
     reader = imageio_ffmpeg.read_frames(path)
@@ -342,7 +347,7 @@ def test_animate_without_an_encoder_writes_a_gif(tmp_path, capsys, monkeypatch):
     status, stdout, err = _simulate(["--duration", "1.0", "--animate", "--fps", "10", "--slow-motion", "1",
                                      "--no-plot", "--out", str(out)], capsys)
     assert status == 0, err
-    assert sorted(p.name for p in out.iterdir()) == ["animation.gif", "summary.json", "trajectory.csv"]
+    assert sorted(p.name for p in out.iterdir()) == ["animation.gif", "scenario.toml", "summary.json", "trajectory.csv"]
     with Image.open(out / "animation.gif") as image:
         assert image.n_frames == 16 and image.size == (640, 360)
     assert "whipple_kick[video]" in stdout
@@ -412,3 +417,125 @@ def test_numerical_failure_keeps_the_partial_run(tmp_path, capsys, monkeypatch):
     assert summary["outcome"] == "failed" and summary["end_time_s"] < 2.0
     rows = (out / "trajectory.csv").read_text().splitlines()
     assert len(rows) > 2
+
+
+# ------------------------------------------------------------ run folders: load, rerun, output rate
+
+#: Timing entries of a summary: the only ones two runs of one scenario may differ in.
+_WALL_TIMES = ("wall_s", "integration_wall_s")
+
+
+def _without_wall_times(summary):
+    return {**summary, "numerics": {k: v for k, v in summary["numerics"].items() if k not in _WALL_TIMES},
+            "provenance": None}
+
+
+def test_a_loaded_cli_run_is_the_run_in_memory(base, tmp_path, capsys):
+    """Issue 25 acceptance: Result.load of a ``simulate`` folder equals wk.run's Result of the same scenario:
+    the summary exactly (JSON keeps every float's bits) but for the wall times and the provenance, the trajectory
+    to trajectory.csv's 13 significant digits (relative 5e-13)."""
+    out = tmp_path / "run"
+    assert _simulate(["--pressure", "400", "--fz", "635", "--no-plot", "--quiet", "--out", str(out)], capsys)[0] == 0
+    loaded = wk.Result.load(out)
+    assert loaded.scenario == base.scenario
+    assert _without_wall_times(loaded.summary) == _without_wall_times(base.summary)
+    assert list(loaded.trajectory.columns) == list(base.trajectory.columns)
+    a, b = loaded.trajectory.to_numpy(), base.trajectory.to_numpy()
+    assert np.all(np.abs(a - b) <= 5e-13 * np.abs(b))
+    assert wk.plotting.response_figure([("", loaded)]) is not None   # figures work on a loaded run
+
+
+def test_scenario_file_reruns_the_run_from_another_folder(tmp_path, capsys, monkeypatch):
+    """Issue 25 acceptance: ``simulate --scenario folder/scenario.toml`` reproduces the run to 1e-12 (here
+    exactly: the same scenario, the same compiled model), also with a kick table given by a relative path and
+    the rerun made from another folder; flags given override the file's values."""
+    monkeypatch.chdir(tmp_path)
+    _smooth_table(tmp_path / "plate.csv")
+    first = tmp_path / "first"
+    assert _simulate(["--kick-table", "plate.csv", "--pressure", "350", "--duration", "0.6", "--no-plot", "--quiet",
+                      "--out", str(first)], capsys)[0] == 0
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)
+    again = tmp_path / "again"
+    assert _simulate(["--scenario", str(first / "scenario.toml"), "--no-plot", "--quiet", "--out", str(again)],
+                     capsys)[0] == 0
+    a, b = wk.Result.load(first), wk.Result.load(again)
+    assert np.max(np.abs(a.trajectory.to_numpy() - b.trajectory.to_numpy())) <= 1e-12
+    assert b.summary["scenario"]["pressure_kpa"] == 350.0 and b.summary["kick"]["table"]["rows"] == 151
+    changed = tmp_path / "changed"
+    assert _simulate(["--scenario", str(first / "scenario.toml"), "--pressure", "450", "--rider-mass", "70",
+                      "--no-plot", "--quiet", "--out", str(changed)], capsys)[0] == 0
+    sc = wk.Result.load(changed).summary["scenario"]
+    assert (sc["pressure_kpa"], sc["fz_n"], sc["rider_mass_kg"], sc["duration"]) == (450.0, None, 70.0, 0.6)
+
+
+@pytest.mark.parametrize("content, fragments", [
+    ('speed = "fast"\n', ["scenario file", "speed = 'fast'", "not a finite number"]),
+    ("sped = 3.0\n", ["unknown key 'sped'", "speed"]),
+    ("speed = 30.0\n", ["scenario file", "speed", "(0, 15] m/s"]),
+    ("speed = \n", ["not valid TOML"]),
+    ("low_inertia = 1\n", ["low_inertia = 1", "true or false"]),
+])
+def test_bad_scenario_file_is_one_line_and_status_2(content, fragments, tmp_path, capsys):
+    path = tmp_path / "bad.toml"
+    path.write_text(content)
+    status, stdout, err = _simulate(["--scenario", str(path), "--out", str(tmp_path / "run")], capsys)
+    assert status == 2 and stdout == "" and err.count("\n") == 1, err
+    for fragment in fragments:
+        assert fragment in err
+    assert not (tmp_path / "run").exists()
+
+
+def test_output_rate_sets_the_rows_of_trajectory_csv(tmp_path, capsys):
+    out = tmp_path / "run"
+    assert _simulate(["--duration", "0.6", "--output-rate", "100", "--no-plot", "--quiet", "--out", str(out)],
+                     capsys)[0] == 0
+    rows = (out / "trajectory.csv").read_text().splitlines()
+    assert len(rows) == 1 + 111                  # header + -0.5..0.6 s at 100 Hz
+    assert json.loads((out / "summary.json").read_text())["scenario"]["output_rate"] == 100.0
+    status, _, err = _simulate(["--output-rate", "0.5", "--out", str(tmp_path / "slow")], capsys)
+    assert status == 2 and "output rate = 0.5 Hz" in err and "[1, 100000] Hz" in err
+
+
+def test_compare_writes_the_figure_and_the_table(tmp_path, capsys):
+    """Issue 25: ``compare RUN_DIR... --out`` on three run folders (one falls) writes compare.png and compare.csv
+    (one row per quantity, one column per run, named by the folders) and prints the table."""
+    from whipple_kick.cli import compare_main
+
+    folders = []
+    for name, argv in (("p400", []), ("p300", ["--pressure", "300"]), ("off", ["--controller", "off"])):
+        folders.append(str(tmp_path / name))
+        assert _simulate([*argv, "--duration", "3", "--no-plot", "--quiet", "--out", folders[-1]], capsys)[0] == 0
+    out = tmp_path / "cmp"
+    with pytest.raises(SystemExit) as info:
+        compare_main([*folders, "--out", str(out)])
+    stdout, err = capsys.readouterr()
+    assert info.value.code == 0, err
+    assert sorted(p.name for p in out.iterdir()) == ["compare.csv", "compare.png"]
+    assert (out / "compare.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    import pandas as pd
+    table = pd.read_csv(out / "compare.csv", index_col="quantity")
+    assert list(table.columns) == ["p400", "p300", "off"]
+    assert table.loc["outcome"].tolist() == ["completed", "completed", "fell"]
+    assert table.loc["tyres.pressure_rear_kpa"].astype(float).tolist() == [400.0, 300.0, 400.0]
+    assert "fell" in stdout and "compare.png" in stdout
+    with pytest.raises(SystemExit) as info:
+        compare_main([folders[0], str(tmp_path), "--out", str(tmp_path / "cmp2")])
+    stdout, err = capsys.readouterr()
+    assert info.value.code == 2 and err.count("\n") == 1 and "is not a run folder" in err
+    assert not (tmp_path / "cmp2").exists()
+
+
+def test_gitignore_covers_the_folders_the_commands_write():
+    """The quick start run from the repository root leaves git status clean: simulate's, stability's and compare's
+    default folders and thesis_figures.py's figures/ are ignored (names as _default_out/_new_folder make them)."""
+    import pathlib
+
+    from whipple_kick.cli import _default_out, _new_folder
+    root = pathlib.Path(__file__).resolve().parent.parent
+    names = [_default_out(wk.Scenario(fz_n=635.0)).name, _default_out(wk.Scenario(), "stability").name,
+             _new_folder("compare").name, "figures"]
+    done = subprocess.run(["git", "-C", str(root), "check-ignore", "--no-index", *(f"{n}/x.csv" for n in names)],
+                          capture_output=True, text=True, check=False)
+    assert done.stdout.split() == [f"{n}/x.csv" for n in names], (names, done.stderr)

@@ -292,7 +292,7 @@ def test_force_removes_the_previous_runs_files(tmp_path, capsys):
     (out / "notes.txt").write_text("mine\n")
     status, _, err = _simulate(["--duration", "0.6", "--force", "--no-plot", "--quiet", "--out", str(out)], capsys)
     assert status == 0, err
-    assert sorted(p.name for p in out.iterdir()) == ["notes.txt", "summary.json", "trajectory.csv"]
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt", "scenario.toml", "summary.json", "trajectory.csv"]
 
 
 # ------------------------------------------------------------ kick table units

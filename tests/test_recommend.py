@@ -57,7 +57,7 @@ def test_recommend_pressure_function_fine_grid():
     assert list(rec.table["measured"]) == [True, False, True, False, True]
     best = rec.table.loc[rec.table["rank"] == 1]
     assert float(best["pressure_kpa"].iloc[0]) == rec.best_pressure_kpa
-    assert float(best["last_peak_time"].iloc[0]) == rec.table["last_peak_time"].min()
+    assert float(best["last_peak_time_s"].iloc[0]) == rec.table["last_peak_time_s"].min()
     assert rec.best_measured_kpa in (300.0, 400.0, 500.0)
     assert "recommendation for 701 N:" in wk.recommend.format_recommendation(rec)
 
@@ -121,14 +121,14 @@ def test_a_run_that_fell_is_never_ranked_ahead(fz, base):
 
 def _rows(**columns):
     n = len(columns["pressure_kpa"])
-    defaults = {"measured": [True] * n, "recovery.time_s": [np.nan] * n, "last_peak_time": [np.nan] * n,
+    defaults = {"measured": [True] * n, "recovery.time_s": [np.nan] * n, "last_peak_time_s": [np.nan] * n,
                 "fell": [False] * n, "status": ["ok"] * n}
     return pd.DataFrame({**defaults, **columns})
 
 
 def test_ranking_rules_on_a_synthetic_table():
     # A fall with the shortest last-peak time still ranks last; ties broken by the other criterion.
-    rows = _rows(pressure_kpa=[300.0, 400.0, 500.0], last_peak_time=[1.0, 0.2, 1.0],
+    rows = _rows(pressure_kpa=[300.0, 400.0, 500.0], last_peak_time_s=[1.0, 0.2, 1.0],
                  **{"recovery.time_s": [4.0, np.nan, 3.0]}, fell=[False, True, False])
     assert list(np.argsort(wk.recommend._rank(rows, "last_peak")) + 1) == [2, 3, 1]
     assert wk.recommend._verdict(rows, "last_peak") == (500.0, 0.0, "no clear optimum")
@@ -161,6 +161,8 @@ def test_recommend_pressure_cli_criterion_and_extend(tmp_path):
                  "--out", str(folder), "--no-progress")
     assert first.returncode == 0, first.stderr
     assert "ranked by the last-peak time" in first.stdout
+    assert (folder / "recommendation.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"   # beside table.csv
+    assert "wrote recommendation.png" in first.stdout
     # Another sweep into the same folder needs --extend.
     refused = _cli("--fz", "701", "--pressures", "300", "--duration", "3", "--out", str(folder), "--no-progress")
     assert refused.returncode == 2 and "extend" in refused.stderr

@@ -1,6 +1,7 @@
 """Results of a run: the trajectory table and its units, the summary, the recovery and the energy balance."""
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -73,7 +74,7 @@ def test_recovery_is_reported_for_yaw_roll_and_steer_rates(base):
     df = base.trajectory
     after = df["time"].to_numpy() >= 0.0
     for name, entry in signals.items():
-        t_rec, peak = entry["time_s"], entry["first_peak_rad_s"]
+        t_rec, peak = entry["time_s"], entry["first_peak_from_steady_rad_s"]
         assert 0.0 < t_rec < 6.0 and peak > 0.0 and entry["reason"] is None
         steady = df[name].iloc[0]
         dev = np.abs(df[name].to_numpy() - steady)
@@ -149,3 +150,68 @@ def test_trajectory_csv_names_carry_units_and_read_back(base, tmp_path):
     back = wk.results.read_trajectory(path)
     assert list(back.columns) == list(base.trajectory.columns)
     np.testing.assert_allclose(back.to_numpy(), base.trajectory.to_numpy(), rtol=6e-13, atol=1e-300)
+
+
+def test_save_and_load_round_trip(base, tmp_path):
+    """Result.save writes the three files; Result.load gives the summary back exactly and the trajectory to
+    trajectory.csv's 13 significant digits (relative 5e-13); a loaded result saves the same files again."""
+    assert base.save(tmp_path / "run") == ["trajectory.csv", "summary.json", "scenario.toml"]
+    loaded = wk.Result.load(tmp_path / "run")
+    assert loaded.summary == base.summary and loaded.scenario == base.scenario
+    a, b = loaded.trajectory.to_numpy(), base.trajectory.to_numpy()
+    assert np.all(np.abs(a - b) <= 5e-13 * np.abs(b))
+    loaded.save(tmp_path / "again")
+    for name in ("trajectory.csv", "summary.json", "scenario.toml"):
+        assert (tmp_path / "again" / name).read_bytes() == (tmp_path / "run" / name).read_bytes()
+
+
+def test_load_of_a_folder_that_is_not_a_run_is_one_line(tmp_path):
+    with pytest.raises(wk.InputError, match="does not exist"):
+        wk.Result.load(tmp_path / "missing")
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(wk.InputError, match=r"is not a run folder: it has no summary\.json"):
+        wk.Result.load(tmp_path / "empty")
+    (tmp_path / "empty" / "summary.json").write_text("{not json")
+    (tmp_path / "empty" / "trajectory.csv").write_text("time [s]\n0\n")
+    with pytest.raises(wk.InputError, match="is not a run summary"):
+        wk.Result.load(tmp_path / "empty")
+
+
+#: Unit suffixes of summary keys (results.unit_suffix of the units used): s, rad, rad/s, m, N, N m, J, W, kg, kPa,
+#: m/s, m/s^2, 1/s.
+_UNIT_SUFFIX = re.compile(r"_(s|rad|rad_s|m|n|n_m|j|w|kg|kpa|m_s|m_s2|1_s)$")
+#: Numbers without a unit: counts, ratios and tolerances; the gains' units are in controller.gain_units, the steady
+#: powers' unit in the name of their section (steady_power_w).
+_DIMENSIONLESS = re.compile(r"^(controller\.gain_scale|controller\.gains\..*|steady_state\.steady_power_w\..*|"
+                            r"steady_state\.residual|metrics\.n_peaks|metrics\.(log_decrement|damping_ratio)_\d_\d|"
+                            r"numerics\.(rtol|nfev|njev|evaluations|budget\..*))$")
+
+
+def _numeric_keys(node, prefix=""):
+    for key, value in node.items():
+        if isinstance(value, dict):
+            yield from _numeric_keys(value, f"{prefix}{key}.")
+        elif (isinstance(value, (int, float)) and not isinstance(value, bool)) or (
+                isinstance(value, list) and value and isinstance(value[0], (int, float, list))):
+            yield f"{prefix}{key}"
+
+
+def test_every_number_in_the_summary_has_a_unit_in_its_key(base):
+    """Issue 25: a unit suffix on every key holding a number (dimensionless ones listed above), and the peaks
+    named 'absolute' or 'from steady'."""
+    keys = list(_numeric_keys({k: v for k, v in base.summary.items() if k not in ("scenario", "units")}))
+    assert len(keys) > 80
+    assert [k for k in keys if not (_UNIT_SUFFIX.search(k) or _DIMENSIONLESS.match(k))] == []
+    peaks = [k for k in keys if k.startswith(("peaks.", "metrics.", "recovery.")) and "peak" in k
+             and "time" not in k and not k.startswith("metrics.n_")]   # the response's (not the plate's) peaks
+    assert peaks and all("absolute" in k or "from_steady" in k for k in peaks), peaks
+
+
+def test_recovered_says_whether_all_three_rates_settled(base):
+    s = base.summary
+    assert s["recovered"] is True and s["outcome"] == "completed" and s["recovery"]["time_s"] is not None
+    short = run(Scenario(duration=1.0))          # too short to settle (the default run recovers at 2.7 s)
+    assert short.summary["outcome"] == "completed" and short.summary["recovered"] is False
+    assert short.summary["recovery"]["time_s"] is None
+    fell = run(Scenario(controller="off", duration=3.0))
+    assert fell.summary["fell"] and fell.summary["recovered"] is False

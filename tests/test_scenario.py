@@ -82,3 +82,30 @@ def test_authors_code_preset_is_the_thesis_preset_with_their_assumptions():
         Scenario(start="level").validate()
     with pytest.raises(InputError, match="keep_speeds' needs piecewise = True"):
         Scenario(plate_stop="keep_speeds", piecewise=False).validate()
+
+
+def test_scenario_file_round_trip_keeps_every_field(tmp_path):
+    """to_file -> from_file gives the same Scenario (== compares every field, floats bit for bit), None included
+    (steer_limit_deg None means no limit, not the default 90 deg)."""
+    sc = Scenario(fz_n=701.0, pressure_front_kpa=300.0, pressure_rear_kpa=450.0, speed=4.25, design_speed=3.0,
+                  gain_scale=0.5, low_inertia=True, kick_accel=10.0, kick_direction="left", rtol=1e-11,
+                  output_rate=250.0, steer_limit_deg=None, tyre_transient="force_lag", friction="none")
+    path = tmp_path / "scenario.toml"
+    sc.to_file(path, note="a note")
+    assert "# NOTE: a note" in path.read_text() and 'steer_limit_deg = "none"' in path.read_text()
+    assert Scenario.from_file(path) == sc
+
+
+def test_scenario_file_paths_are_absolute_when_written_and_relative_to_the_file_when_read(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    sc = Scenario(kick_profile="table", kick_table="plate.csv", bicycle="bikes/mine.toml")
+    (tmp_path / "run").mkdir()
+    sc.to_file(tmp_path / "run" / "scenario.toml")
+    text = (tmp_path / "run" / "scenario.toml").read_text()
+    assert f'kick_table = "{tmp_path / "plate.csv"}"' in text and f'bicycle = "{tmp_path / "bikes" / "mine.toml"}"' in text
+    sub = tmp_path / "sub"
+    sub.mkdir()
+    (sub / "plate.csv").write_text("time,y\n0,0\n0.15,0.15\n")
+    (sub / "mine.toml").write_text('kick_profile = "table"\nkick_table = "plate.csv"\nduration = 1\n')
+    sc = Scenario.from_file(sub / "mine.toml")        # the table beside the file, not in the working folder
+    assert sc.kick_table == str(sub / "plate.csv") and sc.duration == 1.0 and sc.speed == 3.0

@@ -27,7 +27,7 @@ def test_kick_to_the_left_mirrors_the_first_yaw_peak(base):
     right = run(Scenario(kick_direction="right", symmetric_tyres=True, duration=0.5))
     np.testing.assert_allclose(left.trajectory["yaw_rate"], -right.trajectory["yaw_rate"], atol=1e-7)
     # A plate moving right pushes the rear wheel right: the bicycle first yaws left (u3 < 0).
-    assert base.summary["metrics"]["peak_values"][0] < 0.0
+    assert base.summary["metrics"]["yaw_rate_peaks_from_steady_rad_s"][0] < 0.0
 
 
 def test_symmetric_tyres_run_upright():
@@ -176,7 +176,7 @@ def test_controller_off_falls_within_2_s_of_the_kick_with_the_thesis_force_lag(p
     s = _nine(pressure, fz, controller="off", tyre_transient="force_lag")
     assert s["fell"] and s["outcome"] == "fell"
     assert 0.0 < s["fall_time_s"] <= 2.0
-    assert s["recovery"]["time_s"] is None and s["metrics"]["last_peak_time"] is None
+    assert s["recovery"]["time_s"] is None and s["metrics"]["last_peak_time_s"] is None
 
 
 @pytest.mark.parametrize("pressure, fz", NINE_CASES)
@@ -189,20 +189,20 @@ def test_controller_off_loses_the_bicycle_within_2_s_of_the_kick(pressure, fz):
     assert s["outcome"] == "fell" and s["fall_reason"] == "steer"
     assert 0.0 < s["fall_time_s"] <= 2.0
     assert fork_over is None or fork_over >= s["fall_time_s"] - 1e-3   # the run ends at the limit itself
-    assert s["recovery"]["time_s"] is None and s["metrics"]["last_peak_time"] is None
+    assert s["recovery"]["time_s"] is None and s["metrics"]["last_peak_time_s"] is None
 
 
 @pytest.mark.parametrize("transient, share", [("contact_patch", 0.2), ("force_lag", 0.4)])
 def test_the_thesis_last_peak_time_is_not_a_recovery_time(transient, share):
     """Thesis Section 8.3's "recovery time" (the last yaw-rate peak above 8 % of the largest) is
-    kept as metrics.last_peak_time. In the default run it is 1.12 s, when the yaw rate is still 0.27
+    kept as metrics.last_peak_time_s. In the default run it is 1.12 s, when the yaw rate is still 0.27
     of its first peak away from steady (bound 0.2, four times the 5 % band; the recovery time is
     2.71 s); on the thesis' force lag 1.10 s and 0.50 of it (bound 0.4; recovery 4.17 s)."""
     changes = {} if transient == "contact_patch" else {"tyre_transient": transient}
     s = _nine(400.0, 635.0, **changes)
-    last_peak = s["metrics"]["last_peak_time"]
+    last_peak = s["metrics"]["last_peak_time_s"]
     assert last_peak < s["recovery"]["time_s"]
-    assert abs(s["metrics"]["peak_values"][-1]) > share * s["recovery"]["signals"]["yaw_rate"]["first_peak_rad_s"]
+    assert abs(s["metrics"]["yaw_rate_peaks_from_steady_rad_s"][-1]) > share * s["recovery"]["signals"]["yaw_rate"]["first_peak_from_steady_rad_s"]
     assert "recovery_time" not in s["metrics"]
 
 
@@ -349,7 +349,7 @@ def test_rider_designed_at_the_run_speed_by_default():
     assert s["controller"]["design_speed_m_s"] == 2.5
     assert [s["controller"]["gains"][k] for k in wk.control.GAIN_ORDER] == pytest.approx(K, rel=1e-12)
     # The poles reported are those of the rider in use at the run's speed (here the design's own).
-    poles = np.array([complex(*p) for p in s["controller"]["linear_closed_loop_poles"]])
+    poles = np.array([complex(*p) for p in s["linear_stability"]["poles_no_slip_model_1_s"]])
     np.testing.assert_allclose(np.sort_complex(poles), np.sort_complex(design_poles), rtol=1e-9)
     assert s["linear_stability"]["stable"] and s["linear_stability"]["message"] is None
 
@@ -369,7 +369,7 @@ def test_the_3_m_s_rider_is_unstable_below_2_48_m_s_and_says_so():
     assert crossing == pytest.approx(2.48, abs=0.02) and slowest(crossing).imag == 0.0   # measured 2.467 m/s
     s = run(Scenario(speed=2.0, design_speed=3.0, duration=0.5)).summary
     assert s["controller"]["design_speed_m_s"] == 3.0
-    no_slip = complex(*s["controller"]["linear_closed_loop_poles"][0])
+    no_slip = complex(*s["linear_stability"]["poles_no_slip_model_1_s"][0])
     assert no_slip.real == pytest.approx(1.03, abs=0.01) and no_slip.imag == 0.0
     stability = s["linear_stability"]
     assert not stability["stable"] and stability["slowest_pole_1_s"][0] > 0.5   # slip model: +1.13 1/s
@@ -405,15 +405,15 @@ def _finite_partial(result):
 
 # ------------------------------------------------------------------ numerics
 
-_CONVERGENCE_KEYS = ("max_abs_yaw_rate", "max_abs_roll_rate", "max_abs_steer_rate", "max_abs_roll",
-                     "max_abs_steer", "max_abs_slip_rear", "max_abs_fy_rear", "max_abs_fy_front")
+_CONVERGENCE_KEYS = ("max_abs_yaw_rate_absolute_rad_s", "max_abs_roll_rate_absolute_rad_s", "max_abs_steer_rate_absolute_rad_s", "max_abs_roll_absolute_rad",
+                     "max_abs_steer_absolute_rad", "max_abs_slip_rear_absolute_rad", "max_abs_fy_rear_absolute_n", "max_abs_fy_front_absolute_n")
 
 
 def _headline(result):
     s = result.summary
     out = {k: s["peaks"][k] for k in _CONVERGENCE_KEYS}
-    out["first_peak"] = s["metrics"]["peak_values"][0]
-    out["first_peak_time"] = s["metrics"]["peak_times"][0]
+    out["first_peak"] = s["metrics"]["yaw_rate_peaks_from_steady_rad_s"][0]
+    out["first_peak_time"] = s["metrics"]["yaw_rate_peak_times_s"][0]
     for key in ("fall_time_s",):
         if s[key] is not None:
             out[key] = s[key]
@@ -481,7 +481,7 @@ def test_smooth_table_reproduces_the_builtin_smooth_profile(smooth_pair):
     np.testing.assert_array_equal(a["time"].to_numpy(), b["time"].to_numpy())
     assert np.max(np.abs(a["yaw_rate"] - b["yaw_rate"])) < 2e-7
     assert np.max(np.abs(a["roll"] - b["roll"])) < 1e-7
-    assert tab.summary["metrics"]["peak_values"][0] == pytest.approx(ref.summary["metrics"]["peak_values"][0],
+    assert tab.summary["metrics"]["yaw_rate_peaks_from_steady_rad_s"][0] == pytest.approx(ref.summary["metrics"]["yaw_rate_peaks_from_steady_rad_s"][0],
                                                                      rel=1e-7)
     # The summary's kick comes from the spline: 10/sqrt(3) D/T^2 = 38.49 m/s^2 (spline: 38.492).
     k = tab.summary["kick"]
@@ -508,8 +508,8 @@ def test_constant_table_is_close_to_the_builtin_constant_profile(base, tables):
     # Before the last intervals the spline is the constant-acceleration parabola.
     assert np.max(np.abs(a["plate_velocity"] - b["plate_velocity"])[during]) < 1e-5   # measured 1.0e-6 m/s
     assert np.max(np.abs(a["yaw_rate"] - b["yaw_rate"])[during]) < 1e-5
-    peak = abs(base.summary["metrics"]["peak_values"][0])
-    assert tab.summary["metrics"]["peak_values"][0] == pytest.approx(base.summary["metrics"]["peak_values"][0],
+    peak = abs(base.summary["metrics"]["yaw_rate_peaks_from_steady_rad_s"][0])
+    assert tab.summary["metrics"]["yaw_rate_peaks_from_steady_rad_s"][0] == pytest.approx(base.summary["metrics"]["yaw_rate_peaks_from_steady_rad_s"][0],
                                                                      rel=0.01)
     dyaw = np.abs(a["yaw_rate"] - b["yaw_rate"]).to_numpy()
     assert np.max(dyaw) < 0.03 * peak

@@ -377,6 +377,8 @@ def test_cli_writes_the_three_files(tmp_path, capsys):
     assert set(table["loop"]) == {"open", "closed"} and set(table["model"]) == {"slip", "no-slip"}
     summary = json.loads((out / "summary.json").read_text())
     assert summary["scenario"]["symmetric_tyres"] is True and summary["loops"] == ["open", "closed"]
+    assert summary["provenance"]["versions"]["whipple_kick"] == wk.__version__    # issue 25: provenance here too
+    assert set(summary["provenance"]["input_files"]) == {"bicycle", "rider", "tyre"}
     assert (out / "stability.png").stat().st_size > 10000
 
 

@@ -1,12 +1,12 @@
 """Sweeps: cases, parallel runs, the table of results, executors, saved trajectories."""
 import json
 
-from conftest import SWEEP_BASE as BASE
-from conftest import SWEEP_GRID as GRID
 import numpy as np
 import pandas as pd
 import pytest
 
+from conftest import SWEEP_BASE as BASE
+from conftest import SWEEP_GRID as GRID
 import whipple_kick as wk
 from whipple_kick.errors import InputError
 from whipple_kick.scenario import Scenario
@@ -18,7 +18,7 @@ def test_table_has_one_row_per_case_with_inputs_and_metrics(default_run):
     assert list(table["status"]) == ["ok", "ok", "ok", "failed"]
     assert table["error"].iloc[:3].isna().all()
     # Every scenario field is a column, then the flattened results.
-    for column in ("fz_n", "tyre", "duration", "last_peak_time", "damping_ratio_1_3", "recovery.time_s",
+    for column in ("fz_n", "tyre", "duration", "last_peak_time_s", "damping_ratio_1_3", "recovery.time_s",
                    "recovery.signals.roll_rate.time_s", "linear_stability.stable", "steady_state.found_by",
                    "steady_state.roll_rad", "controller.gains.kq4", "numerics.model_hash", "run.worker"):
         assert column in table.columns, column
@@ -30,7 +30,7 @@ def test_failing_case_is_recorded_with_its_error(default_run):
     folder, table = default_run
     row = table.iloc[3]
     assert row["error"].startswith("InputError: ") and "600" in row["error"] and "kPa" in row["error"]
-    assert np.isnan(row["last_peak_time"])
+    assert np.isnan(row["last_peak_time_s"])
     log = wk.sweep_store.read_log(folder)
     assert log[row["case_id"]]["status"] == "failed"
     assert not wk.sweep_store.trajectory_path(folder, row["case_id"]).exists()
@@ -42,7 +42,7 @@ def test_sweep_results_equal_a_direct_run(default_run):
     direct = wk.run(BASE.with_changes(pressure_kpa=400.0)).summary
     flat = wk.sweep_engine.flatten_summary(direct)
     row = table.iloc[1]
-    assert flat["last_peak_time"] is not None
+    assert flat["last_peak_time_s"] is not None
     for key, value in flat.items():
         if key in wk.sweep_engine.VOLATILE_COLUMNS:
             continue

@@ -2,11 +2,11 @@
 import concurrent.futures as cf
 import os
 
-from conftest import SWEEP_BASE as BASE
 import numpy as np
 import pandas as pd
 import pytest
 
+from conftest import SWEEP_BASE as BASE
 import whipple_kick as wk
 from whipple_kick.errors import InputError
 
@@ -17,13 +17,13 @@ def test_folder_holds_manifest_table_and_trajectories(default_run):
     assert manifest["status"] == "complete"
     assert (manifest["n_ok"], manifest["n_failed"]) == (3, 1)
     assert manifest["model_hash"] == wk.slip.model_hash()
-    assert manifest["versions"]["numpy"] == np.__version__
+    assert manifest["provenance"]["versions"]["numpy"] == np.__version__
     assert manifest["base_scenario"]["duration"] == 3.0
     assert [c["case_id"] for c in manifest["cases"]] == list(table["case_id"])
     assert manifest["cases"][0]["overrides"] == {"pressure_kpa": 300.0}
     on_disk = pd.read_csv(folder / wk.sweep_store.TABLE_FILE)
     assert list(on_disk["case_id"]) == list(table["case_id"])
-    np.testing.assert_allclose(on_disk["last_peak_time"], table["last_peak_time"], rtol=1e-11)
+    np.testing.assert_allclose(on_disk["last_peak_time_s"], table["last_peak_time_s"], rtol=1e-11)
     traj, summary = wk.sweep_store.load_trajectory(folder, table["case_id"].iloc[0])
     assert list(traj.columns) == list(wk.sweep_engine.DEFAULT_TRAJECTORY_COLUMNS)
     assert traj["yaw_rate"].dtype == np.float32

@@ -4,9 +4,9 @@ import os
 import subprocess
 import sys
 
-from conftest import run_console
 import pytest
 
+from conftest import run_console
 from whipple_kick.cli import validate_main
 from whipple_kick.scenario import Scenario
 

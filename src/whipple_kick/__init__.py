@@ -34,8 +34,9 @@ __all__ = ["InputError", "Result", "Scenario", "SimulationError", "__version__",
 
 _SUBMODULES = (
     "analysis", "animation", "assembly", "authors_code", "benchmark", "bicycles", "cache", "classic", "cli",
-    "codegen", "control", "derivation", "energy", "errors", "experiments", "fileio", "geometry", "inputs", "integration", "kane",
-    "lsoda", "magic_formula", "parameters", "plotting", "recommend", "results", "riders", "scenario", "simulation",
+    "carcass", "codegen", "control", "derivation", "energy", "errors", "experiments", "fileio", "geometry", "inputs",
+    "integration", "kane", "lsoda", "magic_formula", "parameters", "plotting", "provenance", "recommend", "results",
+    "riders", "scenario", "simulation",
     "slip", "slip_build", "stability", "steady", "sweep_engine", "sweep_store", "symbols", "transient", "tyres",
     "validation",
 )

@@ -55,7 +55,7 @@ def _run(main, argv, prog="whipple_kick", kept="no results were kept"):
 
 
 def _benchmark(argv):
-    parser = argparse.ArgumentParser(
+    parser = _OneLineParser(
         prog="whipple-benchmark",
         description="Linearise the classic Carvallo-Whipple model of the Meijaard et al. (2007) "
                     "benchmark bicycle and print its eigenvalues [1/s] against forward speed [m/s].")
@@ -95,7 +95,13 @@ def _output_options(group, figure):
 
 
 class _OneLineParser(argparse.ArgumentParser):
-    """Argument parser whose usage errors are one line on stderr (exit status 2)."""
+    """Argument parser whose usage errors are one line on stderr (exit status 2), with ``--version``."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        from . import __version__
+        self.add_argument("--version", action="version", version=f"%(prog)s (whipple_kick {__version__})",
+                          help="print the package version and exit")
 
     def error(self, message):
         print(f"{self.prog}: error: {message} (see {self.prog} --help)", file=sys.stderr)
@@ -249,6 +255,13 @@ def _simulate_parser():
                    help="steady running shown before the kick in s (default 0.5)")
     g.add_argument("--rtol", type=_number("relative"), default=1e-10, metavar="RTOL",
                    help="LSODA relative tolerance (default 1e-10; the thesis used 1e-12)")
+    g.add_argument("--output-rate", type=_number("Hz"), default=1000.0, metavar="HZ",
+                   help="samples per second of the run in Hz (default 1000: about 1 MB of trajectory.csv per "
+                        "simulated second); the metrics are computed from these samples, e.g. the recovery time "
+                        "to 1/HZ")
+    g.add_argument("--scenario", metavar="FILE",
+                   help="rerun the scenario of a TOML file (every run folder has scenario.toml); flags given "
+                        "override its values")
     _output_options(g, "response.png")
     g = p.add_argument_group("animation")
     g.add_argument("--animate", action="store_true",
@@ -286,6 +299,11 @@ def _animation_options(args):
 _FIELD_FLAGS = {"fz_n": ("fz",), "rider_mass_kg": ("rider_mass",), "pressure_kpa": ("pressure",),
                 "pressure_front_kpa": ("pressure_front",), "pressure_rear_kpa": ("pressure_rear",),
                 "thesis_load_n": ("thesis_load",), "kick_profile": ("kick_profile", "kick_table")}
+
+
+#: Fields a flag's field replaces in a --scenario file or the --compat preset (their alternatives).
+_REPLACED_FIELDS = {"fz_n": ("rider_mass_kg",), "rider_mass_kg": ("fz_n",), "kick_duration": ("kick_accel",),
+                    "kick_accel": ("kick_duration",), "pressure_kpa": ("pressure_front_kpa", "pressure_rear_kpa")}
 
 
 def _flags_given(argv):
@@ -361,17 +379,23 @@ def _scenario_from_args(args, given=()):
         kick_duration=args.kick_duration, kick_accel=args.kick_accel,
         kick_profile="constant" if profile is None else profile, kick_table=args.kick_table,
         kick_direction=args.kick_direction, settle=args.settle, duration=args.duration, rtol=args.rtol,
-        plate_stop=args.plate_stop, kick_heading=args.kick_heading, start=args.start,
+        plate_stop=args.plate_stop, kick_heading=args.kick_heading, start=args.start, output_rate=args.output_rate,
     )
-    if args.compat is None:
+    if args.compat is None and args.scenario is None:
         return Scenario(**fields)
+    if args.compat is not None and args.scenario is not None:
+        raise InputError("--scenario FILE gives the whole scenario; do not combine it with --compat")
     changes = {name: value for name, value in fields.items()
                if any(flag in given for flag in _FIELD_FLAGS.get(name, (name,)))}
+    for name in [n for n in changes if n in _REPLACED_FIELDS]:
+        changes = {**dict.fromkeys(_REPLACED_FIELDS[name]), **changes}
+    if args.scenario is not None:
+        return Scenario.from_file(args.scenario).with_changes(**changes)
     return Scenario.authors_code(**changes)
 
 
 #: Every file ``simulate`` may write (``--force`` removes them before a run).
-_OUTPUT_FILES = ("trajectory.csv", "summary.json", "response.png", "animation.mp4", "animation.gif")
+_OUTPUT_FILES = ("trajectory.csv", "summary.json", "scenario.toml", "response.png", "animation.mp4", "animation.gif")
 #: Every file ``stability`` may write.
 _STABILITY_FILES = ("eigenvalues.csv", "summary.json", "stability.png")
 
@@ -406,7 +430,7 @@ def _default_out(scenario, prefix="kick"):
 
 
 def _new_folder(name):
-    """``<cwd>/<name>_<date-time>``, numbered on if it exists."""
+    """``<name>_<date-time>`` under the current directory, numbered if it exists (never an existing folder)."""
     import datetime
     import pathlib
     stamp = datetime.datetime.now().strftime("%Y%m%d-%H%M%S")
@@ -524,8 +548,9 @@ def _print_summary(result, out, files):
     else:
         print(f"  result: no fall in {sc['duration']:g} s")
     m, rec = s["metrics"], s["recovery"]
-    if m["peak_values"]:
-        print(f"  yaw rate: first peak {m['peak_values'][0]:+.3f} rad/s (from steady) at {m['peak_times'][0]:.3f} s")
+    if m["yaw_rate_peaks_from_steady_rad_s"]:
+        print(f"  yaw rate: first peak from steady {m['yaw_rate_peaks_from_steady_rad_s'][0]:+.3f} rad/s "
+              f"at {m['yaw_rate_peak_times_s'][0]:.3f} s")
     if not s["fell"]:
         settled = ", ".join(f"{name.replace('_', ' ')} {sig['time_s']:.2f} s" if sig["time_s"] is not None
                             else f"{name.replace('_', ' ')} not within the run"
@@ -534,8 +559,10 @@ def _print_summary(result, out, files):
         print("  recovery time: " + (f"{rec['time_s']:.3f} s after the kick (all three settled)"
                                      if rec["time_s"] is not None else "none within the run"))
     pk = s["peaks"]
-    print(f"  peaks: |roll rate| {pk['max_abs_roll_rate']:.3f} rad/s, |steer rate| {pk['max_abs_steer_rate']:.3f} rad/s, "
-          f"|Fy rear| {pk['max_abs_fy_rear']:.0f} N, |slip rear| {pk['max_abs_slip_rear'] * deg:.1f} deg")
+    print(f"  largest absolute values after the kick: |yaw rate| {pk['max_abs_yaw_rate_absolute_rad_s']:.3f} rad/s, "
+          f"|roll rate| {pk['max_abs_roll_rate_absolute_rad_s']:.3f} rad/s, "
+          f"|steer rate| {pk['max_abs_steer_rate_absolute_rad_s']:.3f} rad/s, |Fy rear| {pk['max_abs_fy_rear_absolute_n']:.0f} N, "
+          f"|slip rear| {pk['max_abs_slip_rear_absolute_rad'] * deg:.1f} deg")
     e = s["energy"]
     jumps = "".join(f", plate stop ({e['plate_stop']}) {j['kinetic_energy_change_j']:+.3f} J kinetic"
                     for j in e["velocity_jumps"])
@@ -549,17 +576,6 @@ def _print_summary(result, out, files):
           f"integration {n['integration_wall_s']:.2f} s, "
           f"run {n['wall_s']:.2f} s")
     print(f"  wrote {', '.join(files)} in {out}")
-
-
-def _write_results(result, out):
-    """trajectory.csv and summary.json of ``result`` in ``out`` (each written atomically); returns the file names."""
-    import json
-
-    from . import fileio, results
-    fileio.write_csv(results.with_units(result.trajectory), out / "trajectory.csv",
-                     significant_digits=results.TRAJECTORY_CSV_DIGITS)
-    fileio.write_atomic(out / "summary.json", json.dumps(result.summary, indent=2, allow_nan=False) + "\n")
-    return ["trajectory.csv", "summary.json"]
 
 
 def _data_warnings(prog, quiet):
@@ -583,7 +599,7 @@ def _simulate(argv):
     from . import assembly
     args = _simulate_parser().parse_args(argv)
     report_data_warnings = _data_warnings("simulate", args.quiet)
-    given = _flags_given(argv) if args.compat is not None else ()
+    given = _flags_given(argv) if args.compat is not None or args.scenario is not None else ()
     scenario = assembly.preflight(_scenario_from_args(args, given))
     movie_options = _animation_options(args)
     with _output_folder(args.out or _default_out(scenario), args.force, _OUTPUT_FILES) as job:
@@ -594,7 +610,7 @@ def _simulate(argv):
             if exc.partial is None:
                 raise
             # What ran before the failure is kept for the user to inspect.
-            _write_results(exc.partial, out)
+            exc.partial.save(out)
             job.keep = True
             raise SimulationError(
                 f"{exc}; the run up to t = {exc.partial.summary['end_time_s']:g} s is in {out}") from None
@@ -614,16 +630,15 @@ def _simulate_into(args, scenario, movie_options, out, written):
     """
     from . import simulation
     result = simulation.run(scenario)
-    files = _write_results(result, out)
+    files = result.save(out)
     written.extend(files)
     if not result.summary["linear_stability"]["stable"]:
         # A warning, not a failure: the run is valid (the bicycle may well fall).
         print(f"simulate: warning: {result.summary['linear_stability']['message']}", file=sys.stderr)
     if not args.no_plot:
         from . import plotting
-        k = result.summary["kick"]
         plotting.response_figure([("", result)], out / "response.png", title=plotting.result_title(result),
-                                 kick=(k["start_s"], k["start_s"] + k["duration_s"]))
+                                 kick=plotting.kick_band(result))
         files.append("response.png")
         written.append("response.png")
     note = None
@@ -724,7 +739,25 @@ def _recommend(argv):
         print("\nwhat the best pressure depends on:")
         for line in verdicts:
             print(f"  {line}")
+    if args.out is not None:
+        import pathlib
+
+        import pandas as pd
+
+        from . import plotting
+        metric = recommend.CRITERIA[recommend.criterion_key(args.criterion)][0]
+        for (direction, form), by_load in recs.items():
+            name = SWEEP_FIGURE if len(variants) == 1 else SWEEP_FIGURE.replace(".png", f"_{direction}_{form}.png")
+            plotting.sweep_figure(pd.concat([rec.table.assign(fz_n=rec.fz_n) for rec in by_load], ignore_index=True),
+                                  x="pressure_kpa", y="fz_n", metric=metric, path=pathlib.Path(args.out) / name,
+                                  title=f"{args.tyre} ({form}, kicks to the {direction}): {metric} against "
+                                        "pressure, one line per rear load")
+            print(f"\nwrote {name} beside the sweep's table in {args.out}")
     return 0
+
+
+#: The figure ``recommend-pressure --out`` writes into its sweep folder.
+SWEEP_FIGURE = "recommendation.png"
 
 
 def recommend_main(argv=None):
@@ -737,6 +770,52 @@ def recommend_main(argv=None):
         print(f"recommend-pressure: {exc}", file=sys.stderr)
         status = 1
     sys.exit(status)
+
+
+# ------------------------------------------------------------------ compare
+
+#: Every file ``compare`` writes.
+_COMPARE_FILES = ("compare.png", "compare.csv")
+
+
+def _compare(argv):
+    import pathlib
+
+    p = _OneLineParser(
+        prog="compare", allow_abbrev=False,
+        description="Overlay kick-plate runs (folders written by simulate or Result.save) in one figure, each "
+                    "run's kick, fall, recovery time and 5 %% bands marked (compare.png), and tabulate their "
+                    "results side by side (compare.csv, printed).",
+        epilog="From Python: wk.plotting.compare(results), wk.results.compare_table(results). See docs/workflow.md.")
+    p.add_argument("runs", nargs="+", metavar="RUN_DIR", help="run folders (each with summary.json and trajectory.csv)")
+    p.add_argument("--labels", nargs="+", metavar="LABEL", help="one legend entry per run (default: the folder names)")
+    _output_options(p.add_argument_group("output"), "compare.png")
+    args = p.parse_args(argv)
+    from . import fileio, plotting, results
+    runs = [results.Result.load(folder) for folder in args.runs]
+    labels = args.labels or [pathlib.Path(folder).resolve().name for folder in args.runs]
+    if args.labels is None and len(set(labels)) < len(labels):
+        labels = results.run_labels(runs)
+    table = results.compare_table(runs, labels)
+    with _output_folder(args.out or _new_folder("compare"), args.force, _COMPARE_FILES) as job:
+        out = job.out
+        job.written.append("compare.csv")
+        fileio.write_csv(table.reset_index(), out / "compare.csv")
+        if not args.no_plot:
+            job.written.append("compare.png")
+            plotting.compare(runs, out / "compare.png", labels=labels,
+                             title=f"{len(runs)} runs compared: " + "; ".join(labels))
+    if not args.quiet:
+        import pandas as pd
+        with pd.option_context("display.max_colwidth", 40, "display.width", 200):
+            print(table.to_string(na_rep="-"))
+        print(f"  wrote {', '.join(n for n in _COMPARE_FILES if (out / n).exists())} in {out}")
+    return 0
+
+
+def compare_main(argv=None):
+    """Console script ``compare``: runs overlaid in one figure and their results side by side (``compare --help``)."""
+    sys.exit(_run(_compare, argv, "compare"))
 
 
 # ------------------------------------------------------------------ stability
@@ -772,7 +851,7 @@ def _stability_parser():
 def _stability(argv):
     import time
 
-    from . import assembly, stability
+    from . import assembly, provenance, stability
     from .scenario import Scenario
     args = _stability_parser().parse_args(argv)
     started = time.perf_counter()
@@ -785,6 +864,7 @@ def _stability(argv):
         job.written.extend(_STABILITY_FILES)   # written together at the end: any of them may be there
         result = stability.analyse(scenario, speeds)
         result.summary["numerics"] = {"wall_s": time.perf_counter() - started}
+        result.summary["provenance"] = provenance.record(provenance.input_files(scenario))
         files = stability.write(result, out, plot=not args.no_plot)
     missing = {loop: m["speeds_without_steady_motion"] for loop, m in result.summary["steady_motion"].items()
                if m["speeds_without_steady_motion"]}
@@ -864,8 +944,9 @@ def _validate(argv):
                                     duration=args.duration, rtol=args.rtol)
     for case in validation.experiments.load().cases.values():   # every flag checked before any run or folder
         assembly.preflight(base.with_changes(fz_n=case.fz_n, pressure_kpa=case.pressure_kpa))
-    out, created = _prepare_out(args.out or _new_folder("validation"), args.force, _VALIDATE_FILES)
-    try:
+    with _output_folder(args.out or _new_folder("validation"), args.force, _VALIDATE_FILES) as job:
+        out = job.out
+        job.written.extend(_VALIDATE_FILES)   # what a failure before the end removes
         result = validation.validate(base, directions=args.directions, workers=args.workers,
                                      time_origin=args.time_origin)
         if args.compare_transients:
@@ -874,9 +955,6 @@ def _validate(argv):
             result.summary["by_tyre_transient"] = validation.transient_summary(forms, verdicts)
         result.summary["wall_s"] = time.perf_counter() - started
         files = validation.write(result, out, plot=not args.no_plot)
-    except BaseException:
-        _discard(out, created, _VALIDATE_FILES)
-        raise
     if not args.quiet:
         print(f"validate: {len(result.runs)} model runs against the thesis' kick-plate measurements "
               f"(tyre transient {base.tyre_transient}, {base.speed:g} m/s, {base.kick_profile} kick at "

@@ -116,6 +116,20 @@ def _outcome(run):
     return fell, summary.get("fall_time_s") if fell else None, baseline, fall_angle, steer_limit
 
 
+def recovery_marks(run):
+    """(recovery time [s] or None, {column: (steady value, half band)}) of a Result; a DataFrame has none.
+
+    The bands are each rate's steady value +/- 5 % of its first peak from
+    steady (``summary["recovery"]["signals"]``): recovered from the time all
+    three rates stay inside theirs.
+    """
+    summary = getattr(run, "summary", None) or {}
+    recovery = summary.get("recovery", {})
+    bands = {name: (entry["steady_rad_s"], entry["band_rad_s"]) for name, entry in recovery.get("signals", {}).items()
+             if entry.get("band_rad_s") is not None}
+    return (recovery.get("time_s") if summary.get("recovered") else None), bands
+
+
 def response_figure(runs, path=None, title=None, kick=None, time_range=None, dpi=150):
     """Plot the response panels for one or more runs.
 
@@ -123,8 +137,8 @@ def response_figure(runs, path=None, title=None, kick=None, time_range=None, dpi
     ----------
     runs : sequence of (label, Result or DataFrame)
         Runs to overlay; DataFrames need the columns of :data:`RESPONSE_PANELS`,
-        ``time`` [s] and ``roll`` [rad]. A Result's fall and steady turn are
-        marked.
+        ``time`` [s] and ``roll`` [rad]. A Result's fall, steady turn, recovery
+        time and 5 % bands (:func:`recovery_marks`) are marked.
     path : str or pathlib.Path, optional
         Write a PNG there.
     title : str, optional
@@ -158,11 +172,14 @@ def response_figure(runs, path=None, title=None, kick=None, time_range=None, dpi
     axes = fig.subplots(len(RESPONSE_PANELS), 1, sharex=True)
     limits = {column: [] for column, _ in RESPONSE_PANELS}
     baselines = []
+    marked = False
     for k, (label, run) in enumerate(runs):
         df = _frame_of(run)
         fell, fall_time, baseline, fall_angle, steer_limit = _outcome(run)
+        recovered_at, bands = recovery_marks(run)
         color = f"C{k}"
-        text = f"{label} (fell at {fall_time:.3f} s)" if fell and label else label
+        text = (f"{label} (fell at {fall_time:.3f} s)" if fell and label else
+                f"{label} (recovered at {recovered_at:.2f} s)" if recovered_at is not None and label else label)
         t = df["time"].to_numpy()
         for ax, (column, _) in zip(axes, RESPONSE_PANELS, strict=True):
             ax.plot(t, df[column], lw=1.2, label=text, color=color)
@@ -170,6 +187,17 @@ def response_figure(runs, path=None, title=None, kick=None, time_range=None, dpi
                                                 df["steer"] if "steer" in df else None, steer_limit))
             if fell:
                 ax.axvline(fall_time, color=color, lw=1.0, ls="--", gid="fall")
+            if column in bands:
+                steady, band = bands[column]
+                for level in (steady - band, steady + band):
+                    ax.axhline(level, color=color, lw=0.6, ls=(0, (4, 3)), alpha=0.7, gid="band")
+            if recovered_at is not None:
+                ax.axvline(recovered_at, color=color, lw=1.0, ls="-.", gid="recovery")
+        if recovered_at is not None:
+            axes[0].text(recovered_at, 0.97 - 0.09 * k, f"recovered at {recovered_at:.2f} s", color=color, fontsize=8,
+                         ha="left", va="top", gid="recovery", transform=mtransforms.blended_transform_factory(
+                             axes[0].transData, axes[0].transAxes))
+        marked |= bool(bands)
         if fell:
             # Stacked below the top panel's upper edge when several runs fall.
             axes[0].text(fall_time, 0.97 - 0.09 * k, f"fell at {fall_time:.3f} s", color=color, fontsize=8,
@@ -198,6 +226,10 @@ def response_figure(runs, path=None, title=None, kick=None, time_range=None, dpi
         what = "steady motion (the run starts upright)" if upright else "steady turn before the kick"
         axes[0].text(0.01, 0.03, f"dotted: {what}, {value} (the yaw-rate baseline)",
                      fontsize=7.5, color="0.25", transform=axes[0].transAxes, ha="left", va="bottom", gid="baseline")
+    if marked:
+        axes[1].text(0.01, 0.03, "dashed: steady value +/- 5 % of the first peak; dash-dot: recovered (all three "
+                     "rates inside their bands from then on)", fontsize=7.5, color="0.25", transform=axes[1].transAxes,
+                     ha="left", va="bottom", gid="band")
     axes[-1].set_xlabel("time from kick start [s]")
     if time_range is not None:
         axes[-1].set_xlim(*time_range)
@@ -208,10 +240,198 @@ def response_figure(runs, path=None, title=None, kick=None, time_range=None, dpi
         fig.suptitle("\n".join(lines), fontsize=10)
     top = RESPONSE_TOP - (RESPONSE_TITLE_LINE * (len(lines) + 1) if lines else 0.0)
     fig.subplots_adjust(top=top, **RESPONSE_MARGINS)
+    return _written(fig, path, dpi)
+
+
+def _written(fig, path, dpi):
+    """``fig``, or None once it is written to ``path`` as PNG (when a path is given)."""
     if path is None:
         return fig
     fig.savefig(path, dpi=dpi, pil_kwargs={"compress_level": PNG_COMPRESS_LEVEL})
     return None
+
+
+def kick_band(result):
+    """(start, end) [s] of a Result's kick, from its summary."""
+    k = result.summary["kick"]
+    return k["start_s"], k["start_s"] + k["duration_s"]
+
+
+def compare(results, path=None, labels=None, title=None, time_range=None, dpi=150):
+    """One figure overlaying runs, each with its kick, fall, recovery time and 5 % bands marked.
+
+    The response panels of :func:`response_figure`, one colour per run; the
+    legend names each run and its fall or recovery time. Runs with different
+    kicks get a band each, in their colour. The table of their metrics side
+    by side is :func:`whipple_kick.results.compare_table`.
+
+    Parameters
+    ----------
+    results : sequence of Result
+        Runs (from :func:`whipple_kick.run` or :meth:`whipple_kick.Result.load`).
+    path : str or pathlib.Path, optional
+        Write a PNG there.
+    labels : sequence of str, optional
+        Legend entries (default :func:`whipple_kick.results.run_labels`: the
+        scenario fields in which the runs differ).
+    title, time_range, dpi
+        As :func:`response_figure`.
+
+    Returns
+    -------
+    matplotlib.figure.Figure or None
+        The figure, or None when it was written to ``path``.
+
+    Example
+    -------
+    >>> import whipple_kick as wk
+    >>> runs = [wk.run(wk.Scenario(pressure_kpa=p, duration=4.0)) for p in (300.0, 500.0)]
+    >>> runs.append(wk.run(wk.Scenario(controller="off", duration=3.0)))
+    >>> fig = wk.plotting.compare(runs)
+    >>> [t.get_text() for t in fig.axes[0].get_legend().get_texts()][2]
+    'pressure_kpa=400, controller=off, duration=3 (fell at 1.585 s)'
+    """
+    from .errors import InputError
+    from .results import checked_labels
+
+    results = list(results)
+    if not results:
+        raise InputError("nothing to compare: give at least one run")
+    labels = checked_labels(results, labels)
+    kicks = [kick_band(r) for r in results]
+    same = len(set(kicks)) == 1
+    fig = response_figure(list(zip(labels, results, strict=True)), title=title, time_range=time_range,
+                          kick=kicks[0] if same else None)
+    if not same:
+        for k, (start, end) in enumerate(kicks):
+            for ax in fig.axes:
+                ax.axvspan(start, end, color=f"C{k}", alpha=0.15, zorder=0, gid="kick")
+    return _written(fig, path, dpi)
+
+
+#: Kinds of :func:`sweep_figure`.
+SWEEP_KINDS = ("lines", "heatmap")
+
+
+def _sweep_cells(table, x, metric, y):
+    """Per case: (x, y or None, metric value or NaN, fell, failed), duplicates of (x, y) refused."""
+    import pandas as pd
+
+    from .errors import InputError
+    for name in (x, metric) + (() if y is None else (y,)):
+        if name not in table.columns:
+            raise InputError(f"column {name!r} is not in the sweep table ({len(table.columns)} columns, e.g. "
+                             "pressure_kpa, fz_n, recovery.time_s, last_peak_time_s; see table.columns)")
+    keys = [x] if y is None else [x, y]
+    if table.duplicated(subset=keys).any():
+        raise InputError(f"several cases share the same {' and '.join(keys)} (the sweep varies other fields too); "
+                         "select the rows of one figure first, e.g. table[table['speed'] == 3.0]")
+    values = pd.to_numeric(table[metric], errors="coerce").to_numpy(dtype=float)
+    fell = (table["fell"] == True).to_numpy() if "fell" in table else np.zeros(len(table), bool)   # noqa: E712
+    failed = (table["status"] != "ok").to_numpy() if "status" in table else np.zeros(len(table), bool)
+    return table[x].to_numpy(dtype=float), None if y is None else table[y].to_numpy(), values, fell, failed
+
+
+def sweep_figure(table, x, metric, y=None, kind="lines", path=None, title=None, dpi=150):
+    """A sweep's ``metric`` against ``x`` (a line per ``y`` value, or a heat map of x by y), fallen cases marked.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        A sweep table (:func:`whipple_kick.sweep`, table.csv of a sweep
+        folder, :attr:`whipple_kick.recommend.Recommendation.table`): one row
+        per case, ``fell`` and ``status`` used when present.
+    x : str
+        Column along the horizontal axis (e.g. ``"pressure_kpa"``).
+    metric : str
+        Column plotted (e.g. ``"recovery.time_s"``, ``"last_peak_time_s"``).
+    y : str, optional
+        Column that tells the lines apart (or, in a heat map, the vertical axis),
+        e.g. ``"fz_n"``.
+    kind : {"lines", "heatmap"}
+        Lines: a case that fell is an x at the top of the axes (it has no
+        recovery time), a failed case a hollow square. Heat map (needs ``y``):
+        each cell says its value, "fell" or "failed".
+    path, title, dpi
+        As :func:`response_figure`.
+
+    Returns
+    -------
+    matplotlib.figure.Figure or None
+        The figure, or None when it was written to ``path``.
+
+    Raises
+    ------
+    InputError
+        A column is missing, ``kind`` is unknown, or several cases share one
+        point (x, y).
+
+    Example
+    -------
+    >>> import whipple_kick as wk
+    >>> table = wk.sweep({"pressure_kpa": [300, 400, 500], "fz_n": [570, 701]}, progress=False)
+    >>> fig = wk.plotting.sweep_figure(table, x="pressure_kpa", y="fz_n", metric="recovery.time_s")
+    >>> [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    ['fz_n = 570', 'fz_n = 701']
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    import matplotlib.transforms as mtransforms
+
+    from .errors import InputError
+    if kind not in SWEEP_KINDS:
+        raise InputError(f"sweep figure kind {kind!r} is unknown; choose one of {', '.join(SWEEP_KINDS)}")
+    if kind == "heatmap" and y is None:
+        raise InputError("a heat map needs y, the column of its vertical axis (e.g. y='fz_n')")
+    xs, ys, values, fell, failed = _sweep_cells(table, x, metric, y)
+    fig = Figure(figsize=(7.0, 4.5))
+    FigureCanvasAgg(fig)
+    ax = fig.subplots()
+    if kind == "lines":
+        groups = [(None, np.ones(xs.size, bool))] if y is None else [(v, ys == v) for v in sorted(set(ys))]
+        top = mtransforms.blended_transform_factory(ax.transData, ax.transAxes)
+        for k, (value, rows) in enumerate(groups):
+            order = np.flatnonzero(rows)[np.argsort(xs[rows], kind="stable")]
+            color = f"C{k}"
+            label = None if y is None else (f"{y} = {value:g}" if isinstance(value, (int, float, np.number))
+                                            else f"{y} = {value}")
+            ax.plot(xs[order], values[order], marker="o", ms=4, color=color, label=label, gid="metric")
+            down = order[fell[order]]
+            ax.plot(xs[down], np.full(down.size, 0.96), ls="none", marker="x", ms=8, mew=2, color=color,
+                    transform=top, gid="fell")
+            broken = order[failed[order] & ~fell[order]]
+            ax.plot(xs[broken], np.full(broken.size, 0.96), ls="none", marker="s", mfc="none", color=color,
+                    transform=top, gid="failed")
+        ax.set_xlabel(x)
+        ax.set_ylabel(metric)
+        ax.grid(True, lw=0.4, alpha=0.5)
+        if y is not None:
+            ax.legend(fontsize=8, loc="best")
+        if fell.any() or failed.any():
+            ax.text(0.01, 0.02, "x at the top: the case fell (no value); hollow square: it failed", fontsize=7.5,
+                    color="0.25", transform=ax.transAxes, gid="fell")
+    else:
+        columns, rows = sorted(set(xs)), sorted(set(ys))
+        grid = np.full((len(rows), len(columns)), np.nan)
+        for xv, yv, v in zip(xs, ys, values, strict=True):
+            grid[rows.index(yv), columns.index(xv)] = v
+        mesh = ax.pcolormesh(np.arange(len(columns) + 1) - 0.5, np.arange(len(rows) + 1) - 0.5,
+                             np.ma.masked_invalid(grid), cmap="viridis", gid="metric")
+        fig.colorbar(mesh, ax=ax, label=metric)
+        for xv, yv, v, down, broken in zip(xs, ys, values, fell, failed, strict=True):
+            text, gid = (("fell", "fell") if down else ("failed", "failed") if broken else
+                         ("-" if not np.isfinite(v) else f"{v:.3g}", "value"))
+            ax.text(columns.index(xv), rows.index(yv), text, ha="center", va="center", fontsize=8, gid=gid,
+                    color="k" if gid != "value" else "w")
+        ax.set_xticks(range(len(columns)), [f"{v:g}" for v in columns])
+        ax.set_yticks(range(len(rows)), [f"{v:g}" if isinstance(v, (int, float, np.number)) else str(v)
+                                         for v in rows])
+        ax.set_xlabel(x)
+        ax.set_ylabel(y)
+    if title:
+        ax.set_title(title, fontsize=10)
+    fig.tight_layout()
+    return _written(fig, path, dpi)
 
 
 def controller_text(summary):

@@ -32,9 +32,9 @@ from .sweep_engine import check_some_ok, sweep
 #: :func:`whipple_kick.analysis.recovery`: the time from which yaw, roll and
 #: steer rates all stay within 5 % of their first peaks (``recovery.time_s``).
 #: ``last_peak`` is the thesis' rule (time of the last yaw-rate peak above 8 %
-#: of the largest, Section 8.3, Table 8.9; ``last_peak_time``).
-CRITERIA = {"settling": ("recovery.time_s", "last_peak_time"),
-            "last_peak": ("last_peak_time", "recovery.time_s")}
+#: of the largest, Section 8.3, Table 8.9; ``last_peak_time_s``).
+CRITERIA = {"settling": ("recovery.time_s", "last_peak_time_s"),
+            "last_peak": ("last_peak_time_s", "recovery.time_s")}
 _CRITERION_TEXT = {"last_peak": "last-peak time (last yaw-rate peak above 8 % of the largest, thesis)",
                    "settling": "recovery time (yaw, roll and steer rates within 5 % of their first peaks)"}
 #: Spread [s] of each criterion's value, below which a difference between pressures is not to be
@@ -85,9 +85,9 @@ class Recommendation:
         choose"`` (one pressure) or ``"none recovered"``.
     table : pandas.DataFrame
         One row per pressure: ``pressure_kpa``, ``measured``,
-        ``recovery.time_s`` [s], ``last_peak_time`` [s], the yaw, roll and
+        ``recovery.time_s`` [s], ``last_peak_time_s`` [s], the yaw, roll and
         steer rates' settling times [s], ``n_peaks``, ``damping_ratio_1_3``,
-        ``period`` [s], ``max_abs_roll`` [rad], ``fell``, ``status``,
+        ``period_s``, ``peaks.max_abs_roll_absolute_rad``, ``fell``, ``status``,
         ``error``, ``rank``.
     """
 
@@ -182,9 +182,9 @@ def _verdict(rows, criterion):
 
 #: Columns of :attr:`Recommendation.table`.
 _RECOMMENDATION_COLUMNS = (
-    "pressure_kpa", "measured", "recovery.time_s", "last_peak_time", "recovery.signals.yaw_rate.time_s",
+    "pressure_kpa", "measured", "recovery.time_s", "last_peak_time_s", "recovery.signals.yaw_rate.time_s",
     "recovery.signals.roll_rate.time_s", "recovery.signals.steer_rate.time_s", "n_peaks",
-    "damping_ratio_1_3", "period", "max_abs_roll", "fell", "status", "error")
+    "damping_ratio_1_3", "period_s", "peaks.max_abs_roll_absolute_rad", "fell", "status", "error")
 
 
 def recommend_pressures(loads, tyre="T03", pressures=None, fine=False, step_kpa=10.0, base=None,
@@ -316,8 +316,8 @@ def format_recommendation(rec):
         lines.append(
             f"{r['pressure_kpa']:8g} {'yes' if r['measured'] else '':>5} "
             f"{cell(r['recovery.time_s'], '{:.3f}'):>12} {settle:>25} "
-            f"{cell(r['last_peak_time'], '{:.3f}'):>13} {cell(r['damping_ratio_1_3'], '{:.4f}'):>8} "
-            f"{cell(r['max_abs_roll'], '{:.2f}', 180.0 / math.pi):>14} {int(r['rank']):4d}  {note}")
+            f"{cell(r['last_peak_time_s'], '{:.3f}'):>13} {cell(r['damping_ratio_1_3'], '{:.4f}'):>8} "
+            f"{cell(r['peaks.max_abs_roll_absolute_rad'], '{:.2f}', 180.0 / math.pi):>14} {int(r['rank']):4d}  {note}")
     head = f"recommendation for {rec.fz_n:g} N: "
     if rec.verdict == "nothing to choose":
         only = float(rec.table["pressure_kpa"].iloc[0])

@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from . import energy, lsoda, slip
+from . import energy, lsoda, provenance, slip
 from .errors import InputError, SimulationError
 
 #: Significant digits of trajectory.csv's floats: a relative round-off of at most 5e-13, far below the
@@ -67,7 +67,7 @@ UNITS = {"time": "s", **dict(COORDINATE_COLUMNS.values()), **dict(SPEED_COLUMNS.
          **dict.fromkeys(PATCH_STATE_COLUMNS.values(), "rad"), **dict.fromkeys(CARCASS_STATE_COLUMNS.values(), "m"),
          **{c: slip.OUTPUTS[o][0] for o, c in {**APPLIED_COLUMNS, **OUTPUT_COLUMNS}.items()},
          **dict(energy.COLUMNS.values()), BALANCE_COLUMN: "J"}
-#: Columns whose peaks after the kick the summary lists (``max_abs_<column>``).
+#: Columns whose largest absolute values after the kick the summary lists (``max_abs_<column>_absolute_<unit>``).
 PEAK_COLUMNS = ("yaw_rate", "roll_rate", "steer_rate", "roll", "steer", "slip_rear", "fy_rear", "fy_front",
                 "steer_torque")
 
@@ -89,6 +89,96 @@ class Result:
     scenario: "object"
     trajectory: "object"
     summary: dict = field(default_factory=dict)
+
+    def save(self, folder) -> list:
+        """Write the run into ``folder`` as ``simulate`` does: trajectory.csv, summary.json, scenario.toml.
+
+        Each file is written atomically; the folder is created if needed.
+        trajectory.csv holds every column with its unit in the header
+        (:func:`with_units`), to :data:`TRAJECTORY_CSV_DIGITS` significant
+        digits; scenario.toml reruns the run (``simulate --scenario``,
+        :meth:`whipple_kick.scenario.Scenario.from_file`).
+
+        Returns
+        -------
+        list of str
+            The names of the files written.
+
+        Example
+        -------
+        >>> import whipple_kick as wk
+        >>> result = wk.run(wk.Scenario(duration=1.0))
+        >>> result.save("kick_run")
+        ['trajectory.csv', 'summary.json', 'scenario.toml']
+        """
+        import json
+        import pathlib
+
+        from . import fileio
+        out = pathlib.Path(folder)
+        out.mkdir(parents=True, exist_ok=True)
+        fileio.write_csv(with_units(self.trajectory), out / TRAJECTORY_FILE, significant_digits=TRAJECTORY_CSV_DIGITS)
+        fileio.write_atomic(out / SUMMARY_FILE, json.dumps(self.summary, indent=2, allow_nan=False) + "\n")
+        self.scenario.to_file(out / SCENARIO_FILE, note=_scenario_note(self.summary))
+        return [TRAJECTORY_FILE, SUMMARY_FILE, SCENARIO_FILE]
+
+    @classmethod
+    def load(cls, folder) -> "Result":
+        """The :class:`Result` of a run folder written by :meth:`save` (or ``simulate``).
+
+        The summary is the one written (exactly), the trajectory equals the
+        run's to trajectory.csv's precision (relative 5e-13), the scenario is
+        the summary's (file paths in it as the run was given them; the
+        folder's scenario.toml has them absolute, to rerun it from anywhere);
+        figures, metrics and :meth:`save` work on it as on the result
+        :func:`whipple_kick.run` returned. The input files need not exist.
+
+        Raises
+        ------
+        InputError
+            ``folder`` is not a run folder (no summary.json or trajectory.csv) or a file in it is unreadable.
+
+        Example
+        -------
+        >>> import whipple_kick as wk
+        >>> result = wk.Result.load("kick_run")        # doctest: +SKIP
+        >>> result.summary["recovered"], result.trajectory["yaw_rate"].iloc[-1]   # doctest: +SKIP
+        (True, 0.0945...)
+        """
+        import json
+        import pathlib
+
+        from .scenario import Scenario
+        path = pathlib.Path(folder)
+        if not path.is_dir():
+            raise InputError(f"run folder {str(path)!r} {'is not a folder' if path.exists() else 'does not exist'}")
+        for name in (SUMMARY_FILE, TRAJECTORY_FILE):
+            if not (path / name).is_file():
+                raise InputError(f"{str(path)!r} is not a run folder: it has no {name} (simulate writes "
+                                 f"{TRAJECTORY_FILE} and {SUMMARY_FILE})")
+        try:
+            summary = json.loads((path / SUMMARY_FILE).read_text(encoding="utf-8"))
+            scenario = Scenario(**summary["scenario"])
+        except (ValueError, KeyError, TypeError) as exc:
+            raise InputError(f"{str(path / SUMMARY_FILE)!r} is not a run summary: {exc}") from None
+        return cls(scenario=scenario, trajectory=read_trajectory(path / TRAJECTORY_FILE), summary=summary)
+
+
+#: The files of a run folder (:meth:`Result.save`).
+TRAJECTORY_FILE = "trajectory.csv"
+SUMMARY_FILE = "summary.json"
+SCENARIO_FILE = "scenario.toml"
+
+
+def _scenario_note(summary):
+    """What scenario.toml cannot rerun of a run made with Python objects (custom tyres or gains), or None."""
+    custom = [what for what, used in (
+        ("tyre objects", str(summary.get("tyres", {}).get("name", "")).startswith("custom")),
+        ("steer-torque gains", summary.get("controller", {}).get("type") == "custom gains")) if used]
+    if not custom:
+        return None
+    return (f"this run used custom {' and '.join(custom)} given in Python (wk.run(..., tyres=, gains=)); "
+            "this file alone does not reproduce them")
 
 
 def trajectory_frame(solution, tyre_transient="carcass"):
@@ -172,22 +262,78 @@ def response_metrics(df, baseline, x0, scenario, traj):
     try:
         metrics = analysis.kick_metrics(df, t_kick=0.0, baseline=baseline, include_spectra=False,
                                         fall_roll=fall_roll)
-        rec = analysis.recovery(df, 0.0, {name: float(x0[slip.X[state]]) for name, state in
-                                          (("yaw_rate", "u3"), ("roll_rate", "u4"), ("steer_rate", "u7"))},
-                                ended=ended)
+        rec = analysis.recovery(df, 0.0, rate_baselines(x0), ended=ended)
     except InputError as exc:   # a failure so early that too little of the response exists
         metrics = {"unavailable": {"all": f"no response to analyse: {exc}"}}
         rec = {"time_s": None, "reason": ended or str(exc), "signals": {}}
-    # The integrator's event is exact; kick_metrics sees |roll| only up to the limit.
-    metrics["fell"] = bool(traj.fell)
-    metrics["fall_time"] = traj.fall_time
+    # The fall is the integrator's exact event (summary fell, fall_time_s): kick_metrics' own estimate of it,
+    # from |roll| up to the limit, is left out of the summary (DUPLICATE_METRICS).
     unavailable = metrics.setdefault("unavailable", {})
-    if traj.fell:
-        unavailable.pop("fall_time", None)
     if ended is not None and metrics.get("last_peak_time") is not None:
         # The last peak above 8 % before a fall or a failure is not the end of the response.
         metrics["last_peak_time"], unavailable["last_peak_time"] = None, ended
     return metrics, rec
+
+
+#: The recovery's signals and the states they are: column -> state.
+RECOVERY_STATES = {"yaw_rate": "u3", "roll_rate": "u4", "steer_rate": "u7"}
+
+
+def rate_baselines(x0):
+    """Steady value [rad/s] of each recovery signal (:data:`RECOVERY_STATES`) in the state ``x0``."""
+    return {name: float(x0[slip.X[state]]) for name, state in RECOVERY_STATES.items()}
+
+
+def unit_suffix(unit):
+    """A unit as a key suffix, as every summary key ends: ``"rad/s"`` -> ``"rad_s"``, ``"N m"`` -> ``"n_m"``.
+
+    Example
+    -------
+    >>> unit_suffix("rad/s"), unit_suffix("N m"), unit_suffix("m/s^2")
+    ('rad_s', 'n_m', 'm_s2')
+    """
+    return unit.lower().replace("/", "_").replace(" ", "_").replace("^", "")
+
+
+#: Summary keys of the :func:`whipple_kick.analysis.kick_metrics` entries renamed to carry their unit and
+#: reference (CHANGELOG.md lists old -> new); the ``period_*`` entries get ``_s``, dimensionless ones
+#: (``n_peaks``, ``log_decrement_*``, ``damping_ratio_*``) keep their names.
+METRIC_KEYS = {"peak_times": "yaw_rate_peak_times_s", "peak_values": "yaw_rate_peaks_from_steady_rad_s",
+               "last_peak_time": "last_peak_time_s"}
+#: kick_metrics entries the summary holds once elsewhere: ``fell``, ``fall_time_s`` at the top, the largest
+#: absolute values in ``peaks``.
+DUPLICATE_METRICS = ("fell", "fall_time", *(f"max_abs_{name}" for name in PEAK_COLUMNS))
+
+
+def metric_key(name):
+    """The summary key of a :func:`whipple_kick.analysis.kick_metrics` entry (:data:`METRIC_KEYS`).
+
+    Example
+    -------
+    >>> metric_key("last_peak_time"), metric_key("period_1_3"), metric_key("damping_ratio_1_3")
+    ('last_peak_time_s', 'period_1_3_s', 'damping_ratio_1_3')
+    """
+    return METRIC_KEYS.get(name, f"{name}_s" if name.startswith("period") else name)
+
+
+def _summary_metrics(metrics):
+    """(metrics, unavailable) of the summary: keys renamed by :func:`metric_key`, duplicates left out."""
+    values = {metric_key(k): v for k, v in metrics.items() if k != "unavailable" and k not in DUPLICATE_METRICS}
+    missing = {metric_key(k): v for k, v in metrics["unavailable"].items() if k not in DUPLICATE_METRICS}
+    return values, missing
+
+
+def _recovery_section(recovery, baselines):
+    """The recovery with each signal's first peak named "from steady", its steady value and its 5 % band."""
+    from . import analysis
+
+    signals = {}
+    for name, entry in recovery["signals"].items():
+        peak = entry["first_peak_rad_s"]
+        signals[name] = {"first_peak_from_steady_rad_s": peak, "steady_rad_s": baselines[name],
+                         "band_rad_s": None if peak is None else analysis.SETTLING_FRACTION * abs(peak),
+                         "time_s": entry["time_s"], "reason": entry["reason"]}
+    return {**recovery, "signals": signals}
 
 
 def clean(value):
@@ -273,8 +419,12 @@ def summarise(scenario, kick, assembly, solution, frame, *, custom_tyres=False) 
     traj = solution.trajectory
     baseline = float(assembly.reference.x[slip.X["u3"]])
     metrics, recovery = response_metrics(frame, baseline, assembly.reference.x, scenario, traj)
+    recovery = _recovery_section(recovery, rate_baselines(assembly.reference.x))
+    metrics, unavailable = _summary_metrics(metrics)
     summary = {
         "outcome": "failed" if traj.failed else "fell" if traj.fell else "completed",
+        # Recovered: yaw, roll and steer rates all settled within 5 % of their first peaks (recovery.time_s).
+        "recovered": not (traj.failed or traj.fell) and recovery["time_s"] is not None,
         "fell": bool(traj.fell),
         "fall_time_s": traj.fall_time,
         "fall_reason": traj.fall_reason,
@@ -291,11 +441,12 @@ def summarise(scenario, kick, assembly, solution, frame, *, custom_tyres=False) 
         "peaks": _peaks(frame),
         "energy": _energy_summary(frame, solution.jumps, scenario),
         "recovery": recovery,
-        "metrics": {k: v for k, v in metrics.items() if k != "unavailable"},
-        "metrics_unavailable": metrics["unavailable"],
+        "metrics": metrics,
+        "metrics_unavailable": unavailable,
         "numerics": _numerics_section(scenario, solution, frame),
         "scenario": scenario.to_dict(),
         "units": {column: UNITS[column] for column in frame.columns},
+        "provenance": provenance.record(provenance.input_files(scenario, custom_tyres)),
     }
     return clean(summary)
 
@@ -414,9 +565,9 @@ def _controller_section(scenario, assembly):
         "gains": gains,
         "gain_units": {name: symbols.info(name).unit for name in gains},
         "law": assembly_module.control_law(gains),
-        # At the run's speed, for the gains used (the LQR design's own poles are at its design speed).
-        "linear_closed_loop_poles": assembly.stability["poles_no_slip_model_1_s"],
-        "design_poles": None if poles is None else [[p.real, p.imag] for p in poles],
+        # The LQR design's own poles, at its design speed (at the run's speed, for the gains used:
+        # linear_stability.poles_no_slip_model_1_s).
+        "design_poles_1_s": None if poles is None else [[p.real, p.imag] for p in poles],
     }
 
 
@@ -446,8 +597,8 @@ def _steady_section(scenario, assembly, baseline):
 
 def _peaks(frame):
     after = frame["time"].to_numpy() >= 0.0
-    return {f"max_abs_{name}": float(np.max(np.abs(frame[name].to_numpy()[after]), initial=0.0))
-            for name in PEAK_COLUMNS}
+    return {f"max_abs_{name}_absolute_{unit_suffix(UNITS[name])}":
+            float(np.max(np.abs(frame[name].to_numpy()[after]), initial=0.0)) for name in PEAK_COLUMNS}
 
 
 def _numerics_section(scenario, solution, frame):
@@ -464,3 +615,81 @@ def _numerics_section(scenario, solution, frame):
         "max_abs_holonomic_m": float(np.max(np.abs(frame["holonomic_residual"]))),
         "model_hash": slip.model_hash(),
     }
+
+
+# ------------------------------------------------------------------ comparing runs
+
+#: Rows of :func:`compare_table`: the results by their sweep-table names
+#: (:func:`whipple_kick.sweep_engine.flatten_summary`), then the set-up.
+COMPARE_ROWS = (
+    "outcome", "recovered", "fall_time_s", "fall_reason", "recovery.time_s", "recovery.last_to_settle",
+    *(f"recovery.signals.{name}.time_s" for name in RECOVERY_STATES),
+    *(f"recovery.signals.{name}.first_peak_from_steady_rad_s" for name in RECOVERY_STATES),
+    "last_peak_time_s", "damping_ratio_1_3", "period_s",
+    *(f"peaks.max_abs_{name}_absolute_{unit_suffix(UNITS[name])}" for name in PEAK_COLUMNS),
+    "tyres.name", "tyres.pressure_rear_kpa", "tyres.pressure_front_kpa", "tyres.transient",
+    "bicycle.static_load_rear_n", "steady_state.speed_m_s", "controller.type", "controller.gain_scale",
+    "kick.displacement_m", "kick.duration_s", "kick.direction", "end_time_s",
+)
+
+
+def run_labels(results):
+    """A short label per run: the scenario fields in which the runs differ (``"pressure_kpa=300"``), else "run k".
+
+    Example
+    -------
+    >>> from whipple_kick.scenario import Scenario
+    >>> runs = [Result(Scenario(pressure_kpa=p), None) for p in (300.0, 400.0)]
+    >>> run_labels(runs)
+    ['pressure_kpa=300', 'pressure_kpa=400']
+    """
+    fields = [r.scenario.to_dict() for r in results]
+    differ = [name for name in fields[0] if len({repr(f[name]) for f in fields}) > 1] if fields else []
+    labels = [", ".join(f"{name}={f[name]:g}" if isinstance(f[name], float) else f"{name}={f[name]}"
+                        for name in differ) for f in fields]
+    if not differ or len(set(labels)) < len(labels):
+        return [f"run {k + 1}" for k in range(len(results))]
+    return labels
+
+
+def checked_labels(results, labels=None):
+    """``labels`` as a list, one per run (default :func:`run_labels`); InputError when the counts differ."""
+    labels = run_labels(results) if labels is None else list(labels)
+    if len(labels) != len(results):
+        raise InputError(f"{len(labels)} labels for {len(results)} runs; give one label per run")
+    return labels
+
+
+def compare_table(results, labels=None):
+    """The runs' results side by side: one row per quantity (:data:`COMPARE_ROWS`), one column per run.
+
+    Parameters
+    ----------
+    results : sequence of Result
+    labels : sequence of str, optional
+        Column names (default :func:`run_labels`).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Index ``quantity`` (the summary's names, units in them); None where a
+        run has no value (e.g. the fall time of a run that recovered).
+
+    Example
+    -------
+    >>> import whipple_kick as wk
+    >>> runs = [wk.run(wk.Scenario(controller=c, duration=3.0)) for c in ("lqr", "off")]
+    >>> compare_table(runs).loc["outcome"].tolist()
+    ['completed', 'fell']
+    """
+    import pandas as pd
+
+    from .sweep_engine import flatten_summary
+
+    labels = checked_labels(results, labels)
+    columns = {}
+    for label, result in zip(labels, results, strict=True):
+        flat = flatten_summary(result.summary)
+        columns[label] = [flat.get(row) for row in COMPARE_ROWS]
+    frame = pd.DataFrame(columns, index=pd.Index(COMPARE_ROWS, name="quantity"), dtype=object)
+    return frame.where(frame.notna(), None)

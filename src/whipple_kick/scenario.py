@@ -15,7 +15,7 @@ Example
 >>> sc.pressures, sc.with_changes(speed=4.0).lqr_design_speed
 ((300.0, 300.0), 4.0)
 """
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, dataclass, fields, replace
 
 from . import carcass, inputs, transient
 from .errors import InputError, check_range
@@ -339,6 +339,96 @@ class Scenario:
         """Fields as a plain dict (JSON-ready)."""
         return asdict(self)
 
+    def to_file(self, path, *, note=None) -> None:
+        """Write the scenario as a TOML file that :meth:`from_file` (and ``simulate --scenario``) reads back.
+
+        Every field is written, ``None`` as the string ``"none"`` (TOML has no
+        null). File paths (``kick_table``, a ``bicycle`` given as a path) are
+        written absolute, so the file reruns the case from any folder.
+        ``note`` adds a comment line (e.g. what the file cannot reproduce).
+
+        Example
+        -------
+        >>> import pathlib, tempfile
+        >>> path = pathlib.Path(tempfile.mkdtemp()) / "scenario.toml"
+        >>> Scenario(pressure_kpa=300.0, design_speed=3.0).to_file(path)
+        >>> Scenario.from_file(path) == Scenario(pressure_kpa=300.0, design_speed=3.0)
+        True
+        """
+        import json
+        import pathlib
+
+        from . import fileio
+        lines = ["# whipple_kick scenario: one kick-plate run. Rerun it with `simulate --scenario FILE` (flags override",
+                 "# its values) or wk.run(wk.Scenario.from_file(FILE)). Units: SI, pressures in kPa; \"none\": the",
+                 "# field's rule for no value (see help(wk.Scenario)). Paths relative to this file's folder."]
+        if note:
+            lines.append(f"# NOTE: {note}")
+        for name, value in asdict(self).items():
+            if value is not None and name in _PATH_FIELDS and _is_path(name, value):
+                value = str(pathlib.Path(value).resolve())
+            text = ('"none"' if value is None else ("true" if value else "false") if isinstance(value, bool)
+                    else repr(float(value)) if isinstance(value, (int, float)) else json.dumps(str(value)))
+            lines.append(f"{name} = {text}")
+        fileio.write_atomic(path, "\n".join(lines) + "\n")
+
+    @classmethod
+    def from_file(cls, path) -> "Scenario":
+        """The scenario of a TOML file (as :meth:`to_file` writes it; keys left out keep their defaults), validated.
+
+        Relative paths in it (``kick_table``, a ``bicycle`` path) are taken
+        relative to the file's folder.
+
+        Raises
+        ------
+        InputError
+            One line naming the file and the bad key or value: a missing or
+            non-TOML file, an unknown key, a value of the wrong type, or a
+            value out of range (:meth:`validate`).
+
+        Example
+        -------
+        >>> sc = Scenario.from_file("kick_run/scenario.toml")    # doctest: +SKIP
+        >>> wk.run(sc.with_changes(pressure_kpa=300.0))          # doctest: +SKIP
+        """
+        import math
+        import pathlib
+
+        from .parameters import tomllib
+        file = pathlib.Path(path)
+        label = f"scenario file {str(path)!r}"
+        try:
+            with open(file, "rb") as fh:
+                data = tomllib.load(fh)
+        except FileNotFoundError:
+            raise InputError(f"{label} does not exist") from None
+        except IsADirectoryError:
+            raise InputError(f"{label} is a folder, not a file") from None
+        except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+            raise InputError(f"{label} is not valid TOML: {exc}") from None
+        types = {f.name: f.type for f in fields(cls)}
+        values = {}
+        for key, value in data.items():
+            if key not in types:
+                raise InputError(f"{label}: unknown key {key!r}; known keys: {', '.join(types)}")
+            kinds = {types[key], *getattr(types[key], "__args__", ())}   # float | None -> {float, None}
+            optional = type(None) in kinds
+            if optional and value == "none":
+                value = None
+            elif float in kinds and isinstance(value, (int, float)) and not isinstance(value, bool) \
+                    and math.isfinite(value):
+                value = float(value)
+            elif not ((bool in kinds and isinstance(value, bool)) or (str in kinds and isinstance(value, str))):
+                want = "true or false" if bool in kinds else "a string" if str in kinds else "a finite number"
+                raise InputError(f"{label}: {key} = {value!r} is not {want}" + (' (or "none")' if optional else ""))
+            elif key in _PATH_FIELDS and _is_path(key, value) and not pathlib.Path(value).is_absolute():
+                value = str(file.parent / value)
+            values[key] = value
+        try:
+            return cls(**values).validate()
+        except InputError as exc:
+            raise InputError(f"{label}: {exc}") from None
+
     def with_changes(self, **changes) -> "Scenario":
         """A copy with fields changed (not validated: :meth:`validate` does that).
 
@@ -348,3 +438,13 @@ class Scenario:
         300.0
         """
         return replace(self, **changes)
+
+
+#: Fields that may hold a file path (written absolute by :meth:`Scenario.to_file`).
+_PATH_FIELDS = ("bicycle", "kick_table")
+
+
+def _is_path(name, value):
+    """Whether the value of field ``name`` is a file path rather than a shipped set's name."""
+    text = str(value)
+    return name == "kick_table" or text.endswith(".toml") or "/" in text or "\\" in text

@@ -40,7 +40,7 @@ from .sweep_store import Folder, canonical, case_id, slim, table, trajectory_pat
 
 # Summary sections that are not results of the run (the inputs are already
 # columns; the units are documented in whipple_kick.results.UNITS).
-_SKIPPED_SECTIONS = ("scenario", "units")
+_SKIPPED_SECTIONS = ("scenario", "units", "provenance")   # provenance: once, in the manifest
 #: Trajectory columns saved per case by default: what the thesis' figures and
 #: metrics use plus the plate motion and the rear tyre's load, so a case can
 #: be re-analysed or plotted without re-running it.
@@ -166,12 +166,12 @@ def flatten_summary(summary):
     """Scalar results of a :func:`simulation.run` summary as one flat dict.
 
     The Section 8.3 metrics (``summary["metrics"]``) keep their own names
-    (``last_peak_time``, ``damping_ratio_1_3``, ``max_abs_roll``, ...); the
-    yaw-rate peak times and values are JSON lists in ``peak_times`` and
-    ``peak_values``, the reasons for unavailable metrics a JSON object in
+    (``last_peak_time_s``, ``damping_ratio_1_3``, ``period_s``, ...); the
+    yaw-rate peak times and values are JSON lists in ``yaw_rate_peak_times_s`` and
+    ``yaw_rate_peaks_from_steady_rad_s``, the reasons for unavailable metrics a JSON object in
     ``metrics_unavailable``. Every other scalar is named by its path, e.g.
     ``recovery.time_s`` (the recovery time), ``recovery.signals.roll_rate.time_s``,
-    ``linear_stability.stable``, ``steady_state.roll_rad``, ``controller.gains.kq4``,
+    ``peaks.max_abs_roll_absolute_rad``, ``linear_stability.stable``, ``steady_state.roll_rad``, ``controller.gains.kq4``,
     ``bicycle.rider_mass_kg``, ``numerics.nfev``. Lists elsewhere (the
     closed-loop poles, the tyre notes) are left out.
     """

@@ -23,12 +23,11 @@ import hashlib
 import json
 import os
 import pathlib
-import platform
 import time
 
 import numpy as np
 
-from . import fileio, slip
+from . import fileio, provenance, slip
 from .errors import InputError
 from .scenario import Scenario
 
@@ -84,17 +83,6 @@ def case_id(scenario):
 
 
 # ----------------------------------------------------------------------- the folder
-
-def _versions():
-    from importlib import metadata
-    out = {"python": platform.python_version(), "platform": platform.platform()}
-    for name in ("whipple_kick", "numpy", "scipy", "pandas", "sympy", "control", "yeadon"):
-        try:
-            out[name] = metadata.version(name)
-        except metadata.PackageNotFoundError:
-            out[name] = None
-    return out
-
 
 def read_log(folder):
     """Records of a sweep folder by case id (the last record of a case wins).
@@ -237,7 +225,7 @@ class Folder:
             "format": FOLDER_FORMAT,
             "created": (old or {}).get("created", _now()),
             "model_hash": self.model,
-            "versions": _versions(),
+            "provenance": provenance.record(provenance.input_files(base)),
             "base_scenario": scenario_dict(base),
             "trajectory": None if trajectory is None else {
                 **trajectory, "columns": trajectory["columns"] if trajectory["columns"] == "all"
