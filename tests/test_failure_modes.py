@@ -191,12 +191,13 @@ def test_stale_hidden_temporaries_do_not_make_the_folder_busy_and_are_removed(tm
     (out / ".trajectory.csv.99999999.tmp").write_text("half a trajectory")
     status, _, err = _simulate(["--duration", "0.6", "--no-plot", "--quiet", "--out", str(out)], capsys)
     assert status == 0, err
-    assert sorted(p.name for p in out.iterdir()) == ["summary.json", "trajectory.csv"]
+    assert sorted(p.name for p in out.iterdir()) == ["scenario.toml", "summary.json", "trajectory.csv"]
     (out / ".summary.json.99999999.tmp").write_text("{")
     (out / ".notes.txt.99999999.tmp").write_text("not ours: kept")
     status, _, err = _simulate(["--duration", "0.6", "--no-plot", "--quiet", "--force", "--out", str(out)], capsys)
     assert status == 0, err
-    assert sorted(p.name for p in out.iterdir()) == [".notes.txt.99999999.tmp", "summary.json", "trajectory.csv"]
+    assert sorted(p.name for p in out.iterdir()) == [".notes.txt.99999999.tmp", "scenario.toml", "summary.json",
+                                                     "trajectory.csv"]
 
 
 # ------------------------------------------------------------ one run per output folder
@@ -222,7 +223,7 @@ def test_lock_of_a_killed_run_is_taken_over_and_not_left_behind(tmp_path, capsys
     (out / cli.OUT_LOCK_FILE).write_text("99999999\n")      # a run killed by SIGKILL
     status, _, err = _simulate(["--duration", "0.6", "--no-plot", "--quiet", "--out", str(out)], capsys)
     assert status == 0, err
-    assert sorted(p.name for p in out.iterdir()) == ["summary.json", "trajectory.csv"]
+    assert sorted(p.name for p in out.iterdir()) == ["scenario.toml", "summary.json", "trajectory.csv"]
 
 
 # ------------------------------------------------------------ cache folder

@@ -161,7 +161,7 @@ def response_figure(runs, path=None, title=None, kick=None, time_range=None, dpi
     >>> result = wk.run(wk.Scenario(controller="off", duration=2.0))
     >>> fig = response_figure([("", result)], kick=(0.0, 0.15))
     >>> [t.get_text() for t in fig.axes[0].texts if t.get_text().startswith("fell")]
-    ['fell at 1.585 s']
+    ['fell at 1.536 s']
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
@@ -289,7 +289,7 @@ def compare(results, path=None, labels=None, title=None, time_range=None, dpi=15
     >>> runs.append(wk.run(wk.Scenario(controller="off", duration=3.0)))
     >>> fig = wk.plotting.compare(runs)
     >>> [t.get_text() for t in fig.axes[0].get_legend().get_texts()][2]
-    'pressure_kpa=400, controller=off, duration=3 (fell at 1.585 s)'
+    'pressure_kpa=400, controller=off, duration=3 (fell at 1.536 s)'
     """
     from .errors import InputError
     from .results import checked_labels

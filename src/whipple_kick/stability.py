@@ -813,7 +813,7 @@ def analyse(scenario, speeds, *, loops=None, tyres=None):
     Example
     -------
     >>> from whipple_kick import Scenario
-    >>> res = analyse(Scenario(symmetric_tyres=True), [3.0, 4.0, 5.0], loops=("open",))
+    >>> res = analyse(Scenario(symmetric_tyres=True), [3.0, 3.5, 4.0, 4.5, 5.0], loops=("open",))
     >>> sorted(set(res.eigenvalues["mode"]))
     ['capsize', 'caster', 'lateral_rear', 'relaxation_front', 'relaxation_rear', 'vertical', 'weave', 'wobble']
     """
@@ -1458,7 +1458,7 @@ def speeds_text(summary, loop):
     Example
     -------
     >>> from whipple_kick import Scenario
-    >>> result = analyse(Scenario(symmetric_tyres=True), [3.0, 4.0, 5.0], loops=("open",))
+    >>> result = analyse(Scenario(symmetric_tyres=True), [3.0, 3.5, 4.0, 4.5, 5.0], loops=("open",))
     >>> print(speeds_text(result.summary, "open"))
     slip: weave 3.82 m/s, capsize none; stable none
     no-slip: weave 3.97 m/s, capsize none; stable 3.97-5.00 (sweep end) m/s
@@ -1497,7 +1497,7 @@ def figure(result, path, title=None):
     Example
     -------
     >>> from whipple_kick import Scenario
-    >>> _ = figure(analyse(Scenario(symmetric_tyres=True), [3.0, 4.0, 5.0]), "stability.png")
+    >>> _ = figure(analyse(Scenario(symmetric_tyres=True), [3.0, 3.5, 4.0, 4.5, 5.0]), "stability.png")
     """
     import pathlib
 
@@ -1681,7 +1681,7 @@ def describe(scenario, info=None):
     -------
     >>> from whipple_kick import Scenario
     >>> describe(Scenario(symmetric_tyres=True, controller="off"))
-    'T03 400 kPa (zero-slip offsets removed, contact_patch), balanceassist_v1; no rider control'
+    'T03 400 kPa (zero-slip offsets removed, carcass), balanceassist_v1; no rider control'
     """
     rear, front = scenario.pressures
     p = f"{rear:g}" if rear == front else f"{rear:g}/{front:g} (rear/front)"
@@ -1734,7 +1734,7 @@ def report_lines(summary):
     Example
     -------
     >>> from whipple_kick import Scenario
-    >>> result = analyse(Scenario(symmetric_tyres=True), [3.0, 4.0, 5.0], loops=("open",))
+    >>> result = analyse(Scenario(symmetric_tyres=True), [3.0, 3.5, 4.0, 4.5, 5.0], loops=("open",))
     >>> print("\\n".join(report_lines(result.summary)))
       open loop (no rider control):
         slip: weave 3.82 m/s, capsize none; stable none
