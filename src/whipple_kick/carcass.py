@@ -29,13 +29,18 @@ stays on the limit: ``carcass_sliding="peak"`` (default) holds it at the
 peak (a Coulomb plateau, nothing of the fit past the peak used);
 ``"curve"`` lets it follow the steady curve at the wheel's kinematic slip
 past the peak (steady sliding reproduces the fit's falling branch). Without
-a damper the limit is enforced as a projection (a sweeping process): on
-the limit the deflection moves with the limit, ``c dy/dt = dF_lim/dt``
-(the load's and camber's rates, and in "curve" mode the kinematic slip's,
-from the accelerations of the same evaluation), with a drift correction
-``-CARCASS_LIMIT_RATE (c y - F_lim)``, as long as the free slide would push
-further out; the excess power is dissipated by sliding. With a damper the
-patch force is the limit and ``dy/dt = (F_lim - c y) / d``.
+a damper the limit is a regularised Coulomb plateau: past it the patch
+slides faster than at the limit's own slip on the rising branch ``a_b`` by
+the excess force over a small viscosity,
+``dy/dt = |v_x| tan(a_b) - v_sy + (F_lim - c y) / SLIDING_VISCOSITY``:
+continuous where the patch reaches the limit, passive (it only adds
+sliding), stiff, and converged (docs/validation.md). (An exact projection,
+the deflection following the limit's own rate while on it, is a Coulomb
+sticking mode with rates that jump at the limit; LSODA stalled on it.)
+With a damper the patch force is the limit and ``dy/dt = (F_lim - c y) / d``.
+A lifted wheel, or a fit whose peak factor D is not positive at the load,
+has no grip: its patch slides with the wheel and the force relaxes through
+the viscosity alone.
 
 Aligning moment: ``M_z = M_ss(a_M, g', F_z)`` with ``sigma0 dg'/dt = |v_x|
 (camber - g')`` and ``a_M`` the patch slip that gives the force ``F`` at the
