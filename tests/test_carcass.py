@@ -250,3 +250,25 @@ def test_block_stays_finite_as_the_rolling_speed_vanishes(rider_bike, t03):
     assert dx[slip.X["camber_patch_r"]] == 0.0
     # Sliding right at 0.8 m/s with no rolling: the patch slides too, the deflection falls (force to the left).
     assert dx[slip.X["carcass_y_r"]] < 0.0
+
+
+def test_ignorable_columns_of_the_jacobian_are_exactly_zero(runs):
+    """The compiled Jacobian skips the ignorable coordinates' columns (q1, q2, q6, q8): a forward difference of
+    the right-hand side in each of them, at states along the default run (kick, plate stop, recovery) and with
+    the coordinates moved far, changes no derivative at all (exactly 0.0, not merely small)."""
+    result = runs["default"]
+    a = wk.assembly.assemble(result.scenario, wk.inputs.kick_of(result.scenario))
+    rhs = slip.CompiledRHS(a.params)
+    x0 = a.start.x
+    for t, shift in ((0.05, 3.0), (0.151, -7.0), (0.3, 50.0)):
+        x = x0.copy()
+        x[slip.X["u4"]] += 0.3
+        x[slip.X["carcass_y_r"]] += 0.004
+        base = rhs(t, x)
+        for name in slip.IGNORABLE:
+            moved = x.copy()
+            moved[slip.X[name]] += shift
+            assert np.array_equal(rhs(t, moved), base), name
+        jac = rhs.jacobian_function(np.ones(len(slip.STATE_NAMES)))(t, x)
+        assert not np.any(jac[:, [slip.X[n] for n in slip.IGNORABLE]])
+    assert slip.JACOBIAN_EVALUATIONS == len(slip.DYNAMIC_STATES) + 1 - 4

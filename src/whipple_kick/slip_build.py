@@ -37,6 +37,7 @@ from .slip import (
     COORDINATES,
     DEPENDENT,
     DYNAMIC_STATES,
+    IGNORABLE,
     INDEPENDENT,
     OUTPUT_NAMES,
     OUTPUTS,
@@ -535,13 +536,15 @@ def c_source():
               f"        int status = wk_slip_rhs(t[i], x + (long)i * {ns}, p, dx, out + (long)i * {len(OUTPUT_NAMES)});",
               "        if (status) return status;", "    }", "    return 0;", "}"]
     # Jacobian by forward differences over the dynamic states (the
-    # quadratures feed nothing back: their columns are exactly zero).
+    # quadratures feed nothing back and nothing depends on the ignorable
+    # coordinates: their columns are exactly zero).
+    skipped = " || ".join(f"j == {STATE_NAMES.index(name)}" for name in IGNORABLE)
     lines += ["int wk_slip_jacobian(double t, const double *x, const double *p, const double *scale, double *J)", "{",
               f"    double f0[{ns}], f1[{ns}], xp[{ns}];",
               "    int status = wk_slip_rhs(t, x, p, f0, 0);", "    if (status) return status;",
               "    memcpy(xp, x, sizeof xp);",
               f"    for (int j = 0; j < {ns}; j++) {{",
-              f"        if (j >= {nd}) {{ for (int i = 0; i < {ns}; i++) J[i * {ns} + j] = 0.0; continue; }}",
+              f"        if (j >= {nd} || {skipped}) {{ for (int i = 0; i < {ns}; i++) J[i * {ns} + j] = 0.0; continue; }}",
               "        volatile double moved = x[j] + 1.4901161193847656e-08 * fmax(fabs(x[j]), scale[j]);",
               "        const double h = moved - x[j];",
               "        xp[j] = moved;",
