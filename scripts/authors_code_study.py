@@ -153,7 +153,7 @@ def _parameters(scenario):
     rear, front, _ = wk.assembly.build_tyres(scenario)
     gains, _ = wk.assembly.controller_gains(scenario, design)
     return slip.model_parameters(moore, rear, front, gains=gains, tyre_transient=scenario.tyre_transient,
-                                 reverse_camber=scenario.camber_sign == "reversed")
+                                 reverse_camber=scenario.camber_sign == "reversed", slip_speed=scenario.slip_speed)
 
 
 def poles():
