@@ -138,6 +138,7 @@ def test_compat_authors_code_and_flags_that_override_it(tmp_path, capsys):
     preset = wk.simulation.Scenario.authors_code(duration=0.3).to_dict()
     assert sc == preset
     assert "camber sign reversed" in stdout and "start: upright" in stdout and "keep_speeds" in stdout
+    assert "front contact is 3.2 mm below the ground" in stdout and "contact points' forward speeds" in stdout
     # The rider of their code is linearly unstable with their camber sign (docs/validation.md).
     assert "linearly unstable" in err
     out2 = tmp_path / "ours"
@@ -149,6 +150,37 @@ def test_compat_authors_code_and_flags_that_override_it(tmp_path, capsys):
     assert sc == wk.simulation.Scenario.authors_code(400.0, camber_sign="physical", plate_stop="impulse",
                                                      duration=0.3).to_dict()
     assert stdout == "" and err == ""
+
+
+def test_compat_with_the_701N_preset_uses_its_gains_and_warns_when_told_otherwise(tmp_path, capsys):
+    """Issue 24: ``--compat authors-code --bicycle balanceassist_701N`` kept the 635 N gains. Now it takes Table
+    8.4's 701 N column; other gains are still possible (--thesis-load) but warned about, in summary.json and on
+    stderr (not with --quiet). The compat preset's own switches have flags that switch them back alone."""
+    gains_701 = wk.control.thesis_gains(701.0)
+    out = tmp_path / "701"
+    status, _, err = _simulate(["--compat", "authors-code", "--bicycle", "balanceassist_701N", "--duration", "0.3",
+                                "--no-plot", "--out", str(out)], capsys)
+    assert status == 0, err
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["controller"]["gains"] == gains_701 and summary["controller"]["warning"] is None
+    assert "warning: the Table 8.4 gains" not in err
+    for quiet in ([], ["--quiet"]):
+        out = tmp_path / f"635{len(quiet)}"
+        status, _, err = _simulate(["--compat", "authors-code", "--bicycle", "balanceassist_701N", "--thesis-load",
+                                    "635", "--duration", "0.3", "--no-plot", "--out", str(out), *quiet], capsys)
+        assert status == 0, err
+        warning = json.loads((out / "summary.json").read_text())["controller"]["warning"]
+        assert warning.startswith("the Table 8.4 gains in use are those for 635 N, but bicycle "
+                                  "'balanceassist_701N' is labelled a rear load of 701 N")
+        assert (f"simulate: warning: {warning}\n" in err) == (not quiet)
+    out = tmp_path / "switches"
+    status, stdout, err = _simulate(["--compat", "authors-code", "--slip-speed", "wheel_centre", "--start-pitch",
+                                     "compressed", "--duration", "0.3", "--no-plot", "--out", str(out)], capsys)
+    assert status == 0, err
+    sc = json.loads((out / "summary.json").read_text())["scenario"]
+    assert sc == wk.simulation.Scenario.authors_code(slip_speed="wheel_centre", start_pitch="compressed",
+                                                     duration=0.3).to_dict()
+    assert "front contact is" not in stdout and "contact points' forward speeds" not in stdout
 
 
 # Every bad input: (argv, fragments the one-line message must contain).

@@ -70,10 +70,23 @@ def test_authors_code_preset_is_the_thesis_preset_with_their_assumptions():
     thesis = Scenario.thesis(500.0)
     differ = {f: (getattr(thesis, f), getattr(sc, f)) for f in sc.to_dict() if getattr(sc, f) != getattr(thesis, f)}
     assert differ == {"camber_sign": ("physical", "reversed"), "start": ("steady", "upright"),
-                      "settle": (0.5, 0.0), "plate_stop": ("impulse", "keep_speeds")}
+                      "settle": (0.5, 0.0), "plate_stop": ("impulse", "keep_speeds"),
+                      "start_pitch": ("compressed", "uncompressed"), "slip_speed": ("wheel_centre", "contact_point")}
     assert sc.pressure_kpa == 500.0 and Scenario.authors_code(400.0, rtol=1e-10).pressure_kpa == 400.0
     # Each assumption switches back alone; an upright start needs the kick to start the run.
     assert Scenario.authors_code(plate_stop="impulse").validate().camber_sign == "reversed"
+    for field_name, ours in (("start_pitch", "compressed"), ("slip_speed", "wheel_centre")):
+        back = Scenario.authors_code(**{field_name: ours}).validate()
+        assert {f for f in sc.to_dict() if getattr(back, f) != getattr(sc, f)} == {field_name}
+    # Only an upright start has a start pitch: a steady start switches it back too.
+    steady = Scenario.authors_code(start="steady", settle=0.5).validate()
+    assert (steady.start_pitch, steady.slip_speed) == ("compressed", "contact_point")
+    with pytest.raises(InputError, match="start pitch 'uncompressed' conflicts with start 'steady'"):
+        Scenario(start_pitch="uncompressed").validate()
+    with pytest.raises(InputError, match="start pitch 'level' is unknown; choose one of compressed, uncompressed"):
+        Scenario(start_pitch="level").validate()
+    with pytest.raises(InputError, match="slip speed 'hub' is unknown; choose one of wheel_centre, contact_point"):
+        Scenario(slip_speed="hub").validate()
     with pytest.raises(InputError, match=r"settle time = 0.5 s conflicts with start 'upright'.*allowed: 0 s"):
         Scenario.authors_code(settle=0.5).validate()
     with pytest.raises(InputError, match="camber sign 'negative' is unknown; choose one of physical, reversed"):

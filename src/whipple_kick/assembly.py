@@ -119,7 +119,7 @@ def assemble(scenario, kick, *, tyres=None, gains=None) -> Assembly:
                                    kick=kick.model_kick(), tyre_transient=scenario.tyre_transient,
                                    reverse_camber=scenario.camber_sign == "reversed",
                                    carcass_sliding=scenario.carcass_sliding, carcass_damping=scenario.carcass_damping,
-                                   carcass_viscosity=scenario.carcass_viscosity)
+                                   carcass_viscosity=scenario.carcass_viscosity, slip_speed=scenario.slip_speed)
     found, start = start_state(params, scenario, controller)
     stability = linear_stability(scenario, moore, gains, found, controller)
     steady_yaw_rate = float(start.x[slip.X["u3"]])
@@ -230,6 +230,25 @@ def thesis_load(scenario):
                      "or thesis_load_n (--thesis-load N) for a rider given by mass or a preset with rider")
 
 
+def thesis_gains_warning(scenario):
+    """One line when ``controller="thesis"`` uses the Table 8.4 gains of another load than the run's, else None.
+
+    The run's load: the one a preset with rider is labelled with, or ``fz_n``.
+    """
+    from . import bicycles
+
+    if scenario.controller != "thesis":
+        return None
+    bike = bicycles.load(scenario.bicycle)
+    own, what = ((bike.thesis_rear_load_n, f"bicycle {bike.name!r} is labelled") if bike.includes_rider
+                 else (scenario.fz_n, "the rider is seated for"))
+    gains = thesis_load(scenario)
+    if own is None or abs(own - gains) < 1e-9:
+        return None
+    return (f"the Table 8.4 gains in use are those for {gains:g} N, but {what} a rear load of {own:g} N "
+            f"(thesis_load_n = {gains:g} N; leave it unset for the gains of {own:g} N)")
+
+
 def build_tyres(scenario):
     """(rear, front) tyres and a list of notes about them."""
     from . import tyres
@@ -328,7 +347,8 @@ def start_state(params, scenario, controller_type):
         found = steady_motion(params, scenario, controller_type)
         return found, found.steady
     try:
-        start = slip.upright_state(params, scenario.speed)
+        start = slip.upright_state(params, scenario.speed,
+                                   pitch_without_compression=scenario.start_pitch == "uncompressed")
     except FloatingPointError as exc:
         raise SimulationError(str(exc)) from None
     try:

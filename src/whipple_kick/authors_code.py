@@ -4,11 +4,12 @@ The thesis (Dell'Orto 2025, Chapter 8) names its simulation code,
 mechmotum/bicycle-kickplate-model. Its standard run (``base_simulation.py``:
 T03 at 500 kPa, Table 8.4 rider, 3 m/s, the thesis kick) falls 3.83 s after
 the kick, while the thesis' figures show recovery. ``tests/data/authors_model``
-holds that run (its README says how it was made);
+holds that run and two more of the same code, at 400 kPa and with the kick
+to the left (its README says how they were made; :data:`STORED_RUNS`);
 :meth:`whipple_kick.simulation.Scenario.authors_code` reproduces the code's
-assumptions where they differ from this model's (camber sign, start, plate
-stop). This module reads the stored run and measures how far a run of this
-model is from it; docs/validation.md ("The authors' published code") and
+assumptions where they differ from this model's (camber sign, start and its
+pitch, slip speed, plate stop). This module reads the stored runs and
+measures how far a run of this model is from one; docs/validation.md ("The authors' published code") and
 ``scripts/authors_code_study.py`` use it.
 
 Example
@@ -17,7 +18,7 @@ Example
 >>> ref = authors_code.load_run("tests/data/authors_model")                  # doctest: +SKIP
 >>> result = run(Scenario.authors_code())                                     # doctest: +SKIP
 >>> authors_code.deviations(result.trajectory, ref.samples)["yaw_rate"]       # doctest: +SKIP
-0.0287...
+0.0179...
 """
 from dataclasses import dataclass
 import json
@@ -78,8 +79,22 @@ class StoredRun:
     tyre: dict
 
 
+#: The runs of the authors' code stored in ``tests/data/authors_model``: name -> (folder in it, the
+#: changes to :meth:`~whipple_kick.simulation.Scenario.authors_code` that make the same case). The
+#: standard run (the folder itself) is the one the mode was tuned on; the other two were held out.
+STORED_RUNS = {"T03_500kPa_635N": (".", {}),
+               "T03_400kPa_635N": ("T03_400kPa_635N", {"pressure_kpa": 400.0}),
+               "T03_500kPa_635N_kickleft": ("T03_500kPa_635N_kickleft", {"kick_direction": "left"})}
+
+
 def load_run(folder):
-    """Read the stored run from ``folder`` (the files of ``tests/data/authors_model``).
+    """Read a stored run from ``folder`` (``tests/data/authors_model`` or one of its :data:`STORED_RUNS`).
+
+    ``run.json`` is either the standard run's record (``initial_state``,
+    ``parameters`` and ``tyre`` by name) or the authors' code's own record of
+    a held-out run (``x0`` and ``p_arr`` in the orders ``x0_order`` and
+    ``p_order``, ``tyre_Fy_coef``, ``tyre_Mz_coef``,
+    ``friction_coeff_in_their_tyre_function``), kept as it was written.
 
     Parameters
     ----------
@@ -104,6 +119,11 @@ def load_run(folder):
     samples = pd.read_csv(folder / SAMPLES_FILE).rename(columns=rename)
     whole = pd.read_csv(folder / WHOLE_RUN_FILE).rename(columns=rename)
     info = json.loads((folder / RUN_FILE).read_text())
+    if "x0" in info:   # the authors' code's own record
+        return StoredRun(samples, whole, float(info["fall_time_s"]), dict(zip(info["x0_order"], info["x0"], strict=True)),
+                         dict(zip(info["p_order"], info["p_arr"], strict=True)),
+                         {"Fy_coef": info["tyre_Fy_coef"], "Mz_coef": info["tyre_Mz_coef"],
+                          "Friction_coeff": info["friction_coeff_in_their_tyre_function"]})
     return StoredRun(samples, whole, float(info["fall_time_s"]), info["initial_state"], info["parameters"],
                      info["tyre"])
 

@@ -132,7 +132,7 @@ def _model_options(p, symmetric_flag=True, design_default="the run's --speed", c
     """
     from . import tyres
     from .carcass import SLIDING_LAWS
-    from .scenario import CAMBER_SIGNS, CONTROLLERS, TYRE_TRANSIENTS
+    from .scenario import CAMBER_SIGNS, CONTROLLERS, SLIP_SPEEDS, TYRE_TRANSIENTS
     from .transient import DEFAULT_TRANSIENT
     g = p.add_argument_group("tyres")
     if case_options:
@@ -166,6 +166,9 @@ def _model_options(p, symmetric_flag=True, design_default="the run's --speed", c
     g.add_argument("--camber-sign", choices=CAMBER_SIGNS, default="physical",
                    help="physical (default: a leaning wheel is pushed toward the lean) or reversed (away from it, "
                         "as the thesis authors' published code; not physical)")
+    g.add_argument("--slip-speed", choices=SLIP_SPEEDS, default="wheel_centre",
+                   help="whose forward speed the tyres' slip angle and relaxation use: wheel_centre (default) or "
+                        "contact_point (as the thesis authors' published code)")
     g = p.add_argument_group("bicycle and rider")
     g.add_argument("--bicycle", default="balanceassist_v1", metavar="NAME",
                    help="bicycle parameter set or .toml path (default balanceassist_v1; presets "
@@ -195,7 +198,7 @@ def _model_options(p, symmetric_flag=True, design_default="the run's --speed", c
 
 def _simulate_parser():
     from .inputs import DIRECTIONS, PROFILES
-    from .scenario import KICK_HEADINGS, PLATE_STOPS, STARTS
+    from .scenario import KICK_HEADINGS, PLATE_STOPS, START_PITCHES, STARTS
     p = _OneLineParser(
         prog="simulate", allow_abbrev=False,
         description="Kick-plate test on the nonlinear Carvallo-Whipple bicycle-rider model with "
@@ -242,13 +245,18 @@ def _simulate_parser():
     g = p.add_argument_group("run and output")
     g.add_argument("--compat", choices=("authors-code",),
                    help="authors-code: the thesis authors' published code (bicycle-kickplate-model) as it ran: "
-                        "balanceassist_635N, Table 8.4 rider, T03 chapter8 with the thesis friction, force lag, "
-                        "rtol 1e-12, camber sign reversed, upright start, kick at t = 0, speeds kept at the plate "
-                        "stop; --pressure defaults to 500; other flags given override its settings. For explaining "
+                        "balanceassist_635N, the Table 8.4 rider of the bicycle's load, T03 chapter8 with the thesis friction, force lag, "
+                        "rtol 1e-12, camber sign reversed, upright start with the uncompressed pitch, kick at t = 0, "
+                        "speeds kept at the plate stop, slip speed of the contact point; --pressure defaults to 500; "
+                        "other flags given override its settings. For explaining "
                         "that code's runs, not for predictions")
     g.add_argument("--start", choices=STARTS, default="steady",
                    help="steady (default: the solved steady motion) or upright (upright straight running, not an "
                         "equilibrium with measured tyres, as the authors' code; needs --settle 0)")
+    g.add_argument("--start-pitch", choices=START_PITCHES, default="compressed",
+                   help="pitch of the upright start: compressed (default: solved with the tyres' compressions, the "
+                        "front contact on the ground) or uncompressed (solved without them, as the authors' code: "
+                        "the front contact starts a few mm below the ground); needs --start upright")
     g.add_argument("--duration", type=_number("s"), default=6.0, metavar="S",
                    help="simulated time after the kick start in s (default 6)")
     g.add_argument("--settle", type=_number("s"), default=0.5, metavar="S",
@@ -326,6 +334,7 @@ def _model_fields(args):
         bicycle=args.bicycle, tyre=args.tyre, coefficient_set=args.coefficient_set, friction=args.friction,
         controller=args.controller, design_speed=args.design_speed, gain_scale=args.gain_scale,
         low_inertia=args.low_inertia, tyre_transient=args.tyre_transient, camber_sign=args.camber_sign,
+        slip_speed=args.slip_speed,
         carcass_sliding=args.carcass_sliding, carcass_damping=args.carcass_damping,
     )
     if not hasattr(args, "pressure"):
@@ -379,7 +388,8 @@ def _scenario_from_args(args, given=()):
         kick_duration=args.kick_duration, kick_accel=args.kick_accel,
         kick_profile="constant" if profile is None else profile, kick_table=args.kick_table,
         kick_direction=args.kick_direction, settle=args.settle, duration=args.duration, rtol=args.rtol,
-        plate_stop=args.plate_stop, kick_heading=args.kick_heading, start=args.start, output_rate=args.output_rate,
+        plate_stop=args.plate_stop, kick_heading=args.kick_heading, start=args.start, start_pitch=args.start_pitch,
+        output_rate=args.output_rate,
     )
     if args.compat is None and args.scenario is None:
         return Scenario(**fields)
@@ -534,10 +544,15 @@ def _print_summary(result, out, files):
     if sc["start"] == "upright":
         print("  start: upright straight running, no rear-wheel torque (not a steady motion: the tyres' "
               "zero-slip forces act from t = 0)")
+        if sc["start_pitch"] == "uncompressed":
+            print(f"  start pitch solved without the tyre compressions (the authors' code): the front contact is "
+                  f"{st['front_contact_below_ground_m'] * 1e3:.1f} mm below the ground throughout")
     else:
         print(f"  steady state: roll {st['roll_rad'] * deg:.2f} deg, steer {st['steer_rad'] * deg:.2f} deg, "
               f"yaw rate {st['yaw_rate_rad_s']:.4f} rad/s, rear-wheel torque {st['rear_wheel_torque_n_m']:+.4f} N m "
               f"({st['rear_wheel_torque_role']})" + ("" if st["found_by"] == "direct" else f" (found by {st['found_by']})"))
+    if sc["slip_speed"] == "contact_point":
+        print("  slip angle and relaxation from the contact points' forward speeds (the authors' code)")
     if sc["camber_sign"] == "reversed":
         print("  camber sign reversed: camber thrust pushes a leaning wheel away from the lean (the authors' "
               "published code; not physical)")
@@ -615,6 +630,8 @@ def _simulate(argv):
             raise SimulationError(
                 f"{exc}; the run up to t = {exc.partial.summary['end_time_s']:g} s is in {out}") from None
     report_data_warnings(result.summary)
+    if not args.quiet and result.summary["controller"]["warning"]:
+        print(f"simulate: warning: {result.summary['controller']['warning']}", file=sys.stderr)
     if not args.quiet:
         _print_summary(result, out, files)
         if note:

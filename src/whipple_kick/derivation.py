@@ -352,6 +352,12 @@ def normal_force(compression, compression_rate, stiffness, damping):
                         (0, True))
 
 
+def _slip_speed(centre_vel, contact_vel, heading, contact_weight):
+    """Forward speed along ``heading``: the wheel centre's, or with ``contact_weight`` 1 the contact point's."""
+    centre = centre_vel.dot(heading)
+    return centre + contact_weight * (contact_vel.dot(heading) - centre)
+
+
 def slip_equations():
     """Derive the slip model: toroidal tyres, vertical compliance, lateral tyre loads as inputs.
 
@@ -435,8 +441,14 @@ def slip_equations():
         # Inputs of the tyre block (model convention: slip > 0 slides to the
         # right, camber > 0 leans right), rolling speeds along each heading.
         "vsy_r": v_r_slide.dot(kin.rear_lateral), "vsy_f": v_f_slide.dot(kin.front_lateral),
-        "vx_r": (kin.points["do"].vel(N) - plate_vel).dot(kin.rear_heading),
-        "vx_f": kin.points["fo"].vel(N).dot(kin.front_heading),
+        # The forward speed the slip angle and the relaxation use: the wheel
+        # centre's (slip_speed_point 0, the default) or the geometric contact
+        # point's (1, as the thesis authors' published code takes it).
+        "vx_r": _slip_speed(kin.points["do"].vel(N) - plate_vel, kin.points["dn"].vel(N) - plate_vel,
+                            kin.rear_heading, par["slip_speed_point"]),
+        "vx_f": _slip_speed(kin.points["fo"].vel(N),
+                            kin.points["fn"].pos_from(kin.points["O"]).dt(N).xreplace(kin.qd_to_u),
+                            kin.front_heading, par["slip_speed_point"]),
         "camber_r": sm.asin(kin.frames["B"].y.dot(A.z)), "camber_f": sm.asin(E.y.dot(A.z)),
         "fz_r": fz_r, "fz_f": fz_f,
         # Power kinematics of the energy accounting.

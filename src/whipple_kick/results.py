@@ -568,6 +568,7 @@ def _controller_section(scenario, assembly):
         # The LQR design's own poles, at its design speed (at the run's speed, for the gains used:
         # linear_stability.poles_no_slip_model_1_s).
         "design_poles_1_s": None if poles is None else [[p.real, p.imag] for p in poles],
+        "warning": None if kind == "custom gains" else assembly_module.thesis_gains_warning(scenario),
     }
 
 
@@ -589,6 +590,8 @@ def _steady_section(scenario, assembly, baseline):
         "yaw_rate_baseline_rad_s": baseline,
         "lateral_drift_m_s": float(x0[slip.X["u2"]]),
         "compression_rear_m": float(x0[slip.X["q9"]]), "compression_front_m": float(x0[slip.X["q10"]]),
+        # An upright start's front contact below the ground (+; start_pitch "uncompressed": the authors' code).
+        "front_contact_below_ground_m": start.unknowns.get("front_contact_offset_m"),
         **_rear_wheel_torque(start),
         "residual": float(start.residual),
         "found_by": found_by,

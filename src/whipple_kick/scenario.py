@@ -19,6 +19,7 @@ from dataclasses import asdict, dataclass, fields, replace
 
 from . import carcass, inputs, transient
 from .errors import InputError, check_range
+from .slip import SLIP_SPEEDS
 
 #: Rider models: the LQR designed on the linearised classic model, the thesis' Table 8.4 gains, or none.
 CONTROLLERS = ("lqr", "thesis", "off")
@@ -45,6 +46,10 @@ CAMBER_SIGNS = ("physical", "reversed")
 #: ``upright`` (upright straight running, not an equilibrium with measured tyres:
 #: the authors' published code).
 STARTS = ("steady", "upright")
+#: Pitch of an upright start: ``compressed`` (solved with the tyres' compressions: the front contact on
+#: the ground) or ``uncompressed`` (solved with both tyres uncompressed, the compressions set after: the
+#: front contact starts below the ground; the authors' published code).
+START_PITCHES = ("compressed", "uncompressed")
 
 
 @dataclass(frozen=True)
@@ -193,6 +198,22 @@ class Scenario:
         (:func:`whipple_kick.slip.upright_state`), as the authors' code
         starts; with measured tyres this is not an equilibrium (their
         offsets act from t = 0). Needs ``settle = 0`` (the kick starts the run).
+    start_pitch : {"compressed", "uncompressed"}
+        Pitch of the upright start. ``compressed`` (default): solved with
+        the tyres' compressions, so the front contact is on the ground.
+        ``uncompressed``: solved with both tyres uncompressed and the
+        compressions set after (vertical equilibrium at that pitch), as the
+        authors' code starts: the front contact then starts below the ground
+        by about the rear compression less the front one (3.2 mm at 500 kPa
+        with ``balanceassist_635N``) and stays so (only the constraint's
+        rate is imposed). Needs ``start = "upright"``.
+    slip_speed : {"wheel_centre", "contact_point"}
+        Whose forward speed along the wheel's heading the tyres' slip angle
+        ``atan(v_sy / |v_x|)`` and relaxation ``sigma / |v_x|`` use: the
+        wheel centre's (default) or the geometric contact point's, as the
+        authors' code takes it. They differ while the wheel's centre moves
+        relative to its contact (rolling, pitching, steering); the
+        trajectory's ``rolling_speed_*`` columns are the speed in use.
     """
 
     bicycle: str = "balanceassist_v1"
@@ -233,19 +254,29 @@ class Scenario:
     kick_heading: str = "fixed"
     camber_sign: str = "physical"
     start: str = "steady"
+    start_pitch: str = "compressed"
+    slip_speed: str = "wheel_centre"
 
     @classmethod
     def thesis(cls, pressure_kpa=400.0, **changes):
         """The Chapter 8 runs as the authors' code made them.
 
-        Bicycle+rider preset ``balanceassist_635N``, Table 8.4 gains for
-        635 N, T03 with the ``chapter8`` coefficients and the ``thesis``
-        friction mode, the thesis' lagged-force tyre transient
-        (``tyre_transient="force_lag"``), LSODA rtol 1e-12. The plate stop
-        and the heading at the kick are the project's (impulse, fixed).
-        ``changes`` override any field.
+        Bicycle+rider preset ``balanceassist_635N``, the Table 8.4 gains of
+        the preset's load (635 N; ``bicycle="balanceassist_701N"`` gets the
+        701 N column, ``thesis_load_n`` another row), T03 with the
+        ``chapter8`` coefficients and the ``thesis`` friction mode, the
+        thesis' lagged-force tyre transient (``tyre_transient="force_lag"``),
+        LSODA rtol 1e-12. The plate stop and the heading at the kick are the
+        project's (impulse, fixed). ``changes`` override any field.
+
+        Example
+        -------
+        >>> import whipple_kick as wk
+        >>> sc = Scenario.thesis(bicycle="balanceassist_701N")
+        >>> wk.assembly.thesis_load(sc), wk.assembly.thesis_gains_warning(sc) is None
+        (701.0, True)
         """
-        base = dict(bicycle="balanceassist_635N", controller="thesis", thesis_load_n=635.0,
+        base = dict(bicycle="balanceassist_635N", controller="thesis",
                     coefficient_set="chapter8", friction="thesis", rtol=1e-12,
                     pressure_kpa=pressure_kpa, tyre_transient="force_lag")
         base.update(changes)
@@ -260,18 +291,25 @@ class Scenario:
         away from the lean), starts from upright running that is not an
         equilibrium, and leaves the rear contact sliding after the plate
         stops. :meth:`thesis` with ``camber_sign="reversed"``,
-        ``start="upright"``, ``settle=0`` (the kick at t = 0) and
-        ``plate_stop="keep_speeds"``; their standard run is at 500 kPa.
-        Each of these can be switched back alone through ``changes``.
-        docs/validation.md ("The authors' published code") compares it with
-        that code's stored run.
+        ``start="upright"``, ``settle=0`` (the kick at t = 0),
+        ``plate_stop="keep_speeds"``, ``start_pitch="uncompressed"`` (the
+        front contact starts below the ground) and
+        ``slip_speed="contact_point"``; their standard run is at 500 kPa.
+        Each of these can be switched back alone through ``changes``
+        (``start="steady"`` also switches the start pitch back, which only an
+        upright start has). docs/validation.md ("The authors' published
+        code") compares it with that code's stored runs.
 
         Example
         -------
         >>> Scenario.authors_code().camber_sign, Scenario.authors_code(start="steady", settle=0.5).start
         ('reversed', 'steady')
+        >>> Scenario.authors_code(slip_speed="wheel_centre").start_pitch
+        'uncompressed'
         """
-        base = dict(camber_sign="reversed", start="upright", settle=0.0, plate_stop="keep_speeds")
+        upright = changes.get("start", "upright") == "upright"
+        base = dict(camber_sign="reversed", start="upright", settle=0.0, plate_stop="keep_speeds",
+                    start_pitch="uncompressed" if upright else "compressed", slip_speed="contact_point")
         base.update(changes)
         return cls.thesis(pressure_kpa, **base)
 
@@ -312,12 +350,17 @@ class Scenario:
                                       ("plate stop", self.plate_stop, PLATE_STOPS),
                                       ("kick heading", self.kick_heading, KICK_HEADINGS),
                                       ("camber sign", self.camber_sign, CAMBER_SIGNS),
-                                      ("start", self.start, STARTS)):
+                                      ("start", self.start, STARTS),
+                                      ("start pitch", self.start_pitch, START_PITCHES),
+                                      ("slip speed", self.slip_speed, SLIP_SPEEDS)):
             if value not in choices:
                 raise InputError(f"{label} {value!r} is unknown; choose one of {', '.join(choices)}")
         if self.start == "upright" and self.settle != 0.0:
             raise InputError(f"settle time = {self.settle:g} s conflicts with start 'upright' (upright running is "
                              "not a steady motion: the kick starts the run); allowed: 0 s")
+        if self.start_pitch == "uncompressed" and self.start != "upright":
+            raise InputError(f"start pitch 'uncompressed' conflicts with start {self.start!r} (the steady motion "
+                             "solves its pitch with the compressions); allowed: start 'upright'")
         if self.plate_stop == "keep_speeds" and not self.piecewise:
             raise InputError("plate stop 'keep_speeds' needs piecewise = True (the single LSODA run re-solves "
                              "the speeds at the plate stop)")

@@ -415,11 +415,16 @@ def tyre_parameters(tyre, wheel, symmetric=False, lateral=True, reverse_camber=F
     return out
 
 
+#: Whose forward speed the tyres' slip angle and relaxation use (:func:`model_parameters`), by the
+#: value of the parameter ``slip_speed_point``.
+SLIP_SPEEDS = ("wheel_centre", "contact_point")
+
+
 def model_parameters(moore, rear_tyre, front_tyre, gains=None, kick=None,
                      symmetric=False, lateral=True, drive_torque=0.0,
                      tyre_transient=transient.DEFAULT_TRANSIENT, reverse_camber=False,
                      carcass_sliding=carcass.DEFAULT_SLIDING, carcass_damping=0.0,
-                     carcass_viscosity=carcass.SLIDING_VISCOSITY):
+                     carcass_viscosity=carcass.SLIDING_VISCOSITY, slip_speed="wheel_centre"):
     """Assemble the slip model's parameters by name.
 
     Parameters
@@ -454,7 +459,14 @@ def model_parameters(moore, rear_tyre, front_tyre, gains=None, kick=None,
         regularisation of an undamped carcass' Coulomb plateau. The stiffnesses ``ccr``/``ccf`` are set by
         :func:`steady_state` (or :func:`upright_state`) from the loads of the
         state found: ``C_Fa(F_z0) / sigma0``.
+    slip_speed : {"wheel_centre", "contact_point"}
+        Whose forward speed along the wheel's heading the slip angle
+        ``atan(vsy / |vx|)`` and the relaxation ``sigma / |vx|`` use: the
+        wheel centre's (default) or the geometric contact point's, as the
+        thesis authors' published code takes it (parameter ``slip_speed_point``).
     """
+    if slip_speed not in SLIP_SPEEDS:
+        raise InputError(f"slip speed {slip_speed!r} is unknown; choose one of {', '.join(SLIP_SPEEDS)}")
     params = {n: float(moore[n]) for n in S.CLASSIC_CONSTANTS}
     params.update(tyre_parameters(rear_tyre, "r", symmetric, lateral, reverse_camber))
     params.update(tyre_parameters(front_tyre, "f", symmetric, lateral, reverse_camber))
@@ -473,6 +485,7 @@ def model_parameters(moore, rear_tyre, front_tyre, gains=None, kick=None,
         "T6c": float(drive_torque),
         "tyre_transient": float(transient.check(tyre_transient)),
         "vsx_r": 0.0,
+        "slip_speed_point": float(SLIP_SPEEDS.index(slip_speed)),
         "ccr": 0.0, "ccf": 0.0,   # set from the steady loads (_steady_tyre_states)
         "dcr": float(carcass_damping), "dcf": float(carcass_damping),
         "carcass_sliding": float(carcass.check_sliding(carcass_sliding)),
@@ -617,7 +630,7 @@ def carcass_stiffness(rhs, fz_rear, fz_front):
     return out / np.array([rhs.p[P["sigr"]], rhs.p[P["sigf"]]])
 
 
-def upright_state(params, speed, tol=1e-13):
+def upright_state(params, speed, tol=1e-13, pitch_without_compression=False):
     """Upright straight running at ``speed`` [m/s]: the start of the thesis authors' published code.
 
     Roll, steer, yaw and every lateral speed are 0, the rear contact moves
@@ -636,12 +649,21 @@ def upright_state(params, speed, tol=1e-13):
         From :func:`model_parameters` (``T6c`` is set to 0).
     speed : float
         Forward speed [m/s], > 0.
+    pitch_without_compression : bool
+        Solve the pitch with both tyres uncompressed, as the thesis authors'
+        published code does, then only the compressions (vertical
+        equilibrium at that pitch). The front contact is then below the
+        ground by about the rear compression less the front one
+        (``unknowns["front_contact_offset_m"]``, + below); the holonomic
+        constraint is kept at that offset for the whole run (only its rate
+        is imposed).
 
     Returns
     -------
     SteadyState
         ``residual`` is that of the solved equations (holonomic and the two
-        vertical accelerations), not of the motion.
+        vertical accelerations, or the two without the holonomic with
+        ``pitch_without_compression``), not of the motion.
 
     Example
     -------
@@ -660,6 +682,10 @@ def upright_state(params, speed, tol=1e-13):
     x = np.zeros(len(STATE_NAMES))
     x[X["u1"]] = speed
     names = ("q5", "q9", "q10")
+    if pitch_without_compression:
+        x[X["q5"]] = steer_axis_tilt(params)
+        x = solve_pitch(rhs, _steady_tyre_states(rhs, x))
+        names = names[1:]
 
     def state(z):
         xs = x.copy()
@@ -669,9 +695,11 @@ def upright_state(params, speed, tol=1e-13):
 
     def residual(z):
         dx, out = rhs.outputs(0.0, state(z))
-        return np.array([out[OUT["holonomic"]] * 1e2, dx[X["u9"]] * 1e-2, dx[X["u10"]] * 1e-2])
+        holonomic = () if pitch_without_compression else (out[OUT["holonomic"]] * 1e2,)
+        return np.array([*holonomic, dx[X["u9"]] * 1e-2, dx[X["u10"]] * 1e-2])
 
-    z0 = np.array([steer_axis_tilt(params), 0.5 * weight / params["kzr"], 0.5 * weight / params["kzf"]])
+    z0 = np.array([steer_axis_tilt(params), 0.5 * weight / params["kzr"],
+                   0.5 * weight / params["kzf"]])[-len(names):]
     sol = root(residual, z0, method="hybr", options={"xtol": tol})
     res = float(np.max(np.abs(residual(sol.x))))
     if not np.all(np.isfinite(sol.x)) or res > 1e-8:
@@ -680,6 +708,7 @@ def upright_state(params, speed, tol=1e-13):
     dx = rhs(0.0, xs)
     unknowns = dict(zip(names, (float(v) for v in sol.x), strict=True))
     unknowns["largest_rate"] = float(max(abs(dx[X[n]]) for n in ("u2", "u3", "u4", "u7")))
+    unknowns["front_contact_offset_m"] = float(rhs.outputs(0.0, xs)[1][OUT["holonomic"]])
     out_params["ccr"], out_params["ccf"] = float(rhs.p[P["ccr"]]), float(rhs.p[P["ccf"]])
     return SteadyState(xs, out_params, res, unknowns)
 

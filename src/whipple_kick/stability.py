@@ -274,7 +274,7 @@ def _base_params(setup):
     sc = setup.scenario
     return slip.model_parameters(setup.moore, *setup.tyres, symmetric=sc.symmetric_tyres,
                                  tyre_transient=sc.tyre_transient,
-                                 reverse_camber=sc.camber_sign == "reversed")
+                                 reverse_camber=sc.camber_sign == "reversed", slip_speed=sc.slip_speed)
 
 
 def _loop_params(setup, speed, loop, base=None):

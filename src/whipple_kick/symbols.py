@@ -128,8 +128,10 @@ def _entries():
         ("Mz_f", "aligning moment the front tyre applies to the wheel about the downward normal", "N m", i),
         ("vsy_r", "lateral sliding velocity of the rear wheel's material contact point relative to the plate", "m/s", i),
         ("vsy_f", "lateral sliding velocity of the front wheel's material contact point relative to the ground", "m/s", i),
-        ("vx_r", "rolling speed of the rear wheel centre relative to the plate, along the rear heading", "m/s", i),
-        ("vx_f", "rolling speed of the front wheel centre along the front heading", "m/s", i),
+        ("vx_r", "rolling speed of the rear wheel centre (or contact point: slip_speed_point) relative to the plate, "
+                 "along the rear heading", "m/s", i),
+        ("vx_f", "rolling speed of the front wheel centre (or contact point: slip_speed_point) along the front "
+                 "heading", "m/s", i),
         ("camber_r", "rear wheel camber angle, + = top leaning right", "rad", i),
         ("camber_f", "front wheel camber angle, + = top leaning right", "rad", i),
         ("fz_r", "rear tyre normal force (spring-damper, never pulling)", "N", i),
@@ -165,6 +167,8 @@ def _entries():
                   "it non-zero)", "m/s", c),
         ("T6c", "constant rear-wheel torque holding the steady speed, about C.y (the rear frame's right-pointing "
                 "axis) on the wheel: + opposes forward rolling (a brake), - drives", "N m", c),
+        ("slip_speed_point", "forward speed the tyres' slip angle and relaxation use: 0 the wheel centre's "
+                             "(default), 1 the geometric contact point's (the authors' published code)", "-", c),
         ("tyre_transient", "tyre transient form: 0 contact_patch, 1 slip_lag, 2 force_lag (thesis), "
                            "3 carcass (default)", "-", c),
         ("ccr", "rear carcass lateral stiffness C_Fa(F_z0)/sigma0 (carcass transient)", "N/m", c),
@@ -210,7 +214,7 @@ SLIP_CONSTANTS = CLASSIC_CONSTANTS + (
     "wr", "wf", "mur", "muf", "lamr", "lamf",
     "kick_t0", "kick_T", "kick_D", "kick_profile", "kick_c0", "kick_c1", "kick_c2", "kick_c3",
     "kq3", "kq4", "kq7", "ku3", "ku4", "ku7", "T6c", "tyre_transient", "vsx_r",
-    "ccr", "ccf", "dcr", "dcf", "carcass_sliding", "carcass_viscosity",
+    "slip_speed_point", "ccr", "ccf", "dcr", "dcf", "carcass_sliding", "carcass_viscosity",
 ) + tuple(f"{kind}{wheel}{k}_{i}" for wheel in "rf" for k in (1, 2)
           for kind, n in (("a", 14), ("c", 18)) for i in range(n))
 
