@@ -122,3 +122,21 @@ def test_scenario_file_paths_are_absolute_when_written_and_relative_to_the_file_
     (sub / "mine.toml").write_text('kick_profile = "table"\nkick_table = "plate.csv"\nduration = 1\n')
     sc = Scenario.from_file(sub / "mine.toml")        # the table beside the file, not in the working folder
     assert sc.kick_table == str(sub / "plate.csv") and sc.duration == 1.0 and sc.speed == 3.0
+
+
+def test_every_field_is_in_exactly_one_group():
+    """Physics, run, numerics and compatibility switches: every field in one group, none twice, none missing;
+    the groups' views hold the values; construction stays flat."""
+    import dataclasses
+
+    from whipple_kick.scenario import FIELD_GROUPS
+    fields = [f.name for f in dataclasses.fields(Scenario)]
+    grouped = [name for names in FIELD_GROUPS.values() for name in names]
+    assert sorted(grouped) == sorted(fields) and len(grouped) == len(set(grouped))
+    sc = Scenario(speed=4.0, rtol=1e-12, camber_sign="reversed", settle=0.2)
+    assert sc.physics["speed"] == 4.0 and sc.numerics["rtol"] == 1e-12 and sc.run["settle"] == 0.2
+    assert sc.compatibility["camber_sign"] == "reversed"
+    # The authors'-code preset changes the thesis preset's compatibility switches and nothing else.
+    thesis, authors = Scenario.thesis(500.0), Scenario.authors_code()
+    assert thesis.physics == authors.physics and thesis.numerics == authors.numerics
+    assert thesis.compatibility != authors.compatibility

@@ -214,6 +214,18 @@ class Scenario:
         authors' code takes it. They differ while the wheel's centre moves
         relative to its contact (rolling, pitching, steering); the
         trajectory's ``rolling_speed_*`` columns are the speed in use.
+
+    The fields fall in four groups (:data:`FIELD_GROUPS`; :attr:`physics`,
+    :attr:`run`, :attr:`numerics`, :attr:`compatibility` give each as a
+    dict): the **physics** of the bicycle, rider, tyres, control and kick;
+    the **run** (how long, how densely sampled, when it counts as lost);
+    the **numerics** (tolerances and integration choices that must not
+    change the answer beyond their stated accuracy); and the
+    **compatibility** switches that reproduce another model's assumptions
+    (the thesis' or its authors' code's: plate stop, heading at the kick,
+    camber sign, start, start pitch, slip speed), each at the project's own
+    choice by default. Construction stays flat: ``Scenario(speed=4.0,
+    rtol=1e-12, camber_sign="reversed")``.
     """
 
     bicycle: str = "balanceassist_v1"
@@ -314,6 +326,35 @@ class Scenario:
         return cls.thesis(pressure_kpa, **base)
 
     # ------------------------------------------------------------ derived values
+
+    @property
+    def physics(self) -> dict:
+        """The physics fields (:data:`FIELD_GROUPS`) and their values."""
+        return self._group("physics")
+
+    @property
+    def run(self) -> dict:
+        """The run's fields: duration, settle, sampling and when it counts as lost."""
+        return self._group("run")
+
+    @property
+    def numerics(self) -> dict:
+        """The numerical choices: tolerance, piecewise integration, the carcass tyre's regularisation."""
+        return self._group("numerics")
+
+    @property
+    def compatibility(self) -> dict:
+        """The switches that reproduce another model's assumptions (each at the project's choice by default).
+
+        Example
+        -------
+        >>> Scenario.authors_code().compatibility["camber_sign"], Scenario().compatibility["camber_sign"]
+        ('reversed', 'physical')
+        """
+        return self._group("compatibility")
+
+    def _group(self, name):
+        return {field: getattr(self, field) for field in FIELD_GROUPS[name]}
 
     @property
     def lqr_design_speed(self) -> float:
@@ -491,3 +532,16 @@ def _is_path(name, value):
     """Whether the value of field ``name`` is a file path rather than a shipped set's name."""
     text = str(value)
     return name == "kick_table" or text.endswith(".toml") or "/" in text or "\\" in text
+
+
+#: Every field of :class:`Scenario` in exactly one group (a test checks it).
+FIELD_GROUPS = {
+    "physics": ("bicycle", "fz_n", "rider_mass_kg", "rider", "tyre", "pressure_kpa", "pressure_front_kpa",
+                "pressure_rear_kpa", "coefficient_set", "friction", "symmetric_tyres", "speed", "controller",
+                "design_speed", "gain_scale", "thesis_load_n", "low_inertia", "kick_displacement", "kick_duration",
+                "kick_accel", "kick_profile", "kick_table", "kick_direction", "tyre_transient", "carcass_sliding",
+                "carcass_damping"),
+    "run": ("settle", "duration", "output_rate", "fall_angle_deg", "steer_limit_deg"),
+    "numerics": ("rtol", "piecewise", "carcass_viscosity"),
+    "compatibility": ("plate_stop", "kick_heading", "camber_sign", "start", "start_pitch", "slip_speed"),
+}
