@@ -195,7 +195,7 @@ def poles():
         params = _parameters(Scenario.authors_code(camber_sign=sign))
         found = steady.find_steady_state(params, 3.0)
         lean = math.degrees(found.steady.x[slip.X["q4"]])
-        upright = slip.steady_state(steady.offset_scaled(params, 0.0), 3.0)
+        upright = steady.steady_state(steady.offset_scaled(params, 0.0), 3.0)
         for about, state in ((f"the steady motion ({lean:+.2f} deg lean)", found.steady),
                              ("upright running without the offsets", upright)):
             p = steady.lateral_poles(state.params, state.x)[:3]

@@ -30,14 +30,14 @@ import numpy as np
 
 def _base_case(rtol=1e-10):
     import whipple_kick as wk
-    from whipple_kick import slip
+    from whipple_kick import slip, steady
     bike = wk.bicycles.load("balanceassist_v1")
     combined, _ = wk.riders.for_rear_load(bike, fz_n=635.0)
     K, _ = wk.control.lqr_gains(combined, 3.0)
     tyre = wk.tyres.load("T03", pressure_kpa=400)
     par = slip.model_parameters(combined, tyre, tyre, gains=wk.control.gains_dict(K),
                                 kick=dict(t0=0.0, duration=0.15, displacement=0.15))
-    return slip.steady_state(par, 3.0)
+    return steady.steady_state(par, 3.0)
 
 
 def bench_rhs(repeats):
@@ -125,14 +125,14 @@ def bench_transient(repeats):
     medians over ``repeats`` rounds and the ratio to the contact-patch form.
     """
     import whipple_kick as wk
-    from whipple_kick import slip
+    from whipple_kick import slip, steady
     forms = ("contact_patch", "carcass", "slip_lag", "force_lag")
     calls, runs, integration = ({f: [] for f in forms} for _ in range(3))
     fast = {}
     base = _base_case()
     for form in forms:
         params = dict(base.params, tyre_transient=float(wk.transient.TRANSIENTS.index(form)))
-        ss = slip.steady_state(params, 3.0)
+        ss = steady.steady_state(params, 3.0)
         x = ss.x.copy()
         x[slip.X["u4"]] = 0.1
         fast[form] = (slip.CompiledRHS(ss.params).fast, x)
@@ -177,7 +177,7 @@ stages = {}
 import numpy, scipy.integrate, pandas, matplotlib
 stages["import numpy, scipy, pandas, matplotlib"] = time.perf_counter() - t0
 t = time.perf_counter()
-from whipple_kick import assembly, cli, plotting, simulation, slip
+from whipple_kick import assembly, cli, plotting, simulation, slip, steady
 from whipple_kick.scenario import Scenario
 stages["import whipple_kick (cli, simulation, plotting)"] = time.perf_counter() - t
 t = time.perf_counter()
@@ -268,7 +268,7 @@ K, _ = wk.control.lqr_gains(combined, 3.0)
 tyre = wk.tyres.load("T03", pressure_kpa=400)
 par = slip.model_parameters(combined, tyre, tyre, gains=wk.control.gains_dict(K),
                             kick=dict(t0=0.0, duration=0.15, displacement=0.15))
-ss = slip.steady_state(par, 3.0)
+ss = steady.steady_state(par, 3.0)
 x = ss.x.copy(); x[slip.X["u4"]] = 0.1
 np.save(sys.argv[1] + "_x.npy", x); np.save(sys.argv[1] + "_p.npy", slip.parameter_vector(ss.params))
 print(slip.library()._name)

@@ -42,7 +42,7 @@ import scipy.linalg as sl
 import scipy.optimize as so
 
 import whipple_kick as wk
-from whipple_kick import control, simulation, slip, tyres
+from whipple_kick import control, simulation, slip, steady, tyres
 from whipple_kick.simulation import Scenario
 
 RIDER_STATES = ("q4", "q7", "u4", "u7")
@@ -61,8 +61,8 @@ def linear_model(scenario, gains=None, tyre_pair=None):
     if gains is None:
         gains, _ = wk.assembly.controller_gains(scenario, design)
     params = slip.model_parameters(moore, rear, front, gains=gains, symmetric=scenario.symmetric_tyres)
-    steady = slip.steady_state(params, scenario.speed)
-    return slip.linear_state_space(steady.params, steady.x)
+    motion = steady.steady_state(params, scenario.speed)
+    return slip.linear_state_space(motion.params, motion.x)
 
 
 def slowest_pole(A, B, K):

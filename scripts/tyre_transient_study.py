@@ -191,7 +191,7 @@ def steady():
     moore, design, _ = wk.assembly.build_bicycle(BASE)
     gains, _ = wk.assembly.controller_gains(BASE, design)
     rear, front, _ = build_tyres(BASE)
-    ss = slip.steady_state(slip.model_parameters(moore, rear, front, gains=gains), 3.0)
+    ss = steady.steady_state(slip.model_parameters(moore, rear, front, gains=gains), 3.0)
     for torque in (0.0, 2 * ss.params["T6c"]):
         params = dict(ss.params, T6c=torque)
         tr = lsoda.integrate(slip.CompiledRHS(params), ss.x, 20.0, output_rate=10)

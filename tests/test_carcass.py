@@ -10,7 +10,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import whipple_kick as wk
-from whipple_kick import carcass, slip, slip_build
+from whipple_kick import carcass, slip, slip_build, steady
 from whipple_kick.scenario import Scenario
 from whipple_kick.simulation import run
 
@@ -88,7 +88,7 @@ def test_force_stays_within_the_friction_limit(runs, case):
 def _frozen_block(params, slip_deg, fz_target=635.0):
     """A state with the rear wheel sliding at ``slip_deg`` (upright, 3 m/s) and an ODE for its deflection alone."""
     rhs = slip.CompiledRHS(params)
-    ss = slip.steady_state(params, 3.0)
+    ss = steady.steady_state(params, 3.0)
     x = ss.x.copy()
     x[slip.X["u2"]] = 3.0 * np.tan(np.radians(slip_deg))
     x = slip.solve_pitch(rhs, x)
@@ -109,7 +109,7 @@ def test_steady_characteristic_of_the_block(rider_bike, t03, law):
     falling branch). Tolerance 1e-4 of the force: the plateau carries viscosity x (sliding speed - the
     peak's), at most 0.005 N s/m x 2 m/s = 0.01 N here."""
     params = slip.model_parameters(rider_bike, t03, t03, symmetric=True, carcass_sliding=law)
-    ss = slip.steady_state(params, 3.0)
+    ss = steady.steady_state(params, 3.0)
     for slip_deg in (-40.0, -20.0, -8.0, -3.0, 0.5, 5.0, 12.0, 40.0):
         rhs, x, j, f = _frozen_block(ss.params, slip_deg)
         sol = solve_ivp(f, (0.0, 1.0), [0.0], method="Radau", rtol=1e-10, atol=1e-13)
@@ -119,11 +119,11 @@ def test_steady_characteristic_of_the_block(rider_bike, t03, law):
         alpha, camber, fz = (out[slip.OUT[n]] for n in ("slip_r", "camber_r", "fz_r"))
         assert np.degrees(alpha) == pytest.approx(slip_deg, abs=0.05)
         symmetric = t03.without_offsets()
-        steady = float(symmetric.lateral_force(alpha, camber, fz))
+        on_curve = float(symmetric.lateral_force(alpha, camber, fz))
         scan = np.radians(np.linspace(-80.0, 80.0, 16001))
         curve = symmetric.lateral_force(scan, camber, fz)
         rising = scan[np.argmax(curve)] <= alpha <= scan[np.argmin(curve)]   # the peak: 8.7 deg at 635 N
-        expected = steady if rising or law == "curve" else (curve.max() if alpha < 0 else curve.min())
+        expected = on_curve if rising or law == "curve" else (curve.max() if alpha < 0 else curve.min())
         assert out[slip.OUT["fy_r"]] == pytest.approx(expected, rel=1e-4, abs=1e-3), (slip_deg, law)
 
 
@@ -132,7 +132,7 @@ def test_patch_slip_inverts_the_steady_curve(rider_bike, t03):
     the rising branch), to 1e-9 rad (the closed form's conditioning near the peak), with the measured
     offsets and a lean."""
     params = slip.model_parameters(rider_bike, t03, t03)
-    ss = slip.steady_state(params, 3.0)
+    ss = steady.steady_state(params, 3.0)
     rhs = slip.CompiledRHS(ss.params)
     x = ss.x.copy()
     x[slip.X["q4"]] = 0.1
@@ -177,7 +177,7 @@ def test_small_slip_eigenvalues_equal_the_force_lag(rider_bike, gains, t03):
     agrees to 1e-6 relative. Measured 3e-8 (the finite-difference Jacobians' own error)."""
     def eigenvalues(form):
         par = slip.model_parameters(rider_bike, t03, t03, gains=gains, symmetric=True, tyre_transient=form)
-        ss = slip.steady_state(par, 3.0)
+        ss = steady.steady_state(par, 3.0)
         return np.linalg.eigvals(slip.linearize(slip.CompiledRHS(ss.params), ss.x))
 
     ref, ev = eigenvalues("force_lag"), eigenvalues("carcass")
@@ -219,7 +219,7 @@ def test_options_agree_with_the_python_block(rider_bike, gains, t03, law, dampin
     exact inversions of the curve near its peak agree to ~eps F / (dF/da)."""
     par = slip.model_parameters(rider_bike, t03, t03, gains=gains, carcass_sliding=law, carcass_damping=damping,
                                 kick=dict(t0=0.0, duration=0.15, displacement=0.15))
-    ss = slip.steady_state(par, 3.0)
+    ss = steady.steady_state(par, 3.0)
     rhs = slip.CompiledRHS(ss.params)
     p = slip.parameter_vector(ss.params)
     rng = np.random.default_rng(7)
@@ -240,7 +240,7 @@ def test_block_stays_finite_as_the_rolling_speed_vanishes(rider_bike, t03):
     """A wheel turned sideways (|vx| = 0) while sliding: finite rates, the camber lag stops, the force
     relaxes toward the limit on its side."""
     par = slip.model_parameters(rider_bike, t03, t03, symmetric=True)
-    ss = slip.steady_state(par, 3.0)
+    ss = steady.steady_state(par, 3.0)
     rhs = slip.CompiledRHS(ss.params)
     x = ss.x.copy()
     x[slip.X["u1"]], x[slip.X["u2"]] = 0.0, 0.8

@@ -55,7 +55,7 @@ def test_base_run_outputs(base):
 
 
 def test_steady_running_before_the_kick(base):
-    """The 0.5 s before the kick is steady (the state from slip.steady_state does not drift)."""
+    """The 0.5 s before the kick is steady (the state from steady.steady_state does not drift)."""
     df = base.trajectory
     before = df[df["time"] <= 0.0]
     steady = base.summary["steady_state"]

@@ -5,13 +5,14 @@ import math
 import numpy as np
 import pytest
 
+import whipple_kick as wk
 from whipple_kick import lsoda, rhs_call, slip
 
 
 @pytest.fixture(scope="module")
 def steady(rider_bike, gains, t03):
     par = slip.model_parameters(rider_bike, t03, t03, gains=gains, kick=dict(t0=0.0, duration=0.15, displacement=0.15))
-    return slip.steady_state(par, 3.0)
+    return wk.steady.steady_state(par, 3.0)
 
 
 @pytest.fixture(scope="module")

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import whipple_kick as wk
-from whipple_kick import benchmark, classic, lsoda, slip, slip_build
+from whipple_kick import benchmark, classic, lsoda, slip, slip_build, steady
 
 
 def _outputs(rhs, trajectory):
@@ -19,7 +19,7 @@ def test_stiff_tyres_approach_the_classic_model(speed):
     errors = []
     for kappa, sigma, kz in ((1e2, 1e-2, 1e7), (1e3, 1e-3, 1e8), (1e5, 1e-5, 1e10)):
         tyre = wk.tyres.linear_tyre(kappa, sigma, kz)
-        ss = slip.steady_state(slip.model_parameters(moore, tyre, tyre), speed)
+        ss = steady.steady_state(slip.model_parameters(moore, tyre, tyre), speed)
         ev = np.linalg.eigvals(slip.linearize(slip.CompiledRHS(ss.params), ss.x))
         matched = np.array([ev[np.argmin(np.abs(ev - r))] for r in ref])
         errors.append(np.max(np.abs(matched - ref) / np.abs(ref)))
@@ -37,7 +37,7 @@ def test_linearisation_predicts_the_response_about_a_steady_turn(rider_bike, gai
     order in the perturbation, so it must be a small fraction of it.
     """
     from scipy.linalg import expm
-    ss = slip.steady_state(slip.model_parameters(rider_bike, t03, t03, gains=gains), 3.0)
+    ss = steady.steady_state(slip.model_parameters(rider_bike, t03, t03, gains=gains), 3.0)
     assert abs(ss.x[slip.X["u3"]]) > 0.05          # really a turn (measured 0.095 rad/s)
     rhs = slip.CompiledRHS(ss.params)
     A = slip.linearize(rhs, ss.x)
@@ -62,7 +62,7 @@ def test_steer_torque_input_matrix_matches_the_classic_model():
     moore = benchmark.to_moore(benchmark.meijaard2007_parameters())
     K, _ = wk.control.lqr_gains(moore, 4.0)
     tyre = wk.tyres.linear_tyre(1e4, 1e-4, 1e9)
-    ss = slip.steady_state(slip.model_parameters(moore, tyre, tyre, gains=wk.control.gains_dict(K)), 4.0)
+    ss = steady.steady_state(slip.model_parameters(moore, tyre, tyre, gains=wk.control.gains_dict(K)), 4.0)
     A, B, Kfull = slip.linear_state_space(ss.params, ss.x)
     ref = np.linalg.eigvals(wk.control.closed_loop_matrix(moore, 4.0, K))
     for Amat, expected in ((A - B @ Kfull, ref), (A, classic.eigenvalues(moore, [4.0])[0])):
@@ -79,7 +79,7 @@ def test_steer_torque_input_matrix_matches_the_classic_model():
 
 def test_energy_never_increases_with_slip_and_damping(rider_bike, t03):
     par = slip.model_parameters(rider_bike, t03, t03, symmetric=True)
-    ss = slip.steady_state(par, 4.5)
+    ss = steady.steady_state(par, 4.5)
     x0 = ss.x.copy()
     x0[slip.X["u4"]], x0[slip.X["u7"]], x0[slip.X["u10"]] = 0.3, 0.2, 0.05
     rhs = slip.CompiledRHS(ss.params)
@@ -96,7 +96,7 @@ def test_energy_never_increases_with_slip_and_damping(rider_bike, t03):
 def test_energy_conserved_without_damping_and_slip(rider_bike, t03):
     par = slip.model_parameters(rider_bike, t03, t03, symmetric=True, lateral=False)
     par["czr"] = par["czf"] = 0.0
-    ss = slip.steady_state(par, 4.5)
+    ss = steady.steady_state(par, 4.5)
     x0 = ss.x.copy()
     x0[slip.X["u4"]], x0[slip.X["u7"]], x0[slip.X["u10"]] = 0.3, 0.2, 0.05
     rhs = slip.CompiledRHS(ss.params)
@@ -112,7 +112,7 @@ def test_energy_conserved_without_damping_and_slip(rider_bike, t03):
 @pytest.mark.parametrize("symmetric", [True, False])
 def test_steady_start_does_not_drift(rider_bike, gains, t03, symmetric):
     par = slip.model_parameters(rider_bike, t03, t03, gains=gains, symmetric=symmetric)
-    ss = slip.steady_state(par, 3.0)
+    ss = steady.steady_state(par, 3.0)
     rhs = slip.CompiledRHS(ss.params)
     tr = lsoda.integrate(rhs, ss.x, 10.0, rtol=1e-10, output_rate=100)
     assert not tr.fell
@@ -132,7 +132,7 @@ def test_steady_start_does_not_drift(rider_bike, gains, t03, symmetric):
 
 def test_tyre_physics_in_the_model(rider_bike, t03):
     par = slip.model_parameters(rider_bike, t03, t03, symmetric=True)
-    ss = slip.steady_state(par, 3.0)
+    ss = steady.steady_state(par, 3.0)
     rhs = slip.CompiledRHS(ss.params)
     rng = np.random.default_rng(7)
     for _ in range(50):
@@ -171,7 +171,7 @@ def test_a_lifted_wheel_closing_on_the_ground_carries_no_force(rider_bike, t03, 
     500 kPa (a front wheel 3.8 cm up closing at 5 m/s), where kz q + cz dq/dt > 0 pushed it with kN.
     Its lateral force, moment and damper dissipation are zero too; C and the NumPy oracle agree."""
     par = slip.model_parameters(rider_bike, t03, t03)
-    ss = slip.steady_state(par, 3.0)
+    ss = steady.steady_state(par, 3.0)
     rhs = slip.CompiledRHS(ss.params)
     q, u = ("q9", "u9") if wheel == "r" else ("q10", "u10")
     x = ss.x.copy()
@@ -205,7 +205,7 @@ def test_mirror_symmetric_kicks(rider_bike, gains, t03):
     for sign in (1.0, -1.0):
         par = slip.model_parameters(rider_bike, t03, t03, gains=gains, symmetric=True,
                                     kick=dict(t0=0.0, duration=0.15, displacement=0.15 * sign))
-        ss = slip.steady_state(par, 3.0)
+        ss = steady.steady_state(par, 3.0)
         rhs = slip.CompiledRHS(ss.params)
         tr = lsoda.integrate(rhs, ss.x, 3.0, t_start=-0.2, breakpoints=(0.0, 0.15), rtol=1e-11, output_rate=200)
         responses.append(tr)
@@ -231,7 +231,7 @@ def test_bad_parameters_are_reported(rider_bike, t03):
 
 def _eigenvalues(rider_bike, gains, rear, front, transient, symmetric):
     par = slip.model_parameters(rider_bike, rear, front, gains=gains, symmetric=symmetric, tyre_transient=transient)
-    ss = slip.steady_state(par, 3.0)
+    ss = steady.steady_state(par, 3.0)
     rhs = slip.CompiledRHS(ss.params)
     return np.linalg.eigvals(slip.linearize(rhs, ss.x)), rhs, ss
 
@@ -332,7 +332,7 @@ def test_patch_states_stay_finite_as_the_rolling_speed_vanishes(rider_bike, t03)
     +-90 deg at a finite rate, the camber lag stops, force and moment follow the steady curve; unloaded,
     they are exactly zero (the contact-patch form; the carcass' own case is in test_carcass.py)."""
     par = slip.model_parameters(rider_bike, t03, t03, symmetric=True, tyre_transient="contact_patch")
-    ss = slip.steady_state(par, 3.0)
+    ss = steady.steady_state(par, 3.0)
     rhs = slip.CompiledRHS(ss.params)
     x = ss.x.copy()
     x[slip.X["u1"]] = 0.0            # no forward speed: vx = 0 at both wheels (upright, no steer)
@@ -360,16 +360,16 @@ def test_patch_states_stay_finite_as_the_rolling_speed_vanishes(rider_bike, t03)
 
 def test_steady_motion_moved_in_time_is_a_solution(rider_bike, gains, t03):
     """advance_steady: integrating the steady turn for 2 s from the state 2 s earlier arrives at the state."""
-    ss = slip.steady_state(slip.model_parameters(rider_bike, t03, t03, gains=gains), 3.0)
+    ss = steady.steady_state(slip.model_parameters(rider_bike, t03, t03, gains=gains), 3.0)
     rhs = slip.CompiledRHS(ss.params)
-    start = slip.advance_steady(rhs, ss.x, -2.0)
+    start = steady.advance_steady(rhs, ss.x, -2.0)
     # Measured yaw -0.190 rad, rear contact 6 m back on a 32 m circle.
     assert start[slip.X["q3"]] == pytest.approx(-2.0 * ss.x[slip.X["u3"]], rel=1e-14)
     tr = lsoda.integrate(rhs, start, 0.0, t_start=-2.0, rtol=1e-12, output_rate=10)
     dyn = [slip.X[n] for n in slip.DYNAMIC_STATES]
     # Measured 3e-11 (positions in m, angles in rad, speeds): integration accuracy at rtol 1e-12.
     np.testing.assert_allclose(tr.end_state[dyn], ss.x[dyn], rtol=0, atol=1e-9)
-    back = slip.advance_steady(rhs, start, 2.0)
+    back = steady.advance_steady(rhs, start, 2.0)
     np.testing.assert_allclose(back, ss.x, rtol=0, atol=1e-12)
 
 
@@ -380,7 +380,7 @@ def test_plate_stop_impulse_is_the_limit_of_a_short_stop(rider_bike, gains, t03)
     kinetic-energy change (measured -0.0279 and -0.0302 J against the impulse's -0.0305 J)."""
     T, D = 0.15, 0.15
     par = slip.model_parameters(rider_bike, t03, t03, gains=gains, kick=dict(t0=0.0, duration=T, displacement=D))
-    ss = slip.steady_state(par, 3.0)
+    ss = steady.steady_state(par, 3.0)
     rhs = slip.CompiledRHS(ss.params)
     x_stop = lsoda.integrate(rhs, ss.x, T, rtol=1e-12, output_rate=1000).end_state
     x_impulse, info = slip.velocity_jump(rhs, T, x_stop, impulse=True)
@@ -429,7 +429,7 @@ def test_upright_start_is_upright_and_balanced_vertically_but_not_steady(rider_b
     With T03's offsets the lateral accelerations are not zero (measured 0.3-2.5 m/s^2 or rad/s^2); with
     symmetric tyres it is the steady motion (same pitch and compressions to 1e-12)."""
     par = slip.model_parameters(rider_bike, t03, t03, gains=gains, tyre_transient="force_lag")
-    start = slip.upright_state(par, 3.0)
+    start = steady.upright_state(par, 3.0)
     x = start.x
     assert start.params["T6c"] == 0.0 and start.residual < 1e-8
     for name in ("q3", "q4", "q7", "u2", "u3", "u4", "u7", "u9", "u10"):
@@ -442,9 +442,9 @@ def test_upright_start_is_upright_and_balanced_vertically_but_not_steady(rider_b
         assert x[slip.X[slot]] == out[slip.OUT[name]] != 0.0
     assert start.unknowns["largest_rate"] > 0.05
     symmetric = slip.model_parameters(rider_bike, t03, t03, gains=gains, symmetric=True)
-    up, steady = slip.upright_state(symmetric, 3.0), slip.steady_state(symmetric, 3.0)
+    up, motion = steady.upright_state(symmetric, 3.0), steady.steady_state(symmetric, 3.0)
     for name in ("q5", "q9", "q10"):
-        assert up.x[slip.X[name]] == pytest.approx(steady.x[slip.X[name]], abs=1e-12)
+        assert up.x[slip.X[name]] == pytest.approx(motion.x[slip.X[name]], abs=1e-12)
     assert up.unknowns["largest_rate"] < 1e-9
 
 
@@ -453,7 +453,7 @@ def test_kept_speeds_leave_the_rear_sliding_at_the_plate_velocity_times_sin_yaw(
     the slide vp sin(yaw) (vp = 2 m/s before the stop), constant while the motion goes on."""
     T, D = 0.15, 0.15
     par = slip.model_parameters(rider_bike, t03, t03, gains=gains, kick=dict(t0=0.0, duration=T, displacement=D))
-    ss = slip.steady_state(par, 3.0)
+    ss = steady.steady_state(par, 3.0)
     rhs = slip.CompiledRHS(ss.params)
     x_stop = lsoda.integrate(rhs, ss.x, T, rtol=1e-12, output_rate=1000).end_state
     slide = slip.kept_speeds_slide(rhs, T, x_stop)

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import whipple_kick as wk
-from whipple_kick import cache, slip, slip_build
+from whipple_kick import cache, slip, slip_build, steady
 
 # Spread of the random tyre states: forces [N] and moments [N m] for the
 # thesis' form, patch slip and camber angles [rad] for the contact forms, carcass
@@ -24,7 +24,7 @@ def test_c_agrees_with_numpy_oracle(rider_bike, gains, t03, transient):
     """
     par = slip.model_parameters(rider_bike, t03, wk.tyres.load("T03", pressure_kpa=350), gains=gains,
                                 kick=dict(t0=0.0, duration=0.15, displacement=0.15), tyre_transient=transient)
-    ss = slip.steady_state(par, 3.0)
+    ss = steady.steady_state(par, 3.0)
     params = dict(ss.params, vsx_r=-0.2)   # a rear slide as the authors' plate stop leaves, in both printings
     rhs = slip.CompiledRHS(params)
     p = slip.parameter_vector(params)

@@ -74,7 +74,7 @@ def test_holonomic_row_is_the_front_contact_height_gradient():
     sc = Scenario(speed=3.0)
     moore, design, _ = wk.assembly.build_bicycle(sc)
     rear, front, _ = wk.assembly.build_tyres(sc)
-    steady = slip.steady_state(slip.model_parameters(moore, rear, front), 3.0)
+    steady = wk.steady.steady_state(slip.model_parameters(moore, rear, front), 3.0)
     rhs = slip.CompiledRHS(steady.params)
     row = rhs.impulse_terms(0.0, steady.x)[1][slip.HOLONOMIC_ROW]
     for k, q in enumerate(slip.COORDINATES):

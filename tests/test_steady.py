@@ -31,7 +31,7 @@ def _heading_rates(found, speed):
 def test_the_common_case_is_the_direct_solve_unchanged():
     params = _params()
     found = steady.find_steady_state(params, 3.0)
-    direct = slip.steady_state(params, 3.0)
+    direct = steady.steady_state(params, 3.0)
     assert found.route == "direct" and found.solves == 1
     np.testing.assert_array_equal(found.steady.x, direct.x)
 
@@ -59,7 +59,7 @@ def test_the_steady_turn_closest_to_upright_is_chosen():
     chosen = abs(found.steady.unknowns["q4"])
     for lean in steady.TURN_LEANS_DEG:
         try:
-            other = slip.steady_state(params, 2.6, guess=steady.turn_guess(params, 2.6, math.radians(lean)))
+            other = steady.steady_state(params, 2.6, guess=steady.turn_guess(params, 2.6, math.radians(lean)))
         except FloatingPointError:
             continue
         assert chosen <= abs(other.unknowns["q4"]) + 1e-9
@@ -86,7 +86,7 @@ def test_turn_guess_is_a_balanced_turn():
 
 def test_lateral_poles_leave_out_only_the_forward_speed():
     params = _params(symmetric=True)
-    st = slip.steady_state(params, 3.0)
+    st = steady.steady_state(params, 3.0)
     poles = steady.lateral_poles(st.params, st.x)
     A, B, K = slip.linear_state_space(st.params, st.x)
     full = np.linalg.eigvals(A - B @ K)

@@ -7,7 +7,7 @@ the bicycle (:func:`build_bicycle`), loads the tyres (:func:`build_tyres`),
 designs or looks up the rider's steer-torque gains (:func:`controller_gains`),
 names every parameter of the compiled model
 (:func:`whipple_kick.slip.model_parameters`), finds the steady motion the
-run starts from (:func:`start_state`) and judges whether the rider is
+run starts from (:func:`whipple_kick.steady.start_state`) and judges whether the rider is
 linearly stable about it (:func:`linear_stability`). The result is one
 :class:`Assembly`, handed to the integration.
 """
@@ -18,8 +18,8 @@ import pathlib
 
 import numpy as np
 
-from . import slip
-from .errors import InputError, SimulationError, check_range
+from . import slip, steady
+from .errors import InputError, check_range
 from .scenario import LOW_INERTIA_KEYS, THESIS_DESIGN_SPEED
 
 #: |steady yaw rate| [rad/s] below which steady running counts as straight (a yaw-angle gain needs it).
@@ -50,7 +50,7 @@ class Assembly:
         The compiled model's parameters (the steady drive torque T6c included).
     found : whipple_kick.steady.Found
         The steady motion stability is judged about, and how it was found.
-    start : whipple_kick.slip.SteadyState
+    start : whipple_kick.steady.SteadyState
         The state the run starts from (the steady motion, or an upright start).
     stability : dict
         :func:`linear_stability`'s verdict.
@@ -72,7 +72,7 @@ class Assembly:
     @property
     def reference(self):
         """The steady motion recovery is measured back to (upright running when the tyres allow none)."""
-        return self.start if self.found.route == SYMMETRIC_ROUTE else self.found.steady
+        return self.start if self.found.route == steady.SYMMETRIC_ROUTE else self.found.steady
 
 
 def assemble(scenario, kick, *, tyres=None, gains=None) -> Assembly:
@@ -120,7 +120,7 @@ def assemble(scenario, kick, *, tyres=None, gains=None) -> Assembly:
                                    reverse_camber=scenario.camber_sign == "reversed",
                                    carcass_sliding=scenario.carcass_sliding, carcass_damping=scenario.carcass_damping,
                                    carcass_viscosity=scenario.carcass_viscosity, slip_speed=scenario.slip_speed)
-    found, start = start_state(params, scenario, controller)
+    found, start = steady.start_state(params, scenario, advice=_steady_advice(scenario, controller))
     stability = linear_stability(scenario, moore, gains, found, controller)
     steady_yaw_rate = float(start.x[slip.X["u3"]])
     if gains.get("kq3", 0.0) and abs(steady_yaw_rate) > STRAIGHT_YAW_RATE:
@@ -316,49 +316,6 @@ def _steady_advice(scenario, controller_type):
     return "choose another speed, rider or tyre pressure, or symmetric tyres"
 
 
-def steady_motion(params, scenario, controller_type):
-    """The steady motion before the kick (:func:`whipple_kick.steady.find_steady_state`)."""
-    from . import steady
-    return steady.find_steady_state(params, scenario.speed, advice=_steady_advice(scenario, controller_type))
-
-
-#: What an upright start's stability is judged about when the tyres' offsets allow no steady motion.
-SYMMETRIC_ABOUT = "upright running without the tyres' zero-slip offsets"
-SYMMETRIC_ROUTE = f"{SYMMETRIC_ABOUT} (no steady motion with them)"
-
-
-def start_state(params, scenario, controller_type):
-    """The steady motion the rider's stability is judged about, and the state the run starts from.
-
-    With ``start="steady"`` both are the steady motion. With
-    ``start="upright"`` the run starts from :func:`whipple_kick.slip.upright_state`;
-    stability is judged about the steady motion of the same model if there
-    is one, else about upright running with the tyres' offsets removed (an
-    exact equilibrium).
-
-    Returns
-    -------
-    found : whipple_kick.steady.Found
-    start : whipple_kick.slip.SteadyState
-    """
-    from . import steady
-
-    if scenario.start == "steady":
-        found = steady_motion(params, scenario, controller_type)
-        return found, found.steady
-    try:
-        start = slip.upright_state(params, scenario.speed,
-                                   pitch_without_compression=scenario.start_pitch == "uncompressed")
-    except FloatingPointError as exc:
-        raise SimulationError(str(exc)) from None
-    try:
-        found = steady_motion(params, scenario, controller_type)
-    except steady.NoSteadyMotion:
-        symmetric = slip.steady_state(steady.offset_scaled(params, 0.0), scenario.speed)
-        found = steady.Found(symmetric, SYMMETRIC_ROUTE, 1)
-    return found, start
-
-
 def linear_stability(scenario, moore, gains, found, controller_type):
     """Is the rider in use linearly stable at the run's speed?
 
@@ -384,7 +341,7 @@ def linear_stability(scenario, moore, gains, found, controller_type):
             slip_poles = steady.lateral_poles(found.steady.params, found.steady.x)
         except FloatingPointError:   # the linearisation's pitch solve failed: the classic model decides
             slip_poles = None
-    about = SYMMETRIC_ABOUT if found.route == SYMMETRIC_ROUTE else "the steady motion"
+    about = steady.SYMMETRIC_ABOUT if found.route == steady.SYMMETRIC_ROUTE else "the steady motion"
     decisive, model = ((slip_poles, f"slip model about {about}, constant speed")
                        if slip_poles is not None else (classic, "no-slip classic model"))
     slowest = decisive[0]

@@ -21,6 +21,7 @@ import numpy as np
 
 from . import energy, inputs, lsoda, slip
 from .errors import SimulationError
+from .steady import advance_steady
 
 
 @dataclass
@@ -126,7 +127,7 @@ def _integrate(steady, scenario, kick):
     kick start from ``steady.x`` (heading N.x, rear contact at the origin),
     so nothing after the kick depends on ``settle``; the settle segment
     starts from the steady motion moved back by ``settle``
-    (:func:`whipple_kick.slip.advance_steady`) and is integrated on its own.
+    (:func:`whipple_kick.steady.advance_steady`) and is integrated on its own.
     ``piecewise=False`` integrates from -settle (from that moved-back state,
     or from ``steady.x`` with ``kick_heading="settled"``) in one LSODA run.
     The constant-acceleration profile's plate stop is a velocity jump
@@ -154,7 +155,7 @@ def _integrate(steady, scenario, kick):
     rhs = slip.CompiledRHS(steady.params)   # the plate at rest at the kick start (a table's first row)
     # An upright start is no steady motion: nothing to move back along, it is where the run starts.
     fixed = scenario.kick_heading == "fixed" and scenario.start == "steady"
-    x_start = slip.advance_steady(rhs, steady.x, t_start - kick_start, t=kick_start) if fixed else steady.x
+    x_start = advance_steady(rhs, steady.x, t_start - kick_start, t=kick_start) if fixed else steady.x
     jumps, jump_map = [], {}
     stop = kick_start + kick_T
     kept = table is None and scenario.piecewise and scenario.kick_profile == "constant" \

@@ -195,7 +195,7 @@ class Scenario:
         ``steady`` (default): the run starts from the solved steady motion.
         ``upright``: from upright straight running with the tyre states at
         their zero-slip values and no rear-wheel torque
-        (:func:`whipple_kick.slip.upright_state`), as the authors' code
+        (:func:`whipple_kick.steady.upright_state`), as the authors' code
         starts; with measured tyres this is not an equilibrium (their
         offsets act from t = 0). Needs ``settle = 0`` (the kick starts the run).
     start_pitch : {"compressed", "uncompressed"}

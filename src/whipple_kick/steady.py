@@ -1,6 +1,6 @@
 """The steady motion before the kick, found robustly, or the physical reason there is none.
 
-:func:`whipple_kick.slip.steady_state` solves the steady equations by
+:func:`whipple_kick.steady_state` solves the steady equations by
 Newton-like iteration from upright straight running. That start is good when
 the tyres' zero-slip offsets ask for a small steady lean, and poor when the
 rider's closed loop is weak at the run's speed: near a speed where a real
@@ -77,17 +77,17 @@ class Found:
 
     Attributes
     ----------
-    steady : whipple_kick.slip.SteadyState
-        As returned by :func:`whipple_kick.slip.steady_state`.
+    steady : whipple_kick.SteadyState
+        As returned by :func:`whipple_kick.steady_state`.
     route : str
         ``"direct"``, ``"steady turn started at L deg of lean (of n found)"``,
         ``"offset continuation (n steps)"`` or ``"speed continuation from
         v m/s (n steps)"``.
     solves : int
-        Calls of :func:`whipple_kick.slip.steady_state` spent.
+        Calls of :func:`whipple_kick.steady_state` spent.
     """
 
-    steady: "slip.SteadyState"
+    steady: "SteadyState"
     route: str
     solves: int
 
@@ -117,14 +117,14 @@ class _Counter:
         self.solves = 0
 
     def solve(self, params, speed, guess=None):
-        """:func:`slip.steady_state`, or None if it finds nothing (or the budget is spent)."""
+        """:func:`steady_state`, or None if it finds nothing (or the budget is spent)."""
         if self.solves >= MAX_SOLVES:
             return None
         self.solves += 1
         if guess is not None:
             guess = {name: (0.0 if abs(value) < _ROUND_OFF else value) for name, value in guess.items()}
         try:
-            return slip.steady_state(params, speed, guess=guess)
+            return steady_state(params, speed, guess=guess)
         except FloatingPointError:
             return None
 
@@ -238,7 +238,7 @@ def _poles_or_none(params, x, speed=None):
     """:func:`lateral_poles` about ``x`` (or about the direct steady solve at ``speed``), None if that fails."""
     try:
         if x is None:
-            found = slip.steady_state(params, speed)
+            found = steady_state(params, speed)
             params, x = found.params, found.x
         return lateral_poles(params, x)
     except (FloatingPointError, InputError):
@@ -285,3 +285,316 @@ def diagnosis(params, speed, last, fraction, advice=None, exhausted=False):
     if advice:
         text += f"; {advice}"
     return text
+
+
+# ------------------------------------------------------------ the steady equations
+
+#: Parameters the steady solve sets (:func:`steady_state`): the rear-wheel torque holding the speed and the
+#: carcass stiffnesses at the steady loads.
+STEADY_PARAMETERS = ("T6c", "ccr", "ccf")
+
+
+class SteadyState:
+    """Result of :func:`steady_state`."""
+
+    def __init__(self, x, params, residual, unknowns):
+        self.x = x                  # full state vector (slip.STATE_NAMES)
+        self.params = params        # parameters with the holding drive torque T6c
+        self.residual = residual    # max |residual| of the steady equations
+        self.unknowns = unknowns    # dict of the solved quantities
+
+    def __repr__(self):
+        u = ", ".join(f"{k}={v:.3g}" for k, v in self.unknowns.items())
+        return f"SteadyState({u}; residual {self.residual:.2g})"
+
+
+def steady_state(params, speed, tol=1e-13, guess=None):
+    """Steady motion at ``speed`` [m/s] with the tyres' offsets balanced.
+
+    Unknowns: roll q4, steer q7, pitch q5, tyre compressions q9, q10, lateral
+    drift velocity u2, yaw rate u3 and the rear-wheel torque T6c that holds
+    the speed (the tyres' zero-slip offsets exchange energy with the rolling,
+    so T6c may brake or drive). The tyre states are at their steady values
+    (forces, or patch slip and camber equal to the kinematic ones); the
+    quadrature states are 0. Equations: front contact on
+    the ground and every acceleration zero in the heading frame
+    (du1/dt + u3 u2 = du2/dt - u3 u1 = du3/dt = du4/dt = du7/dt = du9/dt =
+    du10/dt = 0), with q3 = 0 so the heading is N.x.
+
+    Parameters
+    ----------
+    params : mapping
+        From :func:`model_parameters`; ``T6c`` is replaced by the solution.
+    speed : float
+        Forward speed of the rear contact [m/s], > 0.
+    guess : mapping, optional
+        Starting values of the unknowns by name (e.g. ``SteadyState.unknowns``
+        of a neighbouring case); a name not given starts from upright
+        running. Continuation (:mod:`whipple_kick.steady`) passes it.
+
+    Returns
+    -------
+    SteadyState
+    """
+    from scipy.optimize import root
+
+    from .benchmark import steer_axis_tilt
+
+    rhs = slip.CompiledRHS(params)
+    rr = params["rr"]
+    weight = params["g"] * (params["mc"] + params["md"] + params["me"] + params["mf"])
+    x = np.zeros(len(slip.STATE_NAMES))
+    x[slip.X["u1"]] = speed
+    names = ("q4", "q7", "q5", "q9", "q10", "u2", "u3", "T6c")
+    z0 = np.array([0.0, 0.0, steer_axis_tilt(params),
+                   0.5 * weight / params["kzr"], 0.5 * weight / params["kzf"], 0.0, 0.0, 0.0])
+    if guess is not None:
+        z0 = np.array([float(guess.get(name, value)) for name, value in zip(names, z0, strict=True)])
+    scale = np.array([1.0, 1.0, 1.0, 1e-3, 1e-3, 1.0, 1.0, 1.0])
+
+    def state(z):
+        xs = x.copy()
+        for name, value in zip(names[:-1], z[:-1], strict=True):
+            xs[slip.X[name]] = value
+        rhs.p[slip.P["T6c"]] = z[-1]
+        return _steady_tyre_states(rhs, xs)
+
+    def residual(zs):
+        z = zs * scale
+        xs = state(z)
+        dx, out = rhs.outputs(0.0, xs)
+        u1, u2, u3 = xs[slip.X["u1"]], xs[slip.X["u2"]], xs[slip.X["u3"]]
+        return np.array([
+            out[slip.OUT["holonomic"]] * 1e2,
+            (dx[slip.X["u1"]] + u3 * u2) * rr, dx[slip.X["u2"]] - u3 * u1, dx[slip.X["u3"]],
+            dx[slip.X["u4"]], dx[slip.X["u7"]], dx[slip.X["u9"]] * 1e-2, dx[slip.X["u10"]] * 1e-2,
+        ])
+
+    sol = root(residual, z0 / scale, method="hybr", options={"xtol": tol})
+    z = sol.x * scale
+    res = float(np.max(np.abs(residual(sol.x))))
+    if not np.all(np.isfinite(z)) or res > 1e-8:
+        raise FloatingPointError(f"steady state not found at {speed} m/s: {sol.message} (residual {res:.3g})")
+    xs = state(z)
+    out_params = dict(params)
+    out_params["T6c"] = float(z[-1])
+    out_params["ccr"], out_params["ccf"] = float(rhs.p[slip.P["ccr"]]), float(rhs.p[slip.P["ccf"]])
+    return SteadyState(xs, out_params, res, dict(zip(names, z, strict=True)))
+
+
+def _steady_tyre_states(rhs, x):
+    """``x`` with the tyre slots at their steady values for its kinematics.
+
+    The relaxed forces and moments at the steady curves (``force_lag``), the
+    patch slip and camber at the kinematic ones (contact forms), or the
+    carcass deflection carrying the steady force and the camber (carcass),
+    all at the state's own slip, camber and load. For the carcass tyre the
+    stiffnesses ``ccr``/``ccf`` of ``rhs`` are set first from the state's
+    loads (:func:`carcass_stiffness`), and its stored-energy quadratures to
+    ``c y^2 / 2`` (what the carcass holds at the start).
+    """
+    form = rhs.transient
+    x = np.array(x, dtype=float)
+    _, out = rhs.outputs(0.0, x)
+    if form == "carcass":
+        stiffness = carcass_stiffness(rhs, out[slip.OUT["fz_r"]], out[slip.OUT["fz_f"]])
+        rhs.p[slip.P["ccr"]], rhs.p[slip.P["ccf"]] = stiffness
+        for k, wheel in enumerate("rf"):
+            c = stiffness[k]
+            y = out[slip.OUT[f"fy_ss_{wheel}"]] / c if c > 0.0 else 0.0
+            x[slip.X[f"carcass_y_{wheel}"]] = y
+            x[slip.X[f"camber_patch_{wheel}"]] = out[slip.OUT[f"camber_{wheel}"]]
+            x[slip.X[f"E_carcass_{wheel}"]] = 0.5 * c * y * y
+        return x
+    names = (("fy_ss_r", "fy_ss_f", "mz_ss_r", "mz_ss_f") if form == "force_lag"
+             else ("slip_r", "slip_f", "camber_r", "camber_f"))
+    for slot, out_name in zip(slip.PATCH_STATES, names, strict=True):
+        x[slip.X[slot]] = out[slip.OUT[out_name]]
+    return x
+
+
+def carcass_stiffness(rhs, fz_rear, fz_front):
+    """Carcass lateral stiffnesses (rear, front) [N/m]: ``C_Fa(F_z0) / sigma0`` at the given loads [N].
+
+    ``C_Fa`` is the cornering stiffness ``-dF_y/dslip`` at zero slip and
+    camber (of the blended, scaled curve the model evaluates), computed by
+    the compiled model.
+    """
+    out = np.empty(2)
+    rhs.lib.wk_slip_cornering_stiffness(float(fz_rear), float(fz_front), rhs.p.ctypes.data, out.ctypes.data)
+    return out / np.array([rhs.p[slip.P["sigr"]], rhs.p[slip.P["sigf"]]])
+
+
+def upright_state(params, speed, tol=1e-13, pitch_without_compression=False):
+    """Upright straight running at ``speed`` [m/s]: the start of the thesis authors' published code.
+
+    Roll, steer, yaw and every lateral speed are 0, the rear contact moves
+    along N.x at ``speed``, the rear-wheel torque ``T6c`` is 0; pitch and the
+    tyre compressions are solved so that the front contact is on the ground
+    and both tyres are in vertical equilibrium; the tyre states are at their
+    steady values (zero slip and camber: the fits' zero-slip offsets).
+    With measured tyres this is NOT a steady motion: the offsets push the
+    bicycle off it from the first instant (``unknowns["largest_rate"]`` says
+    how hard: the largest |acceleration| of the lateral speeds u2, u3, u4, u7
+    in SI units).
+
+    Parameters
+    ----------
+    params : mapping
+        From :func:`model_parameters` (``T6c`` is set to 0).
+    speed : float
+        Forward speed [m/s], > 0.
+    pitch_without_compression : bool
+        Solve the pitch with both tyres uncompressed, as the thesis authors'
+        published code does, then only the compressions (vertical
+        equilibrium at that pitch). The front contact is then below the
+        ground by about the rear compression less the front one
+        (``unknowns["front_contact_offset_m"]``, + below); the holonomic
+        constraint is kept at that offset for the whole run (only its rate
+        is imposed).
+
+    Returns
+    -------
+    SteadyState
+        ``residual`` is that of the solved equations (holonomic and the two
+        vertical accelerations, or the two without the holonomic with
+        ``pitch_without_compression``), not of the motion.
+
+    Example
+    -------
+    >>> start = upright_state(params, 3.0)                        # doctest: +SKIP
+    >>> float(start.x[slip.X["q4"]]), float(start.params["T6c"])       # doctest: +SKIP
+    (0.0, 0.0)
+    """
+    from scipy.optimize import root
+
+    from .benchmark import steer_axis_tilt
+
+    out_params = dict(params)
+    out_params["T6c"] = 0.0
+    rhs = slip.CompiledRHS(out_params)
+    weight = params["g"] * (params["mc"] + params["md"] + params["me"] + params["mf"])
+    x = np.zeros(len(slip.STATE_NAMES))
+    x[slip.X["u1"]] = speed
+    names = ("q5", "q9", "q10")
+    if pitch_without_compression:
+        x[slip.X["q5"]] = steer_axis_tilt(params)
+        x = slip.solve_pitch(rhs, _steady_tyre_states(rhs, x))
+        names = names[1:]
+
+    def state(z):
+        xs = x.copy()
+        for name, value in zip(names, z, strict=True):
+            xs[slip.X[name]] = value
+        return _steady_tyre_states(rhs, xs)
+
+    def residual(z):
+        dx, out = rhs.outputs(0.0, state(z))
+        holonomic = () if pitch_without_compression else (out[slip.OUT["holonomic"]] * 1e2,)
+        return np.array([*holonomic, dx[slip.X["u9"]] * 1e-2, dx[slip.X["u10"]] * 1e-2])
+
+    z0 = np.array([steer_axis_tilt(params), 0.5 * weight / params["kzr"],
+                   0.5 * weight / params["kzf"]])[-len(names):]
+    sol = root(residual, z0, method="hybr", options={"xtol": tol})
+    res = float(np.max(np.abs(residual(sol.x))))
+    if not np.all(np.isfinite(sol.x)) or res > 1e-8:
+        raise FloatingPointError(f"upright start not found at {speed} m/s: {sol.message} (residual {res:.3g})")
+    xs = state(sol.x)
+    dx = rhs(0.0, xs)
+    unknowns = dict(zip(names, (float(v) for v in sol.x), strict=True))
+    unknowns["largest_rate"] = float(max(abs(dx[slip.X[n]]) for n in ("u2", "u3", "u4", "u7")))
+    unknowns["front_contact_offset_m"] = float(rhs.outputs(0.0, xs)[1][slip.OUT["holonomic"]])
+    out_params["ccr"], out_params["ccf"] = float(rhs.p[slip.P["ccr"]]), float(rhs.p[slip.P["ccf"]])
+    return SteadyState(xs, out_params, res, unknowns)
+
+
+def advance_steady(rhs, x, tau, t=0.0):
+    """The state of the steady motion through ``x``, ``tau`` seconds later (or earlier if < 0).
+
+    In a steady motion every state is constant except the heading, which
+    turns at the yaw rate u3, the rear contact, which moves on the circle
+    (or line) that the rotating velocity (u1, u2) traces, and the wheel
+    angles, which turn at u6 and u8. Used to start the display-only settle
+    so that it arrives at ``x`` at the kick. Quadratures are returned unchanged.
+
+    Parameters
+    ----------
+    rhs : slip.CompiledRHS
+    x : array_like
+        A steady state (e.g. ``SteadyState.x``).
+    tau : float
+        Time shift [s].
+    t : float
+        Time at which ``x`` holds (the plate must be at rest then).
+
+    Returns
+    -------
+    ndarray
+    """
+    x = np.array(x, dtype=float)
+    _, out = rhs.outputs(t, x)
+    w = out[slip.OUT["u3"]]
+    theta = w * tau
+    # int_0^tau of cos(w s) and sin(w s) ds, without dividing by a zero yaw rate.
+    c_int = tau * np.sinc(theta / np.pi)
+    s_int = tau * np.sin(theta / 2) * np.sinc(theta / (2 * np.pi))
+    u1, u2 = x[slip.X["u1"]], x[slip.X["u2"]]
+    c, s = np.cos(theta), np.sin(theta)
+    x[slip.X["q1"]] += u1 * c_int - u2 * s_int
+    x[slip.X["q2"]] += u1 * s_int + u2 * c_int
+    x[slip.X["u1"]], x[slip.X["u2"]] = c * u1 - s * u2, s * u1 + c * u2
+    x[slip.X["q3"]] += theta
+    x[slip.X["q6"]] += out[slip.OUT["u6"]] * tau
+    x[slip.X["q8"]] += out[slip.OUT["u8"]] * tau
+    return x
+
+
+# ------------------------------------------------------------ the run's start
+
+def steady_motion(params, scenario, advice=None):
+    """The steady motion before the kick (:func:`find_steady_state` at the scenario's speed)."""
+    return find_steady_state(params, scenario.speed, advice=advice)
+
+
+#: What an upright start's stability is judged about when the tyres' offsets allow no steady motion.
+SYMMETRIC_ABOUT = "upright running without the tyres' zero-slip offsets"
+SYMMETRIC_ROUTE = f"{SYMMETRIC_ABOUT} (no steady motion with them)"
+
+
+def start_state(params, scenario, advice=None):
+    """The steady motion the rider's stability is judged about, and the state the run starts from.
+
+    With ``start="steady"`` both are the steady motion. With
+    ``start="upright"`` the run starts from :func:`upright_state`; stability
+    is judged about the steady motion of the same model if there is one,
+    else about upright running with the tyres' offsets removed (an exact
+    equilibrium).
+
+    Parameters
+    ----------
+    params : mapping
+        The model's parameters (:func:`whipple_kick.slip.model_parameters`).
+    scenario : whipple_kick.scenario.Scenario
+    advice : str, optional
+        What a user can change if there is no steady motion (the one-line error's end).
+
+    Returns
+    -------
+    found : Found
+    start : SteadyState
+    """
+    from .errors import SimulationError
+
+    if scenario.start == "steady":
+        found = steady_motion(params, scenario, advice)
+        return found, found.steady
+    try:
+        start = upright_state(params, scenario.speed, pitch_without_compression=scenario.start_pitch == "uncompressed")
+    except FloatingPointError as exc:
+        raise SimulationError(str(exc)) from None
+    try:
+        found = steady_motion(params, scenario, advice)
+    except NoSteadyMotion:
+        symmetric = steady_state(offset_scaled(params, 0.0), scenario.speed)
+        found = Found(symmetric, SYMMETRIC_ROUTE, 1)
+    return found, start

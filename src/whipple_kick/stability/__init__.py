@@ -3,7 +3,7 @@
 For a bicycle, rider, tyre, pressure and load (a
 :class:`whipple_kick.scenario.Scenario`), at each speed of a sweep:
 
-1. the steady motion is found (:func:`whipple_kick.slip.steady_state`,
+1. the steady motion is found (:func:`whipple_kick.steady.steady_state`,
    continued from the previous speed's solution; the robust
    :func:`whipple_kick.steady.find_steady_state` where that fails);
 2. the slip model is linearised about it in the heading frame

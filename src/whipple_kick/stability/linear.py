@@ -66,7 +66,7 @@ class LinearModel:
         Model state names (:data:`whipple_kick.slip.LINEAR_STATES` order).
     labels : list of (str, str)
         Readable name and unit of each state.
-    steady : whipple_kick.slip.SteadyState
+    steady : whipple_kick.steady.SteadyState
         The steady motion linearised about.
     found_by : str
         How the steady motion was found.
@@ -134,7 +134,7 @@ def linearise(params, steady_state, loop, found_by="direct", constant_speed=True
     ----------
     params : mapping
         Slip-model parameters; their gains are the rider's (0 for ``loop="open"``).
-    steady_state : whipple_kick.slip.SteadyState
+    steady_state : whipple_kick.steady.SteadyState
         A steady motion of ``params``.
     loop : {"open", "closed"}
     found_by : str
@@ -153,7 +153,7 @@ def linearise(params, steady_state, loop, found_by="direct", constant_speed=True
     this from a Scenario).
 
     >>> params = slip.model_parameters(moore, rear, front)              # doctest: +SKIP
-    >>> model = linearise(params, slip.steady_state(params, 4.0), "open")   # doctest: +SKIP
+    >>> model = linearise(params, steady.steady_state(params, 4.0), "open")   # doctest: +SKIP
     """
     rhs = slip.CompiledRHS(steady_state.params)
     J, B = slip.heading_linearisation(rhs, steady_state.x)
@@ -215,7 +215,7 @@ def _steady(params, speed, guess):
     from whipple_kick import steady
     if guess is not None:
         try:
-            return slip.steady_state(params, speed, guess=guess), "continued"
+            return steady.steady_state(params, speed, guess=guess), "continued"
         except FloatingPointError:
             pass
     found = steady.find_steady_state(params, speed)

@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 
-from whipple_kick import assembly, slip
+from whipple_kick import assembly, slip, steady
 from whipple_kick.errors import InputError, check_range
 
 from ._constants import GROUPS, LOOPS, MAX_SPEEDS, ZERO_TORQUE_N_M
@@ -32,7 +32,7 @@ class _Loop:
         """
         params = _loop_params(self.setup, speed, self.loop, self.base)
         if other is not None:
-            shared = slip.SteadyState(other.x, {**params, **{n: other.params[n] for n in slip.STEADY_PARAMETERS}},
+            shared = steady.SteadyState(other.x, {**params, **{n: other.params[n] for n in steady.STEADY_PARAMETERS}},
                                       other.residual, other.unknowns)
             rhs = slip.CompiledRHS(shared.params)
             if abs(rhs.outputs(0.0, shared.x)[1][slip.OUT["T7"]]) < ZERO_TORQUE_N_M:
