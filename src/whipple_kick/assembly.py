@@ -191,6 +191,14 @@ def _lqr(design_items, speed):
     return tuple(np.ravel(K)), tuple(np.ravel(poles))
 
 
+@functools.lru_cache(maxsize=256)
+def _classic_poles(moore_items, speed, gains_items):
+    # The no-slip model's poles depend on the bicycle, speed and gains only: a sweep over tyres or kicks
+    # computes them once per process (~3 ms a case).
+    from . import control
+    return tuple(control.closed_loop_poles(dict(moore_items), speed, dict(gains_items)))
+
+
 def controller_gains(scenario, design):
     """Steer-torque gains by name, and the LQR design's closed-loop poles at its design speed (or None).
 
@@ -375,9 +383,10 @@ def linear_stability(scenario, moore, gains, found, controller_type):
         ``model`` (which linearisation decided), ``poles_slip_model_1_s``,
         ``poles_no_slip_model_1_s`` (each as [real, imag] pairs), ``criterion``.
     """
-    from . import control, steady
+    from . import steady
 
-    classic = control.closed_loop_poles(moore, scenario.speed, gains)
+    classic = np.asarray(_classic_poles(tuple(sorted(moore.items())), float(scenario.speed),
+                                        tuple(sorted(gains.items()))))
     slip_poles = None
     if not gains.get("kq3", 0.0):
         try:
