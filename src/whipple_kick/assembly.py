@@ -168,7 +168,8 @@ def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia
         combined, rider_mass = riders.seat(bike, rider), float(rider_mass_kg)
     else:
         fz = 635.0 if fz_n is None else fz_n
-        combined, rider_mass = riders.for_rear_load(bike, fz, rider=rider_name)
+        combined, rider_mass = riders.for_rear_load(bike, fz, rider=rider_name,
+                                                    load_range=_rear_load_range(bicycle, _stamp, rider_name))
     rear_n, front_n = riders.static_loads(combined)
     design = dict(combined.moore)
     moore = dict(design)
@@ -181,6 +182,14 @@ def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia
             "rider_mass_kg": rider_mass, "static_load_rear_n": rear_n, "static_load_front_n": front_n,
             "total_mass_kg": sum(float(combined.benchmark[k]) for k in ("mR", "mB", "mH", "mF"))}
     return moore, design, info
+
+
+@functools.lru_cache(maxsize=64)
+def _rear_load_range(bicycle, _stamp, rider_name):
+    # The rear loads a rider can give the bicycle (a probe rider seated, ~10 ms) do not depend on the load:
+    # a sweep over loads finds them once per process.
+    from . import bicycles, riders
+    return riders.rear_load_range(bicycles.load(bicycle), rider_name)
 
 
 @functools.lru_cache(maxsize=256)
