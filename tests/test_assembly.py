@@ -22,6 +22,11 @@ def test_assemble_hands_over_a_finished_model():
         assert abs(dx[slip.X[name]]) < 1e-8, name
     assert model.stability["stable"] and model.bicycle["static_load_rear_n"] == pytest.approx(635.0)
     assert model.params["kq4"] == model.gains["kq4"] and model.params["kick_D"] == 0.15
+    # The no-slip poles, kept per process on bicycle, speed and gains, are those of a fresh computation.
+    fresh = wk.control.closed_loop_poles(model.moore, sc.speed, model.gains)
+    assert model.stability["poles_no_slip_model_1_s"] == [[float(p.real), float(p.imag)] for p in fresh]
+    other = assembly.assemble(sc.with_changes(speed=4.0).validate(), inputs.kick_of(sc))
+    assert other.stability["poles_no_slip_model_1_s"] != model.stability["poles_no_slip_model_1_s"]
 
 
 def test_low_inertia_halves_rear_frame_inertia_and_height():

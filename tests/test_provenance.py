@@ -65,3 +65,17 @@ def test_citation_file_names_the_version_and_the_thesis():
     text = (REPO / "CITATION.cff").read_text()
     assert f"version: {wk.__version__}\n" in text and "cff-version: 1.2.0" in text
     assert "Bicycle tyre lateral characteristics and their effect on bicycle dynamics" in text
+
+
+def test_git_is_asked_once_per_process(monkeypatch):
+    # A sweep runs thousands of cases in a process; the code it runs is the code it imported.
+    calls = []
+    monkeypatch.setattr(provenance, "git_state", lambda: calls.append(1) or {"commit": "c" * 40, "dirty": False})
+    provenance._own_git_state.cache_clear()
+    try:
+        first = provenance.record()
+        first["git"]["dirty"] = True      # each record has its own copy
+        assert provenance.record()["git"] == {"commit": "c" * 40, "dirty": False}
+        assert len(calls) == 1
+    finally:
+        provenance._own_git_state.cache_clear()   # the next record asks the real git again

@@ -188,3 +188,24 @@ def test_rider_file_has_95_measurements_in_metres():
     assert rider.measurements["Ls1L"] == 0.176          # 17.6 cm in the source
     assert rider.configuration["somersault"] == 0.17
     assert rider.height_m == pytest.approx(1.80, abs=0.01)
+
+
+def test_a_load_sweep_seats_the_probe_rider_once(monkeypatch):
+    # The rear-load range (a probe rider seated) does not depend on the load: found once per process.
+    from whipple_kick import assembly, bicycles, riders
+    from whipple_kick.scenario import Scenario
+
+    calls = []
+    probe = riders.rear_load_range
+    monkeypatch.setattr(riders, "rear_load_range", lambda *a, **k: calls.append(a) or probe(*a, **k))
+    assembly._rear_load_range.cache_clear()
+    try:
+        for fz in (611.25, 612.75):
+            assembly.build_bicycle(Scenario(fz_n=fz))
+        assert len(calls) == 1
+    finally:
+        assembly._rear_load_range.cache_clear()
+    bike = bicycles.load("balanceassist_v1")
+    known = riders.for_rear_load(bike, 612.75, load_range=probe(bike))
+    fresh = riders.for_rear_load(bike, 612.75)
+    assert known.rider_mass_kg == fresh.rider_mass_kg and dict(known.combined.moore) == dict(fresh.combined.moore)

@@ -52,6 +52,20 @@ def test_sweep_results_equal_a_direct_run(default_run):
             assert row[key] == value, key
 
 
+def test_a_case_thinned_to_200_hz_keeps_the_summary_of_every_sample():
+    # The sweep fixture runs at 200 Hz, where a 200 Hz trajectory is every sample; at the default 1000 Hz a
+    # table row must still be the run's summary of every sample (peaks, energy balance, extrapolation).
+    scenario = Scenario(duration=1.5, settle=0.1, fz_n=635.0)
+    assert scenario.output_rate == 1000.0
+    spec = wk.sweep_engine._trajectory_spec(wk.sweep_engine.DEFAULT_TRAJECTORY_COLUMNS, "float32", 200.0)
+    record = wk.sweep_engine.run_case(scenario, "x", spec)
+    assert record["trajectory"]["time"].size == 1 + int(round((1.5 + 0.1) * 200))
+    direct = wk.sweep_engine.flatten_summary(wk.run(scenario).summary)
+    volatile = set(wk.sweep_engine.VOLATILE_COLUMNS)
+    assert {k: v for k, v in record["results"].items() if k not in volatile} == \
+        {k: v for k, v in direct.items() if k not in volatile}
+
+
 def test_dask_executor_gives_the_same_table(default_run):
     distributed = pytest.importorskip("distributed")
     _, table = default_run

@@ -346,3 +346,24 @@ def test_a_tyre_without_moment_data_is_told_by_its_flag_not_by_a_message(monkeyp
     assert all((mz == tyres.ZERO_MOMENT_COEFFICIENTS).all() for _, _, mz in rear.blend)
     rear, _, notes = assembly.build_tyres(Scenario(tyre="T03"))
     assert rear.has_aligning_moment and notes == []
+
+
+def test_a_tyre_file_is_parsed_once_and_an_edited_one_afresh(tmp_path, monkeypatch):
+    # A sweep loads the same tyre file for every case: read_tyre_file keeps the parsed file per content.
+    path = _write_variant(tmp_path, name="TX")
+    calls = []
+    parse = tyres.parameters.parse_toml
+    monkeypatch.setattr(tyres.parameters, "parse_toml", lambda *a: calls.append(a[0]) or parse(*a))
+    first = tyres.load("TX", 400, directory=tmp_path)
+    assert tyres.load("TX", 400, directory=tmp_path).lateral_force(0.05, 0.0, 600.0) == \
+        first.lateral_force(0.05, 0.0, 600.0)
+    assert calls == [path]
+    # Same path and size, new content (as fast as a file system's time stamps tick): read afresh.
+    path.write_text(path.read_text().replace("    -729.3696,  # a1", "    -729.3697,  # a1", 1))
+    edited = tyres.load("TX", 300, directory=tmp_path)
+    assert calls == [path, path]
+    assert edited.lateral_force(0.05, 0.0, 600.0) != tyres.load("T03", 300).lateral_force(0.05, 0.0, 600.0)
+    # The parsed file is shared between loads: its coefficients cannot be changed in place.
+    fy = tyres.read_tyre_file(path).sets["table7_9"][300.0][0]
+    with pytest.raises(ValueError, match="read-only"):
+        fy[1] = 0.0

@@ -168,7 +168,8 @@ def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia
         combined, rider_mass = riders.seat(bike, rider), float(rider_mass_kg)
     else:
         fz = 635.0 if fz_n is None else fz_n
-        combined, rider_mass = riders.for_rear_load(bike, fz, rider=rider_name)
+        combined, rider_mass = riders.for_rear_load(bike, fz, rider=rider_name,
+                                                    load_range=_rear_load_range(bicycle, _stamp, rider_name))
     rear_n, front_n = riders.static_loads(combined)
     design = dict(combined.moore)
     moore = dict(design)
@@ -183,12 +184,28 @@ def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia
     return moore, design, info
 
 
+@functools.lru_cache(maxsize=64)
+def _rear_load_range(bicycle, _stamp, rider_name):
+    # The rear loads a rider can give the bicycle (a probe rider seated, ~10 ms) do not depend on the load:
+    # a sweep over loads finds them once per process.
+    from . import bicycles, riders
+    return riders.rear_load_range(bicycles.load(bicycle), rider_name)
+
+
 @functools.lru_cache(maxsize=256)
 def _lqr(design_items, speed):
     # A sweep over pressures or kicks designs the same rider once per process.
     from . import control
     K, poles = control.lqr_gains(dict(design_items), speed)
     return tuple(np.ravel(K)), tuple(np.ravel(poles))
+
+
+@functools.lru_cache(maxsize=256)
+def _classic_poles(moore_items, speed, gains_items):
+    # The no-slip model's poles depend on the bicycle, speed and gains only: a sweep over tyres or kicks
+    # computes them once per process (~3 ms a case).
+    from . import control
+    return tuple(control.closed_loop_poles(dict(moore_items), speed, dict(gains_items)))
 
 
 def controller_gains(scenario, design):
@@ -332,9 +349,10 @@ def linear_stability(scenario, moore, gains, found, controller_type):
         ``model`` (which linearisation decided), ``poles_slip_model_1_s``,
         ``poles_no_slip_model_1_s`` (each as [real, imag] pairs), ``criterion``.
     """
-    from . import control, steady
+    from . import steady
 
-    classic = control.closed_loop_poles(moore, scenario.speed, gains)
+    classic = np.asarray(_classic_poles(tuple(sorted(moore.items())), float(scenario.speed),
+                                        tuple(sorted(gains.items()))))
     slip_poles = None
     if not gains.get("kq3", 0.0):
         try:

@@ -70,12 +70,27 @@ def load_toml(path) -> dict:
     InputError
         If the file is missing or is not valid TOML (one line, naming the file).
     """
-    path = pathlib.Path(path)
+    return parse_toml(path, file_bytes(path))
+
+
+def file_bytes(path) -> bytes:
+    """The bytes of a parameter file (what a parse cache keys on: an edited file is read afresh).
+
+    Raises
+    ------
+    InputError
+        If the file is missing (one line, naming the file).
+    """
     try:
-        with open(path, "rb") as fh:
-            return tomllib.load(fh)
+        return pathlib.Path(path).read_bytes()
     except FileNotFoundError:
         raise InputError(f"parameter file {path} does not exist") from None
+
+
+def parse_toml(path, content: bytes) -> dict:
+    """The TOML ``content`` of the file ``path`` as a dict (InputError naming the file if it is not valid TOML)."""
+    try:
+        return tomllib.loads(content.decode())
     except tomllib.TOMLDecodeError as exc:
         raise InputError(f"parameter file {path} is not valid TOML: {exc}") from None
 

@@ -4,8 +4,9 @@
 and of every sweep folder's manifest.json: enough to say which code, on
 which machine, from which input files (by SHA-256: a kick table or a
 bicycle file edited after the run no longer matches) made a result. The git
-commit is recorded when the package runs from a git checkout (one ``git``
-call of a few milliseconds; None outside a checkout, without git, or if it
+commit is recorded when the package runs from a git checkout (two ``git``
+calls of about 10 ms together, once per process: the code a process runs is
+the code it imported; None outside a checkout, without git, or if it
 fails).
 
 Example
@@ -84,6 +85,16 @@ def git_state(folder=PACKAGE_DIR):
     return {"commit": commit, "dirty": None if status is None else bool(status)}
 
 
+@functools.cache
+def _own_git_state():
+    """:func:`git_state` of the package's checkout, asked once per process (about 10 ms; a sweep runs thousands of cases).
+
+    A process runs the code it imported, so the first answer describes it
+    (a commit or edit made later does not change the running code).
+    """
+    return git_state()
+
+
 def sha256(path) -> str:
     """SHA-256 of a file's bytes, as hex.
 
@@ -132,10 +143,11 @@ def record(files=None) -> dict:
     files : dict, optional
         :func:`input_files` of the run (default none).
     """
+    git = _own_git_state()
     return {
         "date_utc": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
         "host": socket.gethostname(),
         "versions": dict(versions()),
-        "git": git_state(),
+        "git": None if git is None else dict(git),
         "input_files": files or {},
     }

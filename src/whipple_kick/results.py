@@ -9,6 +9,7 @@ the recovery and the Section 8.3 metrics of :mod:`whipple_kick.analysis`,
 numerics. Nothing in a result is NaN (:func:`clean`).
 """
 from dataclasses import dataclass, field
+import functools
 import math
 
 import numpy as np
@@ -197,33 +198,51 @@ def trajectory_frame(solution, tyre_transient="carcass"):
 
     traj = solution.trajectory
     outs = solution.outputs()
-    cols = {"time": traj.t}
-    for q, (name, _) in COORDINATE_COLUMNS.items():
-        cols[name] = traj.x[:, slip.X[q]]
-    for u, (name, _) in SPEED_COLUMNS.items():
-        cols[name] = outs[:, slip.OUT[u]]   # includes the dependent speeds u5 u6 u8
-    yaw, vx_fixed, vy_fixed = cols["yaw"], cols["velocity_x_fixed"], cols["velocity_y_fixed"]
-    cols["forward_speed"] = np.cos(yaw) * vx_fixed + np.sin(yaw) * vy_fixed
-    cols["lateral_speed"] = -np.sin(yaw) * vx_fixed + np.cos(yaw) * vy_fixed
-    for o, name in APPLIED_COLUMNS.items():
-        cols[name] = outs[:, slip.OUT[o]]
-    if tyre_transient != "force_lag":
-        for o, name in PATCH_OUTPUT_COLUMNS.items():   # the state itself in the contact forms
-            cols[name] = outs[:, slip.OUT[o]]
-        cols["camber_patch_rear"] = traj.x[:, slip.X["camber_patch_r"]]
-        cols["camber_patch_front"] = traj.x[:, slip.X["camber_patch_f"]]
-    if tyre_transient == "carcass":
-        for state, name in CARCASS_STATE_COLUMNS.items():
-            cols[name] = traj.x[:, slip.X[state]]
-    for o, name in OUTPUT_COLUMNS.items():
-        cols[name] = outs[:, slip.OUT[o]]
-    for state, (name, _) in energy.COLUMNS.items():
-        cols[name] = traj.x[:, slip.X[state]]
-    frame = pd.DataFrame(cols)
-    frame[BALANCE_COLUMN] = energy.balance_residual(frame)
-    if not np.all(np.isfinite(frame.to_numpy())):
+    layout = frame_layout(tyre_transient)
+    # One float64 block, column by column (Fortran order: each column contiguous), instead of a dict of
+    # columns that pandas copies into a block: a sweep builds ~1e4 of these tables.
+    values = np.empty((traj.t.size, len(layout)), order="F")
+    for k, (name, source, index) in enumerate(layout):
+        if source == "state":
+            values[:, k] = traj.x[:, index]
+        elif source == "output":
+            values[:, k] = outs[:, index]
+        elif name == "time":
+            values[:, k] = traj.t
+    column = {name: k for k, (name, _, _) in enumerate(layout)}
+    yaw, vx_fixed, vy_fixed = (values[:, column[c]] for c in ("yaw", "velocity_x_fixed", "velocity_y_fixed"))
+    values[:, column["forward_speed"]] = np.cos(yaw) * vx_fixed + np.sin(yaw) * vy_fixed
+    values[:, column["lateral_speed"]] = -np.sin(yaw) * vx_fixed + np.cos(yaw) * vy_fixed
+    frame = pd.DataFrame(values, columns=[name for name, _, _ in layout], copy=False)
+    residual = energy.balance_residual(frame)
+    frame[BALANCE_COLUMN] = residual
+    if not (np.all(np.isfinite(values)) and np.all(np.isfinite(residual))):
         raise SimulationError("non-finite values in the trajectory")
     return frame
+
+
+@functools.cache
+def frame_layout(tyre_transient="carcass"):
+    """The columns of :func:`trajectory_frame` before the balance residual: ``(name, source, index)``.
+
+    ``source`` is ``"state"`` (``index`` into the state vector), ``"output"``
+    (into :data:`whipple_kick.slip.OUTPUT_NAMES`) or ``"derived"`` (time, and the
+    heading speeds from yaw and the fixed-axes velocity).
+    """
+    layout = [("time", "derived", None)]
+    layout += [(name, "state", slip.X[q]) for q, (name, _) in COORDINATE_COLUMNS.items()]
+    layout += [(name, "output", slip.OUT[u]) for u, (name, _) in SPEED_COLUMNS.items()]   # u5 u6 u8 too
+    layout += [(name, "derived", None) for name in HEADING_COLUMNS]
+    layout += [(name, "output", slip.OUT[o]) for o, name in APPLIED_COLUMNS.items()]
+    if tyre_transient != "force_lag":
+        layout += [(name, "output", slip.OUT[o]) for o, name in PATCH_OUTPUT_COLUMNS.items()]   # the state itself in the contact forms
+        layout += [("camber_patch_rear", "state", slip.X["camber_patch_r"]),
+                   ("camber_patch_front", "state", slip.X["camber_patch_f"])]
+    if tyre_transient == "carcass":
+        layout += [(name, "state", slip.X[state]) for state, name in CARCASS_STATE_COLUMNS.items()]
+    layout += [(name, "output", slip.OUT[o]) for o, name in OUTPUT_COLUMNS.items()]
+    layout += [(name, "state", slip.X[state]) for state, (name, _) in energy.COLUMNS.items()]
+    return tuple(layout)
 
 
 def with_units(frame):
@@ -505,8 +524,12 @@ def extrapolation(frame, rear, front):
     dict
         ``rear`` and ``front``.
     """
-    after = frame[frame["time"] >= 0.0]
-    t = after["time"].to_numpy()
+    rows = frame["time"].to_numpy() >= 0.0
+
+    def after(column):   # the column's values after the kick start (no copy of the whole table)
+        return frame[column].to_numpy()[rows]
+
+    t = after("time")
     dt = np.diff(t, append=t[-1]) if t.size else t
 
     def seconds(mask):
@@ -515,10 +538,10 @@ def extrapolation(frame, rear, front):
     out = {}
     for wheel, tyre in (("rear", rear), ("front", front)):
         measured = getattr(tyre, "measured", None)
-        patch_column = f"slip_patch_{wheel}" if f"slip_patch_{wheel}" in after else f"slip_{wheel}"
-        patch = np.degrees(np.abs(after[patch_column].to_numpy()))
-        kinematic = np.degrees(np.abs(after[f"slip_{wheel}"].to_numpy()))
-        load = after[f"fz_{wheel}"].to_numpy()
+        patch_column = f"slip_patch_{wheel}" if f"slip_patch_{wheel}" in frame else f"slip_{wheel}"
+        patch = np.degrees(np.abs(after(patch_column)))
+        kinematic = np.degrees(np.abs(after(f"slip_{wheel}")))
+        load = after(f"fz_{wheel}")
         entry = {"max_abs_patch_slip_deg": float(patch.max(initial=0.0)),
                  "max_abs_kinematic_slip_deg": float(kinematic.max(initial=0.0)),
                  "max_load_n": float(load.max(initial=0.0)), "min_load_n": float(load.min(initial=0.0))}

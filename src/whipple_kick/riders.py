@@ -29,6 +29,7 @@ the bicycle's benchmark frame has x forward, y right, z down. So
 from collections.abc import Mapping
 import copy
 import dataclasses
+import functools
 import math
 import types
 from typing import NamedTuple
@@ -140,14 +141,19 @@ def standing_height(measurements):
 
 
 def _read_rider_file(name):
-    """Parse and validate ``parameters/riders/<name>.toml``."""
-    import yeadon
-
+    """Parse and validate ``parameters/riders/<name>.toml``, once per process and content (shared: read only)."""
     names = available()
     if name not in names:
         raise InputError(f"unknown rider {name!r}; available: {', '.join(names)}")
     path = RIDER_DIR / f"{name}.toml"
-    data = parameters.load_toml(path)
+    return _parse_rider_file(path, parameters.file_bytes(path))
+
+
+@functools.lru_cache(maxsize=64)
+def _parse_rider_file(path, content):
+    import yeadon
+
+    data = parameters.parse_toml(path, content)
     if data.get("format") != FORMAT:
         parameters.fail(path, "format", f"must be {FORMAT!r}, got {data.get('format')!r}")
     if data.get("model") != "yeadon":
@@ -572,7 +578,7 @@ def within_rear_load_range(bike, fz_n, low, high):
     return fz
 
 
-def for_rear_load(bike, fz_n, rider="jason", height_m=None):
+def for_rear_load(bike, fz_n, rider="jason", height_m=None, load_range=None):
     """Seat the rider whose mass gives the bicycle a static rear-tyre load ``fz_n``.
 
     The seated posture does not depend on the rider's mass (only on the
@@ -592,6 +598,9 @@ def for_rear_load(bike, fz_n, rider="jason", height_m=None):
         Rider file name.
     height_m : float, optional
         Rider height [m] (see :func:`yeadon_rider`).
+    load_range : tuple, optional
+        :func:`rear_load_range` of this bicycle and rider if already known
+        (it seats a probe rider, ~10 ms, and does not depend on the load).
 
     Returns
     -------
@@ -599,7 +608,7 @@ def for_rear_load(bike, fz_n, rider="jason", height_m=None):
         ``combined, rider_mass = for_rear_load(...)``; ``.front_n`` and
         ``.rear_n`` give the static loads [N].
     """
-    rear_bike, high, per_kg = rear_load_range(bike, rider, height_m)
+    rear_bike, high, per_kg = rear_load_range(bike, rider, height_m) if load_range is None else load_range
     fz = within_rear_load_range(bike, fz_n, rear_bike, high)
     mass = (fz - rear_bike) / per_kg
     combined = seat(bike, yeadon_rider(rider, mass_kg=mass, height_m=height_m))

@@ -254,8 +254,6 @@ def run_case(scenario, case_id, trajectory=None):
         failure (:class:`~whipple_kick.simulation.SimulationError`) keeps the
         results, summary and trajectory of the run up to the failure.
     """
-    from threadpoolctl import threadpool_limits
-
     _preload()
     started = time.time()
     wall0, cpu0 = time.perf_counter(), time.process_time()
@@ -268,7 +266,7 @@ def run_case(scenario, case_id, trajectory=None):
         # time drops alike); with two workers on two cores the spinning also
         # steals the other worker's core. Scoped to the case, so a caller's
         # own process keeps its settings.
-        with threadpool_limits(limits=1):
+        with _blas_controller().limit(limits=1):
             result = simulation.run(scenario)
         _keep(record, result, trajectory)
     except Exception as exc:
@@ -285,6 +283,26 @@ def run_case(scenario, case_id, trajectory=None):
         "worker": f"{socket.gethostname()}:{os.getpid()}",
     }
     return record
+
+
+_blas = (None, -1)   # (threadpoolctl controller, len(sys.modules) when it looked)
+
+
+def _blas_controller():
+    """The process' threadpoolctl controller, looked for again only after new imports.
+
+    Finding the BLAS libraries a process has loaded takes ~1.2 ms, setting
+    their thread count ~10 us; libraries come with imports, so a count of
+    ``sys.modules`` that has not changed means the same libraries.
+    """
+    global _blas
+    from threadpoolctl import ThreadpoolController
+
+    controller, seen = _blas
+    if seen != len(sys.modules):
+        controller = ThreadpoolController()
+        _blas = (controller, len(sys.modules))
+    return controller
 
 
 def _keep(record, result, trajectory):

@@ -18,6 +18,7 @@ OUTPUTS of the two bracketing measured coefficient sets linearly; see
 data's provenance, the friction modes and the known limits of the fits.
 """
 import copy
+import functools
 import math
 import pathlib
 import warnings
@@ -28,7 +29,6 @@ from . import magic_formula as mf
 from . import parameters
 from .errors import InputError, check_range
 from .parameters import fail as _fail
-from .parameters import load_toml
 from .parameters import table as _table
 from .parameters import text as _text
 
@@ -136,11 +136,18 @@ def _coefficient_list(path, key, values, count):
         _fail(path, key, f"must be a list of {count} numbers, got {values!r}")
     if len(values) != count:
         _fail(path, key, f"must hold {count} coefficients, got {len(values)}")
-    return np.array([parameters.number(path, f"{key}[{i}]", v) for i, v in enumerate(values)])
+    array = np.array([parameters.number(path, f"{key}[{i}]", v) for i, v in enumerate(values)])
+    array.setflags(write=False)   # shared by every load of the file (read_tyre_file's cache)
+    return array
 
 
 def read_tyre_file(path):
     """Read and validate one tyre file.
+
+    Parsed once per process and content (a sweep loads the same tyre for
+    every case; parsing and checking it took ~1.2 ms a load): the file's bytes
+    are the cache key, so an edited file is read afresh. The result is
+    shared: its coefficient arrays are read-only.
 
     Raises
     ------
@@ -148,7 +155,12 @@ def read_tyre_file(path):
         One line naming the file, the key and the problem.
     """
     path = pathlib.Path(path)
-    data = load_toml(path)
+    return _read_tyre_file(path, parameters.file_bytes(path))
+
+
+@functools.lru_cache(maxsize=64)
+def _read_tyre_file(path, content):
+    data = parameters.parse_toml(path, content)
     unknown = set(data) - _TOP_KEYS
     if unknown:
         _fail(path, sorted(unknown)[0], f"unknown key; allowed: {', '.join(sorted(_TOP_KEYS))}")
