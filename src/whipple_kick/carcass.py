@@ -99,7 +99,9 @@ _C_GENERIC = r"""
 /* ---- carcass tyre: generic helpers (whipple_kick.carcass) ---- */
 #define WK_CAP_DEG %(cap).17g
 #define WK_DEG (180.0 / M_PI)
-typedef struct { double f1[6], f2[6], w, lam; int two; } wk_curve;   /* f: B C D E Sh Sv */
+/* f: B C D E Sh Sv of each set; up: each set's inner value at its peak, which depends on C and E
+   only (not on the camber), computed once per evaluation and shared by the curves at both cambers. */
+typedef struct { double f1[6], f2[6], w, lam, up[2]; int two; } wk_curve;
 
 /* u with (1 - E) u + E atan(u) = t on the rising part (|u| <= umax): safeguarded Newton. */
 static double wk_inner_inverse(double t, double E, double umax)
@@ -120,14 +122,20 @@ static double wk_inner_inverse(double t, double E, double umax)
     return s * u;
 }
 
-/* Rising branch of one coefficient set in the patch slip alpha [deg]: [lo, hi]. */
-static void wk_set_branch(const double *f, double *lo, double *hi)
+/* Rising branch of one coefficient set in the patch slip alpha [deg]: [lo, hi]; *up caches the inner
+   value at the peak (NAN: not computed yet). */
+static void wk_set_branch(const double *f, double *up_cache, double *lo, double *hi)
 {
     const double B = f[0], C = f[1], E = f[3], Sh = f[4];
-    double umax = INFINITY, up = INFINITY;
-    if (E > 1.0) umax = 1.0 / sqrt(E - 1.0);           /* the inner function's maximum */
-    if (C > 1.0) up = wk_inner_inverse(tan(M_PI / (2.0 * C)), E, umax);
-    if (up > umax) up = umax;
+    double up = *up_cache;
+    if (isnan(up)) {
+        double umax = INFINITY;
+        up = INFINITY;
+        if (E > 1.0) umax = 1.0 / sqrt(E - 1.0);           /* the inner function's maximum */
+        if (C > 1.0) up = wk_inner_inverse(tan(M_PI / (2.0 * C)), E, umax);
+        if (up > umax) up = umax;
+        *up_cache = up;
+    }
     double xp = B > 0.0 ? up / B : INFINITY;
     *hi = fmin(xp - Sh, WK_CAP_DEG);
     *lo = fmax(-xp - Sh, -WK_CAP_DEG);
@@ -147,24 +155,35 @@ static double wk_curve_dF(const wk_curve *c, double a_deg)   /* dF/dalpha per de
     return -c->lam * v;
 }
 
+static void wk_curve_FdF(const wk_curve *c, double a_deg, double *F, double *dF)   /* both, sharing terms */
+{
+    double y, dy, y2, dy2;
+    wk_mf_ydy(a_deg, c->f1, &y, &dy);
+    y *= 1.0 - c->w; dy *= 1.0 - c->w;
+    if (c->two) { wk_mf_ydy(a_deg, c->f2, &y2, &dy2); y += c->w * y2; dy += c->w * dy2; }
+    *F = -c->lam * y; *dF = -c->lam * dy;
+}
+
 /* Rising branch of the (blended) curve: [lo, hi] deg, F(lo) the largest, F(hi) the smallest force. */
-static void wk_curve_branch(const wk_curve *c, double *lo, double *hi)
+static void wk_curve_branch(wk_curve *c, double *lo, double *hi)
 {
     double l1, h1;
-    wk_set_branch(c->f1, &l1, &h1);
+    wk_set_branch(c->f1, &c->up[0], &l1, &h1);
     if (!c->two) { *lo = l1; *hi = h1; return; }
     double l2, h2;
-    wk_set_branch(c->f2, &l2, &h2);
-    /* The blend's extreme lies between the sets' own: bisect on its slope. */
+    wk_set_branch(c->f2, &c->up[1], &l2, &h2);
+    /* The blend's extreme lies between the sets' own: the root of its slope there (Illinois). */
     for (int side = 0; side < 2; side++) {
         double a = side ? fmin(h1, h2) : fmax(l1, l2), b = side ? fmax(h1, h2) : fmin(l1, l2);
         double ga = wk_curve_dF(c, a), gb = wk_curve_dF(c, b);
         double x = b;
         if (ga * gb < 0.0) {
-            for (int i = 0; i < 80 && fabs(b - a) > 1e-12; i++) {
-                x = 0.5 * (a + b);
-                double g = wk_curve_dF(c, x);
-                if ((g < 0.0) == (ga < 0.0)) { a = x; ga = g; } else b = x;
+            for (int i = 0; i < 100; i++) {
+                x = b - gb * (b - a) / (gb - ga);
+                const double g = wk_curve_dF(c, x);
+                if (g == 0.0 || fabs(x - b) <= 1e-11 * (1.0 + fabs(x))) break;
+                if ((g < 0.0) != (gb < 0.0)) { a = b; ga = gb; } else ga *= 0.5;
+                b = x; gb = g;
             }
         } else if (fabs(ga) < fabs(gb)) x = a;
         if (side) *hi = x; else *lo = x;
@@ -176,10 +195,11 @@ static double wk_curve_solve(const wk_curve *c, double target, double k, double 
 {
     double a = fmin(fmax(guess, lo), hi);
     for (int i = 0; i < 100; i++) {
-        double ar = a / WK_DEG, ta = tan(ar);
-        double g = wk_curve_F(c, a) - k * ta - target;
+        double ar = a / WK_DEG, ta = k != 0.0 ? tan(ar) : 0.0, Fa, dFa;
+        wk_curve_FdF(c, a, &Fa, &dFa);
+        double g = Fa - k * ta - target;
         if (g > 0.0) lo = a; else hi = a;
-        double dg = wk_curve_dF(c, a) - k * (1.0 + ta * ta) / WK_DEG;
+        double dg = dFa - k * (1.0 + ta * ta) / WK_DEG;
         double next = dg < 0.0 ? a - g / dg : 0.5 * (lo + hi);
         if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
         if (fabs(next - a) <= 1e-13 * (1.0 + fabs(a)) || hi - lo <= 1e-13) { a = next; break; }
@@ -216,7 +236,7 @@ _C_WHEEL = r"""
    the limit on its side (then *lim is that limit and the slip returned is where the rising branch
    reaches it), 0 inside. Fast path: one set with C > 1 and E <= 1 (every table7_9 fit) whose closed
    form lands inside the cap needs no branch search. */
-static double wk_carcass_slip_%(w)s(const wk_curve *c, double F, int curve_law, double kslip, double loaded,
+static double wk_carcass_slip_%(w)s(wk_curve *c, double F, int curve_law, double kslip, double loaded,
                                    int *sat, double *lim)
 {
     *sat = 0; *lim = 0.0;
@@ -233,6 +253,22 @@ static double wk_carcass_slip_%(w)s(const wk_curve *c, double F, int curve_law, 
         if (s > -1.0 && s < 1.0) {
             const double a = wk_inner_inverse(tan(asin(s) / f[1]), f[3], INFINITY) / f[0] - f[4];
             if (a > -WK_CAP_DEG && a < WK_CAP_DEG) return a;
+        }
+    }
+    if (c->two && !curve_law && c->f1[1] > 1.0 && c->f1[3] <= 1.0 && c->f2[1] > 1.0 && c->f2[3] <= 1.0) {
+        /* A pressure blend: where both sets rise, so does the blend, and its root lies between the two
+           sets' own roots; only a force beyond that common part needs the blend's own extremes. */
+        double l1, h1, l2, h2;
+        wk_set_branch(c->f1, &c->up[0], &l1, &h1);
+        wk_set_branch(c->f2, &c->up[1], &l2, &h2);
+        const double lo_in = fmax(l1, l2), hi_in = fmin(h1, h2);
+        if (lo_in < hi_in) {
+            /* Each set's own root (closed form, unclamped); when both lie where both sets rise, the
+               blend's root is between them and the blend is monotone there. */
+            const double a1 = wk_set_inverse(c->f1, c->lam, F, -INFINITY, INFINITY);
+            const double a2 = wk_set_inverse(c->f2, c->lam, F, -INFINITY, INFINITY);
+            if (a1 > lo_in && a1 < hi_in && a2 > lo_in && a2 < hi_in)
+                return wk_curve_solve(c, F, 0.0, fmin(a1, a2), fmax(a1, a2), (1.0 - c->w) * a1 + c->w * a2);
         }
     }
     double lo, hi;
@@ -259,6 +295,7 @@ static void wk_carcass_%(w)s(double vsy, double vx, double camber, double fz, do
     const double loaded = fz > 0.0 ? 1.0 : 0.0;
     wk_curve c, cl;   /* the curve at the camber and at the lagged camber */
     c.w = cl.w = p[%(wgt)d]; c.lam = cl.lam = p[%(lam)d]; c.two = cl.two = c.w != 0.0;
+    c.up[0] = c.up[1] = NAN;
     wk_fyfac2_%(w)s_1(camber, gl, fzs, p, c.f1, cl.f1);
     if (c.two) wk_fyfac2_%(w)s_2(camber, gl, fzs, p, c.f2, cl.f2);
     o->gl_rate = speed * (camber - gl) / sig;
@@ -300,6 +337,7 @@ static void wk_carcass_%(w)s(double vsy, double vx, double camber, double fz, do
     if (loaded > 0.0 && gl != camber) {
         int sat_l;
         double lim_l;
+        cl.up[0] = c.up[0]; cl.up[1] = c.up[1];   /* the peaks' inner values do not depend on the camber */
         aM = wk_carcass_slip_%(w)s(&cl, F, 0, kslip, loaded, &sat_l, &lim_l);
     }
     o->slip_moment = aM / WK_DEG;

@@ -136,6 +136,9 @@ def _c_carcass_curves():
             f"    return {printer.doprint(y)};\n}}")
     mf_dy = ("static double wk_mf_dy(double a_deg, const double *f)\n{\n"
              f"    return {printer.doprint(sm.diff(y, a_deg))};\n}}")
+    # Value and slope together (the Newton iterations need both): their common terms computed once.
+    mf_dy += ("\nstatic void wk_mf_ydy(double a_deg, const double *f, double *y, double *dy)\n{\n"
+              + _c_block([y, sm.diff(y, a_deg)], ["*y", "*dy"]) + "\n}")
     slip, camber, fz = sm.symbols("slip camber fz", real=True)
     lines = []
     for wheel in "rf":
@@ -174,7 +177,7 @@ def _c_limit_functions():
     for wheel in "rf":
         lines += [f"static double wk_fylim_{wheel}(double camber, double fz, double F, const double *p)", "{",
                   "    if (!(fz > 0.0)) return 0.0;",
-                  "    wk_curve c; double lo, hi;",
+                  "    wk_curve c; double lo, hi;", "    c.up[0] = c.up[1] = NAN;",
                   f"    c.w = p[{P['w' + wheel]}]; c.lam = p[{P['lam' + wheel]}]; c.two = c.w != 0.0;",
                   f"    wk_fyfac_{wheel}_1(camber, fmax(fz, {carcass.FZ_SHAPE_FLOOR!r}), p, c.f1);",
                   f"    if (c.two) wk_fyfac_{wheel}_2(camber, fmax(fz, {carcass.FZ_SHAPE_FLOOR!r}), p, c.f2);",
