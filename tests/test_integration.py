@@ -204,9 +204,9 @@ def test_work_counters_are_the_sum_over_the_pieces(changes, monkeypatch):
 def test_join_concatenates_samples_sums_counters_and_ends_as_the_last_piece():
     from whipple_kick import lsoda
     n = len(wk.slip.STATE_NAMES)
-    a = lsoda.Trajectory(np.array([0.0, 1.0]), np.zeros((2, n)), False, None, 10, "a", end_state=np.zeros(n),
+    a = lsoda.StateHistory(np.array([0.0, 1.0]), np.zeros((2, n)), False, None, 10, "a", end_state=np.zeros(n),
                          njev=2, evaluations=30)
-    b = lsoda.Trajectory(np.array([2.0]), np.ones((1, n)), True, 2.0, 5, "fell", end_state=np.ones(n),
+    b = lsoda.StateHistory(np.array([2.0]), np.ones((1, n)), True, 2.0, 5, "fell", end_state=np.ones(n),
                          njev=1, evaluations=12, fall_reason="steer")
     c = lsoda.join([a, b])
     assert c.t.tolist() == [0.0, 1.0, 2.0] and c.x.shape == (3, n) and c.x[2, 0] == 1.0

@@ -30,7 +30,7 @@ class Solution:
 
     Attributes
     ----------
-    trajectory : whipple_kick.lsoda.Trajectory
+    states : whipple_kick.lsoda.StateHistory
         Samples from -settle to the end (or the fall, or the failure); time
         from the kick start; quadratures 0 at the kick start.
     rhs : slip.CompiledRHS or list of them
@@ -45,7 +45,7 @@ class Solution:
         Wall time of the integration [s].
     """
 
-    trajectory: lsoda.Trajectory
+    states: lsoda.StateHistory
     rhs: object
     owner: np.ndarray | None
     breakpoints: tuple
@@ -54,7 +54,7 @@ class Solution:
 
     def outputs(self) -> np.ndarray:
         """The compiled model's named outputs (:data:`whipple_kick.slip.OUTPUT_NAMES`) at every sample."""
-        traj = self.trajectory
+        traj = self.states
         if self.owner is None:
             return self.rhs.outputs_at(traj.t, traj.x)
         # Each piece's compiled model evaluates the samples it produced.
@@ -137,7 +137,7 @@ def _integrate(steady, scenario, kick):
 
     Returns
     -------
-    traj : lsoda.Trajectory
+    traj : lsoda.StateHistory
     rhs : slip.CompiledRHS or list of them
     owner : ndarray of int or None
         With a list of ``rhs``: which one produced each sample.
@@ -213,7 +213,7 @@ def _integrate_kept_speeds(rhs, params, x, span, rows, stop, scenario, chunk, ju
 
     Returns
     -------
-    traj : lsoda.Trajectory
+    traj : lsoda.StateHistory
     rhs : list of slip.CompiledRHS
         Before and after the stop.
     owner : ndarray of int
@@ -260,7 +260,7 @@ def _integrate_table(params, x0, table, scenario, chunk, t_start=None):
 
     Returns
     -------
-    trajectory : lsoda.Trajectory
+    trajectory : lsoda.StateHistory
     rhs : list of slip.CompiledRHS
         One per piece.
     piece : ndarray of int

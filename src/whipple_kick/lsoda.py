@@ -32,8 +32,12 @@ from . import slip
 
 
 @dataclass
-class Trajectory:
-    """Samples of one run."""
+class StateHistory:
+    """The integrated states at the samples of one run, with its outcome and work counters.
+
+    Not to be confused with :attr:`whipple_kick.results.Result.trajectory`, the table of named columns
+    computed from it (:func:`whipple_kick.results.trajectory_frame`).
+    """
 
     t: np.ndarray            # times [s], shape (n,)
     x: np.ndarray            # states, shape (n, len(slip.STATE_NAMES))
@@ -58,7 +62,7 @@ def join(pieces):
     The samples are concatenated and the work counters (``nfev``, ``njev``,
     ``evaluations``) summed; how the run ended (fall, failure, message, end
     state) is the last piece's. The one place pieces are merged, so that no
-    counter is lost (a hand-made Trajectory once reported 0 Jacobians).
+    counter is lost (a hand-made StateHistory once reported 0 Jacobians).
     """
     pieces = list(pieces)
     return replace(pieces[-1], t=np.concatenate([p.t for p in pieces]), x=np.concatenate([p.x for p in pieces]),
@@ -348,7 +352,7 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
 
     Returns
     -------
-    Trajectory
+    StateHistory
         With ``end_state`` the exact state at ``t_end`` (or at the fall, or
         where it failed), whether or not that is a sample time.
 
@@ -473,5 +477,5 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
     X = np.concatenate(xs) if xs else np.empty((0, len(x)))
     if X.size and not np.all(np.isfinite(X)):
         raise FloatingPointError("non-finite state in the integration result")
-    return Trajectory(t, X, fell, fall_time, nfev, message, end_state=np.asarray(x, dtype=float), failed=failed,
+    return StateHistory(t, X, fell, fall_time, nfev, message, end_state=np.asarray(x, dtype=float), failed=failed,
                       njev=njev, evaluations=spent, fall_reason=fall_reason)

@@ -196,7 +196,7 @@ def trajectory_frame(solution, tyre_transient="carcass"):
     """
     import pandas as pd
 
-    traj = solution.trajectory
+    traj = solution.states
     outs = solution.outputs()
     layout = frame_layout(tyre_transient)
     # One float64 block, column by column (Fortran order: each column contiguous), instead of a dict of
@@ -435,7 +435,7 @@ def summarise(scenario, kick, assembly, solution, frame, *, custom_tyres=False) 
     dict
         No NaN, numpy types converted (:func:`clean`).
     """
-    traj = solution.trajectory
+    traj = solution.states
     baseline = float(assembly.reference.x[slip.X["u3"]])
     metrics, recovery = response_metrics(frame, baseline, assembly.reference.x, scenario, traj)
     recovery = _recovery_section(recovery, rate_baselines(assembly.reference.x))
@@ -628,7 +628,7 @@ def _peaks(frame):
 
 
 def _numerics_section(scenario, solution, frame):
-    traj = solution.trajectory
+    traj = solution.states
     return {
         "method": "LSODA", "rtol": scenario.rtol, "piecewise": scenario.piecewise,
         "plate_stop": scenario.plate_stop, "kick_heading": scenario.kick_heading,

@@ -74,6 +74,6 @@ def run(scenario: Scenario, *, tyres: tuple | None = None, gains: Mapping | None
     summary = results.summarise(scenario, kick, model, solution, frame, custom_tyres=tyres is not None)
     summary["numerics"]["wall_s"] = time.perf_counter() - started
     result = Result(scenario=scenario, trajectory=frame, summary=summary)
-    if solution.trajectory.failed:
-        raise SimulationError(solution.trajectory.message, partial=result)
+    if solution.states.failed:
+        raise SimulationError(solution.states.message, partial=result)
     return result
