@@ -236,7 +236,7 @@ _C_WHEEL = r"""
    the limit on its side (then *lim is that limit and the slip returned is where the rising branch
    reaches it), 0 inside. Fast path: one set with C > 1 and E <= 1 (every table7_9 fit) whose closed
    form lands inside the cap needs no branch search. */
-static double wk_carcass_slip_%(w)s(wk_curve *c, double F, int curve_law, double kslip, double loaded,
+static double wk_carcass_slip_%(w)s(wk_curve *c, double F, int curve_law, double vsy, double speed, double loaded,
                                    int *sat, double *lim)
 {
     *sat = 0; *lim = 0.0;
@@ -245,7 +245,7 @@ static double wk_carcass_slip_%(w)s(wk_curve *c, double F, int curve_law, double
            D = a1 Fz^2 + a2 Fz has fallen to zero at this load (table7_9: from 1.6-3.2 kN): it slides
            with the wheel and the carcass force relaxes through the viscosity alone. */
         *sat = (F > 0.0) - (F < 0.0);
-        return kslip;
+        return atan2(vsy, speed) * WK_DEG;   /* the kinematic slip */
     }
     if (!c->two && !curve_law && c->f1[1] > 1.0 && c->f1[3] <= 1.0 && loaded > 0.0) {
         const double *f = c->f1;
@@ -277,6 +277,7 @@ static double wk_carcass_slip_%(w)s(wk_curve *c, double F, int curve_law, double
     double a_pos = lo, a_neg = hi;
     /* "curve": past the peak the limit is the steady curve at the kinematic slip, reached on the rising
        branch where the curve gives the same force. */
+    const double kslip = curve_law ? atan2(vsy, speed) * WK_DEG : 0.0;   /* the kinematic slip [deg] */
     if (curve_law && kslip < lo) { lim_pos = fmax(0.0, wk_curve_F(c, kslip)); a_pos = wk_curve_inverse(c, lim_pos, 0.0, lo, hi); }
     if (curve_law && kslip > hi) { lim_neg = fmin(0.0, wk_curve_F(c, kslip)); a_neg = wk_curve_inverse(c, lim_neg, 0.0, lo, hi); }
     if (F >= lim_pos) { *sat = 1; *lim = lim_pos; return a_pos; }
@@ -290,7 +291,8 @@ static void wk_carcass_%(w)s(double vsy, double vx, double camber, double fz, do
     const double cc = p[%(cc)d], dc = p[%(dc)d], sig = p[%(sig)d];
     const int curve_law = p[%(law)d] > 0.5;
     const double speed = fabs(vx);
-    const double kslip = atan2(vsy, speed) * WK_DEG;      /* kinematic slip [deg] */
+    /* the kinematic slip [deg], computed only where it is used (the sliding law "curve", no grip) */
+#define WK_KSLIP (atan2(vsy, speed) * WK_DEG)
     const double fzs = fmax(fz, %(floor).17g);
     const double loaded = fz > 0.0 ? 1.0 : 0.0;
     wk_curve c, cl;   /* the curve at the camber and at the lagged camber */
@@ -302,7 +304,7 @@ static void wk_carcass_%(w)s(double vsy, double vx, double camber, double fz, do
     o->F0 = loaded * wk_curve_F(&c, 0.0);
     o->sat = 0; o->cc = cc; o->dc = dc; o->y = y; o->vsy = vsy;
     if (!(cc > 0.0) || c.lam == 0.0) {     /* no lateral force: the carcass relaxes */
-        o->F = 0.0; o->M = 0.0; o->slip = kslip / WK_DEG; o->rate = -speed * y / sig;
+        o->F = 0.0; o->M = 0.0; o->slip = WK_KSLIP / WK_DEG; o->rate = -speed * y / sig;
         o->vslide = vsy + o->rate; return;
     }
     double F, a, lim;
@@ -312,6 +314,7 @@ static void wk_carcass_%(w)s(double vsy, double vx, double camber, double fz, do
            limit (peak, or the curve at the kinematic slip) the patch force is the limit. */
         const double k = dc * speed, target = cc * y - dc * vsy;
         const int grip = loaded > 0.0 && c.f1[2] > 0.0 && !(c.two && !(c.f2[2] > 0.0));
+        const double kslip = curve_law || !grip ? WK_KSLIP : 0.0;
         if (!grip) { sat = 0; F = 0.0; a = kslip; }
         else {
             double lo, hi;
@@ -326,7 +329,7 @@ static void wk_carcass_%(w)s(double vsy, double vx, double camber, double fz, do
         o->rate = (F - cc * y) / dc;
     } else {
         F = cc * y;
-        a = wk_carcass_slip_%(w)s(&c, F, curve_law, kslip, loaded, &sat, &lim);
+        a = wk_carcass_slip_%(w)s(&c, F, curve_law, vsy, speed, loaded, &sat, &lim);
         /* Past the limit the patch slides faster than at the limit's own slip on the rising branch,
            by (limit - c y) / viscosity: continuous with the rising branch, stiff, and passive. */
         o->rate = speed * tan(a / WK_DEG) - vsy + (sat ? (lim - F) / p[%(visc)d] : 0.0);
@@ -338,7 +341,7 @@ static void wk_carcass_%(w)s(double vsy, double vx, double camber, double fz, do
         int sat_l;
         double lim_l;
         cl.up[0] = c.up[0]; cl.up[1] = c.up[1];   /* the peaks' inner values do not depend on the camber */
-        aM = wk_carcass_slip_%(w)s(&cl, F, 0, kslip, loaded, &sat_l, &lim_l);
+        aM = wk_carcass_slip_%(w)s(&cl, F, 0, vsy, speed, loaded, &sat_l, &lim_l);
     }
     o->slip_moment = aM / WK_DEG;
     o->M = wk_mz_%(w)s(aM / WK_DEG, gl, fz, p);
