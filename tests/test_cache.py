@@ -39,7 +39,7 @@ def test_hash_changes_with_source_and_options():
     a = cache.source_hash(["derivation"], extra="x")
     assert a == cache.source_hash(["derivation"], extra="x")
     assert a != cache.source_hash(["derivation"], extra="y")
-    assert a != cache.source_hash(["derivation", "slip"], extra="x")
+    assert a != cache.source_hash(["derivation", "slip/layout"], extra="x")
 
 
 def test_missing_compiler_is_a_clear_error(monkeypatch):
@@ -76,5 +76,7 @@ def test_every_generator_is_part_of_its_own_cache_key():
     rebuilds the entry (classic.py was not in its own key, so a change to _generate_source reused the
     stale module unless someone remembered to bump a layout string)."""
     from whipple_kick import classic, geometry
-    for module, name in ((classic, "classic"), (geometry, "geometry"), (slip, "slip"), (slip, "slip_build")):
+    slip_modules = tuple(f"slip/{p.stem}" for p in (cache._PACKAGE_DIR / "slip").glob("*.py"))
+    for module, name in ((classic, "classic"), (geometry, "geometry"), (slip, "slip_build"),
+                         *((slip, m) for m in slip_modules)):
         assert name in module._SOURCES, (module.__name__, name)

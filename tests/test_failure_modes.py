@@ -76,7 +76,7 @@ def test_failing_compiler_is_one_line_naming_compiler_and_log(tmp_path, monkeypa
 def test_failing_compiler_from_simulate_is_status_1_and_leaves_no_folder(tmp_path, capsys, monkeypatch):
     def fail():
         raise BuildError("the C compiler /bin/false failed (exit status 1: no output)")
-    monkeypatch.setattr(slip, "library_path", fail)
+    monkeypatch.setattr(slip.compiled, "library_path", fail)
     slip.library.cache_clear()
     try:
         out = tmp_path / "run"

@@ -29,7 +29,7 @@ def states(steady):
 
 def _ctypes_path(rhs, monkeypatch):
     """The ctypes fallback ``f(t, x)`` (what runs where the extension cannot be built)."""
-    monkeypatch.setattr(slip, "_native_call", lambda: None)
+    monkeypatch.setattr(slip.compiled, "_native_call", lambda: None)
     return rhs.guarded()
 
 
@@ -90,7 +90,7 @@ class _Past(Exception):
 def test_guard_raises_past_either_limit_only(steady, monkeypatch, use_extension):
     rhs = slip.CompiledRHS(steady.params)
     if not use_extension:
-        monkeypatch.setattr(slip, "_native_call", lambda: None)
+        monkeypatch.setattr(slip.compiled, "_native_call", lambda: None)
     roll, steer = slip.X["q4"], slip.X["q7"]
     f = rhs.guarded(roll, 0.5, _Past, steer, 1.0)
     x = steady.x.copy()
@@ -110,7 +110,7 @@ def test_guard_raises_past_either_limit_only(steady, monkeypatch, use_extension)
 def test_a_non_finite_state_raises_the_models_error(steady, monkeypatch, use_extension):
     rhs = slip.CompiledRHS(steady.params)
     if not use_extension:
-        monkeypatch.setattr(slip, "_native_call", lambda: None)
+        monkeypatch.setattr(slip.compiled, "_native_call", lambda: None)
     f = rhs.guarded(slip.X["q4"], math.inf, _Past)
     x = steady.x.copy()
     x[slip.X["u4"]] = np.nan
@@ -132,7 +132,7 @@ def test_integration_is_the_same_on_either_path(steady, monkeypatch):
     """The 6 s base case's first second through the extension and through ctypes: identical trajectories."""
     rhs = slip.CompiledRHS(steady.params)
     fast = lsoda.integrate(rhs, steady.x, 1.0, breakpoints=(0.15,), rtol=1e-10)
-    monkeypatch.setattr(slip, "_native_call", lambda: None)
+    monkeypatch.setattr(slip.compiled, "_native_call", lambda: None)
     slow_rhs = slip.CompiledRHS(steady.params)
     assert not hasattr(slow_rhs.fast, "repeat")
     slow = lsoda.integrate(slow_rhs, steady.x, 1.0, breakpoints=(0.15,), rtol=1e-10)

@@ -29,6 +29,7 @@ import numpy as np
 from scipy.integrate import LSODA, odeint
 
 from . import slip
+from .transient import DEFAULT_TRANSIENT
 
 
 @dataclass
@@ -92,7 +93,7 @@ DEFAULT_CHUNK = 0.5
 QUADRATURE_ATOL = 1e6
 
 
-def default_atol(rtol, transient=slip.transient.DEFAULT_TRANSIENT):
+def default_atol(rtol, transient=DEFAULT_TRANSIENT):
     """Absolute tolerances per state, scaled to each state's typical size.
 
     Angles and displacements (~1e-2..1) and speeds (~1) get ``rtol`` x 1e-2
@@ -367,7 +368,7 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
     >>> round(float(traj.x[-1, 0] / 1e-3), 6), traj.failed
     (0.367879, False)
     """
-    transient = getattr(rhs, "transient", slip.transient.DEFAULT_TRANSIENT)
+    transient = getattr(rhs, "transient", DEFAULT_TRANSIENT)
     plain = getattr(rhs, "fast", rhs)   # the compiled model's one-foreign-call f(t, x)
     atol = default_atol(rtol, transient) if atol is None else np.asarray(atol, dtype=float)
     jac = rhs.jacobian_function(atol / rtol) if hasattr(rhs, "jacobian_function") else None

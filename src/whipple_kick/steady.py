@@ -44,6 +44,7 @@ import math
 import numpy as np
 
 from . import slip
+from . import symbols as S
 from .errors import InputError
 
 #: Leans [deg] of the steady turns tried when the direct solve fails, smallest first.
@@ -215,7 +216,7 @@ def turn_guess(params, speed, lean):
     kinematics (wheelbase w, steer-axis tilt lam of the bicycle).
     """
     from .benchmark import from_moore
-    bench = from_moore({name: params[name] for name in slip.S.CLASSIC_CONSTANTS})
+    bench = from_moore({name: params[name] for name in S.CLASSIC_CONSTANTS})
     yaw_rate = params["g"] * math.tan(lean) / speed
     return {"q4": lean, "u3": yaw_rate, "q7": yaw_rate * bench["w"] / (speed * math.cos(bench["lam"]))}
 

@@ -5,6 +5,7 @@ import numpy as np
 
 from whipple_kick import assembly, results, slip
 from whipple_kick.errors import InputError, check_range
+from whipple_kick.transient import DEFAULT_TRANSIENT
 
 from ._constants import LOOPS
 
@@ -20,7 +21,7 @@ _LABELS = {
 }
 
 
-def state_labels(transient=slip.transient.DEFAULT_TRANSIENT, constant_speed=True):
+def state_labels(transient=DEFAULT_TRANSIENT, constant_speed=True):
     """(name, unit) of each state of the linear model, in order.
 
     Parameters
