@@ -10,7 +10,8 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import whipple_kick as wk
-from whipple_kick import carcass, slip, slip_build, steady
+from whipple_kick import carcass, slip, steady
+from whipple_kick.build import slip_build
 from whipple_kick.scenario import Scenario
 from whipple_kick.simulation import run
 

@@ -16,7 +16,8 @@ import time
 import numpy as np
 import pytest
 
-from whipple_kick import cache, cli, fileio, inputs, slip, slip_build
+from whipple_kick import cache, cli, fileio, inputs, slip
+from whipple_kick.build import slip_build
 from whipple_kick.cli import simulate_main
 from whipple_kick.errors import BuildError, InputError
 

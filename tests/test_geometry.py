@@ -11,8 +11,9 @@ import numpy as np
 import pytest
 
 import whipple_kick as wk
-from whipple_kick import animation, derivation, geometry, simulation
+from whipple_kick import animation, geometry, simulation
 from whipple_kick import symbols as S
+from whipple_kick.build import derivation
 from whipple_kick.errors import InputError
 
 

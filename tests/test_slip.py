@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 import whipple_kick as wk
-from whipple_kick import benchmark, classic, lsoda, slip, slip_build, steady
+from whipple_kick import benchmark, classic, lsoda, slip, steady
+from whipple_kick.build import slip_build
 
 
 def _outputs(rhs, trajectory):

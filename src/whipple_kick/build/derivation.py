@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 import sympy as sm
 import sympy.physics.mechanics as me
 
-from . import symbols as S
+from whipple_kick import symbols as S
 
 
 @dataclass
