@@ -42,7 +42,7 @@ def _base_case(rtol=1e-10):
 
 def bench_rhs(repeats):
     from whipple_kick import slip
-    from whipple_kick.build import slip_build
+    from whipple_kick.symbolic import slip_build
     ss = _base_case()
     rhs = slip.CompiledRHS(ss.params)
     p = slip.parameter_vector(ss.params)
@@ -99,7 +99,7 @@ def bench_build(repeats):
 
 def bench_run(repeats):
     from whipple_kick import lsoda, slip
-    from whipple_kick.build import slip_build
+    from whipple_kick.symbolic import slip_build
     ss = _base_case()
     p = slip.parameter_vector(ss.params)
     for rtol in (1e-12, 1e-8):

@@ -98,7 +98,7 @@ def gmin():
 def _secant_floor(value):
     """Compile and use the model with ``transient.G_MIN = value`` (its own cache entry)."""
     from whipple_kick import cache, slip
-    from whipple_kick.build import slip_build
+    from whipple_kick.symbolic import slip_build
     original, hash_function = transient.G_MIN, cache.source_hash
 
     def keyed(sources, extra=""):

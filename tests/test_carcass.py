@@ -11,9 +11,9 @@ from scipy.integrate import solve_ivp
 
 import whipple_kick as wk
 from whipple_kick import carcass, slip, steady
-from whipple_kick.build import slip_build
 from whipple_kick.scenario import Scenario
 from whipple_kick.simulation import run
+from whipple_kick.symbolic import slip_build
 
 RUNS = {"default": {}, "left kick": {"kick_direction": "left"}, "40 m/s^2": {"kick_accel": 40.0},
         "controller off": {"controller": "off"}}

@@ -143,7 +143,7 @@ def test_every_symbol_is_described():
 
 
 def test_derivation_uses_only_registered_symbols():
-    from whipple_kick.build import derivation
+    from whipple_kick.symbolic import derivation
     eom = derivation.classic_equations()
     t = sm.Symbol("t")
     names = set()

@@ -17,9 +17,9 @@ import numpy as np
 import pytest
 
 from whipple_kick import cache, cli, fileio, inputs, slip
-from whipple_kick.build import slip_build
 from whipple_kick.cli import simulate_main
 from whipple_kick.errors import BuildError, InputError
+from whipple_kick.symbolic import slip_build
 
 
 def _simulate(argv, capsys):

@@ -13,8 +13,8 @@ import pytest
 import whipple_kick as wk
 from whipple_kick import animation, geometry, simulation
 from whipple_kick import symbols as S
-from whipple_kick.build import derivation
 from whipple_kick.errors import InputError
+from whipple_kick.symbolic import derivation
 
 
 @pytest.fixture(scope="module")

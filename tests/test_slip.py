@@ -5,7 +5,7 @@ import pytest
 
 import whipple_kick as wk
 from whipple_kick import benchmark, classic, lsoda, slip, steady
-from whipple_kick.build import slip_build
+from whipple_kick.symbolic import slip_build
 
 
 def _outputs(rhs, trajectory):

@@ -6,7 +6,7 @@ import pytest
 
 import whipple_kick as wk
 from whipple_kick import cache, slip, steady
-from whipple_kick.build import slip_build
+from whipple_kick.symbolic import slip_build
 
 # Spread of the random tyre states: forces [N] and moments [N m] for the
 # thesis' form, patch slip and camber angles [rad] for the contact forms, carcass

@@ -34,10 +34,10 @@ __all__ = ["InputError", "Result", "Scenario", "SimulationError", "__version__",
 
 _SUBMODULES = (
     "analysis", "animation", "assembly", "authors_code", "benchmark", "bicycles", "cache", "classic", "cli",
-    "build", "carcass", "control", "energy", "errors", "experiments", "fileio", "geometry", "inputs",
+    "carcass", "control", "energy", "errors", "experiments", "fileio", "geometry", "inputs",
     "integration", "kane", "lsoda", "magic_formula", "parameters", "plotting", "provenance", "recommend", "results",
     "riders", "scenario", "simulation",
-    "slip", "stability", "steady", "sweep_engine", "sweep_store", "symbols", "transient", "tyres",
+    "slip", "stability", "steady", "symbolic", "sweep_engine", "sweep_store", "symbols", "transient", "tyres",
     "validation",
 )
 

@@ -6,7 +6,7 @@ is installed):
 
 * the bicycle's points and body orientations come from the model's own
   kinematics (:mod:`whipple_kick.geometry`, generated from
-  :func:`whipple_kick.build.derivation.kinematics`), evaluated at the run's
+  :func:`whipple_kick.symbolic.derivation.kinematics`), evaluated at the run's
   coordinates; the wheels are discs in their planes with spokes turning
   with the wheel angles; the rider is drawn from the Yeadon segments seated
   by :func:`whipple_kick.riders.place` (rigid in the rear frame, as in the

@@ -54,7 +54,7 @@ sliding velocity) and ``F0 = F_ss(0, camber, F_z)``, carcass storage rate
 :mod:`whipple_kick.energy` closes exactly.
 
 This module holds the constants, the C source of the block (printed by
-:mod:`whipple_kick.build.slip_build`; the curve, its factors and gradients are
+:mod:`whipple_kick.symbolic.slip_build`; the curve, its factors and gradients are
 generated from the SymPy Magic Formula, the inverse and the limit search are
 written here) and :func:`reference_block`, an independent Python
 computation of the same block (bracketed root finding on the NumPy curves)

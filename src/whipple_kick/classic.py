@@ -32,7 +32,7 @@ Q = {n: i for i, n in enumerate(COORDINATES)}
 U = {n: i for i, n in enumerate(SPEEDS)}
 
 #: Modules the generated code depends on, this one included (_generate_source writes it).
-_SOURCES = ("symbols", "build/derivation", "build/codegen", "classic")
+_SOURCES = ("symbols", "symbolic/derivation", "symbolic/codegen", "classic")
 _LAYOUT = "classic-v1"
 _PARTITION = kane.ConstraintPartition(SPEEDS, DEPENDENT)
 _STEP = 1e-30  # complex step; any tiny value works, there is no cancellation
@@ -40,7 +40,7 @@ _STEP = 1e-30  # complex step; any tiny value works, there is no cancellation
 
 def _generate_source():
     """Derive the classic model and return the NumPy module source (the build side: SymPy)."""
-    from whipple_kick.build import codegen, derivation
+    from whipple_kick.symbolic import codegen, derivation
     eom = derivation.classic_equations()
     dyn = list(eom.q) + list(eom.u)
     q = [codegen.plain_symbol(s) for s in eom.q]

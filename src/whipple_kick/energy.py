@@ -48,7 +48,7 @@ def common_rates(extra, u, t6):
     Parameters
     ----------
     extra : mapping
-        :func:`whipple_kick.build.derivation.slip_equations`' ``extra`` (plain symbols).
+        :func:`whipple_kick.symbolic.derivation.slip_equations`' ``extra`` (plain symbols).
     u : mapping
         Speed symbols by name (``u6``, ``u7``).
     t6 : sympy.Symbol

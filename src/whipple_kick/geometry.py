@@ -1,6 +1,6 @@
 """Where the bicycle's points are and how its bodies are turned, from the model's own kinematics.
 
-The slip model's kinematics (:func:`whipple_kick.build.derivation.kinematics` with
+The slip model's kinematics (:func:`whipple_kick.symbolic.derivation.kinematics` with
 ``tyre_model=True``: Moore's frames and points with toroidal tyres and
 vertical tyre compressions) are printed once as a vectorised NumPy function
 of the ten coordinates q1..q10 and the geometry constants, and cached like
@@ -25,7 +25,7 @@ COORDINATES = tuple(f"q{i}" for i in range(1, 11))
 #: Constants the geometry depends on (Moore's lengths, tyre crown radii), by name.
 PARAMETER_NAMES = ("d1", "d2", "d3", "l1", "l2", "l3", "l4", "rr", "rf", "rtr", "rtf")
 #: Points drawn, by name: the model's point of that name in
-#: :func:`whipple_kick.build.derivation.kinematics`.
+#: :func:`whipple_kick.symbolic.derivation.kinematics`.
 POINTS = {
     "rear_contact": "dn",            # on the ground (q1, q2)
     "rear_wheel_centre": "do",
@@ -41,7 +41,7 @@ FRAMES = ("A", "B", "C", "D", "E", "F")
 #: Unit directions of the front wheel in the ground plane and in its own plane.
 DIRECTIONS = ("front_heading", "front_lateral", "front_down")
 
-_SOURCES = ("symbols", "build/derivation", "build/codegen", "geometry")
+_SOURCES = ("symbols", "symbolic/derivation", "symbolic/codegen", "geometry")
 _LAYOUT = "geometry-v1"   # bump when numpy_source changes what it writes
 
 
@@ -50,7 +50,7 @@ def _expressions():
     """(outputs, coordinate symbols, parameter symbols) as plain SymPy expressions."""
     import sympy as sm
 
-    from whipple_kick.build import codegen, derivation
+    from whipple_kick.symbolic import codegen, derivation
 
     from . import symbols as S
 
@@ -74,7 +74,7 @@ def _expressions():
 
 def numpy_source():
     """Source of the generated module: ``pose(q, p)`` returns every output as arrays."""
-    from whipple_kick.build import codegen
+    from whipple_kick.symbolic import codegen
 
     outputs, q, p = _expressions()
     return "\n\n".join([

@@ -1,6 +1,6 @@
 """The slip model at run time: the compiled C right-hand side, its parameters, jumps and linearisation.
 
-The C library is built from the symbolic equations by :mod:`whipple_kick.build.slip_build`
+The C library is built from the symbolic equations by :mod:`whipple_kick.symbolic.slip_build`
 on a cache miss (once per version); this module only loads it (ctypes) with
 the plain-data metadata written beside it, so a warm run imports neither
 SymPy nor the derivation. One C call evaluates the right-hand side: the

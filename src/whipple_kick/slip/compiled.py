@@ -55,7 +55,7 @@ def library_path():
     The cache entry is ``slip_<key>.so`` with its C source and plain-data
     metadata (``slip_<key>.json``) beside it, the key hashing the package
     sources it is generated from, the SymPy version, the compiler and its
-    flags. A miss runs :func:`whipple_kick.build.slip_build.build_library` (SymPy,
+    flags. A miss runs :func:`whipple_kick.symbolic.slip_build.build_library` (SymPy,
     20-30 s, one line on stderr). An entry whose metadata is missing or
     records other layouts (states, parameters, outputs) is built again.
     """
@@ -64,7 +64,7 @@ def library_path():
     name = f"slip_{key}.so"
 
     def build(tmp):
-        from whipple_kick.build import slip_build  # SymPy and the derivation: only on a cache miss
+        from whipple_kick.symbolic import slip_build  # SymPy and the derivation: only on a cache miss
         slip_build.build_library(tmp, key, cc, _CFLAGS)
 
     lib_path = cache.build_once(name, build)

@@ -70,9 +70,9 @@ OUT = {n: i for i, n in enumerate(OUTPUT_NAMES)}
 P = {n: i for i, n in enumerate(PARAMETER_NAMES)}
 
 #: Package modules the compiled library is generated from (its cache key hashes them).
-_SOURCES = ("symbols", "build/derivation", "build/codegen", "magic_formula", "transient", "carcass", "energy",
+_SOURCES = ("symbols", "symbolic/derivation", "symbolic/codegen", "magic_formula", "transient", "carcass", "energy",
             "slip/__init__", "slip/layout", "slip/compiled", "slip/call", "slip/parameters", "slip/jumps",
-            "slip/linear", "build/slip_build")
+            "slip/linear", "symbolic/slip_build")
 _PARTITION = kane.ConstraintPartition(SPEEDS, DEPENDENT)
 
 

@@ -1,7 +1,7 @@
 """The slip model's build side: SymPy expressions, C and NumPy source, compilation.
 
 Run only on a cache miss (and by the tests that exercise it): the symbolic
-equations of :func:`whipple_kick.build.derivation.slip_equations` are printed
+equations of :func:`whipple_kick.symbolic.derivation.slip_equations` are printed
 twice from the same expression lists, to C (with common subexpressions
 eliminated, compiled with the system C compiler) and to NumPy (the test
 oracle and speed baseline, :func:`numpy_rhs`). :func:`build_library` writes
@@ -29,7 +29,6 @@ import sympy as sm
 from sympy.printing.c import C99CodePrinter
 
 from whipple_kick import cache, carcass, energy, fileio, kane, magic_formula, transient
-from whipple_kick.build import codegen
 from whipple_kick import symbols as S
 from whipple_kick.errors import BuildError
 from whipple_kick.slip import (
@@ -49,6 +48,7 @@ from whipple_kick.slip import (
     STATE_NAMES,
     P,
 )
+from whipple_kick.symbolic import codegen
 
 #: Tyre-block inputs computed with Kane's terms (plain symbols, registered in :mod:`symbols`).
 _KINEMATICS = ("vsy_r", "vsy_f", "vx_r", "vx_f", "camber_r", "camber_f", "fz_r", "fz_f",
@@ -205,7 +205,7 @@ def _expressions():
         name, the block's copies excluded), ``mass`` (the mass matrix alone)
         and ``symbols``.
     """
-    from whipple_kick.build import derivation
+    from whipple_kick.symbolic import derivation
     eom = derivation.slip_equations()
     dyn = list(eom.q) + list(eom.u)
     t = sm.Symbol("t", real=True)
