@@ -50,9 +50,10 @@ def test_carcass_is_passive_and_the_balance_closes(runs, case):
     for wheel in ("rear", "front"):
         energy = df[f"carcass_energy_{wheel}"].to_numpy()
         stored = 0.5 * carcass_info[f"stiffness_{wheel}_n_per_m"] * df[f"carcass_deflection_{wheel}"].to_numpy() ** 2
-        assert energy.min() > -1e-3
-        np.testing.assert_allclose(energy, stored, rtol=0, atol=1e-3)
-        assert np.max(np.abs(energy - stored)) < 1e-5      # far inside the acceptance
+        # The acceptance is 1e-3 J; the bound here is 1e-5 J, ten times the worst measured
+        # (9e-7 J), so a loss of passivity far smaller than the acceptance still fails.
+        np.testing.assert_allclose(energy, stored, rtol=0, atol=1e-5)
+        assert energy.min() > -1e-5
     assert np.max(np.abs(df[wk.results.BALANCE_COLUMN])) < 1e-6
     # The tyre's work is not trivially small: the plate feeds 10-65 J, sliding takes most of it.
     assert df["plate_work"].iloc[-1] > 10.0 and df["sliding_dissipation"].iloc[-1] > 10.0
