@@ -964,12 +964,15 @@ def _validate(argv):
     with _output_folder(args.out or _new_folder("validation"), args.force, _VALIDATE_FILES) as job:
         out = job.out
         job.written.extend(_VALIDATE_FILES)   # what a failure before the end removes
-        result = validation.validate(base, directions=args.directions, workers=args.workers,
-                                     time_origin=args.time_origin)
         if args.compare_transients:
+            # Every form, the base one included: its validation is the result (not run a second time).
             forms, verdicts = validation.compare_transients(base, directions=args.directions, workers=args.workers,
                                                             time_origin=args.time_origin)
+            result = forms[base.tyre_transient]
             result.summary["by_tyre_transient"] = validation.transient_summary(forms, verdicts)
+        else:
+            result = validation.validate(base, directions=args.directions, workers=args.workers,
+                                         time_origin=args.time_origin)
         result.summary["wall_s"] = time.perf_counter() - started
         files = validation.write(result, out, plot=not args.no_plot)
     if not args.quiet:

@@ -554,19 +554,6 @@ def rear_load_range(bike, rider="jason", height_m=None):
     return rear_bike, rear_bike + MAX_RIDER_MASS_KG * per_kg, per_kg
 
 
-def check_rear_load(bike, fz_n, rider="jason", height_m=None):
-    """Return ``float(fz_n)`` if a rider can put it on ``bike``'s rear tyre (:func:`rear_load_range`).
-
-    Raises
-    ------
-    InputError
-        One line naming the load, the range ``(low, high]`` in N on this
-        bicycle and where its ends come from.
-    """
-    low, high, _ = rear_load_range(bike, rider, height_m)
-    return within_rear_load_range(bike, fz_n, low, high)
-
-
 def within_rear_load_range(bike, fz_n, low, high):
     """``float(fz_n)`` if ``low < fz_n <= high`` (the :func:`rear_load_range` of ``bike``), else one-line InputError."""
     fz = check_range("rear-tyre load fz", fz_n, None, None, "N")  # a finite number
@@ -593,7 +580,7 @@ def for_rear_load(bike, fz_n, rider="jason", height_m=None, load_range=None):
         m/s^2 for ``balanceassist_v1``, the value of its source).
     fz_n : float
         Required static rear-tyre normal force [N]; between the bicycle's own
-        rear load (exclusive) and that with a 200 kg rider (:func:`check_rear_load`).
+        rear load (exclusive) and that with a 200 kg rider (:func:`rear_load_range`).
     rider : str
         Rider file name.
     height_m : float, optional

@@ -80,9 +80,6 @@ TIME_ORIGINS = ("first_peak", "kick")
 CSV_COLUMNS = ("case", "fz_n", "pressure_kpa", "direction", "source", "last_peak_time_s", "n_peaks", "period_s",
                "log_dec_13", "log_dec_24", "log_dec_35", "dominant_frequency_hz", "slow_swing_ratio",
                "last_peak_from_kick_s", "recovery_time_s", "status", "error")
-#: validation.csv column -> measured metric of :data:`whipple_kick.experiments.METRICS` it compares with.
-MEASURED_OF = {"last_peak_time_s": "last_peak_time", "period_s": "period", "log_dec_13": "log_dec_13",
-               "log_dec_24": "log_dec_24", "log_dec_35": "log_dec_35"}
 #: Metrics compared in the summary (mean |model - measured|), with their units.
 COMPARED = {"last_peak_time_s": "s", "n_peaks": "-", "period_s": "s", "log_dec_13": "-", "log_dec_24": "-",
             "log_dec_35": "-", "dominant_frequency_hz": "Hz"}
@@ -300,14 +297,14 @@ def _value(x):
     return v if math.isfinite(v) else None
 
 
-def best_by_rule(table, rule, direction=None):
-    """Best pressure per load [kPa] by ``rule`` (:data:`RULES`) over the ok rows of one source and direction.
+def best_by_rule(table, rule, direction):
+    """Best pressure per load [kPa] by ``rule`` (:data:`RULES`) over the model's ok rows of one direction.
 
-    A load where no pressure has a value of the rule's column maps to None.
+    A load where no pressure has a value of the rule's column maps to None. The measured best
+    pressures are :func:`whipple_kick.experiments.best_pressures`.
     """
     column = RULES[rule]
-    rows = table[(table["source"] == "model") & (table["direction"] == direction) & (table["status"] == "ok")] \
-        if direction else table[table["source"] == "measured"]
+    rows = table[(table["source"] == "model") & (table["direction"] == direction) & (table["status"] == "ok")]
     out = {}
     for fz in sorted(set(table["fz_n"])):
         candidates = [(_value(r[column]), r["pressure_kpa"]) for _, r in rows[rows["fz_n"] == fz].iterrows()
@@ -352,7 +349,7 @@ def compare(table, experiment, directions=DIRECTIONS):
     swing = [_value(v) for v in model["slow_swing_ratio"] if _value(v) is not None]
     bound = exp.processing["peak_threshold"]
     table_89 = {fz: b["best_pressure"] for fz, b in exp.best.items()}
-    best = {"measured": best_by_rule(table, "last_peak"), "table_8_9": table_89}
+    best = {"measured": experiments.best_pressures(exp), "table_8_9": table_89}
     agreement, verdicts = {}, {}
     for rule in RULES:
         best[rule] = {d: best_by_rule(table, rule, d) for d in directions}
@@ -387,8 +384,7 @@ def write(result, out, plot=True):
     from . import fileio, results
     out = pathlib.Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    text = result.table.to_csv(index=False, float_format="%.6g")
-    fileio.write_atomic(out / "validation.csv", text)
+    fileio.write_csv(result.table, out / "validation.csv", significant_digits=6)
     files = ["validation.csv"]
     for name, run in result.runs.items():
         folder = out / "cases" / name
