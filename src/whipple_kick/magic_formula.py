@@ -324,6 +324,7 @@ def _model_factors(factor_builder, count, camber_rad, fz_n, coefficients, fricti
 def _model_curve(factor_builder, count, slip_rad, camber_rad, fz_n, coefficients, friction_scale):
     """Shared body of the ``*_model`` builders: map inputs, fade the constant shift, scale, flip sign, gate on load."""
     alpha, _, _ = _formula_inputs(slip_rad, 0, fz_n)
+    _coefficients(coefficients, count, factor_builder.__name__)   # a wrong count raises at every load
 
     def value():
         factors = _model_factors(factor_builder, count, camber_rad, fz_n, coefficients, friction_scale)

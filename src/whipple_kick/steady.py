@@ -501,10 +501,10 @@ def upright_state(params, speed, tol=1e-13, pitch_without_compression=False):
     if not np.all(np.isfinite(sol.x)) or res > 1e-8:
         raise FloatingPointError(f"upright start not found at {speed} m/s: {sol.message} (residual {res:.3g})")
     xs = state(sol.x)
-    dx = rhs(0.0, xs)
+    dx, out = rhs.outputs(0.0, xs)
     unknowns = dict(zip(names, (float(v) for v in sol.x), strict=True))
     unknowns["largest_rate"] = float(max(abs(dx[slip.X[n]]) for n in ("u2", "u3", "u4", "u7")))
-    unknowns["front_contact_offset_m"] = float(rhs.outputs(0.0, xs)[1][slip.OUT["holonomic"]])
+    unknowns["front_contact_offset_m"] = float(out[slip.OUT["holonomic"]])
     out_params["ccr"], out_params["ccf"] = float(rhs.p[slip.P["ccr"]]), float(rhs.p[slip.P["ccf"]])
     return SteadyState(xs, out_params, res, unknowns)
 
