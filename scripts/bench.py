@@ -197,9 +197,8 @@ t = time.perf_counter()
 result.save(sys.argv[1])
 stages["trajectory.csv + summary.json"] = time.perf_counter() - t
 t = time.perf_counter()
-k = result.summary["kick"]
 plotting.response_figure([("", result)], sys.argv[1] + "/response.png", title=plotting.result_title(result),
-                         kick=(k["start_s"], k["start_s"] + k["duration_s"]))
+                         kick=plotting.kick_band(result))
 stages["response.png (after its imports)"] = time.perf_counter() - t
 stages["total in process"] = time.perf_counter() - t0
 print(json.dumps(stages))

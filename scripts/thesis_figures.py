@@ -54,9 +54,8 @@ def _figure(args, name, runs, title):
         result = run(scenario)
         print(f"  {name}: {label}: {run_line(result.summary)}; {time.perf_counter() - t:.2f} s", file=sys.stderr)
         results.append((label, result))
-    first = results[0][1].summary["kick"]
     wk.plotting.response_figure(results, path, title=title, time_range=tuple(args.time_range),
-                                kick=(first["start_s"], first["start_s"] + first["duration_s"]))
+                                kick=wk.plotting.kick_band(results[0][1]))
     print(path)
 
 

@@ -163,9 +163,7 @@ def build_once(name, build):
                     with fileio.atomic_path(path, private=True) as tmp:
                         build(tmp)
                     fileio.write_atomic(_manifest_path(path), _fingerprint(path) + "\n", private=True)
-        except CacheError:
-            raise
-        except OSError as exc:
+        except OSError as exc:   # a CacheError (errno None) is re-raised below as it is
             if exc.errno not in _FOLDER_ERRORS:
                 raise
             raise CacheError(f"cache folder {path.parent} cannot be written ({exc.strerror or exc}) to build "

@@ -303,10 +303,14 @@ def _animation_options(args):
     return options
 
 
+#: Scenario fields of the options ``_model_options(case_options=True)`` adds, by option name.
+_CASE_FIELDS = {"pressure_kpa": "pressure", "pressure_front_kpa": "pressure_front",
+                "pressure_rear_kpa": "pressure_rear", "fz_n": "fz", "rider_mass_kg": "rider_mass",
+                "thesis_load_n": "thesis_load"}
+
 #: Scenario fields set by flags of another name (the rest by the flag of the field's own name).
-_FIELD_FLAGS = {"fz_n": ("fz",), "rider_mass_kg": ("rider_mass",), "pressure_kpa": ("pressure",),
-                "pressure_front_kpa": ("pressure_front",), "pressure_rear_kpa": ("pressure_rear",),
-                "thesis_load_n": ("thesis_load",), "kick_profile": ("kick_profile", "kick_table")}
+_FIELD_FLAGS = {**{field: (option,) for field, option in _CASE_FIELDS.items()},
+                "kick_profile": ("kick_profile", "kick_table")}
 
 
 #: Fields a flag's field replaces in a --scenario file or the --compat preset (their alternatives).
@@ -320,12 +324,6 @@ def _flags_given(argv):
     for action in parser._actions:
         action.default = argparse.SUPPRESS
     return set(vars(parser.parse_args(argv)))
-
-
-#: Scenario fields of the options ``_model_options(case_options=True)`` adds, by option name.
-_CASE_FIELDS = {"pressure_kpa": "pressure", "pressure_front_kpa": "pressure_front",
-                "pressure_rear_kpa": "pressure_rear", "fz_n": "fz", "rider_mass_kg": "rider_mass",
-                "thesis_load_n": "thesis_load"}
 
 
 def _model_fields(args):
@@ -358,6 +356,8 @@ def _check_loads(bicycle, loads):
     0 N and 10 N get the same message: the loads between the bicycle's own
     rear load and that with the heaviest rider.
     """
+    if not loads:
+        return   # nothing to check (the bicycle itself is checked with the scenario)
     from . import bicycles, riders
     bike = bicycles.load(bicycle)
     if bike.includes_rider:
@@ -808,7 +808,7 @@ def _compare(argv):
     p.add_argument("--labels", nargs="+", metavar="LABEL", help="one legend entry per run (default: the folder names)")
     _output_options(p.add_argument_group("output"), "compare.png")
     args = p.parse_args(argv)
-    from . import fileio, plotting, results
+    from . import plotting, results
     runs = [results.Result.load(folder) for folder in args.runs]
     labels = args.labels or [pathlib.Path(folder).resolve().name for folder in args.runs]
     if args.labels is None and len(set(labels)) < len(labels):

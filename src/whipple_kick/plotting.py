@@ -577,7 +577,4 @@ def validation_figure(result, path=None, dpi=120):
     fig.suptitle("Model against the kick-plate measurements (thesis Section 8.5, Tables 8.6-8.8): "
                  "2 m/s, 150 mm smooth kick at 35 m/s^2", fontsize=10)
     fig.subplots_adjust(left=0.06, right=0.99, top=0.93, bottom=0.05, hspace=0.45, wspace=0.25)
-    if path is None:
-        return fig
-    fig.savefig(path, dpi=dpi, pil_kwargs={"compress_level": PNG_COMPRESS_LEVEL})
-    return None
+    return _written(fig, path, dpi)

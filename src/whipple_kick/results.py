@@ -375,10 +375,12 @@ def clean(value):
     return value
 
 
-def _rear_wheel_torque(steady):
-    """Summary entries of the steady rear-wheel torque T6c: value, sign convention, role, and what it balances."""
-    rhs = slip.CompiledRHS(steady.params)
-    dx, out = rhs.outputs(0.0, steady.x)
+def _rear_wheel_torque(steady, start_outputs):
+    """Summary entries of the steady rear-wheel torque T6c: value, sign convention, role, and what it balances.
+
+    ``start_outputs`` is ``(dx, outputs)`` of the compiled model at ``steady``.
+    """
+    dx, out = start_outputs
     torque = float(steady.params["T6c"])
     power = {name: float(dx[slip.X[state]]) for name, state in (
         ("rear_wheel_torque", "W_wheel"), ("zero_slip_forces", "W_zero_slip"), ("aligning_moments", "W_moment"),
@@ -437,6 +439,8 @@ def summarise(scenario, kick, assembly, solution, frame, *, custom_tyres=False) 
     """
     traj = solution.states
     baseline = float(assembly.reference.x[slip.X["u3"]])
+    # Derivatives and outputs at the start state, read by the steady and carcass sections.
+    start_outputs = slip.CompiledRHS(assembly.start.params).outputs(0.0, assembly.start.x)
     metrics, recovery = response_metrics(frame, baseline, assembly.reference.x, scenario, traj)
     recovery = _recovery_section(recovery, rate_baselines(assembly.reference.x))
     metrics, unavailable = _summary_metrics(metrics)
@@ -451,12 +455,12 @@ def summarise(scenario, kick, assembly, solution, frame, *, custom_tyres=False) 
         "message": traj.message,
         "bicycle": assembly.bicycle,
         "tyres": {**_tyres_section(scenario, assembly, custom_tyres),
-                  "carcass": _carcass_section(scenario, assembly, frame),
+                  "carcass": _carcass_section(scenario, assembly, start_outputs),
                   "extrapolation": extrapolation(frame, assembly.rear, assembly.front)},
         "controller": _controller_section(scenario, assembly),
         "linear_stability": assembly.stability,
         "kick": kick.summary(scenario.kick_direction),
-        "steady_state": _steady_section(scenario, assembly, baseline),
+        "steady_state": _steady_section(scenario, assembly, baseline, start_outputs),
         "peaks": _peaks(frame),
         "energy": _energy_summary(frame, solution.jumps, scenario),
         "recovery": recovery,
@@ -486,13 +490,13 @@ def _tyres_section(scenario, assembly, custom_tyres):
     }
 
 
-def _carcass_section(scenario, assembly, frame):
+def _carcass_section(scenario, assembly, start_outputs):
     """The carcass tyre's stiffness, the load it is taken at (the run's start) and its options; None otherwise."""
     if scenario.tyre_transient != "carcass":
         return None
     # The loads the stiffness was taken at: those of the state the run starts from (the kick start).
-    from . import carcass, slip
-    _, out = slip.CompiledRHS(assembly.start.params).outputs(0.0, assembly.start.x)
+    from . import carcass
+    _, out = start_outputs
     params = assembly.params
     return {
         "stiffness_rear_n_per_m": params["ccr"], "stiffness_front_n_per_m": params["ccf"],
@@ -595,7 +599,7 @@ def _controller_section(scenario, assembly):
     }
 
 
-def _steady_section(scenario, assembly, baseline):
+def _steady_section(scenario, assembly, baseline, start_outputs):
     start, reference = assembly.start, assembly.reference
     x0 = start.x
     if scenario.start == "steady":
@@ -615,7 +619,7 @@ def _steady_section(scenario, assembly, baseline):
         "compression_rear_m": float(x0[slip.X["q9"]]), "compression_front_m": float(x0[slip.X["q10"]]),
         # An upright start's front contact below the ground (+; start_pitch "uncompressed": the authors' code).
         "front_contact_below_ground_m": start.unknowns.get("front_contact_offset_m"),
-        **_rear_wheel_torque(start),
+        **_rear_wheel_torque(start, start_outputs),
         "residual": float(start.residual),
         "found_by": found_by,
     }
