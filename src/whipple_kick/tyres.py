@@ -102,9 +102,11 @@ class TyreFile:
         pressure (kPa, float) -> dict of the per-pressure quantities (SI).
     sets : dict
         set name -> pressure (kPa) -> ``(fy ndarray (14,), mz ndarray (18,) or None)``.
+    measured : dict or None
+        The ``[measured]`` ranges of the fits (:data:`_MEASURED_QUANTITIES`), None if the file has none.
     """
 
-    def __init__(self, path, name, description, size, warning, friction, properties, sets):
+    def __init__(self, path, name, description, size, warning, friction, properties, sets, measured=None):
         self.path = path
         self.name = name
         self.description = description
@@ -113,6 +115,7 @@ class TyreFile:
         self.friction = friction
         self.properties = properties
         self.sets = sets
+        self.measured = measured
 
 
 def _quantity(path, key, entry, unit, low, low_open):
@@ -206,10 +209,8 @@ def _read_tyre_file(path, content):
         if measured["load_min"] > measured["load_max"]:
             _fail(path, "measured.load_min", f"{measured['load_min']:g} N exceeds load_max "
                                              f"{measured['load_max']:g} N")
-    tyre_file = TyreFile(path, name, _text(path, "description", data["description"]),
-                         data.get("size", ""), warning, friction, properties, sets)
-    tyre_file.measured = measured
-    return tyre_file
+    return TyreFile(path, name, _text(path, "description", data["description"]),
+                    data.get("size", ""), warning, friction, properties, sets, measured)
 
 
 def _read_sets(path, table, properties):
@@ -401,7 +402,7 @@ class Tyre:
         self._sets = [(w, coefficients[p][0], coefficients[p][1]) for w, p in self._weights]
         self.has_aligning_moment = all(mz is not None for _, _, mz in self._sets)
         #: Measured ranges of the fits (``slip_deg``, ``load_min``, ``load_max``; deg, N), or None.
-        self.measured = getattr(data, "measured", None)
+        self.measured = data.measured
 
     def __repr__(self):
         return (f"Tyre({self.name!r}, pressure_kpa={self.pressure_kpa:g}, "

@@ -24,16 +24,11 @@ linearisation); the steady motion is :mod:`whipple_kick.steady`'s.
 Everything is reachable as ``whipple_kick.slip.<name>``.
 """
 from .call import (  # noqa: F401 -- the package's names, as before the split
-    _STATUS,
     CompiledRHS,
-    _raise_status,
     parameter_vector,
 )
 from .compiled import (  # noqa: F401 -- the package's names, as before the split
-    _CFLAGS,
     _compiler,
-    _metadata_matches,
-    _native_call,
     layout,
     library,
     library_path,
@@ -44,8 +39,6 @@ from .jumps import (  # noqa: F401 -- the package's names, as before the split
     velocity_jump,
 )
 from .layout import (  # noqa: F401 -- the package's names, as before the split
-    _PARTITION,
-    _SOURCES,
     COORDINATES,
     DEPENDENT,
     DYNAMIC_STATES,
@@ -66,12 +59,8 @@ from .layout import (  # noqa: F401 -- the package's names, as before the split
     tyre_state_names,
 )
 from .linear import (  # noqa: F401 -- the package's names, as before the split
-    _HEADING_SLOTS,
-    _PITCH_DRIVERS,
     HOLONOMIC_ROW,
     LINEAR_STATES,
-    _difference_scales,
-    _heading_derivative,
     heading_linearisation,
     heading_state,
     linear_state_space,

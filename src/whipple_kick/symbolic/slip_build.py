@@ -32,8 +32,6 @@ from whipple_kick import cache, carcass, energy, fileio, kane, magic_formula, tr
 from whipple_kick import symbols as S
 from whipple_kick.errors import BuildError
 from whipple_kick.slip import (
-    _PARTITION,
-    _SOURCES,
     COORDINATES,
     DEPENDENT,
     DYNAMIC_STATES,
@@ -48,6 +46,7 @@ from whipple_kick.slip import (
     STATE_NAMES,
     P,
 )
+from whipple_kick.slip.layout import _PARTITION, _SOURCES
 from whipple_kick.symbolic import codegen
 
 #: Tyre-block inputs computed with Kane's terms (plain symbols, registered in :mod:`symbols`).
