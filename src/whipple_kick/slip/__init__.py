@@ -39,6 +39,7 @@ from .jumps import (  # noqa: F401 -- the package's names, as before the split
     velocity_jump,
 )
 from .layout import (  # noqa: F401 -- the package's names, as before the split
+    _SOURCES,  # the cache key's modules (tests check each generator is in its own key)
     COORDINATES,
     DEPENDENT,
     DYNAMIC_STATES,
