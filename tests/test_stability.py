@@ -450,3 +450,58 @@ def test_stable_range_with_an_end_not_located_says_so():
     text = stability.range_text({"from_m_s": 2.0, "to_m_s": 4.33, "lower_open": False, "upper_open": False,
                                  "note": "lower end not located, ..."})
     assert text == "2.00-4.33 (an end not located: at a sweep speed)"
+
+
+# ------------------------------------------------------------------ weave and capsize where the weave pair splits
+
+def _split_sweep(speeds):
+    """A stand-in sweep on ``A(v) = [[a, 1], [v - 3.87, a]]``, ``a = 3.82 - v``: eigenvalues ``a +- sqrt(v - 3.87)``.
+
+    A pair whose real part crosses zero at 3.82 m/s, splitting at 3.87 m/s
+    into two real eigenvalues; the larger crosses zero at
+    3.87 + (0.9 - sqrt(0.8)) / 2 m/s. Every eigenvector is named by roll: the
+    pair is the weave, the real eigenvalues capsize.
+    """
+    from whipple_kick.stability import summary
+    from whipple_kick.stability import sweep as sweep_module
+
+    def eigen_at(v, k=None):
+        return np.linalg.eig(np.array([[3.82 - v, 1.0], [v - 3.87, 3.82 - v]]))
+
+    lams, vecs = zip(*(eigen_at(v) for v in speeds), strict=True)
+    shares = [np.tile([1.0, 0, 0, 0, 0, 0], (2, 1))] * len(speeds)
+    raw = {}
+    rows = sweep_module._named_rows("slip", "open", speeds, list(lams), list(vecs), shares, raw)
+    return summary._Sweep(pd.DataFrame(rows), np.asarray(speeds), raw["slip", "open"], eigen_at)
+
+
+@pytest.mark.parametrize("speeds", [np.arange(3.5, 4.25, 0.1), np.arange(3.5, 4.25, 0.05),
+                                    np.arange(3.5, 4.25, 0.1) + 1e-12])
+def test_weave_crossing_before_the_split_is_the_weave_speed(speeds):
+    """Before, a pair that crossed zero and then split between two samples was reported as splitting
+    while unstable, at a split speed interpolated from the samples (3.87 m/s on the 0.1 m/s grid); the
+    weave is stable from its crossing, 3.82 m/s, and the capsize eigenvalue crosses zero after the split."""
+    sweep = _split_sweep(speeds)
+    weave, how = stability._weave_speed(sweep)
+    assert weave == pytest.approx(3.82, abs=1e-8) and "crosses zero" in how
+    capsize, how = stability.summary._capsize_speed(sweep, above=weave)
+    assert capsize == pytest.approx(3.87 + (0.9 - math.sqrt(0.8)) / 2, abs=1e-8) and "after" in how
+
+
+def test_weave_and_capsize_speeds_do_not_depend_on_round_off():
+    """Symmetric T03, 400 kPa, 635 N, open loop: the weave pair crosses zero at 3.82 m/s, splits at
+    3.87 m/s, and a real root crosses zero at 3.88 m/s, all between 3.8 and 3.9 on a 0.1 m/s grid.
+
+    Before, on 2:6:0.1 the answer was 3.8606 m/s for both (a split speed
+    interpolated from samples whose roots the tracker had paired one way),
+    or 3.8718 m/s and no capsize speed with every speed moved by 1e-14 m/s
+    (paired the other way), and 3.8184 and 3.8785 m/s on 2:6:0.05.
+    """
+    grid = stability.parse_speeds("2:6:0.1")
+    out = []
+    for speeds in (grid, grid + 1e-14, grid - 1e-12, stability.parse_speeds("2:6:0.05")):
+        s = stability.analyse(DEFAULT, speeds, loops=("open",)).summary["slip"]["open"]
+        out.append((s["weave_speed_m_s"], s["capsize_speed_m_s"]))
+    weave, capsize = np.array(out, dtype=float).T
+    assert np.all(np.abs(weave - 3.818) < 2e-3) and np.all(np.abs(capsize - 3.8785) < 2e-3), out
+    assert np.ptp(weave) < 1e-6 and np.ptp(capsize) < 1e-6, out
