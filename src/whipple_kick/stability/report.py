@@ -65,7 +65,7 @@ def speeds_text(summary, loop):
     >>> from whipple_kick.stability import analyse
     >>> result = analyse(Scenario(symmetric_tyres=True), [3.0, 3.5, 4.0, 4.5, 5.0], loops=("open",))
     >>> print(speeds_text(result.summary, "open"))
-    slip: weave 3.82 m/s, capsize none; stable none
+    slip: weave 3.82 m/s, capsize 3.88 m/s; stable none
     no-slip: weave 3.97 m/s, capsize none; stable 3.97-5.00 (sweep end) m/s
     """
     lines = []
@@ -237,7 +237,7 @@ def report_lines(summary):
     >>> result = analyse(Scenario(symmetric_tyres=True), [3.0, 3.5, 4.0, 4.5, 5.0], loops=("open",))
     >>> print("\\n".join(report_lines(result.summary)))
       open loop (no rider control):
-        slip: weave 3.82 m/s, capsize none; stable none
+        slip: weave 3.82 m/s, capsize 3.88 m/s; stable none
         no-slip: weave 3.97 m/s, capsize none; stable 3.97-5.00 (sweep end) m/s
         wobble 9.2-9.4 Hz, damping ratio 0.063-0.102 (least damped at 3.00 m/s), stable
         modes: weave, capsize, caster, wobble, lateral rear, relaxation rear, relaxation front, vertical

@@ -1,11 +1,17 @@
 """The summary of a sweep: weave and capsize speeds refined between samples, stable ranges, wobble."""
 
+from typing import NamedTuple
+
 import numpy as np
 
 from ._constants import GROUPS, MODE_DESCRIPTIONS, MODES, WOBBLE_MIN_FREQUENCY_HZ
 from .modes import _segments, match_cost
 
 # ------------------------------------------------------------------ the summary
+
+#: Equal steps between two sweep speeds in which a weave pair's split is first looked for (then
+#: bisection): a split and a merge of another pair in the same interval are told apart.
+SPLIT_SCAN = 16
 
 def _root(fun, a, b):
     """Root of ``fun`` in [a, b] by Brent's method (to 1e-9 m/s): ``(speed, None)``, or ``(None, reason)``.
@@ -28,6 +34,18 @@ def _root(fun, a, b):
     return float(brentq(fun, a, b, xtol=1e-9, rtol=1e-12)), None
 
 
+class _Split(NamedTuple):
+    """Where a pair turns real between two sweep speeds, on fresh linearisations (:meth:`_Sweep.split`)."""
+
+    speed: float
+    #: Re of the double eigenvalue there [1/s].
+    real: float
+    #: The pair's eigenvalue (Im > 0) within 1e-9 m/s on the complex side, and the larger of the two real
+    #: eigenvalues on the real side: (speed, eigenvalue, angle-like vector, index of the nearer sweep speed).
+    complex_side: tuple
+    real_side: tuple
+
+
 class _Sweep:
     """One model and loop of a sweep: eigenvalues, tracks and names per speed, with refinement."""
 
@@ -36,6 +54,7 @@ class _Sweep:
         self.lams, self.vecs, self.ids = raw
         # mode name of (speed index, track)
         self.name = {(int(r.speed_index), int(r.track)): r.mode for r in table.itertuples()}
+        self._splits = {}   # (speed index, the pair's tracks) -> split() of that pair
 
     def present(self, k):
         return self.lams[k] is not None
@@ -52,12 +71,17 @@ class _Sweep:
         hit = np.nonzero(self.ids[k] == track_id)[0]
         return complex(self.lams[k][hit[0]]) if hit.size else None
 
-    def tracked_real_part(self, k, track_id):
-        """Re of the eigenvalue continuing ``track_id`` from speed index k to k+1, as a function of speed."""
-        j0 = int(np.nonzero(self.ids[k] == track_id)[0][0])
-        j1 = int(np.nonzero(self.ids[k + 1] == track_id)[0][0])
-        l0, l1 = self.lams[k][j0], self.lams[k + 1][j1]
-        v0, v1 = self.speeds[k], self.speeds[k + 1]
+    def follow(self, start, end, real=None):
+        """Re of the eigenvalue continuing from ``start`` to ``end``, as a function of speed.
+
+        ``start`` and ``end`` are ``(speed, eigenvalue, angle-like vector,
+        index of a sweep speed near it)``. At a speed between them the fresh
+        linearisation's eigenvalue of least :func:`match_cost` to the
+        eigenvalue interpolated between the ends, with the nearer end's
+        vector, is taken; ``real`` (True or False) keeps only real or only
+        complex eigenvalues (a pair before it splits, a real root after).
+        """
+        (v0, l0, x0, k0), (v1, l1, x1, k1) = start, end
 
         def real_part(v):
             if v == v0:
@@ -66,34 +90,85 @@ class _Sweep:
                 return float(l1.real)
             s = (v - v0) / (v1 - v0)
             ref_lam = np.array([(1 - s) * l0 + s * l1])
-            ref_vec = (self.vecs[k][:, [j0]] if s < 0.5 else self.vecs[k + 1][:, [j1]])
-            lam, vec = self.eigen_at(v, k if s < 0.5 else k + 1)
+            ref_vec = np.asarray(x0 if s < 0.5 else x1).reshape(-1, 1)
+            lam, vec = self.eigen_at(v, k0 if s < 0.5 else k1)
+            if real is not None and np.any(keep := (lam.imag == 0.0) == real):
+                lam, vec = lam[keep], vec[:, keep]
             return float(lam[np.argmin(match_cost(ref_lam, ref_vec, lam, vec)[0])].real)
         return real_part
+
+    def tracked_real_part(self, k, track_id):
+        """Re of the eigenvalue continuing ``track_id`` from speed index k to k+1, as a function of speed."""
+        j0 = int(np.nonzero(self.ids[k] == track_id)[0][0])
+        j1 = int(np.nonzero(self.ids[k + 1] == track_id)[0][0])
+        return self.follow((self.speeds[k], self.lams[k][j0], self.vecs[k][:, j0], k),
+                           (self.speeds[k + 1], self.lams[k + 1][j1], self.vecs[k + 1][:, j1], k + 1))
 
     def largest_real_part(self, v, k):
         lam, _ = self.eigen_at(v, k)
         return float(np.max(lam.real))
 
-    def split_speed(self, k, track_id):
-        """Where a pair turns real (or two reals merge) between speed indices k and k+1.
+    def split(self, k, track_id):
+        """Where the pair of ``track_id``, complex at speed index k and real at k+1, turns real: ``(_Split, None)`` or ``(None, reason)``.
 
-        Near such a point the discriminant is linear in speed: the squared
-        imaginary part on the complex side and the squared half-distance of
-        the two real eigenvalues on the other vanish at the same speed.
+        Located on fresh linearisations by the number of complex eigenvalues
+        within a disc about the pair (twice the largest modulus of the pair
+        and of its tracks' eigenvalues at k+1, plus 1 1/s): the first of
+        :data:`SPLIT_SCAN` equal steps from speed k where it drops by two
+        (another pair may merge later in the same interval), then bisection
+        to 1e-9 m/s. Neither the tracker's pairing of the roots nor an
+        interpolation of samples enters, so the speed does not depend on the
+        grid. The pair's real part at the split (the double root) says
+        whether it splits stable or unstable.
         """
-        v0, v1 = self.speeds[k], self.speeds[k + 1]
         a, b = self.eigenvalue(k, track_id), self.eigenvalue(k + 1, track_id)
-        if a is None or b is None:
-            return 0.5 * (v0 + v1)
-        side_complex, side_real, k_real = (a, b, k + 1) if a.imag != 0 else (b, a, k)
-        partner = [complex(l) for l in self.lams[k_real] if l.imag == 0.0 and complex(l) != side_real]
-        if side_complex.imag == 0 or not partner:
-            return 0.5 * (v0 + v1)
-        other = min(partner, key=lambda l: abs(l - side_real))
-        im2, gap2 = side_complex.imag ** 2, ((side_real.real - other.real) / 2) ** 2
-        frac = im2 / (im2 + gap2)
-        return float(v0 + (v1 - v0) * (frac if a.imag != 0 else 1 - frac))
+        if a is None or b is None or a.imag == 0.0 or b.imag != 0.0:
+            return None, (f"the eigenvalue does not turn from complex to real between {self.speeds[k]:g} and "
+                          f"{self.speeds[k + 1]:g} m/s")
+        tracks = frozenset(int(t) for l, t in zip(self.lams[k], self.ids[k], strict=True)
+                           if complex(l) in (a, a.conjugate()))
+        if (k, tracks) not in self._splits:
+            moduli = [abs(a)] + [abs(self.eigenvalue(k + 1, t) or 0.0) for t in tracks]
+            self._splits[k, tracks] = self._locate_split(k, 2 * max(moduli) + 1.0)
+        return self._splits[k, tracks]
+
+    def _locate_split(self, k, radius):
+        v0, v1 = float(self.speeds[k]), float(self.speeds[k + 1])
+
+        def at(v):
+            lam, vec = self.eigen_at(v, k if v - v0 < v1 - v else k + 1)
+            near = np.abs(lam) < radius
+            return v, lam, vec, near, int(np.count_nonzero(near & (lam.imag != 0.0)))
+        lo = at(v0)
+        for v in np.linspace(v0, v1, SPLIT_SCAN + 1)[1:]:
+            hi = at(float(v))
+            if hi[-1] != lo[-1]:
+                break
+            lo = hi
+        if hi[-1] != lo[-1] - 2:
+            return None, (f"no pair turns real between {v0:g} and {v1:g} m/s on fresh linearisations "
+                          f"({lo[-1]} and then {hi[-1]} complex eigenvalues below {radius:.3g} 1/s), although "
+                          "the sweep's samples say so; refine the speed grid there")
+        while hi[0] - lo[0] > 1e-9:
+            mid = 0.5 * (lo[0] + hi[0])
+            if not lo[0] < mid < hi[0]:
+                break
+            here = at(mid)
+            if here[-1] not in (lo[-1], hi[-1]):
+                return None, (f"the number of complex eigenvalues below {radius:.3g} 1/s changes by other "
+                              f"than two near {mid:g} m/s on fresh linearisations; refine the speed grid there")
+            lo, hi = (here, hi) if here[-1] == lo[-1] else (lo, here)
+        (vc, lam_c, vec_c, near_c, _), (vr, lam_r, vec_r, near_r, _) = lo, hi
+        # complex side: the pair is the complex eigenvalue (Im > 0) in the disc nearest the real axis
+        cands = np.nonzero(near_c & (lam_c.imag > 0))[0]
+        jc = int(cands[np.argmin(lam_c.imag[cands])])
+        double = float(lam_c[jc].real)
+        # real side: of the two real eigenvalues in the disc nearest the double root, the larger
+        cands = np.nonzero(near_r & (lam_r.imag == 0.0))[0]
+        two = cands[np.argsort(np.abs(lam_r[cands].real - double))[:2]]
+        jr = int(two[np.argmax(lam_r[two].real)])
+        return _Split(0.5 * (vc + vr), double, (vc, complex(lam_c[jc]), vec_c[:, jc], k if vc - v0 < v1 - vc else k + 1),
+                      (vr, complex(lam_r[jr]), vec_r[:, jr], k if vr - v0 < v1 - vr else k + 1)), None
 
 
 def _unstable(values):
@@ -104,10 +179,13 @@ def _weave_speed(sweep):
     """Lowest speed [m/s] above which the weave is stable, and how it stabilises (or None, reason).
 
     A weave eigenvalue's real part crossing zero is located by Brent's
-    method on fresh linearisations (:meth:`_Sweep.tracked_real_part`); a
-    weave pair that stops being a pair while unstable (splits into two real
-    eigenvalues, one of them unstable) stops being an oscillatory
-    instability there, located by the discriminant (:meth:`_Sweep.split_speed`).
+    method on fresh linearisations (:meth:`_Sweep.tracked_real_part`). Where
+    the weave pair splits into two real eigenvalues between two sweep
+    speeds, the split is located on fresh linearisations too
+    (:meth:`_Sweep.split`): if the pair's real part crosses zero before it
+    splits, the weave speed is that crossing (whatever the real eigenvalues
+    do after); a pair that splits while unstable stops being an oscillatory
+    instability at the split.
     """
     n = len(sweep.speeds)
     unstable = [_unstable(sweep.values(k, "weave")) for k in range(n)]
@@ -120,32 +198,40 @@ def _weave_speed(sweep):
             nxt = sweep.eigenvalue(k + 1, t)
             if lam.real <= 0 or nxt is None:
                 continue
-            crossing, why = _root(sweep.tracked_real_part(k, t), sweep.speeds[k], sweep.speeds[k + 1])
             if sweep.name[k + 1, t] == "weave" and nxt.imag != 0.0:
+                crossing, why = _root(sweep.tracked_real_part(k, t), sweep.speeds[k], sweep.speeds[k + 1])
                 return (crossing, "the weave's real part crosses zero") if why is None else (None, why)
-            # The pair split between the two speeds: still unstable then if a root stays positive.
+            # The pair split between the two speeds (two real eigenvalues near where it went).
             pair = [complex(l) for l in sweep.lams[k + 1] if l.imag == 0.0 and abs(l - nxt) < 4 * abs(lam.imag)]
             if not pair:
                 return None, (f"the weave pair stops being the weave between {sweep.speeds[k]:g} and "
                               f"{sweep.speeds[k + 1]:g} m/s without turning into two real eigenvalues "
                               f"near it (it continues as {nxt.real:+.3g}{nxt.imag:+.3g}j 1/s, "
                               f"{sweep.name[k + 1, t]}); refine the speed grid there")
-            if max(l.real for l in pair) > 0:
-                return sweep.split_speed(k, t), ("the weave pair splits into two real eigenvalues while "
-                                                 "unstable (one stays unstable)")
+            split, why = sweep.split(k, t)
+            if split is None:
+                return None, why
+            if split.real > 0:
+                return split.speed, "the weave pair splits into two real eigenvalues while unstable"
+            j = int(np.nonzero(sweep.ids[k] == t)[0][0])
+            start = (sweep.speeds[k], lam, sweep.vecs[k][:, j], k)
+            crossing, why = _root(sweep.follow(start, split.complex_side, real=False),
+                                  sweep.speeds[k], split.complex_side[0])
             if why is not None:
                 return None, why
-            return crossing, "the weave's real part crosses zero just before the pair splits"
+            return crossing, "the weave's real part crosses zero before the pair splits"
     return None, "the weave is unstable up to the end of the sweep"
 
 
 def _capsize_speed(sweep, above=None):
     """Lowest speed [m/s] (from ``above`` up) where a capsize eigenvalue becomes unstable, and how (or None).
 
-    Within a capsize branch the zero crossing is located by Brent's method;
-    a capsize branch that is born unstable (from a weave pair that splits)
-    becomes unstable at the crossing of its continuation if that lies after
-    the split, else at the split.
+    Within a capsize branch the zero crossing is located by Brent's method.
+    A capsize branch born from a pair that splits between two sweep speeds
+    (located on fresh linearisations, :meth:`_Sweep.split`) is born unstable
+    at the split if the pair splits unstable; else it becomes unstable where
+    the continuation of the larger of the two real eigenvalues crosses zero
+    after the split (Brent's method on fresh linearisations).
     """
     n = len(sweep.speeds)
     found, unlocated = [], []
@@ -156,17 +242,30 @@ def _capsize_speed(sweep, above=None):
             before = sweep.eigenvalue(k, t)
             if lam.real <= 0 or before is None:
                 continue
-            same_branch = sweep.name[k, t] == "capsize" and before.imag == 0.0
-            if before.real <= 0:
+            if before.imag != 0.0:
+                split, why = sweep.split(k, t)
+                if split is not None and split.real > 0:
+                    found.append((split.speed, "the capsize eigenvalue is born unstable where the weave pair splits"))
+                    continue
+                if split is not None:
+                    j = int(np.nonzero(sweep.ids[k + 1] == t)[0][0])
+                    end = (sweep.speeds[k + 1], lam, sweep.vecs[k + 1][:, j], k + 1)
+                    crossing, why = _root(sweep.follow(split.real_side, end, real=True),
+                                          split.real_side[0], sweep.speeds[k + 1])
+                if why is not None:
+                    unlocated.append(why)
+                    continue
+                found.append((crossing, "the capsize eigenvalue crosses zero just after the weave pair splits"))
+            elif before.real <= 0:
                 crossing, why = _root(sweep.tracked_real_part(k, t), sweep.speeds[k], sweep.speeds[k + 1])
                 if why is not None:
                     unlocated.append(why)
                     continue
-                found.append((crossing, "the capsize eigenvalue crosses zero" + ("" if same_branch else
-                                                                                   " just after the weave pair splits")))
-            elif not same_branch:
-                found.append((sweep.split_speed(k, t), "the capsize eigenvalue is born unstable where the "
-                                                       "weave pair splits"))
+                found.append((crossing, "the capsize eigenvalue crosses zero" + (
+                    "" if sweep.name[k, t] == "capsize" else " (named capsize from there on)")))
+            elif sweep.name[k, t] != "capsize":
+                found.append((0.5 * (sweep.speeds[k] + sweep.speeds[k + 1]),
+                              "an unstable real eigenvalue is named capsize from here on (between two sweep speeds)"))
     found = [f for f in found if above is None or f[0] >= above - 1e-9]
     if not found:
         return None, unlocated[0] if unlocated else "no capsize eigenvalue becomes unstable within the sweep"
