@@ -496,6 +496,10 @@ def test_weave_and_capsize_speeds_do_not_depend_on_round_off():
     interpolated from samples whose roots the tracker had paired one way),
     or 3.8718 m/s and no capsize speed with every speed moved by 1e-14 m/s
     (paired the other way), and 3.8184 and 3.8785 m/s on 2:6:0.05.
+    Measured now: 3.81843 and 3.87854 m/s on all four, spread 3e-7 and
+    8e-7 m/s: the linearisation itself differs by ~2e-8 of its largest entry
+    between steady motions equal to 1e-15 (forward differences), which
+    moves the eigenvalues by ~3e-7 1/s.
     """
     grid = stability.parse_speeds("2:6:0.1")
     out = []
@@ -504,4 +508,15 @@ def test_weave_and_capsize_speeds_do_not_depend_on_round_off():
         out.append((s["weave_speed_m_s"], s["capsize_speed_m_s"]))
     weave, capsize = np.array(out, dtype=float).T
     assert np.all(np.abs(weave - 3.818) < 2e-3) and np.all(np.abs(capsize - 3.8785) < 2e-3), out
-    assert np.ptp(weave) < 1e-6 and np.ptp(capsize) < 1e-6, out
+    assert np.ptp(weave) < 1e-5 and np.ptp(capsize) < 1e-5, out
+
+
+def test_capsize_after_a_split_and_a_merge_between_two_sweep_speeds():
+    """500 kPa, 635 N, open loop: between 3.75 and 3.8 m/s the weave pair splits (3.762 m/s) and the
+    smaller real root merges with the low-speed capsize root into a new pair (3.792 m/s), so the number
+    of complex eigenvalues is the same at both samples; the split is found by stepping through the
+    interval, and the larger real root crosses zero at 3.7667 m/s (the weave at 3.7189, before it)."""
+    sc = DEFAULT.with_changes(pressure_kpa=500.0)
+    s = stability.analyse(sc, stability.parse_speeds("3.5:4:0.05"), loops=("open",)).summary["slip"]["open"]
+    assert s["weave_speed_m_s"] == pytest.approx(3.7189, abs=1e-4)
+    assert s["capsize_speed_m_s"] == pytest.approx(3.7667, abs=1e-4) and "after" in s["capsize_speed_how"]
