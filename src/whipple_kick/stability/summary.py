@@ -115,8 +115,8 @@ class _Sweep:
         within a disc about the pair (twice the largest modulus of the pair
         and of its tracks' eigenvalues at k+1, plus 1 1/s): the first of
         :data:`SPLIT_SCAN` equal steps from speed k where it drops by two
-        (another pair may merge later in the same interval), then bisection
-        to 1e-9 m/s. Neither the tracker's pairing of the roots nor an
+        (another pair may merge in the same interval, before or after), then
+        bisection to 1e-9 m/s. Neither the tracker's pairing of the roots nor an
         interpolation of samples enters, so the speed does not depend on the
         grid. The pair's real part at the split (the double root) says
         whether it splits stable or unstable.
@@ -142,13 +142,13 @@ class _Sweep:
         lo = at(v0)
         for v in np.linspace(v0, v1, SPLIT_SCAN + 1)[1:]:
             hi = at(float(v))
-            if hi[-1] != lo[-1]:
+            if hi[-1] == lo[-1] - 2:
                 break
             lo = hi
-        if hi[-1] != lo[-1] - 2:
-            return None, (f"no pair turns real between {v0:g} and {v1:g} m/s on fresh linearisations "
-                          f"({lo[-1]} and then {hi[-1]} complex eigenvalues below {radius:.3g} 1/s), although "
-                          "the sweep's samples say so; refine the speed grid there")
+        else:
+            return None, (f"no pair turns real between {v0:g} and {v1:g} m/s on fresh linearisations (the "
+                          f"number of complex eigenvalues below {radius:.3g} 1/s never drops by two in "
+                          f"{SPLIT_SCAN} steps), although the sweep's samples say so; refine the speed grid there")
         while hi[0] - lo[0] > 1e-9:
             mid = 0.5 * (lo[0] + hi[0])
             if not lo[0] < mid < hi[0]:
