@@ -390,7 +390,7 @@ def test_plate_stop_impulse_is_the_limit_of_a_short_stop(rider_bike, gains, t03)
     assert x_impulse[slip.X["W_plate"]] - x_stop[slip.X["W_plate"]] == pytest.approx(info["impulse_work_j"], abs=1e-12)
     # and the constraints hold after it (the plate at rest).
     M, A, a0 = rhs.impulse_terms(T, x_impulse)
-    u_after = rhs.outputs(T, x_impulse)[1][:10]
+    u_after = rhs.outputs(T, x_impulse)[1][:len(slip.SPEEDS)]
     assert np.max(np.abs(A @ u_after + a0)) < 1e-12
     ind = [slip.X[n] for n in slip.INDEPENDENT]
     ke = rhs.outputs(np.nextafter(T, 0.0), x_stop)[1][slip.OUT["kinetic_energy"]]
@@ -461,12 +461,12 @@ def test_kept_speeds_leave_the_rear_sliding_at_the_plate_velocity_times_sin_yaw(
     assert slide == pytest.approx(2 * D / T * np.sin(x_stop[slip.X["q3"]]), rel=1e-9)
     assert abs(slide) > 0.05
     after = slip.CompiledRHS(dict(ss.params, vsx_r=slide))
-    before = rhs.outputs(np.nextafter(T, 0.0), x_stop)[1][:10]
-    np.testing.assert_allclose(after.outputs(T, x_stop)[1][:10], before, rtol=0, atol=1e-12)
+    before = rhs.outputs(np.nextafter(T, 0.0), x_stop)[1][:len(slip.SPEEDS)]
+    np.testing.assert_allclose(after.outputs(T, x_stop)[1][:len(slip.SPEEDS)], before, rtol=0, atol=1e-12)
     tr = lsoda.integrate(after, x_stop, T + 1.0, t_start=T, rtol=1e-12, output_rate=100)
     for t, x in zip(tr.t, tr.x, strict=True):
         _, A, a0 = after.impulse_terms(t, x)
-        u = after.outputs(t, x)[1][:10]
+        u = after.outputs(t, x)[1][:len(slip.SPEEDS)]
         residual_without_slide = A @ u + a0 + np.array([slide, 0.0, 0.0])
         assert residual_without_slide[0] == pytest.approx(slide, abs=1e-9)
     assert slip.kept_speeds_slide(after, T + 1.0, tr.end_state) == pytest.approx(slide, abs=1e-12)

@@ -119,7 +119,9 @@ def assemble(scenario, kick, *, tyres=None, gains=None) -> Assembly:
                                    kick=kick.model_kick(), tyre_transient=scenario.tyre_transient,
                                    reverse_camber=scenario.camber_sign == "reversed",
                                    carcass_sliding=scenario.carcass_sliding, carcass_damping=scenario.carcass_damping,
-                                   carcass_viscosity=scenario.carcass_viscosity, slip_speed=scenario.slip_speed)
+                                   carcass_viscosity=scenario.carcass_viscosity, slip_speed=scenario.slip_speed,
+                                   body=rider_body(scenario, info),
+                                   carcass_stiffness_scale=scenario.carcass_stiffness_scale)
     found, start = steady.start_state(params, scenario, advice=_steady_advice(scenario, controller))
     stability = linear_stability(scenario, moore, gains, found, controller)
     steady_yaw_rate = float(start.x[slip.X["u3"]])
@@ -143,7 +145,8 @@ def build_bicycle(scenario):
     seats the Yeadon rider once); callers get their own copies.
     """
     key = (scenario.bicycle, _file_stamp(scenario.bicycle), scenario.fz_n, scenario.rider_mass_kg,
-           scenario.rider, scenario.low_inertia)
+           scenario.rider, scenario.low_inertia, scenario.rider_body != "rigid" or scenario.arms == "on",
+           scenario.arms == "on")
     return copy.deepcopy(_bicycle_setup(*key))
 
 
@@ -154,10 +157,13 @@ def _file_stamp(name):
 
 
 @functools.lru_cache(maxsize=256)
-def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia):
+def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia, split=False, arms_on_bar=False):
     from . import benchmark, bicycles, riders
 
     bike = bicycles.load(bicycle)
+    if split and bike.includes_rider:
+        raise InputError(f"bicycle {bike.name!r} has its rider lumped in already: a leaning rider or arms on the "
+                         "bar need a bicycle-only set with a Yeadon rider (e.g. 'balanceassist_v1')")
     if bike.includes_rider:
         if fz_n is not None or rider_mass_kg is not None:
             raise InputError(f"bicycle {bike.name!r} already includes its rider; "
@@ -170,6 +176,11 @@ def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia
         fz = 635.0 if fz_n is None else fz_n
         combined, rider_mass = riders.for_rear_load(bike, fz, rider=rider_name,
                                                     load_range=_rear_load_range(bicycle, _stamp, rider_name))
+    body = None
+    if split:
+        # The same rider, split into legs (rear frame), forearms (front frame, when on the bar) and upper body.
+        rider = riders.yeadon_rider(rider_name, mass_kg=rider_mass)
+        combined, body = riders.seat_with_body(bike, rider, arms_on_bar=arms_on_bar)
     rear_n, front_n = riders.static_loads(combined)
     design = dict(combined.moore)
     moore = dict(design)
@@ -180,7 +191,8 @@ def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia
         moore = benchmark.to_moore(bench)
     info = {"bicycle": bike.name, "includes_rider_preset": bike.includes_rider,
             "rider_mass_kg": rider_mass, "static_load_rear_n": rear_n, "static_load_front_n": front_n,
-            "total_mass_kg": sum(float(combined.benchmark[k]) for k in ("mR", "mB", "mH", "mF"))}
+            "total_mass_kg": sum(float(combined.benchmark[k]) for k in ("mR", "mB", "mH", "mF"))
+            + (body["mt"] if body else 0.0), "body": body}
     return moore, design, info
 
 
@@ -206,6 +218,26 @@ def _classic_poles(moore_items, speed, gains_items):
     # computes them once per process (~3 ms a case).
     from . import control
     return tuple(control.closed_loop_poles(dict(moore_items), speed, dict(gains_items)))
+
+
+def rider_body(scenario, info):
+    """The rider's body parameters by name (:data:`whipple_kick.slip.parameters.BODY_NAMES`) for ``scenario``.
+
+    The rigid rider without arms is :data:`~whipple_kick.slip.parameters.RIGID_BODY`; otherwise the upper
+    body of :func:`build_bicycle` (locked at the hip for the rigid rider with arms on the bar), the hip's and
+    arms' spring-dampers and the reflex.
+    """
+    body = dict(slip.parameters.RIGID_BODY)
+    if info.get("body"):
+        body.update(info["body"])
+        body["hip_locked"] = 0.0 if scenario.rider_body == "leaning" else 1.0
+    body.update(kh=scenario.hip_stiffness if scenario.rider_body == "leaning" else 0.0,
+                ch=scenario.hip_damping if scenario.rider_body == "leaning" else 0.0,
+                ka=scenario.arm_stiffness if scenario.arms == "on" else 0.0,
+                ca=scenario.arm_damping if scenario.arms == "on" else 0.0,
+                rq4=scenario.reflex_roll, ru4=scenario.reflex_roll_rate, rq7=scenario.reflex_steer,
+                ru7=scenario.reflex_steer_rate, reflex_delay=scenario.reflex_delay)
+    return body
 
 
 def controller_gains(scenario, design):

@@ -69,7 +69,9 @@ def common_rates(extra, u, t6):
     vplate_r, wz_r, wz_f = S.syms(["vplate_r", "wz_r", "wz_f"])
     return {
         "W_plate": fy_r * vplate_r,
-        "W_steer": t7 * u["u7"],
+        # The rider's torque acts between the bar and the upper body: its power is
+        # the torque times the bar's rate relative to the upper body (u7 while the hip is locked).
+        "W_steer": t7 * sm.sympify(extra["steer_relative_rate"]),
         "W_wheel": t6 * u["u6"],
         "W_moment": mz_r * wz_r + mz_f * wz_f,
         "D_damper": sm.sympify(extra["damper_dissipation_rate"]),

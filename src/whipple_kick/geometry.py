@@ -64,7 +64,7 @@ def _expressions():
     front_down = kin.front_heading.cross(E.y)
     outputs += [v.to_matrix(N) for v in (kin.front_heading, kin.front_lateral, front_down)]
     outputs = [codegen.plain(sm.Matrix(o), kin.q) for o in outputs]
-    q = [codegen.plain_symbol(s) for s in kin.q]
+    q = [codegen.plain_symbol(s) for s in kin.q[:len(COORDINATES)]]   # q11 (the rider's lean) is not drawn
     p = list(S.syms(PARAMETER_NAMES))
     free = set().union(*(o.free_symbols for o in outputs)) - set(q) - set(p)
     if free:   # every constant must be one of PARAMETER_NAMES

@@ -30,13 +30,13 @@ COORDINATE_COLUMNS = {
     "q1": ("x_rear", "m"), "q2": ("y_rear", "m"), "q3": ("yaw", "rad"), "q4": ("roll", "rad"),
     "q5": ("frame_pitch", "rad"), "q6": ("rear_wheel_angle", "rad"), "q7": ("steer", "rad"),
     "q8": ("front_wheel_angle", "rad"), "q9": ("compression_rear", "m"),
-    "q10": ("compression_front", "m"),
+    "q10": ("compression_front", "m"), "q11": ("upper_body_lean", "rad"),
 }
 SPEED_COLUMNS = {
     "u1": ("velocity_x_fixed", "m/s"), "u2": ("velocity_y_fixed", "m/s"), "u3": ("yaw_rate", "rad/s"),
     "u4": ("roll_rate", "rad/s"), "u5": ("frame_pitch_rate", "rad/s"), "u6": ("rear_wheel_rate", "rad/s"), "u7": ("steer_rate", "rad/s"),
     "u8": ("front_wheel_rate", "rad/s"), "u9": ("compression_rate_rear", "m/s"),
-    "u10": ("compression_rate_front", "m/s"),
+    "u10": ("compression_rate_front", "m/s"), "u11": ("upper_body_lean_rate", "rad/s"),
 }
 #: The rear contact's velocity along the heading (yaw q3) [m/s]: forward and lateral (the drift).
 HEADING_COLUMNS = {"forward_speed": "m/s", "lateral_speed": "m/s"}
@@ -52,6 +52,8 @@ OUTPUT_COLUMNS = {
     "spring_energy": "spring_energy", "sliding_power": "sliding_power", "holonomic": "holonomic_residual",
     "sigma_r": "relaxation_length_rear", "sigma_f": "relaxation_length_front",
     "fy_limit_r": "fy_limit_rear", "fy_limit_f": "fy_limit_front",
+    "T_reflex": "reflex_steer_torque", "reflex_input": "reflex_undelayed_torque", "arm_torque": "arm_steer_torque",
+    "hip_torque": "hip_torque",
 }
 #: Contact-patch states (transient forms contact_patch and slip_lag; the carcass has the camber ones
 #: and its patch slip as the output ``patch_slip_*``): state -> column.

@@ -603,3 +603,101 @@ def for_rear_load(bike, fz_n, rider="jason", height_m=None, load_range=None):
     if abs(achieved - fz) > 1e-6:
         raise RuntimeError(f"rear load {achieved} N misses the requested {fz} N")
     return RearLoadSolution(combined=combined, rider_mass_kg=mass)
+
+
+#: Yeadon segments of the upper body that leans on the saddle (issue 23): pelvis, thorax, chest-head and
+#: the upper arms; the forearms and hands too unless they move with the bar. The legs stay in the rear frame.
+UPPER_BODY_SEGMENTS = ("P", "T", "C", "A1", "B1")
+#: Forearm-hand segments: with the arms on the bar they move with the front frame (their inertia about the
+#: steer axis is the arms' inertia moving with the bar), else with the upper body.
+FOREARM_SEGMENTS = ("A2", "B2")
+LEG_SEGMENTS = ("J1", "J2", "K1", "K2")
+
+
+def lump_into_frame(bench, frame, mass, com, inertia):
+    """Add a rigid body to the benchmark body ``frame`` ("B" rear frame, "H" front frame) of a benchmark set.
+
+    As :func:`lump_into_rear_frame`, for either frame.
+    """
+    keys = {k: k.replace("B", frame) if k != "mB" else f"m{frame}" for k in
+            ("mB", "xB", "zB", "IBxx", "IByy", "IBzz", "IBxz")}
+    renamed = {k: bench[v] for k, v in keys.items()}
+    combined = lump_into_rear_frame(renamed, mass, com, inertia)
+    out = dict(bench)
+    out.update({v: combined[k] for k, v in keys.items()})
+    return out
+
+
+def _segments(human, seat_pt, names):
+    """Mass [kg], mass centre [m] and inertia [kg m^2] of yeadon segments ``names`` in the benchmark frame."""
+    mass, com, inertia = human.combine_inertia(tuple(names))
+    com = seat_pt + YEADON_TO_BIKE @ np.asarray(com).ravel()
+    inertia = YEADON_TO_BIKE @ np.asarray(inertia) @ YEADON_TO_BIKE.T
+    com[1] = 0.0   # mid-plane symmetry (checked for the whole rider by place())
+    inertia[0, 1] = inertia[1, 0] = inertia[1, 2] = inertia[2, 1] = 0.0
+    return float(mass), com, inertia
+
+
+def seat_with_body(bike, rider, arms_on_bar=True):
+    """Seat a rider whose upper body leans on the saddle and whose forearms move with the bar.
+
+    The rider is seated as by :func:`place`. The legs are lumped into the
+    rear frame; with ``arms_on_bar`` the forearms and hands are lumped into
+    the front frame (they turn with the bar); the rest (pelvis, trunk,
+    head, upper arms, and the forearms without ``arms_on_bar``) is the upper
+    body G, hinged at the seat point (the top of the seat post, where
+    yeadon's origin sits) about a horizontal axis along the bicycle's
+    heading. This is Moore's (2012, ch. 4, "Leaning rider extension")
+    upper-body hinge near the saddle, with the segments taken from the
+    rider's own Yeadon model.
+
+    Parameters
+    ----------
+    bike : Bicycle
+        Bicycle-only set with seating geometry.
+    rider : YeadonRider
+    arms_on_bar : bool
+
+    Returns
+    -------
+    combined : Bicycle
+        The bicycle with the legs (and forearms) lumped in; its ``rider`` metadata as :func:`seat`'s.
+    body : dict
+        The upper body's parameters by name (:data:`whipple_kick.slip.parameters.BODY_NAMES`: ``hip_tilt``,
+        ``lh1``, ``lh3``, ``mt``, ``lt1``, ``lt3``, ``it11``, ``it22``, ``it33``, ``it31``), in Moore's
+        rear frame C from the rear wheel centre, with ``hip_locked`` 0.
+    """
+    seated = place(bike, rider)
+    human = rider.human(seated.configuration)
+    seat_pt = seated.seat
+    forearms = FOREARM_SEGMENTS if arms_on_bar else ()
+    upper = UPPER_BODY_SEGMENTS + (() if arms_on_bar else FOREARM_SEGMENTS)
+    bench = lump_into_frame(bike.benchmark, "B", *_segments(human, seat_pt, LEG_SEGMENTS))
+    if forearms:
+        bench = lump_into_frame(bench, "H", *_segments(human, seat_pt, forearms))
+    m_t, com_t, i_t = _segments(human, seat_pt, upper)
+    total = sum(_segments(human, seat_pt, names)[0] for names in (LEG_SEGMENTS, upper, forearms) if names)
+    if abs(total - seated.mass) > 1e-9 * seated.mass:
+        raise RuntimeError(f"the rider's segments sum to {total} kg, not {seated.mass} kg")
+    lam = bike.benchmark["lam"]
+    # Moore's rear frame C: C.x = cos(lam) X - sin(lam) Z, C.z = sin(lam) X + cos(lam) Z (benchmark X fwd, Z down),
+    # from the rear wheel centre (0, 0, -rR). Turning C about C.y by -lam gives H.x = X: a horizontal hinge.
+    c_x = np.array([math.cos(lam), 0.0, -math.sin(lam)])
+    c_z = np.array([math.sin(lam), 0.0, math.cos(lam)])
+    hip = seat_pt - np.array([0.0, 0.0, -bike.benchmark["rR"]])
+    arm = com_t - seat_pt
+    body = {"hip_locked": 0.0, "hip_tilt": -lam, "lh1": float(hip @ c_x), "lh3": float(hip @ c_z),
+            "mt": m_t, "lt1": float(arm[0]), "lt3": float(arm[2]),
+            "it11": float(i_t[0, 0]), "it22": float(i_t[1, 1]), "it33": float(i_t[2, 2]), "it31": float(i_t[0, 2])}
+    combined = Bicycle(
+        name=f"{bike.name}+{rider.name}({rider.mass_kg:g} kg, body)",
+        benchmark=bench, parameterisation="benchmark", includes_rider=True,
+        source=f"{bike.source}\nrider {rider.name}:\n{rider.source}",
+        description=f"{bike.description} With Yeadon rider {rider.name!r} ({rider.mass_kg:g} kg, "
+                    f"{rider.height_m:.3f} m): legs in the rear frame, "
+                    f"{'forearms and hands in the front frame, ' if arms_on_bar else ''}the rest a leaning upper body.",
+        uncertainties={}, geometry=bike.geometry, tyre_placeholders=bike.tyre_placeholders,
+        rider={"name": rider.name, "mass_kg": rider.mass_kg, "height_m": rider.height_m,
+               **{f"rider_{k}": v for k, v in seated.benchmark().items()}},
+    )
+    return combined, body

@@ -42,6 +42,10 @@ KICK_HEADINGS = ("fixed", "settled")
 #: Sign of the camber the Magic Formula is fed: ``physical`` (a leaning wheel is
 #: pushed toward the lean) or ``reversed`` (away from it: the authors' published code).
 CAMBER_SIGNS = ("physical", "reversed")
+#: The rider's body: lumped into the rear frame, or an upper body leaning on the saddle (issue 23).
+RIDER_BODIES = ("rigid", "leaning")
+#: The arms: no mechanical effect on the bar, or forearms turning with it and a spring-damper about the steer axis.
+ARMS = ("off", "on")
 #: State at the start of the run: ``steady`` (the solved steady motion) or
 #: ``upright`` (upright straight running, not an equilibrium with measured tyres:
 #: the authors' published code).
@@ -164,6 +168,31 @@ class Scenario:
     carcass_damping : float
         Lateral damping of each carcass [N s/m], parallel to its stiffness
         (default 0: the thesis' pure relaxation). Carcass transient only.
+    carcass_stiffness_scale : float
+        Factor on both carcass stiffnesses C_Fa(F_z0)/sigma0 (default 1; the
+        identification of issue 23 varies it). Carcass transient only.
+    rider_body : {"rigid", "leaning"}
+        The rider lumped rigidly into the rear frame (default), or an upper
+        body (pelvis, trunk, head, upper arms) leaning on the saddle on the
+        hip spring-damper (:func:`whipple_kick.riders.seat_with_body`).
+    arms : {"off", "on"}
+        "on": the forearms and hands turn with the bar and the arms are a
+        spring-damper about the steer axis between the bar and the upper body
+        (the rear frame with a rigid rider). "off" (default): the hands have
+        no mechanical effect on the bar.
+    hip_stiffness, hip_damping : float
+        The leaning upper body's hip spring [N m/rad] and damper [N m s/rad]:
+        128 and 50, Moore (2012, *Human Control of a Bicycle*, PhD thesis, UC
+        Davis, ch. 4, "Leaning rider extension", from de Lorenzo and Hubbard).
+    arm_stiffness, arm_damping : float
+        The arms about the steer axis [N m/rad, N m s/rad] (default 0: no
+        published value was at hand; docs/experiments.md, identification).
+    reflex_delay : float
+        Delay of the rider's reflex [s], a (3,4) Pade filter (:mod:`whipple_kick.reflex`); 0 none.
+    reflex_roll, reflex_roll_rate, reflex_steer, reflex_steer_rate : float
+        Reflex steer-torque gains on roll [N m/rad], roll rate [N m s/rad],
+        steer [N m/rad] and steer rate [N m s/rad], ``T = -(g x)`` delayed;
+        separate from the voluntary law (the controller). Default 0.
     carcass_viscosity : float
         Numerics: the sliding viscosity [N s/m] that regularises an
         undamped carcass' friction limit (a patch past the limit slides
@@ -262,6 +291,18 @@ class Scenario:
     carcass_sliding: str = carcass.DEFAULT_SLIDING
     carcass_damping: float = 0.0
     carcass_viscosity: float = carcass.SLIDING_VISCOSITY
+    carcass_stiffness_scale: float = 1.0
+    rider_body: str = "rigid"
+    arms: str = "off"
+    hip_stiffness: float = 128.0
+    hip_damping: float = 50.0
+    arm_stiffness: float = 0.0
+    arm_damping: float = 0.0
+    reflex_delay: float = 0.0
+    reflex_roll: float = 0.0
+    reflex_roll_rate: float = 0.0
+    reflex_steer: float = 0.0
+    reflex_steer_rate: float = 0.0
     plate_stop: str = "impulse"
     kick_heading: str = "fixed"
     camber_sign: str = "physical"
@@ -384,6 +425,20 @@ class Scenario:
         if self.controller not in CONTROLLERS:
             raise InputError(f"controller {self.controller!r} is unknown; choose one of {', '.join(CONTROLLERS)}")
         check_range("carcass damping", self.carcass_damping, 0.0, 1e4, "N s/m")
+        check_range("carcass stiffness scale", self.carcass_stiffness_scale, 0.05, 20.0, "(factor)")
+        check_range("hip stiffness", self.hip_stiffness, 0.0, 1e6, "N m/rad")
+        check_range("hip damping", self.hip_damping, 0.0, 1e5, "N m s/rad")
+        check_range("arm stiffness", self.arm_stiffness, 0.0, 1e5, "N m/rad")
+        check_range("arm damping", self.arm_damping, 0.0, 1e4, "N m s/rad")
+        check_range("reflex delay", self.reflex_delay, 0.0, 0.5, "s")
+        for label, value, unit in (("reflex roll gain", self.reflex_roll, "N m/rad"),
+                                   ("reflex roll-rate gain", self.reflex_roll_rate, "N m s/rad"),
+                                   ("reflex steer gain", self.reflex_steer, "N m/rad"),
+                                   ("reflex steer-rate gain", self.reflex_steer_rate, "N m s/rad")):
+            check_range(label, value, -1e4, 1e4, unit)
+        if self.rider_body == "leaning" and self.hip_stiffness == 0.0:
+            raise InputError("hip stiffness = 0 N m/rad leaves a leaning upper body with nothing to hold it "
+                             "up; allowed (0, 1e6] N m/rad")
         # Below 1e-3 N s/m the plateau is so stiff that LSODA stalls at the plate stop (measured 5e-4).
         check_range("carcass sliding viscosity", self.carcass_viscosity, 1e-3, 10.0, "N s/m")
         for label, value, choices in (("tyre transient", self.tyre_transient, TYRE_TRANSIENTS),
@@ -393,7 +448,9 @@ class Scenario:
                                       ("camber sign", self.camber_sign, CAMBER_SIGNS),
                                       ("start", self.start, STARTS),
                                       ("start pitch", self.start_pitch, START_PITCHES),
-                                      ("slip speed", self.slip_speed, SLIP_SPEEDS)):
+                                      ("slip speed", self.slip_speed, SLIP_SPEEDS),
+                                      ("rider body", self.rider_body, RIDER_BODIES),
+                                      ("arms", self.arms, ARMS)):
             if value not in choices:
                 raise InputError(f"{label} {value!r} is unknown; choose one of {', '.join(choices)}")
         if self.start == "upright" and self.settle != 0.0:
@@ -540,7 +597,9 @@ FIELD_GROUPS = {
                 "pressure_rear_kpa", "coefficient_set", "friction", "symmetric_tyres", "speed", "controller",
                 "design_speed", "gain_scale", "thesis_load_n", "low_inertia", "kick_displacement", "kick_duration",
                 "kick_accel", "kick_profile", "kick_table", "kick_direction", "tyre_transient", "carcass_sliding",
-                "carcass_damping"),
+                "carcass_damping", "carcass_stiffness_scale", "rider_body", "arms", "hip_stiffness", "hip_damping",
+                "arm_stiffness", "arm_damping", "reflex_delay", "reflex_roll", "reflex_roll_rate", "reflex_steer",
+                "reflex_steer_rate"),
     "run": ("settle", "duration", "output_rate", "fall_angle_deg", "steer_limit_deg"),
     "numerics": ("rtol", "piecewise", "carcass_viscosity"),
     "compatibility": ("plate_stop", "kick_heading", "camber_sign", "start", "start_pitch", "slip_speed"),

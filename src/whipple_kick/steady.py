@@ -43,7 +43,7 @@ import math
 
 import numpy as np
 
-from . import slip
+from . import reflex, slip
 from . import symbols as S
 from .errors import InputError
 
@@ -343,15 +343,19 @@ def steady_state(params, speed, tol=1e-13, guess=None):
 
     rhs = slip.CompiledRHS(params)
     rr = params["rr"]
-    weight = params["g"] * (params["mc"] + params["md"] + params["me"] + params["mf"])
+    weight = params["g"] * (params["mc"] + params["md"] + params["me"] + params["mf"] + params.get("mt", 0.0))
     x = np.zeros(len(slip.STATE_NAMES))
     x[slip.X["u1"]] = speed
     names = ("q4", "q7", "q5", "q9", "q10", "u2", "u3", "T6c")
     z0 = np.array([0.0, 0.0, steer_axis_tilt(params),
                    0.5 * weight / params["kzr"], 0.5 * weight / params["kzf"], 0.0, 0.0, 0.0])
+    lean = not params.get("hip_locked", 1.0)   # a leaning upper body has its own steady lean
+    if lean:
+        names = names[:-1] + ("q11", "T6c")
+        z0 = np.insert(z0, -1, 0.0)
     if guess is not None:
         z0 = np.array([float(guess.get(name, value)) for name, value in zip(names, z0, strict=True)])
-    scale = np.array([1.0, 1.0, 1.0, 1e-3, 1e-3, 1.0, 1.0, 1.0])
+    scale = np.array([1.0, 1.0, 1.0, 1e-3, 1e-3, 1.0, 1.0] + [1.0] * lean + [1.0])
 
     def state(z):
         xs = x.copy()
@@ -369,6 +373,7 @@ def steady_state(params, speed, tol=1e-13, guess=None):
             out[slip.OUT["holonomic"]] * 1e2,
             (dx[slip.X["u1"]] + u3 * u2) * rr, dx[slip.X["u2"]] - u3 * u1, dx[slip.X["u3"]],
             dx[slip.X["u4"]], dx[slip.X["u7"]], dx[slip.X["u9"]] * 1e-2, dx[slip.X["u10"]] * 1e-2,
+            *([dx[slip.X["u11"]]] if lean else []),
         ])
 
     sol = root(residual, z0 / scale, method="hybr", options={"xtol": tol})
@@ -397,8 +402,12 @@ def _steady_tyre_states(rhs, x):
     form = rhs.transient
     x = np.array(x, dtype=float)
     _, out = rhs.outputs(0.0, x)
+    # The reflex filter in equilibrium with its (steady) input: its output is that input.
+    x[[slip.X[n] for n in slip.REFLEX_STATES]] = reflex.steady_state(out[slip.OUT["reflex_input"]],
+                                                                      rhs.p[slip.P["reflex_delay"]])
     if form == "carcass":
-        stiffness = carcass_stiffness(rhs, out[slip.OUT["fz_r"]], out[slip.OUT["fz_f"]])
+        stiffness = (carcass_stiffness(rhs, out[slip.OUT["fz_r"]], out[slip.OUT["fz_f"]])
+                     * rhs.p[slip.P["carcass_stiffness_scale"]])
         rhs.p[slip.P["ccr"]], rhs.p[slip.P["ccf"]] = stiffness
         for k, wheel in enumerate("rf"):
             c = stiffness[k]
@@ -474,7 +483,7 @@ def upright_state(params, speed, tol=1e-13, pitch_without_compression=False):
     out_params = dict(params)
     out_params["T6c"] = 0.0
     rhs = slip.CompiledRHS(out_params)
-    weight = params["g"] * (params["mc"] + params["md"] + params["me"] + params["mf"])
+    weight = params["g"] * (params["mc"] + params["md"] + params["me"] + params["mf"] + params.get("mt", 0.0))
     x = np.zeros(len(slip.STATE_NAMES))
     x[slip.X["u1"]] = speed
     names = ("q5", "q9", "q10")

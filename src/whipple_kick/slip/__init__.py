@@ -10,11 +10,11 @@ the ``tyre_transient`` parameter), the steer controller, Kane's equations
 and the rates of the energy quadratures (:mod:`whipple_kick.energy`); the
 named outputs (:data:`OUTPUTS`) only when asked for.
 
-State vector layout (by name, see :data:`STATE_NAMES`): q1..q10, the
-independent speeds u1 u2 u3 u4 u7 u9 u10, four tyre states in fixed slots
+State vector layout (by name, see :data:`STATE_NAMES`): q1..q11, the
+independent speeds u1 u2 u3 u4 u7 u9 u10 u11, four tyre states in fixed slots
 (:func:`tyre_state_names`: the contact patch's slip and camber angles, or
 the thesis' relaxed forces fyr fyf mzr mzf, which :data:`X` also names),
-and the quadratures of :data:`whipple_kick.energy.QUADRATURE_STATES`.
+the reflex delay filter's four states, and the quadratures of :data:`whipple_kick.energy.QUADRATURE_STATES`.
 
 The package, one module per concern: :mod:`.layout` (names and indices),
 :mod:`.compiled` (the compiler, the cache entry, loading), :mod:`.call`
@@ -43,6 +43,7 @@ from .layout import (  # noqa: F401 -- the package's names, as before the split
     COORDINATES,
     DEPENDENT,
     DYNAMIC_STATES,
+    HIP_STATES,
     IGNORABLE,
     INDEPENDENT,
     JACOBIAN_EVALUATIONS,
@@ -52,6 +53,7 @@ from .layout import (  # noqa: F401 -- the package's names, as before the split
     PARAMETER_NAMES,
     PATCH_STATES,
     QUADRATURE_STATES,
+    REFLEX_STATES,
     SPEEDS,
     STATE_NAMES,
     TYRE_STATES,

@@ -1,11 +1,11 @@
 """The slip model's layout: states, speeds, outputs and parameters by name, and their indices."""
 
 
-from whipple_kick import energy, kane, transient
+from whipple_kick import energy, kane, reflex, transient
 from whipple_kick import symbols as S
 
-COORDINATES = tuple(f"q{i}" for i in range(1, 11))
-SPEEDS = tuple(f"u{i}" for i in range(1, 11))
+COORDINATES = tuple(f"q{i}" for i in range(1, 12))
+SPEEDS = tuple(f"u{i}" for i in range(1, 12))
 DEPENDENT = ("u5", "u6", "u8")
 INDEPENDENT = tuple(n for n in SPEEDS if n not in DEPENDENT)
 #: Tyre-state slot names of the thesis' form (kept as aliases in :data:`X`).
@@ -13,14 +13,20 @@ TYRE_STATES = transient.STATES["force_lag"]
 #: Tyre-state slot names of the default form.
 PATCH_STATES = transient.STATES["contact_patch"]
 QUADRATURE_STATES = energy.QUADRATURE_STATES
+#: The reflex delay filter's states (:mod:`whipple_kick.reflex`).
+REFLEX_STATES = reflex.STATE_NAMES
 #: States integrated for the dynamics; the quadratures follow them.
-DYNAMIC_STATES = COORDINATES + INDEPENDENT + PATCH_STATES
+DYNAMIC_STATES = COORDINATES + INDEPENDENT + PATCH_STATES + REFLEX_STATES
+#: States that stay at 0 and drive nothing while the rider's hip is locked (the rigid rider).
+HIP_STATES = ("q11", "u11")
 #: Coordinates nothing depends on (Moore's ignorable coordinates: the rear contact's position, the plate
 #: being prescribed in time; the axisymmetric wheels' angles): their Jacobian columns are exactly zero
 #: (a test), so the compiled Jacobian does not evaluate them.
 IGNORABLE = ("q1", "q2", "q6", "q8")
 #: Right-hand-side evaluations one compiled Jacobian costs (the budget counts them).
-JACOBIAN_EVALUATIONS = len(DYNAMIC_STATES) + 1 - len(IGNORABLE)
+#: (The hip's and the reflex filter's columns are skipped too while the hip is locked and the delay is 0,
+#: as in the default rider: the count is for that rider.)
+JACOBIAN_EVALUATIONS = len(DYNAMIC_STATES) + 1 - len(IGNORABLE) - len(HIP_STATES) - len(REFLEX_STATES)
 STATE_NAMES = DYNAMIC_STATES + QUADRATURE_STATES
 #: Named outputs the C function writes when asked, after all ten speeds: name -> (unit, what it is).
 OUTPUTS = {
@@ -39,7 +45,11 @@ OUTPUTS = {
     "fy_ss_f": ("N", "front steady lateral force at the kinematic slip and camber"),
     "mz_ss_r": ("N m", "rear steady aligning moment at the kinematic slip and camber"),
     "mz_ss_f": ("N m", "front steady aligning moment at the kinematic slip and camber"),
-    "T7": ("N m", "steer torque of the rider's control law"),
+    "T7": ("N m", "rider's active steer torque: the voluntary law plus the delayed reflex"),
+    "T_reflex": ("N m", "rider's delayed reflex steer torque (part of T7)"),
+    "reflex_input": ("N m", "rider's reflex steer torque before the delay"),
+    "arm_torque": ("N m", "passive torque of the rider's arms on the bar about the steer axis"),
+    "hip_torque": ("N m", "torque of the hip spring-damper on the upper body about the lean axis"),
     "kinetic_energy": ("J", "kinetic energy of the bicycle and rider"),
     "potential_energy": ("J", "gravitational potential energy"),
     "spring_energy": ("J", "energy stored in the vertical tyre springs"),
@@ -71,6 +81,7 @@ P = {n: i for i, n in enumerate(PARAMETER_NAMES)}
 
 #: Package modules the compiled library is generated from (its cache key hashes them).
 _SOURCES = ("symbols", "symbolic/derivation", "symbolic/codegen", "magic_formula", "transient", "carcass", "energy",
+            "reflex",
             "slip/__init__", "slip/layout", "slip/compiled", "slip/call", "slip/parameters", "slip/jumps",
             "slip/linear", "symbolic/slip_build")
 _PARTITION = kane.ConstraintPartition(SPEEDS, DEPENDENT)

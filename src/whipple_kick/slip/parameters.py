@@ -12,7 +12,13 @@ from whipple_kick.errors import InputError
 #: (Sh and Sv terms not multiplied by camber). "Symmetric tyres" zero them.
 FY_OFFSET_INDICES = magic_formula.FY_OFFSET_INDICES
 MZ_OFFSET_INDICES = magic_formula.MZ_OFFSET_INDICES
-GAIN_NAMES = ("kq3", "kq4", "kq7", "ku3", "ku4", "ku7")
+GAIN_NAMES = ("kq3", "kq4", "kq7", "ku3", "ku4", "ku7", "kq11", "ku11")
+#: The rider's body (issue 23) by parameter name, with the rigid rider's values: the hip locked, the
+#: upper body's mass in the rear frame (mt 0), no arm impedance, no reflex.
+RIGID_BODY = {"hip_locked": 1.0, "hip_tilt": 0.0, "lh1": 0.0, "lh3": 0.0, "mt": 0.0, "lt1": 0.0, "lt3": 0.0,
+              "it11": 0.0, "it22": 0.0, "it33": 0.0, "it31": 0.0, "kh": 0.0, "ch": 0.0, "ka": 0.0, "ca": 0.0,
+              "rq4": 0.0, "rq7": 0.0, "ru4": 0.0, "ru7": 0.0, "reflex_delay": 0.0}
+BODY_NAMES = tuple(RIGID_BODY)
 
 
 def tyre_parameters(tyre, wheel, symmetric=False, lateral=True, reverse_camber=False):
@@ -68,7 +74,8 @@ def model_parameters(moore, rear_tyre, front_tyre, gains=None, kick=None,
                      symmetric=False, lateral=True, drive_torque=0.0,
                      tyre_transient=transient.DEFAULT_TRANSIENT, reverse_camber=False,
                      carcass_sliding=carcass.DEFAULT_SLIDING, carcass_damping=0.0,
-                     carcass_viscosity=carcass.SLIDING_VISCOSITY, slip_speed="wheel_centre"):
+                     carcass_viscosity=carcass.SLIDING_VISCOSITY, slip_speed="wheel_centre", body=None,
+                     carcass_stiffness_scale=1.0):
     """Assemble the slip model's parameters by name.
 
     Parameters
@@ -108,6 +115,14 @@ def model_parameters(moore, rear_tyre, front_tyre, gains=None, kick=None,
         ``atan(vsy / |vx|)`` and the relaxation ``sigma / |vx|`` use: the
         wheel centre's (default) or the geometric contact point's, as the
         thesis authors' published code takes it (parameter ``slip_speed_point``).
+    carcass_stiffness_scale : float
+        Factor on the carcass stiffnesses the steady state sets (default 1).
+    body : mapping, optional
+        The rider's body by parameter name (:data:`BODY_NAMES`: the upper
+        body's placement and inertia, hip and arm spring-dampers, reflex gains
+        and delay; :func:`whipple_kick.riders.body_parameters` makes them).
+        Default: the rigid rider (hip locked, no upper body of its own, no
+        arms, no reflex), which is the model without a body exactly.
     """
     if slip_speed not in SLIP_SPEEDS:
         raise InputError(f"slip speed {slip_speed!r} is unknown; choose one of {', '.join(SLIP_SPEEDS)}")
@@ -134,5 +149,11 @@ def model_parameters(moore, rear_tyre, front_tyre, gains=None, kick=None,
         "dcr": float(carcass_damping), "dcf": float(carcass_damping),
         "carcass_sliding": float(carcass.check_sliding(carcass_sliding)),
         "carcass_viscosity": float(carcass_viscosity),
+        "carcass_stiffness_scale": float(carcass_stiffness_scale),
     })
+    body = dict(body or {})
+    unknown = set(body) - set(BODY_NAMES)
+    if unknown:
+        raise InputError(f"unknown rider-body parameters {sorted(unknown)}; known: {', '.join(BODY_NAMES)}")
+    params.update({n: float(body.get(n, RIGID_BODY[n])) for n in BODY_NAMES})
     return params
