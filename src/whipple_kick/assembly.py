@@ -110,7 +110,10 @@ def assemble(scenario, kick, *, tyres=None, gains=None) -> Assembly:
         notes = [f"custom tyre objects (the scenario's tyre and pressures are not used): "
                  f"rear {rear!r}, front {front!r}"]
     moore, design, info = build_bicycle(scenario)
-    if custom is None:
+    if custom is None and scenario.controller == "lqr" and scenario.lqr_model == "simulated":
+        gains, poles = lqr_on_simulated_model(scenario, moore, design, info, rear, front)
+        controller = scenario.controller
+    elif custom is None:
         gains, poles = controller_gains(scenario, design)
         controller = scenario.controller
     else:
@@ -240,6 +243,79 @@ def rider_body(scenario, info):
     return body
 
 
+def lqr_on_simulated_model(scenario, moore, design, info, rear, front):
+    """The LQR rider designed on the model the run simulates (``lqr_model="simulated"``).
+
+    The model of the run (its tyres, carcass, body, arms and reflex) with
+    symmetric tyres, linearised about upright straight running at the design
+    speed at constant speed (:func:`whipple_kick.slip.heading_linearisation`);
+    the law feeds back roll, steer and their rates, and the upper body's lean
+    and its rate when it leans (:data:`whipple_kick.control.FELT_STATES`),
+    with gains LQR-optimal for that law (identity weights on those states,
+    1 on the torque, as the Whipple design), found from the Whipple design's
+    gains by :func:`whipple_kick.control.output_feedback_lqr`. Where the
+    Whipple gains do not stabilise the model, the arms' and the reflex's
+    gains are brought in from 0 in steps, each design starting from the last.
+
+    Returns
+    -------
+    gains : dict
+        By name (:data:`whipple_kick.slip.parameters.GAIN_NAMES`), times ``gain_scale``.
+    poles : ndarray
+        The design's closed-loop eigenvalues.
+    """
+    from . import control
+
+    speed = float(scenario.lqr_design_speed)
+    body = rider_body(scenario, info)
+    felt = ["kq4", "kq7", "ku4", "ku7"] + (["kq11", "ku11"] if scenario.rider_body == "leaning" else [])
+    K = np.r_[_lqr(tuple(sorted(design.items())), speed)[0], np.zeros(len(felt) - 4)]
+    scaled = ("ka", "ca", "rq4", "rq7", "ru4", "ru7")
+    # Continuation: the share of the arms' and reflex's gains grows while each design stabilises the next model.
+    done, step = (1.0, 1.0) if _linear_design_model(scenario, moore, rear, front, body, felt, K, 1.0, scaled)[3] \
+        else (0.0, 0.1)
+    A, b, C, _ = _linear_design_model(scenario, moore, rear, front, body, felt, K, done, scaled)
+    K, poles = control.output_feedback_lqr(A, b, C, K0=K)
+    while done < 1.0:
+        share = min(1.0, done + step)
+        A, b, C, stable = _linear_design_model(scenario, moore, rear, front, body, felt, K, share, scaled)
+        if stable:
+            K, poles = control.output_feedback_lqr(A, b, C, K0=K)
+            done, step = share, step * 1.5
+        elif step < 1e-3:
+            raise InputError(f"no stabilising LQR rider was found on the model simulated at {speed:g} m/s "
+                             f"(the design lost stability at {share:.1%} of the arms' and reflex's gains)")
+        else:
+            step /= 2.0
+    gains = dict.fromkeys(slip.GAIN_NAMES, 0.0)
+    gains.update({name: float(scenario.gain_scale * k) for name, k in zip(felt, K, strict=True)})
+    return gains, poles
+
+
+def _linear_design_model(scenario, moore, rear, front, body, felt, K, share, scaled):
+    """(A, b, C, whether ``K`` stabilises it) of the design model with ``share`` of the ``scaled`` body gains."""
+    from . import control
+
+    part = {k: (v * share if k in scaled else v) for k, v in body.items()}
+    params = slip.model_parameters(moore, rear, front, symmetric=True, tyre_transient=scenario.tyre_transient,
+                                   carcass_sliding=scenario.carcass_sliding,
+                                   carcass_damping=scenario.carcass_damping,
+                                   carcass_viscosity=scenario.carcass_viscosity, slip_speed=scenario.slip_speed,
+                                   body=part, carcass_stiffness_scale=scenario.carcass_stiffness_scale)
+    up = steady.upright_state(params, float(scenario.lqr_design_speed))
+    rhs = slip.CompiledRHS(up.params)
+    A, b = slip.heading_linearisation(rhs, up.x)
+    names = list(slip.LINEAR_STATES) + list(slip.linear.body_states(rhs.p))
+    keep = [i for i, n in enumerate(names) if n != "v_fwd"]   # constant speed
+    A, b = A[np.ix_(keep, keep)], b[keep]
+    names = [names[i] for i in keep]
+    C = np.zeros((len(felt), len(names)))
+    for row, gain in enumerate(felt):
+        C[row, names.index(control.FELT_STATES[gain])] = 1.0
+    stable = bool(np.max(np.linalg.eigvals(A - b @ K[None, :] @ C).real) < 0.0)
+    return A, b, C, stable
+
+
 def controller_gains(scenario, design):
     """Steer-torque gains by name, and the LQR design's closed-loop poles at its design speed (or None).
 
@@ -346,7 +422,8 @@ UNSTABLE_REAL_PART = 1e-3
 def who_rides(scenario, controller_type):
     """How the summary and the messages name the rider in use."""
     if controller_type == "lqr":
-        return f"the LQR rider designed at {scenario.lqr_design_speed:g} m/s"
+        on = " on the model simulated" if scenario.lqr_model == "simulated" else ""
+        return f"the LQR rider designed{on} at {scenario.lqr_design_speed:g} m/s"
     if controller_type == "thesis":
         return f"the thesis' Table 8.4 rider (designed at {THESIS_DESIGN_SPEED:g} m/s)"
     if controller_type == "off":

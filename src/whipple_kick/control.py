@@ -201,3 +201,76 @@ def closed_loop_poles(moore, speed, gains):
     else:
         poles = np.linalg.eigvals(closed_loop_matrix(moore, speed, K4))
     return poles[np.argsort(-poles.real, kind="stable")]
+
+
+#: What each gain of the rider's voluntary law multiplies (``T7 = -sum(gain * state)``), for
+#: :func:`output_feedback_lqr`'s designs on the model simulated.
+FELT_STATES = {"kq4": "q4", "kq7": "q7", "ku4": "u4", "ku7": "u7", "kq11": "q11", "ku11": "u11", "kq3": "q3"}
+
+
+def output_feedback_lqr(A, b, C, Q=None, R=1.0, K0=None, X0=None):
+    """LQR-optimal gains of a law that feeds back only what the rider feels: ``u = -K C x``.
+
+    Minimises the LQR cost ``integral(y^T Q y + R u^2) dt`` with ``y = C x``,
+    averaged over initial states of covariance ``X0`` (Levine and Athans
+    1970, "On the determination of the optimal constant output feedback
+    gains for linear multivariable systems", IEEE Trans. Automatic Control
+    15(1):44-48): ``J = trace(P X0)``, ``(A - b K C)^T P + P (A - b K C) + C^T
+    (Q + K^T R K) C = 0``, by BFGS with the exact gradient ``2 (R K C - b^T P)
+    L C^T``, ``L`` the closed loop's Lyapunov solution for ``X0``. With
+    ``C`` the identity it is the full-state LQR.
+
+    Parameters
+    ----------
+    A : ndarray (n, n)
+        The model's state matrix (the rider's law left out).
+    b : ndarray (n, 1)
+        Its steer-torque column.
+    C : ndarray (m, n)
+        Picks the felt states.
+    Q : ndarray (m, m), optional
+        Weight on the felt states (default identity, as :func:`lqr_gains`).
+    R : float
+        Weight on the steer torque.
+    K0 : array_like (m,), optional
+        A stabilising start (default zeros; the open loop must then be stable).
+    X0 : ndarray (n, n), optional
+        Initial-state covariance (default ``C^T C`` plus 1e-3 on every state, so
+        the states the rider does not feel count a little).
+
+    Returns
+    -------
+    K : ndarray (m,)
+    poles : ndarray, complex
+        Eigenvalues of ``A - b K C``.
+
+    Raises
+    ------
+    InputError
+        ``K0`` does not stabilise the model.
+    """
+    from scipy.linalg import solve_continuous_lyapunov
+    from scipy.optimize import minimize
+
+    A, b, C = (np.asarray(v, dtype=float) for v in (A, b, C))
+    n, m = A.shape[0], C.shape[0]
+    Qm = np.eye(m) if Q is None else np.asarray(Q, dtype=float)
+    X0 = C.T @ C + 1e-3 * np.eye(n) if X0 is None else np.asarray(X0, dtype=float)
+    K = np.zeros(m) if K0 is None else np.asarray(K0, dtype=float).ravel()
+
+    def cost(k):
+        acl = A - b @ k[None, :] @ C
+        if np.max(np.linalg.eigvals(acl).real) >= -1e-9:
+            return np.inf, np.zeros(m)
+        weight = C.T @ (Qm + R * np.outer(k, k)) @ C
+        P = solve_continuous_lyapunov(acl.T, -weight)
+        L = solve_continuous_lyapunov(acl, -X0)
+        grad = 2.0 * ((R * k[None, :] @ C - b.T @ P) @ L @ C.T).ravel()
+        return float(np.trace(P @ X0)), grad
+
+    if not np.isfinite(cost(K)[0]):
+        raise InputError("the start gains do not stabilise the model the rider is designed on")
+    # BFGS steps that leave the stable set get an infinite cost and are shortened by the line search.
+    best = minimize(cost, K, jac=True, method="BFGS", options={"gtol": 1e-8, "maxiter": 500})
+    k = best.x if np.isfinite(best.fun) and best.fun <= cost(K)[0] else K
+    return k, np.linalg.eigvals(A - b @ k[None, :] @ C)

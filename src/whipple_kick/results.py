@@ -215,6 +215,9 @@ def trajectory_frame(solution, tyre_transient="carcass"):
     yaw, vx_fixed, vy_fixed = (values[:, column[c]] for c in ("yaw", "velocity_x_fixed", "velocity_y_fixed"))
     values[:, column["forward_speed"]] = np.cos(yaw) * vx_fixed + np.sin(yaw) * vy_fixed
     values[:, column["lateral_speed"]] = -np.sin(yaw) * vx_fixed + np.cos(yaw) * vy_fixed
+    # No negative zeros (a switched-off torque, -(0 x), is -0.0): trajectory.csv's rounded "-0" would read
+    # back as 0 and a loaded result would not save the same bytes.
+    values += 0.0
     frame = pd.DataFrame(values, columns=[name for name, _, _ in layout], copy=False)
     residual = energy.balance_residual(frame)
     frame[BALANCE_COLUMN] = residual

@@ -42,6 +42,8 @@ KICK_HEADINGS = ("fixed", "settled")
 #: Sign of the camber the Magic Formula is fed: ``physical`` (a leaning wheel is
 #: pushed toward the lean) or ``reversed`` (away from it: the authors' published code).
 CAMBER_SIGNS = ("physical", "reversed")
+#: The model the LQR rider is designed on.
+LQR_MODELS = ("whipple", "simulated")
 #: The rider's body: lumped into the rear frame, or an upper body leaning on the saddle (issue 23).
 RIDER_BODIES = ("rigid", "leaning")
 #: The arms: no mechanical effect on the bar, or forearms turning with it and a spring-damper about the steer axis.
@@ -171,6 +173,14 @@ class Scenario:
     carcass_stiffness_scale : float
         Factor on both carcass stiffnesses C_Fa(F_z0)/sigma0 (default 1; the
         identification of issue 23 varies it). Carcass transient only.
+    lqr_model : {"whipple", "simulated"}
+        The model the LQR rider (``controller="lqr"``) is designed on: the
+        linearised Carvallo-Whipple model (default; full state, roll and
+        steer), or the model the run simulates (tyres, body, arms, reflex),
+        linearised about upright straight running at the design speed, with
+        the law feeding back what the rider feels (roll, steer, their rates,
+        and the upper body's lean and its rate when it leans), its gains
+        LQR-optimal for that law (:func:`whipple_kick.control.output_feedback_lqr`).
     rider_body : {"rigid", "leaning"}
         The rider lumped rigidly into the rear frame (default), or an upper
         body (pelvis, trunk, head, upper arms) leaning on the saddle on the
@@ -292,6 +302,7 @@ class Scenario:
     carcass_damping: float = 0.0
     carcass_viscosity: float = carcass.SLIDING_VISCOSITY
     carcass_stiffness_scale: float = 1.0
+    lqr_model: str = "whipple"
     rider_body: str = "rigid"
     arms: str = "off"
     hip_stiffness: float = 128.0
@@ -450,6 +461,7 @@ class Scenario:
                                       ("start pitch", self.start_pitch, START_PITCHES),
                                       ("slip speed", self.slip_speed, SLIP_SPEEDS),
                                       ("rider body", self.rider_body, RIDER_BODIES),
+                                      ("LQR design model", self.lqr_model, LQR_MODELS),
                                       ("arms", self.arms, ARMS)):
             if value not in choices:
                 raise InputError(f"{label} {value!r} is unknown; choose one of {', '.join(choices)}")
@@ -597,7 +609,7 @@ FIELD_GROUPS = {
                 "pressure_rear_kpa", "coefficient_set", "friction", "symmetric_tyres", "speed", "controller",
                 "design_speed", "gain_scale", "thesis_load_n", "low_inertia", "kick_displacement", "kick_duration",
                 "kick_accel", "kick_profile", "kick_table", "kick_direction", "tyre_transient", "carcass_sliding",
-                "carcass_damping", "carcass_stiffness_scale", "rider_body", "arms", "hip_stiffness", "hip_damping",
+                "carcass_damping", "carcass_stiffness_scale", "lqr_model", "rider_body", "arms", "hip_stiffness", "hip_damping",
                 "arm_stiffness", "arm_damping", "reflex_delay", "reflex_roll", "reflex_roll_rate", "reflex_steer",
                 "reflex_steer_rate"),
     "run": ("settle", "duration", "output_rate", "fall_angle_deg", "steer_limit_deg"),

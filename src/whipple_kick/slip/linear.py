@@ -7,7 +7,19 @@ from whipple_kick import transient
 from whipple_kick.errors import InputError
 
 from .call import CompiledRHS
-from .layout import DYNAMIC_STATES, OUT, PATCH_STATES, SPEEDS, STATE_NAMES, TYRE_STATES, P, X, tyre_state_names
+from .layout import (
+    DYNAMIC_STATES,
+    HIP_STATES,
+    OUT,
+    PATCH_STATES,
+    REFLEX_STATES,
+    SPEEDS,
+    STATE_NAMES,
+    TYRE_STATES,
+    P,
+    X,
+    tyre_state_names,
+)
 
 # ---------------------------------------------------------------- linearisation
 
@@ -25,6 +37,17 @@ LINEAR_STATES = ("q4", "q7", "q9", "q10", "v_fwd", "v_lat", "u3", "u4", "u7", "u
 def linear_states(name=transient.DEFAULT_TRANSIENT):
     """:data:`LINEAR_STATES` with the tyre slots named for the transient form ``name``."""
     return LINEAR_STATES[:-len(PATCH_STATES)] + tyre_state_names(name)
+
+
+def body_states(p):
+    """The rider body's states a linearisation with parameter vector ``p`` includes, after :data:`LINEAR_STATES`.
+
+    The upper body's lean and its rate when the hip is free; the reflex filter's
+    states when the delay is not 0. (A locked hip's and a zero delay's states
+    drive nothing and stay put: they would only add zero eigenvalues.)
+    """
+    return ((HIP_STATES if p[P["hip_locked"]] == 0.0 else ())
+            + (REFLEX_STATES if p[P["reflex_delay"]] != 0.0 else ()))
 
 
 def solve_pitch(rhs, x, tol=1e-14, max_iter=30):
@@ -167,6 +190,9 @@ def heading_linearisation(rhs, x, t=0.0):
     :func:`linearize` to 1e-7 of each column's largest entry
     (``tests/test_stability.py``).
 
+    With a leaning rider or a delayed reflex, the states of :func:`body_states`
+    follow :data:`LINEAR_STATES` in ``A`` and ``B``.
+
     The steer-torque column is exact: the model is affine in the steer
     torque ``T7 = -(... + ku7 u7)`` and its coefficient depends on the
     coordinates only, so two evaluations that differ only in ``ku7`` give it.
@@ -201,9 +227,10 @@ def heading_linearisation(rhs, x, t=0.0):
     nd = len(DYNAMIC_STATES)
     J = rhs.jacobian_function(_difference_scales(rhs.transient))(t, x0)[:nd, :nd]
     h_q = rhs.impulse_terms(t, x0)[1][HOLONOMIC_ROW]
+    slots = np.concatenate([_HEADING_SLOTS, [X[n] for n in body_states(rhs.p)]]).astype(int)
     # A = S J E: the picked columns of J, plus the pitch column times dq5/dz.
-    A = J[np.ix_(_HEADING_SLOTS, _HEADING_SLOTS)]
-    pitch_column = J[_HEADING_SLOTS, X["q5"]]
+    A = J[np.ix_(slots, slots)]
+    pitch_column = J[slots, X["q5"]]
     for j, k in _PITCH_DRIVERS:
         A[:, j] -= pitch_column * (h_q[k] / h_q[SPEEDS.index("u5")])
     u1, u2, u3 = x0[X["u1"]], x0[X["u2"]], x0[X["u3"]]
@@ -222,7 +249,7 @@ def heading_linearisation(rhs, x, t=0.0):
         f_bumped = rhs(t, x0)
     finally:
         rhs.p[k] = saved
-    B = ((f_base - f_bumped)[_HEADING_SLOTS] / x0[X["u7"]]).reshape(-1, 1)
+    B = ((f_base - f_bumped)[slots] / x0[X["u7"]]).reshape(-1, 1)
     return A, B
 
 
