@@ -181,8 +181,7 @@ def write_csv(frame, path, *, significant_digits: int | None = None) -> None:
             return
         with open(tmp, "w", newline="") as fh:
             fh.write(frame.iloc[:0].to_csv(index=False, lineterminator="\n"))   # pandas' own header
-            # + 0.0 writes a negative zero as 0 (read back, "-0" loses its sign, and a re-save would differ).
-            fh.writelines(csv_text_rows(values + 0.0, significant_digits))
+            fh.writelines(csv_text_rows(values, significant_digits))
 
 
 def read_csv(path, what: str, *, name: str | None = None, **options):
