@@ -274,7 +274,9 @@ def lqr_on_simulated_model(scenario, moore, design, info, rear, front):
     # Continuation: the share of the arms' and reflex's gains grows while each design stabilises the next model.
     done, step = (1.0, 1.0) if _linear_design_model(scenario, moore, rear, front, body, felt, K, 1.0, scaled)[3] \
         else (0.0, 0.1)
-    A, b, C, _ = _linear_design_model(scenario, moore, rear, front, body, felt, K, done, scaled)
+    A, b, C, stable = _linear_design_model(scenario, moore, rear, front, body, felt, K, done, scaled)
+    if not stable:   # the body alone (forearms on the bar, a leaning trunk) already defeats the Whipple design
+        K = control.stabilising_gains(A, b, C, K)
     K, poles = control.output_feedback_lqr(A, b, C, K0=K)
     while done < 1.0:
         share = min(1.0, done + step)

@@ -274,3 +274,34 @@ def output_feedback_lqr(A, b, C, Q=None, R=1.0, K0=None, X0=None):
     best = minimize(cost, K, jac=True, method="BFGS", options={"gtol": 1e-8, "maxiter": 500})
     k = best.x if np.isfinite(best.fun) and best.fun <= cost(K)[0] else K
     return k, np.linalg.eigvals(A - b @ k[None, :] @ C)
+
+
+def stabilising_gains(A, b, C, K0, margin=0.05):
+    """Gains of ``u = -K C x`` near ``K0`` that make ``A - b K C`` stable (spectral abscissa below ``-margin``).
+
+    Minimises the closed loop's largest real part by Nelder-Mead from ``K0``
+    (and from ``K0`` scaled by 2, 0.5 and -1 if that fails): the start
+    :func:`output_feedback_lqr` needs when the model differs much from the
+    one ``K0`` was designed on.
+
+    Raises
+    ------
+    InputError
+        No such gains were found.
+    """
+    from scipy.optimize import minimize
+
+    A, b, C = (np.asarray(v, dtype=float) for v in (A, b, C))
+    K0 = np.asarray(K0, dtype=float).ravel()
+
+    def abscissa(k):
+        return float(np.max(np.linalg.eigvals(A - b @ k[None, :] @ C).real))
+
+    for start in (K0, 2.0 * K0, 0.5 * K0, -K0):
+        if abscissa(start) < -margin:
+            return start
+        found = minimize(lambda k: abscissa(k) + 1e-4 * float(k @ k) ** 0.5, start, method="Nelder-Mead",
+                         options={"xatol": 1e-6, "fatol": 1e-9, "maxiter": 4000, "adaptive": True})
+        if abscissa(found.x) < -margin:
+            return found.x
+    raise InputError("no gains of the rider's law were found that stabilise the model it is designed on")

@@ -1,0 +1,261 @@
+"""Identify the rider's body (issue 23) against the thesis' kick-plate experiments, and test it on held-out loads.
+
+Each candidate model (a combination of mechanisms: the arms on the bar, a
+leaning upper body, a delayed reflex, with the carcass tyre's stiffness and
+damping free in every one) is run on the measured cases of the FITTED loads
+(570 and 635 N, 300/400/500 kPa; thesis Tables 8.6-8.8), processed as the
+recordings were (:func:`whipple_kick.validation.recorded_metrics`), and
+scored against the printed metrics. The best parameters of each combination
+are then run, without refitting, on the HELD-OUT load (701 N, Table 8.8).
+
+The score of one case (smaller is better; each term is an error over the
+size that counts as a miss, squared):
+
+* dominant frequency (measured 5 Hz at 570 N, 6 Hz at 635 N; Section 8.5)
+  over 0.5 Hz;
+* period of peaks #1-#3 over 0.02 s; log decrement #1-#3 over 0.3;
+* number of peaks (6 measured at 570 and 635 N) over 1;
+* last-peak time (from peak #1) over 0.08 s (the issue's goal);
+* slow swing (yaw rate 0.5-1 s after the kick, as a share of peak #1)
+  above 0.08 (the 8 % rule) over 0.08;
+* a metric the model does not give (fewer than three peaks): 9; a fall: 100.
+
+The rider is the LQR designed on the model it rides (``lqr_model="simulated"``)
+at the run's speed. Parameter bounds (``BOUNDS``) and what they rest on are
+printed in docs/experiments.md; the search is a Latin-hypercube sample of
+each combination's box, then Nelder-Mead (in the box's unit coordinates) from
+the best sample. One kick direction (right; ``--directions`` for both).
+
+Usage::
+
+    python scripts/identify_rider.py run --out identify      # the search (about 20 min on 2 cores)
+    python scripts/identify_rider.py report identify         # the tables of docs/experiments.md from its files
+"""
+import argparse
+import json
+import math
+import multiprocessing
+import pathlib
+import sys
+import time
+
+import numpy as np
+
+import whipple_kick as wk
+from whipple_kick import experiments, validation
+
+FITTED_LOADS = (570.0, 635.0)
+HELD_OUT_LOADS = (701.0,)
+PRESSURES = (300.0, 400.0, 500.0)
+#: Run length [s]: the metrics use the first 1.2 s after the kick (the spectrum's 1 s record from 0.2 s).
+DURATION = 2.0
+
+#: Parameter -> (low, high, scale, what bounds it). "log" samples the logarithm.
+BOUNDS = {
+    "arm_stiffness": (1.0, 200.0, "log", "not constrained by a value at hand (no published arm steer stiffness "
+                                         "was retrieved; issue 23 notes)"),
+    "arm_damping": (0.1, 20.0, "log", "not constrained (as the stiffness)"),
+    "hip_stiffness": (50.0, 5000.0, "log", "Moore (2012) ch. 4: 128 N m/rad (estimated by de Lorenzo and "
+                                           "Hubbard); the top is the 2-5x seated-trunk range issue 23 quotes"),
+    "hip_damping": (5.0, 500.0, "log", "Moore (2012) ch. 4: 50 N m s/rad; a decade either side"),
+    "reflex_delay": (0.02, 0.06, "lin", "reflex delays 20-50 ms; 30 ms de Lange (2011) via Moore (2012) "
+                                        "ch. 6; first measured steer reaction 0.04-0.05 s (Section 8.5)"),
+    "reflex_steer": (0.0, 100.0, "lin", "not constrained (a reflexive arm stiffness)"),
+    "reflex_steer_rate": (0.0, 10.0, "lin", "not constrained (a reflexive arm damping)"),
+    "carcass_stiffness_scale": (0.5, 1.5, "lin", "the carcass stiffness C_Fa/sigma0 within +-50 %: the relaxation "
+                                                 "length and cornering stiffness are fitted, not measured, here"),
+    "carcass_damping": (0.0, 200.0, "lin", "0 (the thesis' pure relaxation) to 200 N s/m (issue 23's trial)"),
+}
+#: The combinations: fixed scenario fields and the parameters searched.
+COMBINATIONS = {
+    "rigid": ({}, ["carcass_stiffness_scale", "carcass_damping"]),
+    "arms": ({"arms": "on"}, ["arm_stiffness", "arm_damping", "carcass_stiffness_scale", "carcass_damping"]),
+    "trunk": ({"rider_body": "leaning"}, ["hip_stiffness", "hip_damping", "carcass_stiffness_scale",
+                                          "carcass_damping"]),
+    "arms+trunk": ({"arms": "on", "rider_body": "leaning"},
+                   ["arm_stiffness", "arm_damping", "hip_stiffness", "hip_damping", "carcass_stiffness_scale",
+                    "carcass_damping"]),
+    "arms+reflex": ({"arms": "on"}, ["arm_stiffness", "arm_damping", "reflex_delay", "reflex_steer",
+                                     "reflex_steer_rate", "carcass_stiffness_scale", "carcass_damping"]),
+    "arms+trunk+reflex": ({"arms": "on", "rider_body": "leaning"},
+                          ["arm_stiffness", "arm_damping", "hip_stiffness", "hip_damping", "reflex_delay",
+                           "reflex_steer", "reflex_steer_rate", "carcass_stiffness_scale", "carcass_damping"]),
+}
+#: Misses: metric -> the error that scores 1.
+MISS = {"dominant_frequency_hz": 0.5, "period_s": 0.02, "log_dec_13": 0.3, "n_peaks": 1.0, "last_peak_time_s": 0.08}
+SLOW_SWING_LIMIT = 0.08
+UNAVAILABLE, FELL = 9.0, 100.0
+
+
+def _value(unit, name):
+    low, high, scale, _ = BOUNDS[name]
+    unit = min(1.0, max(0.0, unit))
+    if scale == "log":
+        return float(math.exp(math.log(low) + unit * (math.log(high) - math.log(low))))
+    return float(low + unit * (high - low))
+
+
+def values_of(units, names):
+    """Parameter values by name from unit-box coordinates."""
+    return {n: _value(u, n) for u, n in zip(units, names, strict=True)}
+
+
+def measured(exp, fz, pressure):
+    """The printed metrics of one case."""
+    case = exp.cases[experiments.case_name(fz, pressure)]
+    v = case.values
+    return {"dominant_frequency_hz": exp.spectrum_peak_hz[fz], "period_s": v["period"],
+            "log_dec_13": v["log_dec_13"], "n_peaks": case.last_peak_number, "last_peak_time_s": v["last_peak_time"]}
+
+
+def run_case(job):
+    """Model metrics and score of one case: job = (fields, fz, pressure, direction)."""
+    fields, fz, pressure, direction = job
+    exp = experiments.load()
+    try:
+        sc = validation.base_scenario(fz_n=fz, pressure_kpa=pressure, kick_direction=direction,
+                                      duration=DURATION, **{"lqr_model": "simulated", **fields})
+        result = wk.run(sc)
+    except (wk.errors.InputError, FloatingPointError, RuntimeError) as exc:
+        return {"score": FELL, "status": f"error: {str(exc)[:120]}"}
+    if result.summary["fell"]:
+        return {"score": FELL, "status": "fell"}
+    tr = result.trajectory
+    steady = float(result.summary["steady_state"]["yaw_rate_rad_s"])
+    m = validation.recorded_metrics(tr["time"].to_numpy(), tr["yaw_rate"].to_numpy(), steady,
+                                    processing=exp.processing, window_start=exp.conditions[validation.DOMINANT_WINDOW_KEY])
+    target = measured(exp, fz, pressure)
+    score = 0.0
+    for key, miss in MISS.items():
+        score += UNAVAILABLE if m[key] is None else ((m[key] - target[key]) / miss) ** 2
+    swing = m["slow_swing_ratio"]
+    score += UNAVAILABLE if swing is None else (max(0.0, swing - SLOW_SWING_LIMIT) / SLOW_SWING_LIMIT) ** 2
+    out = {k: m[k] for k in (*MISS, "slow_swing_ratio")}
+    out.update(score=score, status="ok")
+    return out
+
+
+def evaluate(pool, fields, loads, directions):
+    """Mean score and the per-case rows of ``fields`` over the cases of ``loads``."""
+    jobs = [(fields, fz, p, d) for fz in loads for p in PRESSURES for d in directions]
+    rows = pool.map(run_case, jobs)
+    for (_, fz, p, d), row in zip(jobs, rows, strict=True):
+        row.update(fz_n=fz, pressure_kpa=p, direction=d)
+    return float(np.mean([r["score"] for r in rows])), rows
+
+
+def search(pool, name, samples, iterations, directions, log):
+    """Latin-hypercube sample of a combination's box, then Nelder-Mead from the best sample."""
+    from scipy.optimize import minimize
+    from scipy.stats import qmc
+
+    fixed, names = COMBINATIONS[name]
+    history = []
+
+    def cost(units):
+        fields = {**fixed, **values_of(units, names)}
+        score, rows = evaluate(pool, fields, FITTED_LOADS, directions)
+        history.append({"combination": name, "score": score, **values_of(units, names)})
+        log(f"{name:18s} {score:9.3f}  " + " ".join(f"{k}={v:.4g}" for k, v in values_of(units, names).items()))
+        return score
+
+    points = qmc.LatinHypercube(d=len(names), seed=23).random(samples)
+    scores = [cost(p) for p in points]
+    start = points[int(np.argmin(scores))]
+    best = minimize(cost, start, method="Nelder-Mead",
+                    options={"maxfev": iterations, "xatol": 1e-3, "fatol": 1e-3, "initial_simplex":
+                             np.vstack([start] + [np.clip(start + 0.15 * e, 0, 1) for e in np.eye(len(names))])})
+    units = best.x if best.fun <= min(scores) else start
+    return {**fixed, **values_of(units, names)}, history
+
+
+def main_run(args):
+    out = pathlib.Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    directions = tuple(args.directions)
+    log_file = open(out / "log.txt", "w")
+
+    def log(line):
+        print(line, flush=True)
+        log_file.write(line + "\n")
+        log_file.flush()
+
+    started = time.perf_counter()
+    results, history = {}, []
+    with multiprocessing.get_context("fork").Pool(args.workers) as pool:
+        today = {"lqr_model": "whipple"}   # today's validate: the rigid rider, the LQR designed on the Whipple model
+        base_score, base_rows = evaluate(pool, today, FITTED_LOADS, directions)
+        log(f"baseline (rigid rider, carcass defaults): {base_score:.3f}")
+        for name in args.combinations:
+            fields, hist = search(pool, name, args.samples, args.iterations, directions, log)
+            history += hist
+            fit_score, fit_rows = evaluate(pool, fields, FITTED_LOADS, directions)
+            held_score, held_rows = evaluate(pool, fields, HELD_OUT_LOADS, directions)
+            results[name] = {"fields": fields, "fitted_score": fit_score, "held_out_score": held_score,
+                             "fitted": fit_rows, "held_out": held_rows}
+            log(f"== {name}: fitted {fit_score:.3f}, held out {held_score:.3f}: {fields}")
+        default_held = evaluate(pool, today, HELD_OUT_LOADS, directions)
+    payload = {"directions": list(directions), "duration_s": DURATION, "samples": args.samples,
+               "iterations": args.iterations, "miss": MISS, "slow_swing_limit": SLOW_SWING_LIMIT,
+               "bounds": {k: list(v) for k, v in BOUNDS.items()},
+               "baseline": {"fitted_score": base_score, "fitted": base_rows, "held_out_score": default_held[0],
+                            "held_out": default_held[1]},
+               "results": results, "wall_s": time.perf_counter() - started}
+    (out / "identification.json").write_text(json.dumps(payload, indent=1, default=float))
+    import pandas as pd
+    pd.DataFrame(history).to_csv(out / "history.csv", index=False)
+    log(f"wall {payload['wall_s']:.0f} s")
+    main_report(argparse.Namespace(folder=str(out)))
+
+
+def _fmt(v, digits=3):
+    if v is None or (isinstance(v, float) and not math.isfinite(v)):
+        return "-"
+    if isinstance(v, float):
+        return f"{v:.{digits}g}"
+    return str(v)
+
+
+def main_report(args):
+    payload = json.loads((pathlib.Path(args.folder) / "identification.json").read_text())
+    exp = experiments.load()
+    print("| combination | fitted score (570, 635 N) | held-out score (701 N) | parameters |")
+    print("|---|---|---|---|")
+    base = payload["baseline"]
+    print(f"| today's rigid rider, Whipple LQR (no search) | {base['fitted_score']:.2f} | "
+          f"{base['held_out_score']:.2f} | - |")
+    for name, r in payload["results"].items():
+        params = ", ".join(f"{k} {_fmt(v)}" for k, v in r["fields"].items() if k not in ("arms", "rider_body"))
+        print(f"| {name} | {r['fitted_score']:.2f} | {r['held_out_score']:.2f} | {params} |")
+    best = min(payload["results"], key=lambda n: payload["results"][n]["fitted_score"])
+    print(f"\nBest on the fitted loads: {best}. Per case, model against measured (m / meas):\n")
+    keys = ("dominant_frequency_hz", "period_s", "log_dec_13", "n_peaks", "last_peak_time_s")
+    print("| case | set | " + " | ".join(keys) + " | slow swing | status |")
+    print("|---|---|" + "---|" * (len(keys) + 2))
+    r = payload["results"][best]
+    for label, rows in (("fitted", r["fitted"]), ("held out", r["held_out"])):
+        for row in rows:
+            target = measured(exp, row["fz_n"], row["pressure_kpa"])
+            cells = [f"{_fmt(row.get(k))} / {_fmt(target[k])}" for k in keys]
+            print(f"| {row['fz_n']:g} N {row['pressure_kpa']:g} kPa {row['direction']} | {label} | "
+                  + " | ".join(cells) + f" | {_fmt(row.get('slow_swing_ratio'))} | {row['status']} |")
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    sub = p.add_subparsers(dest="command", required=True)
+    r = sub.add_parser("run", help="the search and the held-out test")
+    r.add_argument("--out", default="identify")
+    r.add_argument("--combinations", nargs="+", default=list(COMBINATIONS), choices=list(COMBINATIONS))
+    r.add_argument("--samples", type=int, default=24, help="Latin-hypercube samples per combination")
+    r.add_argument("--iterations", type=int, default=40, help="Nelder-Mead evaluations per combination")
+    r.add_argument("--directions", nargs="+", default=["right"], choices=list(validation.DIRECTIONS))
+    r.add_argument("--workers", type=int, default=2)
+    q = sub.add_parser("report", help="print the tables of a finished run")
+    q.add_argument("folder")
+    args = p.parse_args(argv)
+    (main_run if args.command == "run" else main_report)(args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
