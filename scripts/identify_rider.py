@@ -165,8 +165,26 @@ def search(pool, name, samples, iterations, directions, log):
     best = minimize(cost, start, method="Nelder-Mead",
                     options={"maxfev": iterations, "xatol": 1e-3, "fatol": 1e-3, "initial_simplex":
                              np.vstack([start] + [np.clip(start + 0.15 * e, 0, 1) for e in np.eye(len(names))])})
-    units = best.x if best.fun <= min(scores) else start
-    return {**fixed, **values_of(units, names)}, history
+    units = np.clip(best.x if best.fun <= min(scores) else start, 0.0, 1.0)
+    return {**fixed, **values_of(units, names)}, history, units
+
+
+def sensitivity(pool, name, units, directions):
+    """How much each parameter matters at the optimum: the score with its unit coordinate moved by -+0.1.
+
+    A parameter whose moves change the score by little is not pinned down by the data.
+    """
+    fixed, names = COMBINATIONS[name]
+    out = {}
+    for i, n in enumerate(names):
+        scores = []
+        for step in (-0.1, 0.1):
+            moved = units.copy()
+            moved[i] = min(1.0, max(0.0, moved[i] + step))
+            scores.append(evaluate(pool, {**fixed, **values_of(moved, names)}, FITTED_LOADS, directions)[0])
+        out[n] = {"minus": scores[0], "plus": scores[1],
+                  "values": [values_of([max(0.0, units[i] - 0.1)], [n])[n], values_of([min(1.0, units[i] + 0.1)], [n])[n]]}
+    return out
 
 
 def main_run(args):
@@ -187,12 +205,13 @@ def main_run(args):
         base_score, base_rows = evaluate(pool, today, FITTED_LOADS, directions)
         log(f"baseline (rigid rider, carcass defaults): {base_score:.3f}")
         for name in args.combinations:
-            fields, hist = search(pool, name, args.samples, args.iterations, directions, log)
+            fields, hist, units = search(pool, name, args.samples, args.iterations, directions, log)
             history += hist
             fit_score, fit_rows = evaluate(pool, fields, FITTED_LOADS, directions)
             held_score, held_rows = evaluate(pool, fields, HELD_OUT_LOADS, directions)
             results[name] = {"fields": fields, "fitted_score": fit_score, "held_out_score": held_score,
-                             "fitted": fit_rows, "held_out": held_rows}
+                             "fitted": fit_rows, "held_out": held_rows, "evaluations": len(hist),
+                             "sensitivity": sensitivity(pool, name, units, directions)}
             log(f"== {name}: fitted {fit_score:.3f}, held out {held_score:.3f}: {fields}")
         default_held = evaluate(pool, today, HELD_OUT_LOADS, directions)
     payload = {"directions": list(directions), "duration_s": DURATION, "samples": args.samples,
@@ -227,6 +246,14 @@ def main_report(args):
     for name, r in payload["results"].items():
         params = ", ".join(f"{k} {_fmt(v)}" for k, v in r["fields"].items() if k not in ("arms", "rider_body"))
         print(f"| {name} | {r['fitted_score']:.2f} | {r['held_out_score']:.2f} | {params} |")
+    print("\nWhat the data pin down: the fitted score at the optimum and with each parameter moved by a tenth of "
+          "its range (a score that barely moves: not pinned down).\n")
+    print("| combination | parameter | optimum | score - / + (values) |")
+    print("|---|---|---|---|")
+    for name, r in payload["results"].items():
+        for n, sens in r.get("sensitivity", {}).items():
+            print(f"| {name} | {n} | {_fmt(r['fields'][n])} | {sens['minus']:.2f} ({_fmt(sens['values'][0])}) / "
+                  f"{sens['plus']:.2f} ({_fmt(sens['values'][1])}) vs {r['fitted_score']:.2f} |")
     best = min(payload["results"], key=lambda n: payload["results"][n]["fitted_score"])
     print(f"\nBest on the fitted loads: {best}. Per case, model against measured (m / meas):\n")
     keys = ("dominant_frequency_hz", "period_s", "log_dec_13", "n_peaks", "last_peak_time_s")

@@ -18,3 +18,21 @@ def test_thesis_figures_says_when_a_run_did_not_recover():
     assert line == "fell at 1.250 s (roll); recovery (yaw, roll, steer rates within 5 %) not recovered within the run"
     assert "None" not in thesis_figures.run_line(_summary(None))
     assert thesis_figures.run_line(_summary(2.5)).endswith("within 5 %) 2.500 s")
+
+
+def test_identification_scores_a_case_as_the_docs_say():
+    """scripts/identify_rider.py: a case's score is the sum of its squared misses (MISS), the slow swing's
+    excess over 8 %, 9 for a metric the model does not give and 100 for a fall; a perfect case scores 0."""
+    import identify_rider as ir
+
+    exp = ir.experiments.load()
+    target = ir.measured(exp, 635.0, 400.0)
+    assert target == {"dominant_frequency_hz": 6.0, "period_s": 0.19, "log_dec_13": 0.72, "n_peaks": 6,
+                      "last_peak_time_s": 0.36}
+    # Bounds map the unit box onto each parameter's range (log ranges geometrically).
+    values = ir.values_of([0.0, 1.0, 0.5], ["arm_stiffness", "reflex_delay", "hip_stiffness"])
+    assert values["arm_stiffness"] == 1.0 and abs(values["reflex_delay"] - 0.06) < 1e-15
+    assert abs(values["hip_stiffness"] - (50.0 * 5000.0) ** 0.5) < 1e-9
+    # Every searched parameter has bounds, and every combination names its own.
+    for fixed, names in ir.COMBINATIONS.values():
+        assert set(names) <= set(ir.BOUNDS)
