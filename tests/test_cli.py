@@ -248,6 +248,21 @@ BAD_INPUTS = {
     "scenario-and-compat": (["--scenario", "nope.toml", "--compat", "authors-code"],
                             ["--scenario FILE", "--compat"]),
     "malformed-output-rate": (["--output-rate", "fast"], ["--output-rate", "'fast'", "Hz"]),
+    # The rider's body (issue 23): each names the value, the allowed range and the unit.
+    "reflex-delay-too-long": (["--reflex-delay", "2"], ["reflex delay = 2.0 s", "[0, 0.5] s"]),
+    "negative-hip-stiffness": (["--hip-stiffness", "-1"], ["hip stiffness = -1.0 N m/rad", "[0, 1e+06] N m/rad"]),
+    "negative-arm-damping": (["--arm-damping", "-2"], ["arm damping = -2.0 N m s/rad", "N m s/rad"]),
+    "malformed-arm-stiffness": (["--arm-stiffness", "stiff"], ["--arm-stiffness", "'stiff'", "N m/rad"]),
+    "reflex-gain-too-large": (["--reflex-roll", "1e5"], ["reflex roll gain", "N m/rad"]),
+    "carcass-stiffness-scale-too-large": (["--carcass-stiffness-scale", "100"],
+                                          ["carcass stiffness scale = 100.0", "[0.05, 20]"]),
+    "unknown-rider-body": (["--rider-body", "floppy"], ["--rider-body", "'floppy'", "rigid", "leaning"]),
+    "unknown-arms": (["--arms", "both"], ["--arms", "'both'", "off", "on"]),
+    "unknown-lqr-model": (["--lqr-model", "lin"], ["--lqr-model", "'lin'", "whipple", "simulated"]),
+    "leaning-without-hip-spring": (["--rider-body", "leaning", "--hip-stiffness", "0"],
+                                   ["hip stiffness = 0 N m/rad", "(0, 1e6] N m/rad"]),
+    "leaning-on-a-preset-with-rider": (["--rider-body", "leaning", "--bicycle", "balanceassist_635N"],
+                                       ["balanceassist_635N", "lumped in already", "balanceassist_v1"]),
 }
 
 
@@ -571,3 +586,38 @@ def test_gitignore_covers_the_folders_the_commands_write():
     done = subprocess.run(["git", "-C", str(root), "check-ignore", "--no-index", *(f"{n}/x.csv" for n in names)],
                           capture_output=True, text=True, check=False)
     assert done.stdout.split() == [f"{n}/x.csv" for n in names], (names, done.stderr)
+
+
+def test_rider_body_flags_reach_the_run_and_a_scenario_file(tmp_path, capsys):
+    """``--rider-body leaning --lqr-model simulated``: the leaning upper body is simulated (its lean is in
+    trajectory.csv, the LQR rider feeds it back) and the summary is printed; a rerun of its scenario.toml
+    with body flags given keeps the file's other body fields and changes those given."""
+    out = tmp_path / "lean"
+    status, stdout, err = _simulate(["--rider-body", "leaning", "--lqr-model", "simulated", "--hip-damping", "40",
+                                     "--duration", "1", "--no-plot", "--out", str(out)], capsys)
+    assert status == 0, err
+    assert "no fall in 1 s" in stdout and "summary.json" in stdout
+    s = json.loads((out / "summary.json").read_text())
+    sc = s["scenario"]
+    assert (sc["rider_body"], sc["lqr_model"], sc["hip_damping"], sc["arms"]) == ("leaning", "simulated", 40.0, "off")
+    assert s["controller"]["gains"]["kq11"] != 0.0 and "model simulated" in s["controller"]["rider"]
+    header = [c.split(" [")[0] for c in (out / "trajectory.csv").read_text().splitlines()[0].split(",")]
+    lean = header.index("upper_body_lean")
+    rows = np.loadtxt(out / "trajectory.csv", delimiter=",", skiprows=1)
+    assert np.abs(rows[:, lean]).max() > 1e-3   # the upper body really leans (steady lean and the kick)
+    again = tmp_path / "again"
+    status, _, err = _simulate(["--scenario", str(out / "scenario.toml"), "--reflex-delay", "0.05",
+                                "--duration", "0.2", "--no-plot", "--quiet", "--out", str(again)], capsys)
+    assert status == 0, err
+    sc = wk.Result.load(again).summary["scenario"]
+    assert (sc["rider_body"], sc["lqr_model"], sc["hip_damping"], sc["reflex_delay"], sc["duration"]) == (
+        "leaning", "simulated", 40.0, 0.05, 0.2)
+
+
+def test_stability_does_not_offer_the_rider_body_flags(capsys):
+    """``stability``'s linear model has the rigid rider and the Whipple design only (its parameters take no
+    body): it refuses the body flags rather than dropping the upper body's mass silently."""
+    from whipple_kick.cli import stability_main
+    status, stdout, err = run_console(stability_main, ["--rider-body", "leaning"], capsys)
+    assert status == 2 and stdout == "" and err.count("\n") == 1
+    assert "unrecognized arguments: --rider-body leaning" in err

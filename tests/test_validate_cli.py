@@ -59,7 +59,8 @@ def test_validate_help_lists_the_scenario_flags():
     proc = subprocess.run([exe, "--help"], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0
     for flag in ("--tyre-transient", "--controller", "--gain-scale", "--kick-accel", "--kick-profile", "--directions",
-                 "--time-origin", "--compare-transients", "--out", "--speed", "Tables 8.6-8.9"):
+                 "--time-origin", "--compare-transients", "--out", "--speed", "Tables 8.6-8.9", "--rider-body",
+                 "--reflex-delay", "--lqr-model", "--carcass-stiffness-scale"):
         assert flag in proc.stdout
     assert "--pressure " not in proc.stdout and "--fz " not in proc.stdout   # set by validate itself
 

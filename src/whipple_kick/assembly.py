@@ -165,8 +165,7 @@ def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia
 
     bike = bicycles.load(bicycle)
     if split and bike.includes_rider:
-        raise InputError(f"bicycle {bike.name!r} has its rider lumped in already: a leaning rider or arms on the "
-                         "bar need a bicycle-only set with a Yeadon rider (e.g. 'balanceassist_v1')")
+        raise _lumped_rider_error(bike)
     if bike.includes_rider:
         if fz_n is not None or rider_mass_kg is not None:
             raise InputError(f"bicycle {bike.name!r} already includes its rider; "
@@ -179,12 +178,14 @@ def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia
         fz = 635.0 if fz_n is None else fz_n
         combined, rider_mass = riders.for_rear_load(bike, fz, rider=rider_name,
                                                     load_range=_rear_load_range(bicycle, _stamp, rider_name))
+    # The static loads of the whole rider: the split below moves the upper body out of the bicycle's
+    # parameters (static_loads would miss its weight), not out of the statics (the same mass and mass centre).
+    rear_n, front_n = riders.static_loads(combined)
     body = None
     if split:
         # The same rider, split into legs (rear frame), forearms (front frame, when on the bar) and upper body.
         rider = riders.yeadon_rider(rider_name, mass_kg=rider_mass)
         combined, body = riders.seat_with_body(bike, rider, arms_on_bar=arms_on_bar)
-    rear_n, front_n = riders.static_loads(combined)
     design = dict(combined.moore)
     moore = dict(design)
     if low_inertia:
@@ -197,6 +198,11 @@ def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia
             "total_mass_kg": sum(float(combined.benchmark[k]) for k in ("mR", "mB", "mH", "mF"))
             + (body["mt"] if body else 0.0), "body": body}
     return moore, design, info
+
+
+def _lumped_rider_error(bike):
+    return InputError(f"bicycle {bike.name!r} has its rider lumped in already: a leaning rider or arms on the "
+                      "bar need a bicycle-only set with a Yeadon rider (e.g. 'balanceassist_v1')")
 
 
 @functools.lru_cache(maxsize=64)
@@ -400,7 +406,7 @@ def preflight(scenario):
     """Cheap checks of everything a user can get wrong, before any long work.
 
     Field ranges, tyre name and pressure range, bicycle name and rider
-    conflicts, the Table 8.4 row of ``controller="thesis"``. Raises
+    conflicts (a preset with its rider lumped in cannot lean or hold the bar), the Table 8.4 row of ``controller="thesis"``. Raises
     :class:`InputError`; returns ``scenario``.
     """
     from . import bicycles, control
@@ -411,6 +417,8 @@ def preflight(scenario):
     if bike.includes_rider and (scenario.fz_n is not None or scenario.rider_mass_kg is not None):
         raise InputError(f"bicycle {bike.name!r} already includes its rider; "
                          "do not give a rear-tyre load fz or a rider mass with it")
+    if bike.includes_rider and (scenario.rider_body != "rigid" or scenario.arms == "on"):
+        raise _lumped_rider_error(bike)
     if scenario.controller == "thesis":
         control.thesis_gains(thesis_load(scenario))
     return scenario

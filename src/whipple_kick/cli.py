@@ -121,19 +121,27 @@ def _number(unit):
     return parse
 
 
-def _model_options(p, symmetric_flag=True, design_default="the run's --speed", case_options=True):
+def _model_options(p, symmetric_flag=True, design_default="the run's --speed", case_options=True,
+                   body_options=True):
     """Add the tyre, bicycle-and-rider and controller options of ``simulate`` (shared with ``stability``, ``validate``).
 
     ``symmetric_flag`` adds ``--symmetric-tyres``; ``design_default`` says
     what the LQR design speed is by default; ``case_options`` adds the
     pressures, the rear load or rider mass and ``--thesis-load`` (not for a
-    command that sets them per case). Returns the "riding and control"
-    group, for the caller's speed option.
+    command that sets them per case); ``body_options`` the rider's body,
+    arms and reflex, ``--carcass-stiffness-scale`` and ``--lqr-model`` (not
+    for ``stability``, whose linear model has the rigid rider and the Whipple
+    design only). Returns the "riding and control" group, for the caller's
+    speed option.
     """
     from . import tyres
     from .carcass import SLIDING_LAWS
-    from .scenario import CAMBER_SIGNS, CONTROLLERS, SLIP_SPEEDS, TYRE_TRANSIENTS
+    from .scenario import CAMBER_SIGNS, CONTROLLERS, LQR_MODELS, SLIP_SPEEDS, TYRE_TRANSIENTS, Scenario
     from .transient import DEFAULT_TRANSIENT
+
+    def default(field):
+        return Scenario.__dataclass_fields__[field].default
+
     g = p.add_argument_group("tyres")
     if case_options:
         g.add_argument("--pressure", type=_number("kPa"), metavar="KPA",
@@ -163,6 +171,11 @@ def _model_options(p, symmetric_flag=True, design_default="the run's --speed", c
                         "(it follows the steady curve at the kinematic slip: the fit's falling branch)")
     g.add_argument("--carcass-damping", type=_number("N s/m"), default=0.0, metavar="N_S_PER_M",
                    help="lateral damping of each carcass, parallel to its stiffness (default 0: pure relaxation)")
+    if body_options:
+        g.add_argument("--carcass-stiffness-scale", type=_number("factor"),
+                       default=default("carcass_stiffness_scale"), metavar="FACTOR",
+                       help="factor on both carcass stiffnesses C_Fa/sigma0, in [0.05, 20] "
+                            f"(default {default('carcass_stiffness_scale'):g})")
     g.add_argument("--camber-sign", choices=CAMBER_SIGNS, default="physical",
                    help="physical (default: a leaning wheel is pushed toward the lean) or reversed (away from it, "
                         "as the thesis authors' published code; not physical)")
@@ -180,10 +193,17 @@ def _model_options(p, symmetric_flag=True, design_default="the run's --speed", c
         who.add_argument("--rider-mass", type=_number("kg"), metavar="KG", help="rider mass in kg")
     g.add_argument("--low-inertia", action="store_true",
                    help="halve the rear frame's inertias and mass-centre height (thesis Figure 8.9)")
+    if body_options:
+        _body_options(p, default)
     g = p.add_argument_group("riding and control")
     g.add_argument("--controller", choices=CONTROLLERS, default="lqr",
                    help="lqr: designed on the linearised classic model (default); thesis: Table 8.4 "
                         "gains (570, 635, 701 N only); off: no steer torque")
+    if body_options:
+        g.add_argument("--lqr-model", choices=LQR_MODELS, default=default("lqr_model"),
+                       help="what the LQR rider is designed on: whipple (default: the classic model, full state) or "
+                            "simulated (the model the run simulates, feeding back roll, steer, their rates and the "
+                            "upper body's lean)")
     g.add_argument("--design-speed", type=_number("m/s"), metavar="M/S",
                    help=f"LQR design speed in m/s (default: {design_default}, as a real rider adapts; "
                         "the thesis fixed it at 3)")
@@ -194,6 +214,36 @@ def _model_options(p, symmetric_flag=True, design_default="the run's --speed", c
     g.add_argument("--gain-scale", type=_number("factor"), default=1.0, metavar="FACTOR",
                    help="multiply every controller gain (default 1; the thesis also ran 0.5)")
     return g
+
+
+def _body_options(p, default):
+    """The "rider's body" option group (:func:`_model_options`); ``default(field)`` is the Scenario's default."""
+    from .scenario import ARMS, RIDER_BODIES
+    g = p.add_argument_group("rider's body", "the Yeadon rider split into legs, forearms and a leaning upper body "
+                                             "(a bicycle-only set such as balanceassist_v1), arms and reflex")
+    g.add_argument("--rider-body", choices=RIDER_BODIES, default=default("rider_body"),
+                   help="rigid (default: the rider lumped into the rear frame) or leaning (the upper body leans on "
+                        "the saddle on the hip spring-damper)")
+    g.add_argument("--arms", choices=ARMS, default=default("arms"),
+                   help="on: the forearms turn with the bar and the arms are a spring-damper about the steer axis; "
+                        "off (default): no mechanical effect on the bar")
+    for flag, field, unit, meta, what in (
+            ("--hip-stiffness", "hip_stiffness", "N m/rad", "N_M_PER_RAD", "hip spring of the leaning upper body"),
+            ("--hip-damping", "hip_damping", "N m s/rad", "N_M_S_PER_RAD", "hip damper of the leaning upper body"),
+            ("--arm-stiffness", "arm_stiffness", "N m/rad", "N_M_PER_RAD", "arms' spring about the steer axis "
+                                                                            "(with --arms on)"),
+            ("--arm-damping", "arm_damping", "N m s/rad", "N_M_S_PER_RAD", "arms' damper about the steer axis "
+                                                                            "(with --arms on)"),
+            ("--reflex-delay", "reflex_delay", "s", "S",
+             "delay of the rider's reflex steer torque (a Pade filter; at most 0.5 s)"),
+            ("--reflex-roll", "reflex_roll", "N m/rad", "N_M_PER_RAD", "reflex steer-torque gain on roll"),
+            ("--reflex-roll-rate", "reflex_roll_rate", "N m s/rad", "N_M_S_PER_RAD",
+             "reflex steer-torque gain on roll rate"),
+            ("--reflex-steer", "reflex_steer", "N m/rad", "N_M_PER_RAD", "reflex steer-torque gain on steer"),
+            ("--reflex-steer-rate", "reflex_steer_rate", "N m s/rad", "N_M_S_PER_RAD",
+             "reflex steer-torque gain on steer rate")):
+        g.add_argument(flag, type=_number(unit), default=default(field), metavar=meta,
+                       help=f"{what} in {unit} (default {default(field):g})")
 
 
 def _simulate_parser():
@@ -326,6 +376,13 @@ def _flags_given(argv):
     return set(vars(parser.parse_args(argv)))
 
 
+#: Scenario fields of the rider's-body options (and the LQR design model, the carcass stiffness scale), each
+#: set by the flag of its own name.
+_BODY_FIELDS = ("rider_body", "arms", "hip_stiffness", "hip_damping", "arm_stiffness", "arm_damping", "reflex_delay",
+                "reflex_roll", "reflex_roll_rate", "reflex_steer", "reflex_steer_rate", "carcass_stiffness_scale",
+                "lqr_model")
+
+
 def _model_fields(args):
     """Scenario fields of the options added by :func:`_model_options` (without the case options if it had none)."""
     fields = dict(
@@ -335,6 +392,8 @@ def _model_fields(args):
         slip_speed=args.slip_speed,
         carcass_sliding=args.carcass_sliding, carcass_damping=args.carcass_damping,
     )
+    if hasattr(args, "rider_body"):
+        fields.update({field: getattr(args, field) for field in _BODY_FIELDS})
     if not hasattr(args, "pressure"):
         return fields
     fronts = (args.pressure_front, args.pressure_rear)
@@ -851,7 +910,7 @@ def _stability_parser():
                "removed (straight running; --tyre-offsets measured linearises about the steady turns the "
                "offsets cause), LQR rider designed at each speed. Speed is constant in the linear model "
                "(the forward-speed mode is left out, as in the no-slip model). See docs/stability.md.")
-    g = _model_options(p, symmetric_flag=False, design_default="each speed of the sweep")
+    g = _model_options(p, symmetric_flag=False, design_default="each speed of the sweep", body_options=False)
     g.add_argument("--speeds", default=f"{start:g}:{stop:g}:{step:g}", metavar="START:STOP:STEP",
                    help=f"forward speeds in m/s: START:STOP:STEP (STOP included) or V1,V2,... "
                         f"(default {start:g}:{stop:g}:{step:g})")

@@ -622,6 +622,7 @@ def _steady_section(scenario, assembly, baseline, start_outputs):
         "yaw_rate_baseline_rad_s": baseline,
         "lateral_drift_m_s": float(x0[slip.X["u2"]]),
         "compression_rear_m": float(x0[slip.X["q9"]]), "compression_front_m": float(x0[slip.X["q10"]]),
+        "upper_body_lean_rad": float(x0[slip.X["q11"]]),   # the leaning rider's steady lean at the hip (0 rigid)
         # An upright start's front contact below the ground (+; start_pitch "uncompressed": the authors' code).
         "front_contact_below_ground_m": start.unknowns.get("front_contact_offset_m"),
         **_rear_wheel_torque(start, start_outputs),
