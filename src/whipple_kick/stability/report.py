@@ -12,7 +12,8 @@ from ._constants import LOOPS, MODES, TURN_NOTE_DEG
 #: Colour of each mode in stability.png.
 MODE_COLOURS = {"weave": "tab:blue", "capsize": "tab:red", "caster": "tab:green", "wobble": "tab:purple",
                 "lateral_rear": "tab:orange", "lateral_front": "tab:brown", "relaxation_rear": "tab:olive",
-                "relaxation_front": "tab:cyan", "vertical": "tab:gray"}
+                "relaxation_front": "tab:cyan", "vertical": "tab:gray", "arm_steer": "tab:pink",
+                "lean": "gold", "reflex_delay": "black"}
 #: Real-part range [1/s] of the left ("slow modes") panels, as Meijaard et al. (2007) Fig. 3.
 SLOW_RANGE = (-10.0, 10.0)
 
