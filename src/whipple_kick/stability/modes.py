@@ -94,10 +94,13 @@ def mode_content(model, eigenvalue, vector, wheelbase):
     power = np.abs(scaled) ** 2
     shares = [power[0], power[1], power[2] + power[3], power[4] + power[5], power[6] + power[8], power[7] + power[9]]
     if len(groups) > 1:
-        shares += [power[10], power[11:].sum(axis=0)]
+        shares += [power[10]]
     shares = np.array(shares).T
     total = shares.sum(axis=1, keepdims=True)
     shares = shares / np.where(total > 0, total, 1.0)
+    if len(groups) > 1:   # the reflex column: the filter's own share (:func:`filter_share`), not an amplitude
+        tau = model.steady.params.get("reflex_delay", 0.0)
+        shares = np.column_stack([shares, filter_share(lam, tau) if tau > 0 else np.zeros(lam.size)])
     return (shares[0], scaled[:, 0]) if single else (shares, scaled)
 
 
@@ -135,6 +138,30 @@ def _body_content(model, lam, vec, idx):
                          + np.abs(lam) * (abs(p.get("ru4", 0.0)) + abs(p.get("ru7", 0.0))), 1.0)
     reflex = [vec[idx[r]] / per_rad if r in idx else np.zeros(n) for r in slip.REFLEX_STATES]
     return np.array([lean, *reflex])
+
+
+def filter_share(lam, tau):
+    """How far the reflex's Pade filter departs from the delay at ``lam``: ``1 - |exp(-lam tau)| / |H(lam)|`` (>= 0).
+
+    In any eigenvector the filter's states are its driven response, ``z =
+    (lam tau I - A)^-1 B r``: what tells a filter pole from a motion of the
+    bicycle the filter delays is the eigenvalue itself. Where the filter
+    transfer ``H`` is the delay it approximates (a motion slow against
+    ``1/tau``), this is about 0; near the filter's own poles ``|H|`` grows
+    without bound and it tends to 1 (0.5 where the filter amplifies twice
+    as much as the delay would).
+
+    Example
+    -------
+    >>> round(float(filter_share(np.array([-0.5 + 3j]), 0.1)[0]), 3)
+    0.0
+    """
+    from whipple_kick import reflex
+    num, den = reflex.pade_coefficients(reflex.NUMERATOR_DEGREE, reflex.ORDER)
+    x = np.atleast_1d(np.asarray(lam, dtype=complex)) * tau
+    H = np.abs(np.polyval(num[::-1], x) / np.polyval(den[::-1], x))
+    delay = np.abs(np.exp(-x))
+    return np.clip(1.0 - delay / np.where(H > 0, H, np.inf), 0.0, 1.0)
 
 
 def name_mode(shares, real, frequency_hz, arms=False):
