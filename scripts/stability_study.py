@@ -20,6 +20,11 @@ Usage: ``python scripts/stability_study.py WHAT [--out DIR]``, WHAT one of
 * ``recoveries``: the nine kick-plate runs (the default model, our LQR rider
   at 3 m/s) against the linear closed loop at 3 m/s, ranked by pressure;
 * ``figure``: the default case's stability.png into ``--out``;
+* ``hands``: the wobble (or the arms' steer mode) with hands off and on the
+  bar, 2-8 m/s, open loop and with the LQR rider designed on the model
+  simulated, and the leaning rider's lean mode; ``hands.csv`` and
+  ``hands.png`` in ``--out`` (about 30 s; ``--arm-stiffness``,
+  ``--arm-damping``: not published values);
 * ``all``.
 
 Every table is printed as Markdown. Symmetric tyres (zero-slip offsets
@@ -331,13 +336,118 @@ def figure(out):
     print(f"wrote {path}\n")
 
 
+# ------------------------------------------------------------------------ hands on and off
+
+HANDS_SPEEDS = stability.parse_speeds("2:8:0.25")
+
+
+def _mode_at(table, speed, modes):
+    """(mode, eigenvalue) of the least damped oscillation (Im > 0) named one of ``modes`` at ``speed``, or None."""
+    sel = table[np.isclose(table["speed_m_s"], speed) & table["mode"].isin(modes) & (table["imag_1_s"] > 0)]
+    if sel.empty:
+        return None
+    row = sel.loc[sel["damping_ratio"].idxmin()]
+    return row["mode"], complex(row["real_1_s"], row["imag_1_s"])
+
+
+def hands(out, arm_stiffness=10.0, arm_damping=1.0, speeds=HANDS_SPEEDS):
+    """The wobble's frequency and damping with hands off and on, open and closed loop; the lean mode."""
+    import pandas as pd
+    cases = [("hands off", dict(arms="off")),
+             ("hands on", dict(arms="on", arm_stiffness=arm_stiffness, arm_damping=arm_damping)),
+             ("leaning, hands off", dict(rider_body="leaning")),
+             ("leaning, hands on", dict(rider_body="leaning", arms="on", arm_stiffness=arm_stiffness,
+                                        arm_damping=arm_damping))]
+    rows = []
+    for label, fields in cases:
+        for loop in ("open", "closed"):
+            sc = BASE.with_changes(controller="off" if loop == "open" else "lqr", lqr_model="simulated", **fields)
+            res = stability.analyse(sc, speeds, loops=(loop,))
+            t = res.eigenvalues[res.eigenvalues["model"] == "slip"]
+            for v in speeds:
+                row = {"case": label, "loop": loop, "speed_m_s": float(v)}
+                for key, modes in (("wobble", ("wobble", "arm_steer")), ("lean", ("lean",))):
+                    hit = _mode_at(t, v, modes)
+                    row[f"{key}_mode"] = None if hit is None else hit[0]
+                    row[f"{key}_frequency_hz"] = np.nan if hit is None else abs(hit[1].imag) / (2 * math.pi)
+                    row[f"{key}_damping_ratio"] = np.nan if hit is None else -hit[1].real / abs(hit[1])
+                lean_real = t[np.isclose(t["speed_m_s"], v) & (t["mode"] == "lean")]["real_1_s"]
+                row["lean_slowest_real_1_s"] = float(lean_real.max()) if len(lean_real) else np.nan
+                row["no_model"] = not np.isclose(t["speed_m_s"], v).any()
+                rows.append(row)
+    df = pd.DataFrame(rows)
+    print(f"Wobble with hands off and on the bar (arms {arm_stiffness:g} N m/rad, {arm_damping:g} N m s/rad: "
+          "not published values), T03 400 kPa, offsets removed; closed loop: LQR designed on the model "
+          "simulated at each speed ('-': no design stabilises the start)\n")
+    print("| speed [m/s] | " + " | ".join(f"{c}, {l}: f [Hz], damping" for c, _ in cases[:2]
+                                           for l in ("open", "closed")) + " |")
+    print("|---" * 5 + "|")
+    cell = lambda r: "-" if r.no_model or np.isnan(r.wobble_frequency_hz) else \
+        f"{r.wobble_frequency_hz:.2f}, {r.wobble_damping_ratio:.3f}" + (" (arm steer)" if r.wobble_mode == "arm_steer"
+                                                                        else "")
+    for v in speeds[::4]:
+        sel = df[np.isclose(df["speed_m_s"], v)]
+        cells = [cell(next(sel[(sel["case"] == c) & (sel["loop"] == l)].itertuples()))
+                 for c, _ in cases[:2] for l in ("open", "closed")]
+        print(f"| {v:g} | " + " | ".join(cells) + " |")
+    print("\nLean mode of the leaning rider (hip 128 N m/rad, 50 N m s/rad): oscillation if any, else the "
+          "slowest real root\n")
+    print("| speed [m/s] | " + " | ".join(f"{c}, {l}" for c, _ in cases[2:] for l in ("open", "closed")) + " |")
+    print("|---" * 5 + "|")
+    lean = lambda r: "-" if r.no_model else (f"{r.lean_frequency_hz:.2f} Hz, {r.lean_damping_ratio:.3f}"
+                                             if not np.isnan(r.lean_frequency_hz) else
+                                             f"{r.lean_slowest_real_1_s:+.3f} 1/s" if not np.isnan(r.lean_slowest_real_1_s)
+                                             else "not named")
+    for v in speeds[::4]:
+        sel = df[np.isclose(df["speed_m_s"], v)]
+        cells = [lean(next(sel[(sel["case"] == c) & (sel["loop"] == l)].itertuples()))
+                 for c, _ in cases[2:] for l in ("open", "closed")]
+        print(f"| {v:g} | " + " | ".join(cells) + " |")
+    print()
+    if out is not None:
+        out = pathlib.Path(out)
+        out.mkdir(parents=True, exist_ok=True)
+        wk.fileio.write_csv(df, out / "hands.csv")
+        _hands_figure(df, cases, out / "hands.png", arm_stiffness, arm_damping)
+        print(f"wrote {out / 'hands.csv'}, {out / 'hands.png'}\n")
+    return df
+
+
+def _hands_figure(df, cases, path, arm_stiffness, arm_damping):
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    fig = Figure(figsize=(12, 4.2))
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(1, 2)
+    for (label, _), colour in zip(cases, ("tab:blue", "tab:red", "tab:green", "tab:purple"), strict=True):
+        for loop, ls in (("open", "-"), ("closed", "--")):
+            g = df[(df["case"] == label) & (df["loop"] == loop)]
+            axes[0].plot(g["speed_m_s"], g["wobble_frequency_hz"], color=colour, ls=ls, label=f"{label}, {loop}")
+            axes[1].plot(g["speed_m_s"], g["wobble_damping_ratio"], color=colour, ls=ls)
+    axes[0].set_ylabel("wobble (or arm steer) frequency [Hz]")
+    axes[1].set_ylabel("damping ratio")
+    for ax in axes:
+        ax.set_xlabel("speed [m/s]")
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize=8)
+    fig.suptitle(f"Wobble, hands off and on (arms {arm_stiffness:g} N m/rad, {arm_damping:g} N m s/rad; "
+                 "not published values)", fontsize=10)
+    fig.savefig(path, dpi=110)
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("what", choices=("table", "coefficients", "properties", "sensitivity", "consistency",
-                                         "recoveries", "figure", "all"))
+                                         "recoveries", "figure", "hands", "all"))
     parser.add_argument("--out", help="folder for the figures (table, figure)")
     parser.add_argument("--pressure", type=float, nargs="+", default=[400.0],
                         help="pressures [kPa] of the properties table (default 400)")
+    parser.add_argument("--arm-stiffness", type=float, default=10.0,
+                        help="hands: the arms' stiffness about the steer axis [N m/rad] (default 10; an "
+                             "assumption, not a published value)")
+    parser.add_argument("--arm-damping", type=float, default=1.0,
+                        help="hands: the arms' damping about the steer axis [N m s/rad] (default 1; an "
+                             "assumption, not a published value)")
     args = parser.parse_args(argv)
     rows = None
     if args.what in ("coefficients", "all"):
@@ -355,6 +465,8 @@ def main(argv=None):
         recoveries(rows)
     if args.what in ("figure", "all") and args.out:
         figure(args.out)
+    if args.what in ("hands", "all"):
+        hands(args.out, args.arm_stiffness, args.arm_damping)
 
 
 if __name__ == "__main__":

@@ -520,3 +520,47 @@ def test_capsize_after_a_split_and_a_merge_between_two_sweep_speeds():
     s = stability.analyse(sc, stability.parse_speeds("3.5:4:0.05"), loops=("open",)).summary["slip"]["open"]
     assert s["weave_speed_m_s"] == pytest.approx(3.7189, abs=1e-4)
     assert s["capsize_speed_m_s"] == pytest.approx(3.7667, abs=1e-4) and "after" in s["capsize_speed_how"]
+
+
+# ------------------------------------------------------------ the rider's body (issue 23)
+
+def _named(table, speed, mode):
+    return table[(table["model"] == "slip") & np.isclose(table["speed_m_s"], speed) & table["mode"].isin(mode)
+                 & (table["imag_1_s"] >= 0)]
+
+
+def test_leaning_rider_has_a_lean_mode_near_the_hip_estimate():
+    # A stiff, lightly damped hip so the lean oscillates (the default 128 N m/rad nearly cancels gravity).
+    sc = DEFAULT.with_changes(rider_body="leaning", controller="off", hip_stiffness=400.0, hip_damping=5.0)
+    res = stability.analyse(sc, [1.0, 1.5, 2.0])
+    lean = _named(res.eigenvalues, 1.0, ["lean"])
+    assert len(lean) == 1 and lean["share_lean"].iloc[0] > 0.5   # the eigenvector is mostly q11
+    body = wk.assembly.rider_body(sc, wk.assembly.build_bicycle(sc)[2])
+    inertia = body["it11"] + body["mt"] * body["lt3"] ** 2          # about the hinge
+    stiffness = 400.0 - body["mt"] * 9.81 * -body["lt3"]             # hip spring less gravity
+    f_sdof = math.sqrt(stiffness / inertia) / (2 * math.pi)         # 1.04 Hz
+    f = lean["frequency_hz"].iloc[0]                                 # 1.67 Hz: the bicycle rolls and steers too
+    assert 1.3 * f_sdof < f < 1.9 * f_sdof
+    # The rigid rider's table has no lean or reflex columns (unchanged).
+    assert "share_lean" not in stability.analyse(DEFAULT, [3.0], loops=("open",)).eigenvalues
+
+
+def test_arm_steer_mode_frequency_rises_with_arm_stiffness():
+    # Hands on, the steer oscillates on the arms: named arm_steer while the front tyre lags little
+    # (2.9 Hz at 200 N m/rad), wobble once it takes the tyre along (4.1 Hz at 400, 5.8 Hz at 800).
+    freqs = []
+    for stiffness in (200.0, 400.0, 800.0):
+        sc = DEFAULT.with_changes(arms="on", controller="off", arm_stiffness=stiffness, arm_damping=1.0)
+        steer = _named(stability.analyse(sc, [2.5, 3.0, 3.5]).eigenvalues, 3.0, ["arm_steer", "wobble"])
+        arm = steer.loc[steer["share_steer"].idxmax()]
+        assert arm["share_steer"] > 0.4 and (stiffness > 200.0 or arm["mode"] == "arm_steer")
+        freqs.append(float(arm["frequency_hz"]))
+    assert freqs[0] < freqs[1] < freqs[2]
+
+
+def test_reflex_filter_poles_are_named_reflex_delay():
+    sc = DEFAULT.with_changes(controller="off", reflex_delay=0.1, reflex_roll=20.0, reflex_roll_rate=5.0)
+    res = stability.analyse(sc, [3.5, 4.0, 4.5])
+    assert len(_named(res.eigenvalues, 4.0, ["reflex_delay"])) >= 1
+    model = res.models["open", 1]
+    assert model.states[-4:] == slip.REFLEX_STATES and model.matrix.shape == (18, 18)

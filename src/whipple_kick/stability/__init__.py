@@ -46,6 +46,7 @@ Example
 3.82
 """
 from ._constants import (  # noqa: F401 -- the package's names, as before the split
+    BODY_GROUPS,
     DEFAULT_SPEEDS,
     DOMINANT_SHARE,
     GROUPS,
@@ -62,12 +63,14 @@ from ._constants import (  # noqa: F401 -- the package's names, as before the sp
 from .linear import (  # noqa: F401 -- the package's names, as before the split
     STATES,
     LinearModel,
+    active_states,
     linear_model,
     linearise,
     state_labels,
 )
 from .modes import (  # noqa: F401 -- the package's names, as before the split
     _wheelbase,
+    groups_of,
     match_cost,
     mode_content,
     name_mode,

@@ -3,9 +3,12 @@
 LOOPS = ("open", "closed")
 #: Content groups of an eigenvector (:func:`mode_content`).
 GROUPS = ("roll", "steer", "heading", "vertical", "rear_tyre", "front_tyre")
+#: Content groups added when the model has the rider's body (a leaning rider, a delayed reflex): the
+#: upper body's lean on the hip and the reflex delay filter's states.
+BODY_GROUPS = ("lean", "reflex")
 #: Mode names (:func:`name_mode`), in the order the figure's legend lists them.
-MODES = ("weave", "capsize", "caster", "wobble", "lateral_rear", "lateral_front", "relaxation_rear",
-         "relaxation_front", "vertical")
+MODES = ("weave", "capsize", "caster", "wobble", "arm_steer", "lean", "lateral_rear", "lateral_front",
+         "relaxation_rear", "relaxation_front", "vertical", "reflex_delay")
 #: What each mode name means (summary.json, docs/stability.md).
 MODE_DESCRIPTIONS = {
     "weave": "oscillation of roll, steer and heading together (the knife-edge bicycle's weave)",
@@ -18,6 +21,13 @@ MODE_DESCRIPTIONS = {
     "relaxation_rear": "non-oscillatory, the rear tyre's contact patch relaxing toward its kinematic slip",
     "relaxation_front": "the same for the front tyre",
     "vertical": "tyre compressions (bounce and pitch on the vertical tyre stiffness)",
+    "arm_steer": "arms on the bar: steer-dominated oscillation on the arms' stiffness and damping, faster than "
+                 "WOBBLE_MIN_FREQUENCY_HZ, with the front tyre lagging less than in the wobble (with more, "
+                 "it is still named wobble: the wobble on the arms)",
+    "lean": "leaning rider: the upper body's lean on the hip's spring-damper carries more of the amplitude "
+            "than roll, steer, heading or either tyre (oscillatory, or real when the hip is overdamped)",
+    "reflex_delay": "delayed reflex: the Pade delay filter's own poles (its states carry most of the amplitude, "
+                    "scaled by the reflex's torque per radian); a filter artefact, not a motion of the bicycle",
 }
 #: A steer-dominated oscillation slower than this [Hz] is the caster mode coupled with the
 #: front tyre's relaxation (at walking speed), not wobble: bicycle wobble is reported at

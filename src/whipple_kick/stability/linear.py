@@ -1,5 +1,5 @@
 """The slip model linearised about its steady motion at one speed (:class:`LinearModel`)."""
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -9,7 +9,8 @@ from whipple_kick.transient import DEFAULT_TRANSIENT
 
 from ._constants import LOOPS
 
-# Heading-frame states at constant speed and how the summary and StateSpace name them.
+# Heading-frame states at constant speed of the rigid rider (a leaning rider or a delayed reflex adds
+# its states after them: :func:`active_states`), and how the summary and StateSpace name them.
 STATES = tuple(n for n in slip.LINEAR_STATES if n != "v_fwd")
 _LABELS = {
     **{q: col for q, col in results.COORDINATE_COLUMNS.items()},
@@ -18,10 +19,36 @@ _LABELS = {
     **{state: (col, "m") for state, col in results.CARCASS_STATE_COLUMNS.items()},
     "v_fwd": ("forward_velocity", "m/s"), "v_lat": ("lateral_velocity", "m/s"),
     "fyr": ("fy_rear", "N"), "fyf": ("fy_front", "N"), "mzr": ("mz_rear", "N m"), "mzf": ("mz_front", "N m"),
+    # the reflex delay filter's states (controllable canonical form, torque-like)
+    **{name: (f"reflex_filter_{name.rsplit('_', 1)[1]}", "N m") for name in slip.REFLEX_STATES},
 }
 
 
-def state_labels(transient=DEFAULT_TRANSIENT, constant_speed=True):
+def active_states(transient=DEFAULT_TRANSIENT, body=(), constant_speed=True):
+    """State names of the linear model: :func:`whipple_kick.slip.linear_states` then the rider body's.
+
+    Parameters
+    ----------
+    transient : str
+        Tyre transient form (names the four tyre states).
+    body : tuple of str
+        The body states the linearisation includes
+        (:func:`whipple_kick.slip.linear.body_states`): the upper body's lean
+        q11, u11 when the hip is free, the reflex filter's states when the
+        delay is not 0; none for the rigid rider.
+    constant_speed : bool
+        Without the forward velocity (the default model).
+
+    Example
+    -------
+    >>> active_states(body=("q11", "u11"))[-3:]
+    ('camber_patch_f', 'q11', 'u11')
+    """
+    names = tuple(slip.linear_states(transient)) + tuple(body)
+    return tuple(n for n in names if not (constant_speed and n == "v_fwd"))
+
+
+def state_labels(transient=DEFAULT_TRANSIENT, constant_speed=True, body=()):
     """(name, unit) of each state of the linear model, in order.
 
     Parameters
@@ -30,6 +57,8 @@ def state_labels(transient=DEFAULT_TRANSIENT, constant_speed=True):
         Tyre transient form (names the four tyre states).
     constant_speed : bool
         Without the forward velocity (the default model).
+    body : tuple of str
+        The rider body's states after them (:func:`active_states`).
 
     Returns
     -------
@@ -40,8 +69,7 @@ def state_labels(transient=DEFAULT_TRANSIENT, constant_speed=True):
     >>> state_labels()[:2]
     [('roll', 'rad'), ('steer', 'rad')]
     """
-    names = slip.linear_states(transient)
-    return [_LABELS[n] for n in names if not (constant_speed and n == "v_fwd")]
+    return [_LABELS[n] for n in active_states(transient, body, constant_speed)]
 
 
 # ----------------------------------------------------------------- linear model
@@ -64,7 +92,8 @@ class LinearModel:
     K : ndarray (1, n)
         The rider's gains on these states (``T7 = -K x``); zero open loop.
     states : tuple of str
-        Model state names (:data:`whipple_kick.slip.LINEAR_STATES` order).
+        Model state names (:data:`whipple_kick.slip.LINEAR_STATES` order, then
+        the rider body's states the model has: :func:`active_states`).
     labels : list of (str, str)
         Readable name and unit of each state.
     steady : whipple_kick.steady.SteadyState
@@ -113,18 +142,28 @@ class LinearModel:
                      name=f"slip model at {self.speed:g} m/s ({'closed' if closed else 'open'} loop)")
 
 
-def _constant_speed(A, B):
-    keep = [i for i, n in enumerate(slip.LINEAR_STATES) if n != "v_fwd"]
+def _constant_speed(A, B, names):
+    keep = [i for i, n in enumerate(names) if n != "v_fwd"]
     return A[np.ix_(keep, keep)], B[keep]
 
 
+#: The state each gain of the rider's voluntary law multiplies (``T7 = -K x``).
+_GAIN_STATES = (("kq4", "q4"), ("kq7", "q7"), ("ku3", "u3"), ("ku4", "u4"), ("ku7", "u7"),
+                ("kq11", "q11"), ("ku11", "u11"))
+
+
 def _gains_vector(params, states):
-    """The rider's gains on ``states`` (``T7 = -K x``; the yaw-angle gain is refused)."""
+    """The rider's gains on ``states`` (``T7 = -K x``; the yaw-angle gain is refused).
+
+    A gain on the upper body's lean needs the lean among ``states`` (a
+    leaning rider); on a locked hip it multiplies a state that stays 0.
+    """
     if params.get("kq3", 0.0):
         raise InputError("a yaw-angle gain kq3 breaks the heading invariance the linear model needs")
     K = np.zeros((1, len(states)))
-    for gain, state in (("kq4", "q4"), ("kq7", "q7"), ("ku3", "u3"), ("ku4", "u4"), ("ku7", "u7")):
-        K[0, states.index(state)] = params.get(gain, 0.0)
+    for gain, state in _GAIN_STATES:
+        if state in states:
+            K[0, states.index(state)] = params.get(gain, 0.0)
     return K
 
 
@@ -158,15 +197,16 @@ def linearise(params, steady_state, loop, found_by="direct", constant_speed=True
     """
     rhs = slip.CompiledRHS(steady_state.params)
     J, B = slip.heading_linearisation(rhs, steady_state.x)
-    states = slip.linear_states(rhs.transient)
+    body = tuple(slip.linear.body_states(rhs.p))
     if constant_speed:
-        J, B = _constant_speed(J, B)
-        states = tuple(n for n in states if n not in ("v_fwd",))
-    # The model as parametrised is A - B K; the open loop adds B K back.
-    K = _gains_vector(params, list(slip.LINEAR_STATES if not constant_speed else STATES))
+        J, B = _constant_speed(J, B, slip.LINEAR_STATES + body)
+    states = active_states(rhs.transient, body, constant_speed)
+    # The model as parametrised is A - B K; the open loop adds B K back (the body's passive
+    # hip and arms and the delayed reflex stay: they are the model's, not the voluntary law's).
+    K = _gains_vector(params, list(active_states(DEFAULT_TRANSIENT, body, constant_speed)))
     return LinearModel(speed=float(steady_state.x[slip.X["u1"]]), loop=loop, A=J + B @ K, B=B,
-                       K=K if loop == "closed" else np.zeros_like(K), states=tuple(states),
-                       labels=state_labels(rhs.transient, constant_speed), steady=steady_state,
+                       K=K if loop == "closed" else np.zeros_like(K), states=states,
+                       labels=state_labels(rhs.transient, constant_speed, body), steady=steady_state,
                        found_by=found_by)
 
 
@@ -181,6 +221,12 @@ class _Setup:
     tyres: tuple
     notes: list
     controller: str
+    #: The no-slip model's bicycle with its rider and the set its LQR is designed on: the rigid rider's
+    #: (the same rider lumped into the rear frame, arms off the bar) when the scenario splits the body.
+    classic_moore: dict = None
+    classic_design: dict = None
+    #: The LQR rider designed on the model simulated, by design speed (``lqr_model="simulated"``).
+    designs: dict = field(default_factory=dict)
 
 
 def _setup(scenario, tyres=None):
@@ -190,25 +236,56 @@ def _setup(scenario, tyres=None):
         rear, front, notes = assembly.build_tyres(scenario)
     else:
         (rear, front), notes = tyres, [f"tyres given: {tyres[0]!r} (rear), {tyres[1]!r} (front)"]
-    return _Setup(scenario, moore, design, info, (rear, front), notes, scenario.controller)
+    classic_moore, classic_design = moore, design
+    if scenario.rider_body != "rigid" or scenario.arms == "on":
+        classic_moore, classic_design, _ = assembly.build_bicycle(scenario.with_changes(rider_body="rigid",
+                                                                                        arms="off"))
+    return _Setup(scenario, moore, design, info, (rear, front), notes, scenario.controller, classic_moore,
+                  classic_design)
 
 
 def _base_params(setup):
-    """Slip-model parameters of the scenario without steer control."""
+    """Slip-model parameters of the scenario without steer control (with the rider's body, arms and reflex)."""
     sc = setup.scenario
     return slip.model_parameters(setup.moore, *setup.tyres, symmetric=sc.symmetric_tyres,
                                  tyre_transient=sc.tyre_transient,
-                                 reverse_camber=sc.camber_sign == "reversed", slip_speed=sc.slip_speed)
+                                 reverse_camber=sc.camber_sign == "reversed", slip_speed=sc.slip_speed,
+                                 body=assembly.rider_body(sc, setup.info))
 
 
 def _loop_params(setup, speed, loop, base=None):
-    """Slip-model parameters at ``speed`` for ``loop`` (the rider's gains designed for that speed)."""
+    """Slip-model parameters at ``speed`` for ``loop`` (the rider's gains designed for that speed).
+
+    With ``lqr_model="simulated"`` the LQR rider is designed on the model
+    simulated (:func:`whipple_kick.assembly.lqr_on_simulated_model`), once
+    per design speed.
+    """
     params = dict(_base_params(setup) if base is None else base)
     if loop == "closed":
-        gains, _ = assembly.controller_gains(setup.scenario.with_changes(speed=float(speed)),
-                                               setup.design)
-        params.update(gains)
+        params.update(_rider_gains(setup, speed))
     return params
+
+
+def _rider_gains(setup, speed):
+    """The rider's gains by name at ``speed`` (the LQR on the simulated model cached per design speed)."""
+    sc = setup.scenario.with_changes(speed=float(speed))
+    if sc.controller != "lqr" or sc.lqr_model != "simulated":
+        return assembly.controller_gains(sc, setup.design)[0]
+    key = float(sc.lqr_design_speed)
+    if key not in setup.designs:
+        try:
+            setup.designs[key] = assembly.lqr_on_simulated_model(sc, setup.moore, setup.design, setup.info,
+                                                                 *setup.tyres)[0]
+        except InputError as exc:
+            setup.designs[key] = NoRiderDesign(f"no LQR rider designed on the model simulated at {key:g} m/s: "
+                                               f"{exc}")
+    if isinstance(setup.designs[key], NoRiderDesign):
+        raise setup.designs[key]
+    return setup.designs[key]
+
+
+class NoRiderDesign(InputError):
+    """The LQR rider could not be designed on the model simulated at a speed (the sweep leaves it out there)."""
 
 
 def _steady(params, speed, guess):

@@ -4,7 +4,14 @@ import numpy as np
 
 from whipple_kick import results, slip
 
-from ._constants import DOMINANT_SHARE, MIN_NAME_RUN, TYRE_SHARE, WOBBLE_MIN_FREQUENCY_HZ
+from ._constants import (
+    BODY_GROUPS,
+    DOMINANT_SHARE,
+    GROUPS,
+    MIN_NAME_RUN,
+    TYRE_SHARE,
+    WOBBLE_MIN_FREQUENCY_HZ,
+)
 
 # ------------------------------------------------------------------ mode content
 
@@ -66,7 +73,8 @@ def mode_content(model, eigenvalue, vector, wheelbase):
     speed = model.speed
     tau = 1.0 / np.maximum(np.abs(lam), speed / wheelbase)
     lag = []
-    for name in model.states[-4:]:   # tyre slots: rear, front, rear, front
+    bicycle = [n for n in model.states if n not in _BODY_STATES]
+    for name in bicycle[-4:]:   # tyre slots: rear, front, rear, front
         i = idx[name]
         gain = 1.0
         if name in slip.TYRE_STATES or name in results.CARCASS_STATE_COLUMNS:
@@ -79,15 +87,84 @@ def mode_content(model, eigenvalue, vector, wheelbase):
         vec[idx["q9"]] / wheelbase, vec[idx["q10"]] / wheelbase,
         *lag,
     ])
+    groups = [scaled]
+    if len(bicycle) < len(model.states):   # the rider's body: the upper body's lean, the reflex filter
+        groups.append(_body_content(model, lam, vec, idx))
+    scaled = np.vstack(groups)
     power = np.abs(scaled) ** 2
-    shares = np.array([power[0], power[1], power[2] + power[3], power[4] + power[5],
-                       power[6] + power[8], power[7] + power[9]]).T
+    shares = [power[0], power[1], power[2] + power[3], power[4] + power[5], power[6] + power[8], power[7] + power[9]]
+    if len(groups) > 1:
+        shares += [power[10]]
+    shares = np.array(shares).T
     total = shares.sum(axis=1, keepdims=True)
     shares = shares / np.where(total > 0, total, 1.0)
+    if len(groups) > 1:   # the reflex column: the filter's own share (:func:`filter_share`), not an amplitude
+        tau = model.steady.params.get("reflex_delay", 0.0)
+        shares = np.column_stack([shares, filter_share(lam, tau) if tau > 0 else np.zeros(lam.size)])
     return (shares[0], scaled[:, 0]) if single else (shares, scaled)
 
 
-def name_mode(shares, real, frequency_hz):
+#: States of the rider's body (after the bicycle's in a :class:`LinearModel`).
+_BODY_STATES = frozenset(slip.HIP_STATES + slip.REFLEX_STATES)
+
+
+def groups_of(model):
+    """The content groups of ``model``'s eigenvectors: :data:`GROUPS`, and :data:`BODY_GROUPS` with a body.
+
+    Example
+    -------
+    >>> from whipple_kick import Scenario
+    >>> from whipple_kick.stability import linear_model
+    >>> groups_of(linear_model(Scenario(symmetric_tyres=True), 4.0))
+    ('roll', 'steer', 'heading', 'vertical', 'rear_tyre', 'front_tyre')
+    """
+    return GROUPS + (BODY_GROUPS if any(n in _BODY_STATES for n in model.states) else ())
+
+
+def _body_content(model, lam, vec, idx):
+    """Angle-like amplitudes of the rider body's states: the lean q11, the reflex filter's states.
+
+    The upper body's lean on the hip is an angle [rad] like the roll. The
+    reflex filter's states are torques [N m] (controllable canonical form of
+    :mod:`whipple_kick.reflex`): divided by the reflex's torque per radian
+    of motion at this eigenvalue, ``|rq4| + |rq7| + |lambda| (|ru4| + |ru7|)``
+    (at least 1 N m/rad), they compare with the angles that drive them.
+    Rows: lean, then the four filter states (zero where the model lacks them).
+    """
+    n = lam.size
+    lean = vec[idx["q11"]] if "q11" in idx else np.zeros(n)
+    p = model.steady.params
+    per_rad = np.maximum(abs(p.get("rq4", 0.0)) + abs(p.get("rq7", 0.0))
+                         + np.abs(lam) * (abs(p.get("ru4", 0.0)) + abs(p.get("ru7", 0.0))), 1.0)
+    reflex = [vec[idx[r]] / per_rad if r in idx else np.zeros(n) for r in slip.REFLEX_STATES]
+    return np.array([lean, *reflex])
+
+
+def filter_share(lam, tau):
+    """How far the reflex's Pade filter departs from the delay at ``lam``: ``1 - |exp(-lam tau)| / |H(lam)|`` (>= 0).
+
+    In any eigenvector the filter's states are its driven response, ``z =
+    (lam tau I - A)^-1 B r``: what tells a filter pole from a motion of the
+    bicycle the filter delays is the eigenvalue itself. Where the filter
+    transfer ``H`` is the delay it approximates (a motion slow against
+    ``1/tau``), this is about 0; near the filter's own poles ``|H|`` grows
+    without bound and it tends to 1 (0.5 where the filter amplifies twice
+    as much as the delay would).
+
+    Example
+    -------
+    >>> round(float(filter_share(np.array([-0.5 + 3j]), 0.1)[0]), 3)
+    0.0
+    """
+    from whipple_kick import reflex
+    num, den = reflex.pade_coefficients(reflex.NUMERATOR_DEGREE, reflex.ORDER)
+    x = np.atleast_1d(np.asarray(lam, dtype=complex)) * tau
+    H = np.abs(np.polyval(num[::-1], x) / np.polyval(den[::-1], x))
+    delay = np.abs(np.exp(-x))
+    return np.clip(1.0 - delay / np.where(H > 0, H, np.inf), 0.0, 1.0)
+
+
+def name_mode(shares, real, frequency_hz, arms=False):
     """Name a mode from its content (:func:`mode_content` shares, averaged over a branch).
 
     Rules, in order (shares of :data:`GROUPS`; dominant = at least
@@ -127,15 +204,22 @@ def name_mode(shares, real, frequency_hz):
     >>> name_mode([0.9, 0.05, 0.05, 0, 0, 0], True, 0.0)
     'capsize'
     """
-    roll, steer, heading, vertical, rear, front = (float(s) for s in shares)
+    roll, steer, heading, vertical, rear, front, lean, reflex = (
+        [float(s) for s in shares] + [0.0] * len(BODY_GROUPS))[:len(GROUPS) + len(BODY_GROUPS)]
+    if reflex >= DOMINANT_SHARE:
+        return "reflex_delay"
     if vertical >= DOMINANT_SHARE:
         return "vertical"
+    if lean >= max(roll, steer, heading, rear, front):
+        return "lean"
     if real:
         if rear + front >= DOMINANT_SHARE:
             return "relaxation_rear" if rear >= front else "relaxation_front"
         return "capsize" if roll >= steer else "caster"
     if steer >= max(roll, heading) and front > max(rear, roll, TYRE_SHARE):
         return "wobble" if frequency_hz >= WOBBLE_MIN_FREQUENCY_HZ else "caster"
+    if arms and steer >= max(roll, heading, lean) and frequency_hz >= WOBBLE_MIN_FREQUENCY_HZ:
+        return "arm_steer"
     if rear + front >= DOMINANT_SHARE:
         return "lateral_rear" if rear >= front else "lateral_front"
     return "weave"
@@ -290,6 +374,6 @@ def name_tracks(points, min_run=MIN_NAME_RUN):
             keys.append((keys[-1][0] + 1 if gap else (keys[-1][0] if keys else 0), p["real"]))
         for start, stop in _segments(keys):
             branch = pts[start:stop]
-            names = [name_mode(p["shares"], p["real"], p["frequency_hz"]) for p in branch]
+            names = [name_mode(p["shares"], p["real"], p["frequency_hz"], p.get("arms", False)) for p in branch]
             for p, name in zip(branch, _merge_short_runs(names, min_run), strict=True):
                 p["mode"] = name

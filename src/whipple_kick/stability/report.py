@@ -12,7 +12,8 @@ from ._constants import LOOPS, MODES, TURN_NOTE_DEG
 #: Colour of each mode in stability.png.
 MODE_COLOURS = {"weave": "tab:blue", "capsize": "tab:red", "caster": "tab:green", "wobble": "tab:purple",
                 "lateral_rear": "tab:orange", "lateral_front": "tab:brown", "relaxation_rear": "tab:olive",
-                "relaxation_front": "tab:cyan", "vertical": "tab:gray"}
+                "relaxation_front": "tab:cyan", "vertical": "tab:gray", "arm_steer": "tab:pink",
+                "lean": "gold", "reflex_delay": "black"}
 #: Real-part range [1/s] of the left ("slow modes") panels, as Meijaard et al. (2007) Fig. 3.
 SLOW_RANGE = (-10.0, 10.0)
 
@@ -192,9 +193,18 @@ def describe(scenario, info=None):
         rider = "Table 8.4 rider"
     else:
         rider = "no rider control"
+    if scenario.controller == "lqr" and scenario.lqr_model == "simulated":
+        rider += " on the model simulated"
     scale = f" x{scenario.gain_scale:g}" if scenario.controller != "off" and scenario.gain_scale != 1 else ""
+    body = []   # the rider's body (issue 23), named only when it is not the rigid rider's
+    if scenario.rider_body == "leaning":
+        body.append(f"leaning rider (hip {scenario.hip_stiffness:g} N m/rad, {scenario.hip_damping:g} N m s/rad)")
+    if scenario.arms == "on":
+        body.append(f"arms on the bar ({scenario.arm_stiffness:g} N m/rad, {scenario.arm_damping:g} N m s/rad)")
+    if scenario.reflex_delay:
+        body.append(f"reflex delayed {scenario.reflex_delay * 1e3:g} ms")
     return (f"{scenario.tyre} {p} kPa ({offsets}, {scenario.tyre_transient}), {scenario.bicycle}{load}; "
-            f"{rider}{scale}")
+            f"{rider}{scale}" + "".join(f"; {b}" for b in body))
 
 
 def write(result, out, plot=True):
@@ -257,6 +267,12 @@ def report_lines(summary):
                          f"{least['speed_m_s']:.2f} m/s), {'UNSTABLE somewhere' if wob['unstable'] else 'stable'}")
         elif wob is not None:
             lines.append("    no wobble (no steer-dominated oscillation with the front tyre lagging)")
+        for mode in ("arm_steer", "lean"):   # the rider body's modes (issue 23)
+            if mode in info["modes"]:
+                m = info["modes"][mode]
+                lines.append(f"    {mode.replace('_', ' ')} {m['frequency_hz'][0]:.2f}-{m['frequency_hz'][1]:.2f} Hz at "
+                             f"{m['speeds_m_s'][0]:g}-{m['speeds_m_s'][1]:g} m/s, largest real part "
+                             f"{m['largest_real_part_1_s']:+.3f} 1/s (at {m['at_speed_m_s']:g} m/s)")
         lines.append("    modes: " + ", ".join(m.replace("_", " ") for m in info["modes"]))
         lean = summary.get("steady_motion", {}).get(loop, {}).get("largest_lean_rad")
         if lean is not None and abs(lean) > math.radians(TURN_NOTE_DEG):

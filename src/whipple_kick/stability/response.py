@@ -86,9 +86,13 @@ def free_response(model, vector, amplitude=1e-4, duration=2.0, rate=500.0, rtol=
     traj = lsoda.integrate(rhs, x0, duration, rtol=rtol, output_rate=rate)
     if traj.failed or traj.fell:
         raise FloatingPointError(f"the free response did not complete: {traj.message}")
-    keep = [slip.linear_states(rhs.transient).index(n) for n in model.states]
-    z_ref = slip.heading_state(model.steady.x)[keep]
-    deviation = np.array([slip.heading_state(x)[keep] for x in traj.x]) - z_ref
+    names = list(slip.linear_states(rhs.transient))
+    keep = [names.index(n) for n in model.states if n in names]
+    body = [slip.X[n] for n in model.states if n not in names]   # the rider body's states follow
+
+    def heading(x):
+        return np.concatenate([slip.heading_state(x)[keep], np.asarray(x)[body]])
+    deviation = np.array([heading(x) for x in traj.x]) - heading(model.steady.x)
     return traj.t, deviation
 
 

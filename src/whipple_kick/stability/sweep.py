@@ -7,8 +7,8 @@ import numpy as np
 from whipple_kick import assembly, slip, steady
 from whipple_kick.errors import InputError, check_range
 
-from ._constants import GROUPS, LOOPS, MAX_SPEEDS, ZERO_TORQUE_N_M
-from .linear import _base_params, _check_loop, _loop_params, _setup, _steady, linearise
+from ._constants import BODY_GROUPS, GROUPS, LOOPS, MAX_SPEEDS, ZERO_TORQUE_N_M
+from .linear import NoRiderDesign, _base_params, _check_loop, _loop_params, _setup, _steady, linearise
 from .modes import _wheelbase, mode_content, name_tracks, track
 from .report import describe
 from .summary import _summarise
@@ -21,6 +21,9 @@ class _Loop:
     def __init__(self, setup, loop, wheelbase):
         self.setup, self.loop, self.wheelbase = setup, loop, wheelbase
         self.base = _base_params(setup)
+        # The eigenvectors' content groups: the rider body's too when its states are linearised.
+        body = slip.linear.body_states(slip.parameter_vector(self.base))
+        self.groups = GROUPS + (BODY_GROUPS if body else ())
 
     def model(self, speed, guess=None, other=None):
         """LinearModel at ``speed`` (NoSteadyMotion if there is none).
@@ -63,11 +66,11 @@ def _classic_eigen(canonical, speed, K=None):
     return np.linalg.eig(A)
 
 
-def _classic_content(lam, vec):
-    """Shares of :data:`GROUPS` of the classic model's eigenvectors (roll and steer only)."""
+def _classic_content(lam, vec, groups=GROUPS):
+    """Shares of ``groups`` of the classic model's eigenvectors (roll and steer only)."""
     power = np.abs(vec[:2]) ** 2
     power = power / np.where(power.sum(axis=0) > 0, power.sum(axis=0), 1.0)
-    shares = np.zeros((lam.size, len(GROUPS)))
+    shares = np.zeros((lam.size, len(groups)))
     shares[:, 0], shares[:, 1] = power[0], power[1]
     return vec[:2], shares
 
@@ -215,8 +218,9 @@ def analyse(scenario, speeds, *, loops=None, tyres=None):
     for loop in loops:
         contexts[loop] = _Loop(setup, loop, wheelbase)
         lams, vecs, shares = _sweep_loop(contexts[loop], speeds, models, steady_rows)
-        rows += _named_rows("slip", loop, speeds, lams, vecs, shares, raw)
-    rows += _classic_rows(setup, speeds, loops, raw)
+        rows += _named_rows("slip", loop, speeds, lams, vecs, shares, raw, groups=contexts[loop].groups,
+                            arms=scenario.arms == "on")
+    rows += _classic_rows(setup, speeds, loops, raw, groups=contexts[loops[0]].groups)
     result = Stability(scenario, speeds, pd.DataFrame(rows), pd.DataFrame(steady_rows), models=models)
     result.summary = {"title": describe(scenario, setup.info), "scenario": scenario.to_dict(),
                       "bicycle": setup.info, "tyre_notes": setup.notes, "loops": list(loops),
@@ -248,7 +252,7 @@ def _sweep_loop(ctx, speeds, models, steady_rows):
         other = models.get(("open" if ctx.loop == "closed" else "closed", k))
         try:
             model = ctx.model(float(v), guess, None if other is None else other.steady)
-        except NoSteadyMotion as exc:
+        except (NoSteadyMotion, NoRiderDesign) as exc:
             steady_rows.append({"loop": ctx.loop, "speed_m_s": float(v), "found_by": None, "message": str(exc)})
             lams.append(None)
             vecs.append(None)
@@ -273,11 +277,14 @@ def _steady_row(loop, speed, model):
             "rear_wheel_torque_n_m": float(model.steady.params["T6c"])}
 
 
-def _named_rows(model_name, loop, speeds, lams, vecs, shares_all, raw=None):
+def _named_rows(model_name, loop, speeds, lams, vecs, shares_all, raw=None, groups=GROUPS, arms=False):
     """Rows of the eigenvalue table for one loop: tracked, then named per branch.
 
     ``raw``, if given, receives ``(model_name, loop) -> (eigenvalues, vectors,
-    track ids)`` per speed, for the summary's refinements.
+    track ids)`` per speed, for the summary's refinements. ``groups`` names
+    the shares' columns (:data:`GROUPS`, then :data:`BODY_GROUPS` with a
+    body); ``arms``: the rider's arms hold the bar (a steer oscillation
+    without the front tyre is then the arms' and steer's mode).
     """
     ids = track(lams, vecs)
     if raw is not None:
@@ -291,25 +298,27 @@ def _named_rows(model_name, loop, speeds, lams, vecs, shares_all, raw=None):
             points.append({"model": model_name, "loop": loop, "speed_m_s": float(speeds[k]), "speed_index": k,
                            "track": int(cur[j]), "real": e.imag == 0.0, "real_1_s": e.real, "imag_1_s": e.imag,
                            "frequency_hz": abs(e.imag) / (2 * math.pi),
-                           "damping_ratio": -e.real / abs(e) if e != 0 else 0.0, "shares": shares[j]})
+                           "damping_ratio": -e.real / abs(e) if e != 0 else 0.0, "shares": shares[j],
+                           "arms": arms})
     name_tracks(points)
     rows = []
     for p in points:
         shares = p.pop("shares")
         p.pop("real")
-        rows.append({**p, **{f"share_{g}": float(s) for g, s in zip(GROUPS, shares, strict=True)}})
+        p.pop("arms")
+        rows.append({**p, **{f"share_{g}": float(s) for g, s in zip(groups, shares, strict=True)}})
     return rows
 
 
 def _canonical(setup):
-    """The classic model's canonical matrices M, C1, K0, K2 (and g) of the scenario's bicycle."""
+    """The classic model's canonical matrices M, C1, K0, K2 (and g) of the scenario's bicycle (rigid rider)."""
     from whipple_kick import classic
-    canonical = classic.canonical_matrices(setup.moore)
-    canonical["g"] = float(setup.moore["g"])
+    canonical = classic.canonical_matrices(setup.classic_moore)
+    canonical["g"] = float(setup.classic_moore["g"])
     return canonical
 
 
-def _classic_rows(setup, speeds, loops, raw=None):
+def _classic_rows(setup, speeds, loops, raw=None, groups=GROUPS):
     """The no-slip model's eigenvalues, tracked and named like the slip model's (roll and steer content)."""
     canonical = _canonical(setup)
     rows = []
@@ -320,17 +329,18 @@ def _classic_rows(setup, speeds, loops, raw=None):
             if loop == "closed":
                 K = _classic_gains(setup, v)
             lam, vec = _classic_eigen(canonical, float(v), K)
-            scaled, shares = _classic_content(lam, vec)
+            scaled, shares = _classic_content(lam, vec, groups)
             lams.append(lam)
             vecs.append(scaled)
             shares_all.append(shares)
-        rows += _named_rows("no-slip", loop, speeds, lams, vecs, shares_all, raw)
+        rows += _named_rows("no-slip", loop, speeds, lams, vecs, shares_all, raw, groups=groups)
     return rows
 
 
 def _classic_gains(setup, speed):
+    """The rider's gains on the no-slip model: the scenario's controller on the rigid rider (Whipple design)."""
     from whipple_kick import control
-    gains, _ = assembly.controller_gains(setup.scenario.with_changes(speed=float(speed)), setup.design)
+    gains, _ = assembly.controller_gains(setup.scenario.with_changes(speed=float(speed)), setup.classic_design)
     return np.array([gains.get(n, 0.0) for n in control.GAIN_ORDER])
 
 
