@@ -614,10 +614,14 @@ def test_rider_body_flags_reach_the_run_and_a_scenario_file(tmp_path, capsys):
         "leaning", "simulated", 40.0, 0.05, 0.2)
 
 
-def test_stability_does_not_offer_the_rider_body_flags(capsys):
-    """``stability``'s linear model has the rigid rider and the Whipple design only (its parameters take no
-    body): it refuses the body flags rather than dropping the upper body's mass silently."""
+def test_stability_takes_the_rider_body_flags(tmp_path, capsys):
+    """``stability --rider-body leaning``: the linear model has the upper body (its lean mode is named in the
+    table) -- the flags reach the sweep's parameters rather than being dropped."""
     from whipple_kick.cli import stability_main
-    status, stdout, err = run_console(stability_main, ["--rider-body", "leaning"], capsys)
-    assert status == 2 and stdout == "" and err.count("\n") == 1
-    assert "unrecognized arguments: --rider-body leaning" in err
+    out = tmp_path / "stab"
+    status, stdout, err = run_console(stability_main, ["--rider-body", "leaning", "--hip-stiffness", "400",
+                                                       "--hip-damping", "5", "--controller", "off", "--speeds",
+                                                       "2,3", "--out", str(out), "--no-plot", "--quiet"], capsys)
+    assert status == 0, err
+    summary = json.loads((out / "summary.json").read_text())
+    assert "lean" in json.dumps(summary)

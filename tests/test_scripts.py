@@ -34,5 +34,5 @@ def test_identification_scores_a_case_as_the_docs_say():
     assert values["arm_stiffness"] == 1.0 and abs(values["reflex_delay"] - 0.06) < 1e-15
     assert abs(values["hip_stiffness"] - (50.0 * 5000.0) ** 0.5) < 1e-9
     # Every searched parameter has bounds, and every combination names its own.
-    for fixed, names in ir.COMBINATIONS.values():
+    for _fixed, names in ir.COMBINATIONS.values():
         assert set(names) <= set(ir.BOUNDS)

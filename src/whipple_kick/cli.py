@@ -129,10 +129,8 @@ def _model_options(p, symmetric_flag=True, design_default="the run's --speed", c
     what the LQR design speed is by default; ``case_options`` adds the
     pressures, the rear load or rider mass and ``--thesis-load`` (not for a
     command that sets them per case); ``body_options`` the rider's body,
-    arms and reflex, ``--carcass-stiffness-scale`` and ``--lqr-model`` (not
-    for ``stability``, whose linear model has the rigid rider and the Whipple
-    design only). Returns the "riding and control" group, for the caller's
-    speed option.
+    arms and reflex, ``--carcass-stiffness-scale`` and ``--lqr-model``.
+    Returns the "riding and control" group, for the caller's speed option.
     """
     from . import tyres
     from .carcass import SLIDING_LAWS
@@ -910,7 +908,7 @@ def _stability_parser():
                "removed (straight running; --tyre-offsets measured linearises about the steady turns the "
                "offsets cause), LQR rider designed at each speed. Speed is constant in the linear model "
                "(the forward-speed mode is left out, as in the no-slip model). See docs/stability.md.")
-    g = _model_options(p, symmetric_flag=False, design_default="each speed of the sweep", body_options=False)
+    g = _model_options(p, symmetric_flag=False, design_default="each speed of the sweep")
     g.add_argument("--speeds", default=f"{start:g}:{stop:g}:{step:g}", metavar="START:STOP:STEP",
                    help=f"forward speeds in m/s: START:STOP:STEP (STOP included) or V1,V2,... "
                         f"(default {start:g}:{stop:g}:{step:g})")
