@@ -135,12 +135,19 @@ def run_case(job):
     return out
 
 
+def run_directions(job):
+    """:func:`run_case` for each kick direction of one case in one worker (the rider's design is shared)."""
+    fields, fz, pressure, directions = job
+    rows = [run_case((fields, fz, pressure, d)) for d in directions]
+    for d, row in zip(directions, rows, strict=True):
+        row.update(fz_n=fz, pressure_kpa=pressure, direction=d)
+    return rows
+
+
 def evaluate(pool, fields, loads, directions):
     """Mean score and the per-case rows of ``fields`` over the cases of ``loads``."""
-    jobs = [(fields, fz, p, d) for fz in loads for p in PRESSURES for d in directions]
-    rows = pool.map(run_case, jobs)
-    for (_, fz, p, d), row in zip(jobs, rows, strict=True):
-        row.update(fz_n=fz, pressure_kpa=p, direction=d)
+    jobs = [(fields, fz, p, tuple(directions)) for fz in loads for p in PRESSURES]
+    rows = [row for case in pool.map(run_directions, jobs) for row in case]
     return float(np.mean([r["score"] for r in rows])), rows
 
 

@@ -111,7 +111,8 @@ def assemble(scenario, kick, *, tyres=None, gains=None) -> Assembly:
                  f"rear {rear!r}, front {front!r}"]
     moore, design, info = build_bicycle(scenario)
     if custom is None and scenario.controller == "lqr" and scenario.lqr_model == "simulated":
-        gains, poles = lqr_on_simulated_model(scenario, moore, design, info, rear, front)
+        gains, poles = (_cached_simulated_design(scenario, moore, design, info, rear, front) if tyres is None
+                        else lqr_on_simulated_model(scenario, moore, design, info, rear, front))
         controller = scenario.controller
     elif custom is None:
         gains, poles = controller_gains(scenario, design)
@@ -249,6 +250,26 @@ def rider_body(scenario, info):
     return body
 
 
+#: Designs on the simulated model, per process, by the scenario with the fields the design does not read
+#: (the kick, the run's length and numerics) set to their defaults: both kick directions of a case design once.
+_SIMULATED_DESIGNS = {}
+_NOT_IN_DESIGN = ("kick_displacement", "kick_duration", "kick_accel", "kick_profile", "kick_table", "kick_direction",
+                  "settle", "duration", "rtol", "output_rate", "fall_angle_deg", "steer_limit_deg", "piecewise")
+
+
+def _cached_simulated_design(scenario, moore, design, info, rear, front):
+    from dataclasses import fields
+
+    defaults = {f.name: f.default for f in fields(scenario) if f.name in _NOT_IN_DESIGN}
+    key = scenario.with_changes(**defaults)
+    if key not in _SIMULATED_DESIGNS:
+        if len(_SIMULATED_DESIGNS) > 256:
+            _SIMULATED_DESIGNS.clear()
+        _SIMULATED_DESIGNS[key] = lqr_on_simulated_model(scenario, moore, design, info, rear, front)
+    gains, poles = _SIMULATED_DESIGNS[key]
+    return dict(gains), np.array(poles)
+
+
 def lqr_on_simulated_model(scenario, moore, design, info, rear, front):
     """The LQR rider designed on the model the run simulates (``lqr_model="simulated"``).
 
@@ -277,24 +298,31 @@ def lqr_on_simulated_model(scenario, moore, design, info, rear, front):
     felt = ["kq4", "kq7", "ku4", "ku7"] + (["kq11", "ku11"] if scenario.rider_body == "leaning" else [])
     K = np.r_[_lqr(tuple(sorted(design.items())), speed)[0], np.zeros(len(felt) - 4)]
     scaled = ("ka", "ca", "rq4", "rq7", "ru4", "ru7")
-    # Continuation: the share of the arms' and reflex's gains grows while each design stabilises the next model.
-    done, step = (1.0, 1.0) if _linear_design_model(scenario, moore, rear, front, body, felt, K, 1.0, scaled)[3] \
-        else (0.0, 0.1)
-    A, b, C, stable = _linear_design_model(scenario, moore, rear, front, body, felt, K, done, scaled)
+    # Continuation: the share of the arms' and reflex's gains grows while the gains still stabilise the
+    # next model; where they do not, they are re-optimised at the last share they did (a larger margin).
+    def model(share):
+        return _linear_design_model(scenario, moore, rear, front, body, felt, K, share, scaled)
+
+    done, step = (1.0, 1.0) if model(1.0)[3] else (0.0, 0.25)
+    A, b, C, stable = model(done)
     if not stable:   # the body alone (forearms on the bar, a leaning trunk) already defeats the Whipple design
         K = control.stabilising_gains(A, b, C, K)
-    K, poles = control.output_feedback_lqr(A, b, C, K0=K)
+    optimised_at = None
     while done < 1.0:
         share = min(1.0, done + step)
-        A, b, C, stable = _linear_design_model(scenario, moore, rear, front, body, felt, K, share, scaled)
-        if stable:
-            K, poles = control.output_feedback_lqr(A, b, C, K0=K)
-            done, step = share, step * 1.5
+        if model(share)[3]:
+            done, step = share, step * 2.0
+        elif optimised_at != done:
+            A, b, C, _ = model(done)
+            K, _ = control.output_feedback_lqr(A, b, C, K0=K)
+            optimised_at = done
         elif step < 1e-3:
             raise InputError(f"no stabilising LQR rider was found on the model simulated at {speed:g} m/s "
                              f"(the design lost stability at {share:.1%} of the arms' and reflex's gains)")
         else:
             step /= 2.0
+    A, b, C, _ = model(1.0)
+    K, poles = control.output_feedback_lqr(A, b, C, K0=K)
     gains = dict.fromkeys(slip.GAIN_NAMES, 0.0)
     gains.update({name: float(scenario.gain_scale * k) for name, k in zip(felt, K, strict=True)})
     return gains, poles
