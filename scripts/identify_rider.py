@@ -29,7 +29,7 @@ the best sample. One kick direction (right; ``--directions`` for both).
 Usage::
 
     python scripts/identify_rider.py run --out identify      # the search (about 20 min on 2 cores)
-    python scripts/identify_rider.py report identify         # the tables of docs/experiments.md from its files
+    python scripts/identify_rider.py report identify         # its tables (docs/identification.json: the docs' run)
 """
 import argparse
 import json
@@ -243,7 +243,8 @@ def _fmt(v, digits=3):
 
 
 def main_report(args):
-    payload = json.loads((pathlib.Path(args.folder) / "identification.json").read_text())
+    path = pathlib.Path(args.folder)
+    payload = json.loads((path if path.is_file() else path / "identification.json").read_text())
     exp = experiments.load()
     print("| combination | fitted score (570, 635 N) | held-out score (701 N) | parameters |")
     print("|---|---|---|---|")
@@ -262,12 +263,13 @@ def main_report(args):
             print(f"| {name} | {n} | {_fmt(r['fields'][n])} | {sens['minus']:.2f} ({_fmt(sens['values'][0])}) / "
                   f"{sens['plus']:.2f} ({_fmt(sens['values'][1])}) vs {r['fitted_score']:.2f} |")
     best = min(payload["results"], key=lambda n: payload["results"][n]["fitted_score"])
-    print(f"\nBest on the fitted loads: {best}. Per case, model against measured (m / meas):\n")
+    print(f"\nBest on the fitted loads: {best}.\n")
+    goal_lines(payload["results"][best])
+    print("Per case, model against measured (m / meas):\n")
     keys = ("dominant_frequency_hz", "period_s", "log_dec_13", "n_peaks", "last_peak_time_s")
     print("| case | set | " + " | ".join(keys) + " | slow swing | status |")
     print("|---|---|" + "---|" * (len(keys) + 2))
     r = payload["results"][best]
-    goal_lines(r)
     for label, rows in (("fitted", r["fitted"]), ("held out", r["held_out"])):
         for row in rows:
             target = measured(exp, row["fz_n"], row["pressure_kpa"])
@@ -293,6 +295,52 @@ def goal_lines(result):
           f"within 0.08 s in {within} of {len(result['held_out'])}.\n")
 
 
+def main_stops(args):
+    """What stops the best combination from meeting the goal: its closed loop's modes and the slow swing vs the gains."""
+    from whipple_kick import assembly, inputs, slip
+
+    path = pathlib.Path(args.folder)
+    payload = json.loads((path if path.is_file() else path / "identification.json").read_text())
+    best = min(payload["results"], key=lambda n: payload["results"][n]["fitted_score"])
+    fields = {"lqr_model": "simulated", **payload["results"][best]["fields"]}
+    print(f"Best combination: {best} {fields}\n")
+    print("Its linearised closed loop at 2 m/s (635 N, 400 kPa, offsets removed): oscillatory modes below 10 Hz "
+          "and the content of their eigenvectors (largest = 1)\n")
+    print("| eigenvalue [1/s] | f [Hz] | damping ratio | roll | steer | lean | yaw rate |")
+    print("|---|---|---|---|---|---|---|")
+    sc = validation.base_scenario(fz_n=635.0, pressure_kpa=400.0, symmetric_tyres=True, **fields)
+    model = assembly.assemble(sc, inputs.kick_of(sc))
+    rhs = slip.CompiledRHS(model.params)
+    A, _ = slip.heading_linearisation(rhs, model.start.x)
+    names = list(slip.LINEAR_STATES) + list(slip.linear.body_states(rhs.p))
+    keep = [i for i, n in enumerate(names) if n != "v_fwd"]
+    names = [names[i] for i in keep]
+    values, vectors = np.linalg.eig(A[np.ix_(keep, keep)])
+    for k in np.argsort(values.imag):
+        lam = values[k]
+        if lam.imag <= 0.0 or lam.imag / (2 * math.pi) > 10.0:
+            continue
+        content = {n: abs(vectors[names.index(n), k]) if n in names else 0.0 for n in ("q4", "q7", "q11", "u3")}
+        top = max(content.values())
+        print(f"| {lam.real:.2f} {lam.imag:+.2f}j | {lam.imag / (2 * math.pi):.2f} | {-lam.real / abs(lam):.2f} | "
+              + " | ".join(f"{content[n] / top:.2f}" for n in ("q4", "q7", "q11", "u3")) + " |")
+    print("\nSlow swing (yaw rate 0.5-1 s after the kick / peak #1) against the rider's gains (gain_scale times the "
+          "design), 635 N, 400 kPa, kick to the right:\n")
+    print("| gain scale | fell | slow swing | peaks | dominant f [Hz] | last peak from the kick [s] |")
+    print("|---|---|---|---|---|---|")
+    exp = experiments.load()
+    for scale in (0.5, 1.0, 2.0, 4.0, 8.0):
+        run = wk.run(validation.base_scenario(fz_n=635.0, pressure_kpa=400.0, duration=3.0, gain_scale=scale,
+                                              **fields))
+        tr = run.trajectory
+        m = validation.recorded_metrics(tr["time"].to_numpy(), tr["yaw_rate"].to_numpy(),
+                                        float(run.summary["steady_state"]["yaw_rate_rad_s"]),
+                                        processing=exp.processing,
+                                        window_start=exp.conditions[validation.DOMINANT_WINDOW_KEY])
+        print(f"| {scale:g} | {run.summary['fell']} | {_fmt(m['slow_swing_ratio'])} | {m['n_peaks']} | "
+              f"{_fmt(m['dominant_frequency_hz'])} | {_fmt(m['last_peak_from_kick_s'])} |")
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     sub = p.add_subparsers(dest="command", required=True)
@@ -304,9 +352,12 @@ def main(argv=None):
     r.add_argument("--directions", nargs="+", default=["right"], choices=list(validation.DIRECTIONS))
     r.add_argument("--workers", type=int, default=2)
     q = sub.add_parser("report", help="print the tables of a finished run")
-    q.add_argument("folder")
+    q.add_argument("folder", help="a run's --out folder, or its identification.json")
+    w = sub.add_parser("stops", help="what stops the best combination: its closed-loop modes, the slow swing "
+                                     "against the rider's gains (about 10 s)")
+    w.add_argument("folder", help="a run's --out folder, or its identification.json")
     args = p.parse_args(argv)
-    (main_run if args.command == "run" else main_report)(args)
+    {"run": main_run, "report": main_report, "stops": main_stops}[args.command](args)
 
 
 if __name__ == "__main__":

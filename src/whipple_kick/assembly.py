@@ -295,8 +295,12 @@ def lqr_on_simulated_model(scenario, moore, design, info, rear, front):
 
     speed = float(scenario.lqr_design_speed)
     body = rider_body(scenario, info)
-    felt = ["kq4", "kq7", "ku4", "ku7"] + (["kq11", "ku11"] if scenario.rider_body == "leaning" else [])
+    felt = (["kq4", "kq7", "ku4", "ku7"] + (["kq11", "ku11"] if scenario.rider_body == "leaning" else [])
+            + (["kq3"] if scenario.lqr_heading else []))
     K = np.r_[_lqr(tuple(sorted(design.items())), speed)[0], np.zeros(len(felt) - 4)]
+    if scenario.lqr_heading:   # start from the Whipple model's heading design (its yaw gain holds the heading)
+        whipple = dict(zip(control.HEADING_GAIN_ORDER, control.heading_lqr_gains(design, speed)[0], strict=True))
+        K = np.array([whipple.get(name, 0.0) for name in felt])
     scaled = ("ka", "ca", "rq4", "rq7", "ru4", "ru7")
     # Continuation: the share of the arms' and reflex's gains grows while the gains still stabilise the
     # next model; where they do not, they are re-optimised at the last share they did (a larger margin).
@@ -345,6 +349,11 @@ def _linear_design_model(scenario, moore, rear, front, body, felt, K, share, sca
     keep = [i for i, n in enumerate(names) if n != "v_fwd"]   # constant speed
     A, b = A[np.ix_(keep, keep)], b[keep]
     names = [names[i] for i in keep]
+    if "kq3" in felt:   # the heading q3 as a state: dq3/dt = u3 (nothing else depends on it)
+        n = len(names)
+        A = np.block([[A, np.zeros((n, 1))], [np.eye(n)[[names.index("u3")]], np.zeros((1, 1))]])
+        b = np.vstack([b, [[0.0]]])
+        names.append("q3")
     C = np.zeros((len(felt), len(names)))
     for row, gain in enumerate(felt):
         C[row, names.index(control.FELT_STATES[gain])] = 1.0

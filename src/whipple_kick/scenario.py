@@ -181,6 +181,10 @@ class Scenario:
         the law feeding back what the rider feels (roll, steer, their rates,
         and the upper body's lean and its rate when it leans), its gains
         LQR-optimal for that law (:func:`whipple_kick.control.output_feedback_lqr`).
+    lqr_heading : bool
+        With ``lqr_model="simulated"``: the law also feeds back the heading
+        (yaw angle q3, gain kq3), so the rider steers back to the heading held
+        before the kick. Needs straight steady running (``symmetric_tyres``).
     rider_body : {"rigid", "leaning"}
         The rider lumped rigidly into the rear frame (default), or an upper
         body (pelvis, trunk, head, upper arms) leaning on the saddle on the
@@ -303,6 +307,7 @@ class Scenario:
     carcass_viscosity: float = carcass.SLIDING_VISCOSITY
     carcass_stiffness_scale: float = 1.0
     lqr_model: str = "whipple"
+    lqr_heading: bool = False
     rider_body: str = "rigid"
     arms: str = "off"
     hip_stiffness: float = 128.0
@@ -447,6 +452,9 @@ class Scenario:
                                    ("reflex steer gain", self.reflex_steer, "N m/rad"),
                                    ("reflex steer-rate gain", self.reflex_steer_rate, "N m s/rad")):
             check_range(label, value, -1e4, 1e4, unit)
+        if self.lqr_heading and (self.controller != "lqr" or self.lqr_model != "simulated"):
+            raise InputError("lqr_heading needs the LQR rider designed on the model simulated "
+                             "(controller 'lqr', lqr_model 'simulated')")
         if self.rider_body == "leaning" and self.hip_stiffness == 0.0:
             raise InputError("hip stiffness = 0 N m/rad leaves a leaning upper body with nothing to hold it "
                              "up; allowed (0, 1e6] N m/rad")
@@ -609,7 +617,7 @@ FIELD_GROUPS = {
                 "pressure_rear_kpa", "coefficient_set", "friction", "symmetric_tyres", "speed", "controller",
                 "design_speed", "gain_scale", "thesis_load_n", "low_inertia", "kick_displacement", "kick_duration",
                 "kick_accel", "kick_profile", "kick_table", "kick_direction", "tyre_transient", "carcass_sliding",
-                "carcass_damping", "carcass_stiffness_scale", "lqr_model", "rider_body", "arms", "hip_stiffness", "hip_damping",
+                "carcass_damping", "carcass_stiffness_scale", "lqr_model", "lqr_heading", "rider_body", "arms", "hip_stiffness", "hip_damping",
                 "arm_stiffness", "arm_damping", "reflex_delay", "reflex_roll", "reflex_roll_rate", "reflex_steer",
                 "reflex_steer_rate"),
     "run": ("settle", "duration", "output_rate", "fall_angle_deg", "steer_limit_deg"),
