@@ -450,3 +450,14 @@ def test_bad_body_fields_are_one_line_input_errors(changes, fragments):
     assert "\n" not in message
     for fragment in fragments:
         assert fragment in message, (fragment, message)
+
+
+def test_the_simulated_design_can_hold_the_heading():
+    """``lqr_heading``: the design on the model simulated adds the yaw angle to what the rider feels (kq3 != 0),
+    the run recovers, and asking for it with the Whipple design is a one-line InputError."""
+    sc = wk.Scenario(duration=2.0, symmetric_tyres=True, lqr_model="simulated", lqr_heading=True)
+    result = wk.run(sc)
+    gains = result.summary["controller"]["gains"]
+    assert gains["kq3"] != 0.0 and not result.summary["fell"]
+    with pytest.raises(wk.errors.InputError, match="lqr_heading needs the LQR rider designed on the model simulated"):
+        wk.Scenario(lqr_heading=True).validate()

@@ -202,6 +202,9 @@ def _model_options(p, symmetric_flag=True, design_default="the run's --speed", c
                        help="what the LQR rider is designed on: whipple (default: the classic model, full state) or "
                             "simulated (the model the run simulates, feeding back roll, steer, their rates and the "
                             "upper body's lean)")
+        g.add_argument("--lqr-heading", action="store_true",
+                       help="with --lqr-model simulated: the rider also holds the heading held before the kick "
+                            "(needs --symmetric-tyres: straight steady running)")
     g.add_argument("--design-speed", type=_number("m/s"), metavar="M/S",
                    help=f"LQR design speed in m/s (default: {design_default}, as a real rider adapts; "
                         "the thesis fixed it at 3)")
@@ -378,7 +381,7 @@ def _flags_given(argv):
 #: set by the flag of its own name.
 _BODY_FIELDS = ("rider_body", "arms", "hip_stiffness", "hip_damping", "arm_stiffness", "arm_damping", "reflex_delay",
                 "reflex_roll", "reflex_roll_rate", "reflex_steer", "reflex_steer_rate", "carcass_stiffness_scale",
-                "lqr_model")
+                "lqr_model", "lqr_heading")
 
 
 def _model_fields(args):
