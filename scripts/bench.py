@@ -262,7 +262,7 @@ def bench_cli(repeats):
 _DUMP = r"""
 import sys, numpy as np
 import whipple_kick as wk
-from whipple_kick import slip
+from whipple_kick import slip, steady
 bike = wk.bicycles.load("balanceassist_v1")
 combined, _ = wk.riders.for_rear_load(bike, fz_n=635.0)
 K, _ = wk.control.lqr_gains(combined, 3.0)
