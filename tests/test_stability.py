@@ -564,3 +564,18 @@ def test_reflex_filter_poles_are_named_reflex_delay():
     assert len(_named(res.eigenvalues, 4.0, ["reflex_delay"])) >= 1
     model = res.models["open", 1]
     assert model.states[-4:] == slip.REFLEX_STATES and model.matrix.shape == (18, 18)
+
+
+def test_pressure_load_figure_draws_the_nine_case_table(tmp_path):
+    """The figure of the pressure-load table: three loads (the nine thesis cases) draw one colour each; it
+    raised a ValueError before (three loads zipped strictly against four colours)."""
+    import pandas as pd
+
+    from whipple_kick.stability.pressure_load import pressure_load_figure
+
+    rows = [{"fz_n": fz, "pressure_kpa": p, "at_speed_m_s": 2.0, "weave_speed_m_s": 3.8, "capsize_speed_m_s": 3.9,
+             "noslip_weave_speed_m_s": 4.1, "noslip_capsize_speed_m_s": 6.0, "closed_weave_damping_ratio": 0.5,
+             "closed_slowest_real_1_s": -1.0, "closed_wobble_frequency_hz": 9.0, "closed_wobble_damping_ratio": 0.05}
+            for fz in (570.0, 635.0, 701.0) for p in (300.0, 400.0, 500.0)]
+    path = pressure_load_figure(pd.DataFrame(rows), tmp_path / "pl.png")
+    assert path.stat().st_size > 10_000

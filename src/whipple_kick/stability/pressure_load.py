@@ -149,7 +149,9 @@ def pressure_load_figure(table, path):
     FigureCanvasAgg(fig)
     axes = fig.subplots(1, 3)
     rate_axis, wobble_damping_axis = axes[1].twinx(), axes[2].twinx()
-    colours = dict(zip(sorted(set(table["fz_n"])), ("tab:blue", "tab:orange", "tab:green", "tab:red"), strict=True))
+    # One colour per load, in order (the palette's cycle: any number of loads).
+    palette = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown")
+    colours = {fz: palette[k % len(palette)] for k, fz in enumerate(sorted(set(table["fz_n"])))}
     at = float(table["at_speed_m_s"].iloc[0])
     for load, g in table.groupby("fz_n"):
         c, p = colours[load], g["pressure_kpa"]
