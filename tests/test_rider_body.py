@@ -461,3 +461,13 @@ def test_the_simulated_design_can_hold_the_heading():
     assert gains["kq3"] != 0.0 and not result.summary["fell"]
     with pytest.raises(wk.errors.InputError, match="lqr_heading needs the LQR rider designed on the model simulated"):
         wk.Scenario(lqr_heading=True).validate()
+
+
+def test_lateral_poles_carry_the_leaning_body():
+    """steady.lateral_poles (the failure diagnoses' poles) include the leaning body's two states, and agree
+    with the rigid rider's count otherwise."""
+    sc = wk.Scenario(rider_body="leaning", lqr_model="simulated")
+    model = assembly.assemble(sc, inputs.kick_of(sc))
+    poles = steady.lateral_poles(model.params, model.start.x)
+    assert poles.size == len(slip.LINEAR_STATES) - 1 + 2
+    assert np.all(np.isfinite(poles)) and poles[0].real < 0.0
