@@ -277,7 +277,7 @@ def lqr_on_simulated_model(scenario, moore, design, info, rear, front):
     symmetric tyres, linearised about upright straight running at the design
     speed at constant speed (:func:`whipple_kick.slip.heading_linearisation`);
     the law feeds back roll, steer and their rates, and the upper body's lean
-    and its rate when it leans (:data:`whipple_kick.control.FELT_STATES`),
+    and its rate when it leans (:data:`whipple_kick.slip.parameters.GAIN_STATES`),
     with gains LQR-optimal for that law (identity weights on those states,
     1 on the torque, as the Whipple design), found from the Whipple design's
     gains by :func:`whipple_kick.control.output_feedback_lqr`. Where the
@@ -334,8 +334,6 @@ def lqr_on_simulated_model(scenario, moore, design, info, rear, front):
 
 def _linear_design_model(scenario, moore, rear, front, body, felt, K, share, scaled):
     """(A, b, C, whether ``K`` stabilises it) of the design model with ``share`` of the ``scaled`` body gains."""
-    from . import control
-
     part = {k: (v * share if k in scaled else v) for k, v in body.items()}
     params = slip.model_parameters(moore, rear, front, symmetric=True, tyre_transient=scenario.tyre_transient,
                                    carcass_sliding=scenario.carcass_sliding,
@@ -356,7 +354,7 @@ def _linear_design_model(scenario, moore, rear, front, body, felt, K, share, sca
         names.append("q3")
     C = np.zeros((len(felt), len(names)))
     for row, gain in enumerate(felt):
-        C[row, names.index(control.FELT_STATES[gain])] = 1.0
+        C[row, names.index(slip.GAIN_STATES[gain])] = 1.0
     stable = bool(np.max(np.linalg.eigvals(A - b @ K[None, :] @ C).real) < 0.0)
     return A, b, C, stable
 

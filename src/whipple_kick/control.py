@@ -203,10 +203,6 @@ def closed_loop_poles(moore, speed, gains):
     return poles[np.argsort(-poles.real, kind="stable")]
 
 
-#: What each gain of the rider's voluntary law multiplies (``T7 = -sum(gain * state)``), for
-#: :func:`output_feedback_lqr`'s designs on the model simulated.
-FELT_STATES = {"kq4": "q4", "kq7": "q7", "ku4": "u4", "ku7": "u7", "kq11": "q11", "ku11": "u11", "kq3": "q3"}
-
 
 def output_feedback_lqr(A, b, C, Q=None, R=1.0, K0=None, X0=None):
     """LQR-optimal gains of a law that feeds back only what the rider feels: ``u = -K C x``.

@@ -20,6 +20,7 @@ from .layout import (
     X,
     tyre_state_names,
 )
+from .parameters import GAIN_STATES
 
 # ---------------------------------------------------------------- linearisation
 
@@ -278,6 +279,7 @@ def linear_state_space(params, x, step=1e-7):
     j = LINEAR_STATES.index("u7")
     B = (A_cl[:, j] - linearize(CompiledRHS(bumped), x, step)[:, j]).reshape(-1, 1)
     K = np.zeros((1, len(LINEAR_STATES)))
-    for gain, state in (("kq4", "q4"), ("kq7", "q7"), ("ku3", "u3"), ("ku4", "u4"), ("ku7", "u7")):
-        K[0, LINEAR_STATES.index(state)] = params[gain]
+    for gain, state in GAIN_STATES.items():
+        if state in LINEAR_STATES:   # the bicycle's states (q3 is not one: kq3 is refused above)
+            K[0, LINEAR_STATES.index(state)] = params[gain]
     return A_cl + B @ K, B, K

@@ -147,11 +147,6 @@ def _constant_speed(A, B, names):
     return A[np.ix_(keep, keep)], B[keep]
 
 
-#: The state each gain of the rider's voluntary law multiplies (``T7 = -K x``).
-_GAIN_STATES = (("kq4", "q4"), ("kq7", "q7"), ("ku3", "u3"), ("ku4", "u4"), ("ku7", "u7"),
-                ("kq11", "q11"), ("ku11", "u11"))
-
-
 def _gains_vector(params, states):
     """The rider's gains on ``states`` (``T7 = -K x``; the yaw-angle gain is refused).
 
@@ -161,7 +156,7 @@ def _gains_vector(params, states):
     if params.get("kq3", 0.0):
         raise InputError("a yaw-angle gain kq3 breaks the heading invariance the linear model needs")
     K = np.zeros((1, len(states)))
-    for gain, state in _GAIN_STATES:
+    for gain, state in slip.GAIN_STATES.items():   # q3 is not among the states (kq3 is refused above)
         if state in states:
             K[0, states.index(state)] = params.get(gain, 0.0)
     return K
