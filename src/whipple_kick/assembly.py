@@ -111,7 +111,7 @@ def assemble(scenario, kick, *, tyres=None, gains=None) -> Assembly:
                  f"rear {rear!r}, front {front!r}"]
     moore, design, info = build_bicycle(scenario)
     if custom is None and scenario.controller == "lqr" and scenario.lqr_model == "simulated":
-        gains, poles = (_cached_simulated_design(scenario, moore, design, info, rear, front) if tyres is None
+        gains, poles = (_cached_simulated_design(scenario) if tyres is None
                         else lqr_on_simulated_model(scenario, moore, design, info, rear, front))
         controller = scenario.controller
     elif custom is None:
@@ -250,24 +250,29 @@ def rider_body(scenario, info):
     return body
 
 
-#: Designs on the simulated model, per process, by the scenario with the fields the design does not read
-#: (the kick, the run's length and numerics) set to their defaults: both kick directions of a case design once.
-_SIMULATED_DESIGNS = {}
+#: Fields the design on the simulated model does not read (the kick, the run's length and numerics).
 _NOT_IN_DESIGN = ("kick_displacement", "kick_duration", "kick_accel", "kick_profile", "kick_table", "kick_direction",
                   "settle", "duration", "rtol", "output_rate", "fall_angle_deg", "steer_limit_deg", "piecewise")
 
 
-def _cached_simulated_design(scenario, moore, design, info, rear, front):
+def _cached_simulated_design(scenario):
+    """:func:`lqr_on_simulated_model` of ``scenario``, once per process for the fields the design reads.
+
+    Both kick directions (or any kick) of a case share one design.
+    """
     from dataclasses import fields
 
-    defaults = {f.name: f.default for f in fields(scenario) if f.name in _NOT_IN_DESIGN}
-    key = scenario.with_changes(**defaults)
-    if key not in _SIMULATED_DESIGNS:
-        if len(_SIMULATED_DESIGNS) > 256:
-            _SIMULATED_DESIGNS.clear()
-        _SIMULATED_DESIGNS[key] = lqr_on_simulated_model(scenario, moore, design, info, rear, front)
-    gains, poles = _SIMULATED_DESIGNS[key]
+    key = scenario.with_changes(**{f.name: f.default for f in fields(scenario) if f.name in _NOT_IN_DESIGN})
+    gains, poles = _simulated_design(key)
     return dict(gains), np.array(poles)
+
+
+@functools.lru_cache(maxsize=256)
+def _simulated_design(scenario):
+    rear, front, _ = build_tyres(scenario)
+    moore, design, info = build_bicycle(scenario)
+    gains, poles = lqr_on_simulated_model(scenario, moore, design, info, rear, front)
+    return tuple(gains.items()), tuple(poles)
 
 
 def lqr_on_simulated_model(scenario, moore, design, info, rear, front):
@@ -302,38 +307,44 @@ def lqr_on_simulated_model(scenario, moore, design, info, rear, front):
         whipple = dict(zip(control.HEADING_GAIN_ORDER, control.heading_lqr_gains(design, speed)[0], strict=True))
         K = np.array([whipple.get(name, 0.0) for name in felt])
     scaled = ("ka", "ca", "rq4", "rq7", "ru4", "ru7")
+    models = {}
+
+    def model(share):
+        """(A, b, C) of the design model with ``share`` of the ``scaled`` gains, built once per share."""
+        if share not in models:
+            models[share] = _linear_design_model(scenario, moore, rear, front, body, felt, share, scaled)
+        return models[share]
+
+    def stabilises(gains, share):
+        A, b, C = model(share)
+        return bool(np.max(np.linalg.eigvals(A - b @ gains[None, :] @ C).real) < 0.0)
+
     # Continuation: the share of the arms' and reflex's gains grows while the gains still stabilise the
     # next model; where they do not, they are re-optimised at the last share they did (a larger margin).
-    def model(share):
-        return _linear_design_model(scenario, moore, rear, front, body, felt, K, share, scaled)
-
-    done, step = (1.0, 1.0) if model(1.0)[3] else (0.0, 0.25)
-    A, b, C, stable = model(done)
-    if not stable:   # the body alone (forearms on the bar, a leaning trunk) already defeats the Whipple design
-        K = control.stabilising_gains(A, b, C, K)
+    done, step = (1.0, 1.0) if stabilises(K, 1.0) else (0.0, 0.25)
+    if not stabilises(K, done):   # the body alone (forearms on the bar, a leaning trunk) defeats the Whipple design
+        K = control.stabilising_gains(*model(done), K)
     optimised_at = None
     while done < 1.0:
         share = min(1.0, done + step)
-        if model(share)[3]:
+        if stabilises(K, share):
             done, step = share, step * 2.0
         elif optimised_at != done:
-            A, b, C, _ = model(done)
-            K, _ = control.output_feedback_lqr(A, b, C, K0=K)
+            K, _ = control.output_feedback_lqr(*model(done), K0=K)
             optimised_at = done
         elif step < 1e-3:
             raise InputError(f"no stabilising LQR rider was found on the model simulated at {speed:g} m/s "
                              f"(the design lost stability at {share:.1%} of the arms' and reflex's gains)")
         else:
             step /= 2.0
-    A, b, C, _ = model(1.0)
-    K, poles = control.output_feedback_lqr(A, b, C, K0=K)
+    K, poles = control.output_feedback_lqr(*model(1.0), K0=K)
     gains = dict.fromkeys(slip.GAIN_NAMES, 0.0)
     gains.update({name: float(scenario.gain_scale * k) for name, k in zip(felt, K, strict=True)})
     return gains, poles
 
 
-def _linear_design_model(scenario, moore, rear, front, body, felt, K, share, scaled):
-    """(A, b, C, whether ``K`` stabilises it) of the design model with ``share`` of the ``scaled`` body gains."""
+def _linear_design_model(scenario, moore, rear, front, body, felt, share, scaled):
+    """(A, b, C) of the design model with ``share`` of the ``scaled`` body gains (C picks the ``felt`` states)."""
     part = {k: (v * share if k in scaled else v) for k, v in body.items()}
     params = slip.model_parameters(moore, rear, front, symmetric=True, tyre_transient=scenario.tyre_transient,
                                    carcass_sliding=scenario.carcass_sliding,
@@ -355,8 +366,7 @@ def _linear_design_model(scenario, moore, rear, front, body, felt, K, share, sca
     C = np.zeros((len(felt), len(names)))
     for row, gain in enumerate(felt):
         C[row, names.index(slip.GAIN_STATES[gain])] = 1.0
-    stable = bool(np.max(np.linalg.eigvals(A - b @ K[None, :] @ C).real) < 0.0)
-    return A, b, C, stable
+    return A, b, C
 
 
 def controller_gains(scenario, design):
