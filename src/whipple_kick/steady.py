@@ -229,19 +229,17 @@ def lateral_poles(params, x):
     rear-wheel torque, and its own slow mode is not the rider's balance.
     Sorted by decreasing real part.
     """
-    A, B, K = slip.linear_state_space(params, x)
-    keep = [i for i, name in enumerate(slip.LINEAR_STATES) if name != "v_fwd"]
-    closed = (A - B @ K)[np.ix_(keep, keep)]
     rhs = slip.CompiledRHS(params)
     body = slip.linear.body_states(rhs.p)
     if body:
         # A leaning body or a delayed reflex: the compiled Jacobian's linearisation, which carries their states
-        # (the finite differences above perturb the bicycle's states only).
-        A_full = slip.heading_linearisation(rhs, x)[0]
-        names = list(slip.LINEAR_STATES) + list(body)
-        keep = [i for i, name in enumerate(names) if name != "v_fwd"]
-        closed = A_full[np.ix_(keep, keep)]
-    poles = np.linalg.eigvals(closed)
+        # (the finite differences of linear_state_space perturb the bicycle's states only).
+        closed = slip.heading_linearisation(rhs, x)[0]
+    else:
+        A, B, K = slip.linear_state_space(params, x)
+        closed = A - B @ K
+    keep = [i for i, name in enumerate(slip.LINEAR_STATES + body) if name != "v_fwd"]
+    poles = np.linalg.eigvals(closed[np.ix_(keep, keep)])
     return poles[np.argsort(-poles.real, kind="stable")]
 
 
