@@ -423,12 +423,19 @@ def place(bike, rider):
 
 
 def lump_into_rear_frame(bench, mass, com, inertia):
-    """Add a rigid body to the rear frame B of a benchmark-form set.
+    """Add a rigid body to the rear frame B of a benchmark-form set (:func:`lump_into_frame` with ``"B"``)."""
+    return lump_into_frame(bench, "B", mass, com, inertia)
+
+
+def lump_into_frame(bench, frame, mass, com, inertia):
+    """Add a rigid body to the benchmark body ``frame`` ("B" rear frame, "H" front frame) of a benchmark set.
 
     Parameters
     ----------
     bench : mapping
         Benchmark parameters.
+    frame : {"B", "H"}
+        The body it is added to.
     mass : float
         Added mass [kg].
     com : sequence of 3 floats
@@ -439,13 +446,14 @@ def lump_into_rear_frame(bench, mass, com, inertia):
     Returns
     -------
     dict
-        Benchmark parameters with the combined rear frame (mB, xB, zB, IB..).
+        Benchmark parameters with the combined body (m<frame>, x<frame>, z<frame>, I<frame>..).
     """
+    f = frame
     out = dict(bench)
-    m_b, m_r = bench["mB"], float(mass)
+    m_b, m_r = bench[f"m{f}"], float(mass)
     m = m_b + m_r
-    x = (m_b * bench["xB"] + m_r * com[0]) / m
-    z = (m_b * bench["zB"] + m_r * com[2]) / m
+    x = (m_b * bench[f"x{f}"] + m_r * com[0]) / m
+    z = (m_b * bench[f"z{f}"] + m_r * com[2]) / m
 
     def shifted(m_i, ixx, iyy, izz, ixz, xi, zi):
         # Parallel-axis theorem to the combined mass centre; a tensor's xz entry is -sum(m x z).
@@ -453,12 +461,30 @@ def lump_into_rear_frame(bench, mass, com, inertia):
         return (ixx + m_i * dz * dz, iyy + m_i * (dx * dx + dz * dz),
                 izz + m_i * dx * dx, ixz - m_i * dx * dz)
 
-    a = shifted(m_b, bench["IBxx"], bench["IByy"], bench["IBzz"], bench["IBxz"], bench["xB"], bench["zB"])
+    a = shifted(m_b, bench[f"I{f}xx"], bench[f"I{f}yy"], bench[f"I{f}zz"], bench[f"I{f}xz"], bench[f"x{f}"],
+                bench[f"z{f}"])
     i = np.asarray(inertia, dtype=float)
     b = shifted(m_r, i[0, 0], i[1, 1], i[2, 2], i[0, 2], com[0], com[2])
-    out.update(mB=m, xB=x, zB=z, IBxx=a[0] + b[0], IByy=a[1] + b[1], IBzz=a[2] + b[2],
-               IBxz=a[3] + b[3])
+    out.update({f"m{f}": m, f"x{f}": x, f"z{f}": z, f"I{f}xx": a[0] + b[0], f"I{f}yy": a[1] + b[1],
+                f"I{f}zz": a[2] + b[2], f"I{f}xz": a[3] + b[3]})
     return out
+
+
+def _with_rider(bike, rider, seated, bench, name, how):
+    """The :class:`Bicycle` of ``bike`` with ``rider`` seated (``seated``, :func:`place`'s) as ``bench`` has it.
+
+    ``name`` is added to the set's name, ``how`` says in the description where the rider went.
+    """
+    return Bicycle(
+        name=f"{bike.name}+{rider.name}({rider.mass_kg:g} kg{name})",
+        benchmark=bench, parameterisation="benchmark", includes_rider=True,
+        source=f"{bike.source}\nrider {rider.name}:\n{rider.source}",
+        description=f"{bike.description} With Yeadon rider {rider.name!r} "
+                    f"({rider.mass_kg:g} kg, {rider.height_m:.3f} m){how}",
+        uncertainties={}, geometry=bike.geometry, tyre_placeholders=bike.tyre_placeholders,
+        rider={"name": rider.name, "mass_kg": rider.mass_kg, "height_m": rider.height_m,
+               **{f"rider_{k}": v for k, v in seated.benchmark().items()}},
+    )
 
 
 def seat(bike, rider):
@@ -479,16 +505,7 @@ def seat(bike, rider):
     """
     seated = place(bike, rider)
     bench = lump_into_rear_frame(bike.benchmark, seated.mass, seated.com, seated.inertia)
-    return Bicycle(
-        name=f"{bike.name}+{rider.name}({rider.mass_kg:g} kg)",
-        benchmark=bench, parameterisation="benchmark", includes_rider=True,
-        source=f"{bike.source}\nrider {rider.name}:\n{rider.source}",
-        description=f"{bike.description} With Yeadon rider {rider.name!r} "
-                    f"({rider.mass_kg:g} kg, {rider.height_m:.3f} m) lumped into the rear frame.",
-        uncertainties={}, geometry=bike.geometry, tyre_placeholders=bike.tyre_placeholders,
-        rider={"name": rider.name, "mass_kg": rider.mass_kg, "height_m": rider.height_m,
-               **{f"rider_{k}": v for k, v in seated.benchmark().items()}},
-    )
+    return _with_rider(bike, rider, seated, bench, "", " lumped into the rear frame.")
 
 
 def static_loads(params):
@@ -614,20 +631,6 @@ FOREARM_SEGMENTS = ("A2", "B2")
 LEG_SEGMENTS = ("J1", "J2", "K1", "K2")
 
 
-def lump_into_frame(bench, frame, mass, com, inertia):
-    """Add a rigid body to the benchmark body ``frame`` ("B" rear frame, "H" front frame) of a benchmark set.
-
-    As :func:`lump_into_rear_frame`, for either frame.
-    """
-    keys = {k: k.replace("B", frame) if k != "mB" else f"m{frame}" for k in
-            ("mB", "xB", "zB", "IBxx", "IByy", "IBzz", "IBxz")}
-    renamed = {k: bench[v] for k, v in keys.items()}
-    combined = lump_into_rear_frame(renamed, mass, com, inertia)
-    out = dict(bench)
-    out.update({v: combined[k] for k, v in keys.items()})
-    return out
-
-
 def _segments(human, seat_pt, names):
     """Mass [kg], mass centre [m] and inertia [kg m^2] of yeadon segments ``names`` in the benchmark frame."""
     mass, com, inertia = human.combine_inertia(tuple(names))
@@ -670,34 +673,26 @@ def seat_with_body(bike, rider, arms_on_bar=True):
     seated = place(bike, rider)
     human = rider.human(seated.configuration)
     seat_pt = seated.seat
-    forearms = FOREARM_SEGMENTS if arms_on_bar else ()
-    upper = UPPER_BODY_SEGMENTS + (() if arms_on_bar else FOREARM_SEGMENTS)
-    bench = lump_into_frame(bike.benchmark, "B", *_segments(human, seat_pt, LEG_SEGMENTS))
-    if forearms:
-        bench = lump_into_frame(bench, "H", *_segments(human, seat_pt, forearms))
-    m_t, com_t, i_t = _segments(human, seat_pt, upper)
-    total = sum(_segments(human, seat_pt, names)[0] for names in (LEG_SEGMENTS, upper, forearms) if names)
+    legs = _segments(human, seat_pt, LEG_SEGMENTS)
+    m_t, com_t, i_t = _segments(human, seat_pt, UPPER_BODY_SEGMENTS + (() if arms_on_bar else FOREARM_SEGMENTS))
+    bench = lump_into_frame(bike.benchmark, "B", *legs)
+    total = legs[0] + m_t
+    if arms_on_bar:
+        forearms = _segments(human, seat_pt, FOREARM_SEGMENTS)
+        bench = lump_into_frame(bench, "H", *forearms)
+        total += forearms[0]
     if abs(total - seated.mass) > 1e-9 * seated.mass:
         raise RuntimeError(f"the rider's segments sum to {total} kg, not {seated.mass} kg")
     lam = bike.benchmark["lam"]
-    # Moore's rear frame C: C.x = cos(lam) X - sin(lam) Z, C.z = sin(lam) X + cos(lam) Z (benchmark X fwd, Z down),
-    # from the rear wheel centre (0, 0, -rR). Turning C about C.y by -lam gives H.x = X: a horizontal hinge.
-    c_x = np.array([math.cos(lam), 0.0, -math.sin(lam)])
-    c_z = np.array([math.sin(lam), 0.0, math.cos(lam)])
-    hip = seat_pt - np.array([0.0, 0.0, -bike.benchmark["rR"]])
+    # Moore's rear frame C (C.x, C.z in benchmark x, z), from the rear wheel centre (0, 0, -rR). Turning C
+    # about C.y by -lam gives H.x = X: a horizontal hinge.
+    c_x, c_z = _benchmark._pitch_matrix(lam)
+    hip = (seat_pt - np.array([0.0, 0.0, -bike.benchmark["rR"]]))[[0, 2]]
     arm = com_t - seat_pt
     body = {"hip_locked": 0.0, "hip_tilt": -lam, "lh1": float(hip @ c_x), "lh3": float(hip @ c_z),
             "mt": m_t, "lt1": float(arm[0]), "lt3": float(arm[2]),
             "it11": float(i_t[0, 0]), "it22": float(i_t[1, 1]), "it33": float(i_t[2, 2]), "it31": float(i_t[0, 2])}
-    combined = Bicycle(
-        name=f"{bike.name}+{rider.name}({rider.mass_kg:g} kg, body)",
-        benchmark=bench, parameterisation="benchmark", includes_rider=True,
-        source=f"{bike.source}\nrider {rider.name}:\n{rider.source}",
-        description=f"{bike.description} With Yeadon rider {rider.name!r} ({rider.mass_kg:g} kg, "
-                    f"{rider.height_m:.3f} m): legs in the rear frame, "
-                    f"{'forearms and hands in the front frame, ' if arms_on_bar else ''}the rest a leaning upper body.",
-        uncertainties={}, geometry=bike.geometry, tyre_placeholders=bike.tyre_placeholders,
-        rider={"name": rider.name, "mass_kg": rider.mass_kg, "height_m": rider.height_m,
-               **{f"rider_{k}": v for k, v in seated.benchmark().items()}},
-    )
+    where = "forearms and hands in the front frame, " if arms_on_bar else ""
+    combined = _with_rider(bike, rider, seated, bench, ", body",
+                           f": legs in the rear frame, {where}the rest a leaning upper body.")
     return combined, body
