@@ -248,7 +248,7 @@ BAD_INPUTS = {
     "scenario-and-compat": (["--scenario", "nope.toml", "--compat", "authors-code"],
                             ["--scenario FILE", "--compat"]),
     "malformed-output-rate": (["--output-rate", "fast"], ["--output-rate", "'fast'", "Hz"]),
-    # The rider's body (issue 23): each names the value, the allowed range and the unit.
+    # The rider's body: each names the value, the allowed range and the unit.
     "reflex-delay-too-long": (["--reflex-delay", "2"], ["reflex delay = 2.0 s", "[0, 0.5] s"]),
     "negative-hip-stiffness": (["--hip-stiffness", "-1"], ["hip stiffness = -1.0 N m/rad", "[0, 1e+06] N m/rad"]),
     "negative-arm-damping": (["--arm-damping", "-2"], ["arm damping = -2.0 N m s/rad", "N m s/rad"]),

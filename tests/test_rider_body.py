@@ -1,4 +1,4 @@
-"""The rider's body (issue 23): the locked body is the lumped rider, the split conserves the rider, the hip and
+"""The rider's body: the locked body is the lumped rider, the split conserves the rider, the hip and
 arm single-degree-of-freedom systems, the reflex delay through the full model, energy, the output-feedback LQR,
 the steady lean and the scenario's checks.
 

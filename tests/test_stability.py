@@ -522,7 +522,7 @@ def test_capsize_after_a_split_and_a_merge_between_two_sweep_speeds():
     assert s["capsize_speed_m_s"] == pytest.approx(3.7667, abs=1e-4) and "after" in s["capsize_speed_how"]
 
 
-# ------------------------------------------------------------ the rider's body (issue 23)
+# ------------------------------------------------------------ the rider's body
 
 def _named(table, speed, mode):
     return table[(table["model"] == "slip") & np.isclose(table["speed_m_s"], speed) & table["mode"].isin(mode)

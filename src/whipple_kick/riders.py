@@ -47,7 +47,7 @@ RIDER_DIR = parameters.shipped("riders")
 
 FORMAT = "whipple_kick rider, version 1"
 
-#: Largest rider mass accepted anywhere [kg] (issue 5: "a rider over 200 kg" is an error).
+#: Largest rider mass accepted anywhere [kg] (a rider over 200 kg is refused).
 MAX_RIDER_MASS_KG = 200.0
 
 #: Rotation taking yeadon-frame components to benchmark-frame components.
@@ -622,7 +622,7 @@ def for_rear_load(bike, fz_n, rider="jason", height_m=None, load_range=None):
     return RearLoadSolution(combined=combined, rider_mass_kg=mass)
 
 
-#: Yeadon segments of the upper body that leans on the saddle (issue 23): pelvis, thorax, chest-head and
+#: Yeadon segments of the upper body that leans on the saddle: pelvis, thorax, chest-head and
 #: the upper arms; the forearms and hands too unless they move with the bar. The legs stay in the rear frame.
 UPPER_BODY_SEGMENTS = ("P", "T", "C", "A1", "B1")
 #: Forearm-hand segments: with the arms on the bar they move with the front frame (their inertia about the

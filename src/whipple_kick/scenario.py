@@ -44,7 +44,7 @@ KICK_HEADINGS = ("fixed", "settled")
 CAMBER_SIGNS = ("physical", "reversed")
 #: The model the LQR rider is designed on.
 LQR_MODELS = ("whipple", "simulated")
-#: The rider's body: lumped into the rear frame, or an upper body leaning on the saddle (issue 23).
+#: The rider's body: lumped into the rear frame, or an upper body leaning on the saddle.
 RIDER_BODIES = ("rigid", "leaning")
 #: The arms: no mechanical effect on the bar, or forearms turning with it and a spring-damper about the steer axis.
 ARMS = ("off", "on")
@@ -172,7 +172,7 @@ class Scenario:
         (default 0: the thesis' pure relaxation). Carcass transient only.
     carcass_stiffness_scale : float
         Factor on both carcass stiffnesses C_Fa(F_z0)/sigma0 (default 1; the
-        identification of issue 23 varies it). Carcass transient only.
+        identification of the rider's body varies it, scripts/identify_rider.py). Carcass transient only.
     lqr_model : {"whipple", "simulated"}
         The model the LQR rider (``controller="lqr"``) is designed on: the
         linearised Carvallo-Whipple model (default; full state, roll and

@@ -194,7 +194,7 @@ def _entries():
                                     "(ccr, ccf)", "-", c),
         ("carcass_viscosity", "sliding viscosity of an undamped carcass tyre's patch past its friction limit "
                               "(regularises the Coulomb plateau)", "N s/m", c),
-        # --- rider with a body (issue 23): a leaning upper body, arms on the bar, reflexes --
+        # --- rider with a body: a leaning upper body, arms on the bar, reflexes --
         ("hip_locked", "1: the upper body is rigidly part of the rear frame (rigid rider, q11 held at 0); "
                        "0: it leans on the hip spring-damper", "-", c),
         ("hip_tilt", "angle about C.y from the rear frame's C.x axis to the hip (lean) axis H.x: minus the steer "

@@ -16,7 +16,7 @@ GAIN_NAMES = ("kq3", "kq4", "kq7", "ku3", "ku4", "ku7", "kq11", "ku11")
 #: The state each gain of the rider's voluntary law multiplies (``T7 = -sum(gain * state)``).
 GAIN_STATES = {"kq3": "q3", "kq4": "q4", "kq7": "q7", "ku3": "u3", "ku4": "u4", "ku7": "u7", "kq11": "q11",
                "ku11": "u11"}
-#: The rider's body (issue 23) by parameter name, with the rigid rider's values: the hip locked, the
+#: The rider's body by parameter name, with the rigid rider's values: the hip locked, the
 #: upper body's mass in the rear frame (mt 0), no arm impedance, no reflex.
 RIGID_BODY = {"hip_locked": 1.0, "hip_tilt": 0.0, "lh1": 0.0, "lh3": 0.0, "mt": 0.0, "lt1": 0.0, "lt3": 0.0,
               "it11": 0.0, "it22": 0.0, "it33": 0.0, "it31": 0.0, "kh": 0.0, "ch": 0.0, "ka": 0.0, "ca": 0.0,

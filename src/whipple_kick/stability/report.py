@@ -196,7 +196,7 @@ def describe(scenario, info=None):
     if scenario.controller == "lqr" and scenario.lqr_model == "simulated":
         rider += " on the model simulated"
     scale = f" x{scenario.gain_scale:g}" if scenario.controller != "off" and scenario.gain_scale != 1 else ""
-    body = []   # the rider's body (issue 23), named only when it is not the rigid rider's
+    body = []   # the rider's body, named only when it is not the rigid rider's
     if scenario.rider_body == "leaning":
         body.append(f"leaning rider (hip {scenario.hip_stiffness:g} N m/rad, {scenario.hip_damping:g} N m s/rad)")
     if scenario.arms == "on":
@@ -267,7 +267,7 @@ def report_lines(summary):
                          f"{least['speed_m_s']:.2f} m/s), {'UNSTABLE somewhere' if wob['unstable'] else 'stable'}")
         elif wob is not None:
             lines.append("    no wobble (no steer-dominated oscillation with the front tyre lagging)")
-        for mode in ("arm_steer", "lean"):   # the rider body's modes (issue 23)
+        for mode in ("arm_steer", "lean"):   # the rider body's modes
             if mode in info["modes"]:
                 m = info["modes"][mode]
                 lines.append(f"    {mode.replace('_', ' ')} {m['frequency_hz'][0]:.2f}-{m['frequency_hz'][1]:.2f} Hz at "
