@@ -139,8 +139,8 @@ def test_a_leaning_rider_reports_the_static_loads_of_the_whole_rider():
     rigid = assembly.build_bicycle(wk.Scenario())[2]
     for changes in ({"rider_body": "leaning"}, {"arms": "on"}, {"rider_body": "leaning", "arms": "on"}):
         sc = wk.Scenario(**changes)
-        _, design, info = assembly.build_bicycle(sc)
-        bench = benchmark.from_moore(design)
+        split, _, info = assembly.build_bicycle(sc)
+        bench = benchmark.from_moore(split)
         body = info["body"]
         bike = wk.bicycles.load(sc.bicycle)
         seat = riders.place(bike, riders.yeadon_rider(sc.rider, mass_kg=info["rider_mass_kg"])).seat
@@ -471,3 +471,13 @@ def test_lateral_poles_carry_the_leaning_body():
     poles = steady.lateral_poles(model.params, model.start.x)
     assert poles.size == len(slip.LINEAR_STATES) - 1 + 2
     assert np.all(np.isfinite(poles)) and poles[0].real < 0.0
+
+
+def test_the_whipple_design_sees_the_whole_rider():
+    """With a body, the Whipple model the LQR is designed on (``build_bicycle``'s ``design``) is the whole rider
+    lumped into the rear frame, as for the rigid rider: not the bicycle with legs and forearms only, which
+    would leave the upper body's mass out of the rider's gains."""
+    rigid = assembly.build_bicycle(wk.Scenario())[1]
+    for changes in ({"rider_body": "leaning"}, {"arms": "on"}, {"rider_body": "leaning", "arms": "on"}):
+        moore, design, _ = assembly.build_bicycle(wk.Scenario(**changes))
+        assert design == rigid and moore != rigid

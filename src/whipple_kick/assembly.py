@@ -144,7 +144,8 @@ def build_bicycle(scenario):
 
     The info holds the rider mass [kg] and the static loads [N] of the
     unmodified bicycle; ``moore`` has the low-inertia change applied if asked.
-    ``design`` is the unmodified set the LQR is designed on. Cached per
+    ``design`` is the unmodified set the LQR is designed on: the whole rider
+    lumped into the rear frame, also when ``moore`` splits it into a body. Cached per
     process on the fields it reads (a sweep over pressures, speeds or kicks
     seats the Yeadon rider once); callers get their own copies.
     """
@@ -179,16 +180,16 @@ def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia
         fz = 635.0 if fz_n is None else fz_n
         combined, rider_mass = riders.for_rear_load(bike, fz, rider=rider_name,
                                                     load_range=_rear_load_range(bicycle, _stamp, rider_name))
-    # The static loads of the whole rider: the split below moves the upper body out of the bicycle's
-    # parameters (static_loads would miss its weight), not out of the statics (the same mass and mass centre).
+    # The static loads and the Whipple model the LQR is designed on are the whole rider's: the split below
+    # moves the upper body out of the bicycle's parameters, not out of the statics or the rider's mass.
     rear_n, front_n = riders.static_loads(combined)
+    design = dict(combined.moore)
     body = None
     if split:
         # The same rider, split into legs (rear frame), forearms (front frame, when on the bar) and upper body.
         rider = riders.yeadon_rider(rider_name, mass_kg=rider_mass)
         combined, body = riders.seat_with_body(bike, rider, arms_on_bar=arms_on_bar)
-    design = dict(combined.moore)
-    moore = dict(design)
+    moore = dict(combined.moore)
     if low_inertia:
         bench = dict(combined.benchmark)
         for key in LOW_INERTIA_KEYS:

@@ -216,10 +216,9 @@ class _Setup:
     tyres: tuple
     notes: list
     controller: str
-    #: The no-slip model's bicycle with its rider and the set its LQR is designed on: the rigid rider's
-    #: (the same rider lumped into the rear frame, arms off the bar) when the scenario splits the body.
+    #: The no-slip model's bicycle with its rider: the rigid rider's (the same rider lumped into the rear
+    #: frame, arms off the bar) when the scenario splits the body. (``design`` is that rider's already.)
     classic_moore: dict = None
-    classic_design: dict = None
     #: The LQR rider designed on the model simulated, by design speed (``lqr_model="simulated"``).
     designs: dict = field(default_factory=dict)
 
@@ -231,12 +230,10 @@ def _setup(scenario, tyres=None):
         rear, front, notes = assembly.build_tyres(scenario)
     else:
         (rear, front), notes = tyres, [f"tyres given: {tyres[0]!r} (rear), {tyres[1]!r} (front)"]
-    classic_moore, classic_design = moore, design
+    classic_moore = moore   # the no-slip reference's rider is the rigid one (design is that rider already)
     if scenario.rider_body != "rigid" or scenario.arms == "on":
-        classic_moore, classic_design, _ = assembly.build_bicycle(scenario.with_changes(rider_body="rigid",
-                                                                                        arms="off"))
-    return _Setup(scenario, moore, design, info, (rear, front), notes, scenario.controller, classic_moore,
-                  classic_design)
+        classic_moore = assembly.build_bicycle(scenario.with_changes(rider_body="rigid", arms="off"))[0]
+    return _Setup(scenario, moore, design, info, (rear, front), notes, scenario.controller, classic_moore)
 
 
 def _base_params(setup):
