@@ -243,8 +243,10 @@ def _expressions():
             f"{kind}_ss_{w}": curves[kind](w, slip[w], k_sym[f"camber_{w}"], k_sym[f"fz_{w}"])
             for kind in ("fy", "mz") for w in "rf"}
     outputs.update({
-        "T7": k_sym["T7"], "T_reflex": S.sym("T_reflex"), "reflex_input": plain(ex["reflex_input"]), "arm_torque": plain(ex["arm_torque"]),
-        "hip_torque": plain(ex["hip_torque"]), "kinetic_energy": plain(eom.kinetic_energy),
+        # The reflex's torques are locals of the right-hand side (and arguments of the NumPy outputs).
+        "T7": k_sym["T7"], "T_reflex": S.sym("T_reflex"), "reflex_input": sm.Symbol("reflex_input", real=True),
+        "arm_torque": plain(ex["arm_torque"]), "hip_torque": plain(ex["hip_torque"]),
+        "kinetic_energy": plain(eom.kinetic_energy),
         "potential_energy": plain(eom.potential_energy), "spring_energy": plain(ex["spring_energy"]),
         "holonomic": plain(eom.holonomic),
         "sliding_power": k_sym["Fy_r"] * k_sym["vsy_r"] + k_sym["Fy_f"] * k_sym["vsy_f"],
@@ -264,6 +266,7 @@ def _expressions():
             "kinematics": [k_sym[n] for n in _KINEMATICS],
             "applied": [k_sym[n] for n in _APPLIED],
             "reflex": [S.sym("T_reflex")],
+            "reflex_outputs": [S.sym("T_reflex"), sm.Symbol("reflex_input", real=True)],
         },
     }
 
@@ -631,7 +634,7 @@ def numpy_source():
     block_symbols = [sm.Symbol(n, real=True) for n in _BLOCK_EXTRAS + _LIMIT_OUTPUTS]
     parts.append(codegen.numpy_function(
         "outputs", [("t", t), ("q", sy["q"]), ("u", sy["u"]), ("k", sy["kinematics"]), ("a", sy["applied"]),
-                    ("e", block_symbols), ("r", sy["reflex"]), ("p", sy["p"])],
+                    ("e", block_symbols), ("r", sy["reflex_outputs"]), ("p", sy["p"])],
         [sm.Matrix(_output_list(ex, "inline"))], doc="Named outputs after the speeds."))
     return "\n\n".join(parts)
 
@@ -683,7 +686,8 @@ def numpy_rhs(t, x, p, with_outputs=False):
         dx = np.concatenate([u, udot[_PARTITION.ind], block[4:8], reflex.rates(z, r_in, tau), rates])
         if with_outputs:
             limits = [_reference_limit(p, w, kin, applied[k]) for k, w in enumerate("rf")]
-            outputs = mod.outputs([t], q, u, kin, applied, np.concatenate([block[8:], limits]), [t_reflex], p)[0]
+            outputs = mod.outputs([t], q, u, kin, applied, np.concatenate([block[8:], limits]), [t_reflex, r_in],
+                                  p)[0]
             return dx, np.concatenate([u, outputs])
     return dx
 
