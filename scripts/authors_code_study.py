@@ -37,8 +37,11 @@ import tempfile
 import numpy as np
 
 import whipple_kick as wk
-from whipple_kick import authors_code, bicycles, slip, steady
-from whipple_kick.simulation import Scenario, run
+from whipple_kick.library import bicycles
+from whipple_kick.model import slip
+from whipple_kick.simulate import steady
+from whipple_kick.simulate.simulation import Scenario, run
+from whipple_kick.studies import authors_code
 
 DATA = pathlib.Path(__file__).resolve().parent.parent / "tests" / "data" / "authors_model"
 

@@ -30,7 +30,8 @@ import numpy as np
 
 def _base_case(rtol=1e-10):
     import whipple_kick as wk
-    from whipple_kick import slip, steady
+    from whipple_kick.model import slip
+    from whipple_kick.simulate import steady
     bike = wk.bicycles.load("balanceassist_v1")
     combined, _ = wk.riders.for_rear_load(bike, fz_n=635.0)
     K, _ = wk.control.lqr_gains(combined, 3.0)
@@ -41,8 +42,8 @@ def _base_case(rtol=1e-10):
 
 
 def bench_rhs(repeats):
-    from whipple_kick import slip
-    from whipple_kick.symbolic import slip_build
+    from whipple_kick.model import slip
+    from whipple_kick.model.symbolic import slip_build
     ss = _base_case()
     rhs = slip.CompiledRHS(ss.params)
     p = slip.parameter_vector(ss.params)
@@ -98,8 +99,9 @@ def bench_build(repeats):
 
 
 def bench_run(repeats):
-    from whipple_kick import lsoda, slip
-    from whipple_kick.symbolic import slip_build
+    from whipple_kick.model import slip
+    from whipple_kick.model.symbolic import slip_build
+    from whipple_kick.simulate import lsoda
     ss = _base_case()
     p = slip.parameter_vector(ss.params)
     for rtol in (1e-12, 1e-8):
@@ -127,7 +129,8 @@ def bench_transient(repeats):
     medians over ``repeats`` rounds and the ratio to the contact-patch form.
     """
     import whipple_kick as wk
-    from whipple_kick import slip, steady
+    from whipple_kick.model import slip
+    from whipple_kick.simulate import steady
     forms = ("contact_patch", "carcass", "slip_lag", "force_lag")
     calls, runs, integration = ({f: [] for f in forms} for _ in range(3))
     fast = {}
@@ -180,7 +183,7 @@ import numpy, scipy.integrate, pandas, matplotlib
 stages["import numpy, scipy, pandas, matplotlib"] = time.perf_counter() - t0
 t = time.perf_counter()
 from whipple_kick import assembly, cli, plotting, simulation, slip, steady
-from whipple_kick.scenario import Scenario
+from whipple_kick.simulate.scenario import Scenario
 stages["import whipple_kick (cli, simulation, plotting)"] = time.perf_counter() - t
 t = time.perf_counter()
 slip.library()
@@ -276,7 +279,7 @@ print(slip.library()._name)
 """
 _RUN = r"""
 import json, statistics, sys
-from whipple_kick.simulation import Scenario, run
+from whipple_kick.simulate.simulation import Scenario, run
 changes = json.loads(sys.argv[1])
 run(Scenario(duration=0.2, **changes))
 runs = [run(Scenario(**changes)).summary["numerics"] for _ in range(3)]
@@ -325,7 +328,7 @@ def bench_compare(args):
     # method for both libraries. The call from Python: this checkout's as the integrator makes it
     # (slip.CompiledRHS.fast), the other's as its CompiledRHS.__call__ did (contiguous input,
     # x.ctypes, ctypes call, copy).
-    from whipple_kick import rhs_call, slip
+    from whipple_kick.model import rhs_call, slip
     native = rhs_call.module(slip._compiler())
 
     def c_alone(label, n):

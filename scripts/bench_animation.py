@@ -4,7 +4,7 @@ The case of the performance bound: the default 6.5 s run (0.5 s steady
 running + 6 s after the kick) animated at 30 frames per second in real time
 (196 frames). Each repeat times, in the same process and back to back:
 
-* ``animate``: ``whipple_kick.animation.animate(result, path, slow_motion=1)``,
+* ``animate``: ``whipple_kick.figures.animation.animate(result, path, slow_motion=1)``,
   everything from the finished run to the closed file (scene, rider, figure,
   drawing, encoding);
 * ``empty``: matplotlib's own writer (``FFMpegWriter`` for mp4, ``PillowWriter``
@@ -37,7 +37,7 @@ def _empty_frames(fmt, path, frames, size, fps, dpi):
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    from whipple_kick import animation
+    from whipple_kick.figures import animation
 
     fig = Figure(figsize=(size[0] / dpi, size[1] / dpi), dpi=dpi)
     FigureCanvasAgg(fig)
@@ -62,7 +62,7 @@ def _compare_3d(result, repeats, fps=30.0, size=(1280, 720), dpi=100):
     import numpy as np
     from scipy.spatial import ConvexHull
 
-    from whipple_kick import animation
+    from whipple_kick.figures import animation
 
     t = result.trajectory["time"].to_numpy()
     times = animation.frame_times(float(t[0]), float(t[-1]), fps)
@@ -103,7 +103,7 @@ def _compare_3d(result, repeats, fps=30.0, size=(1280, 720), dpi=100):
             np.asarray(canvas.buffer_rgba())
         theirs.append(1e3 * (time.perf_counter() - t0) / times.size)
     print(f"drawing only, {times.size} frames {size[0]}x{size[1]}, {repeats} repeats:")
-    print(f"  whipple_kick.animation (NumPy projection, 2D artists): median {statistics.median(ours):.1f} ms/frame")
+    print(f"  whipple_kick.figures.animation (NumPy projection, 2D artists): median {statistics.median(ours):.1f} ms/frame")
     print(f"  matplotlib 3D axes, same scene redrawn:               median {statistics.median(theirs):.1f} ms/frame"
           f"  (ratio {statistics.median(theirs) / statistics.median(ours):.1f})")
 
@@ -117,7 +117,7 @@ def main(argv=None):
     args = p.parse_args(argv)
 
     import whipple_kick as wk
-    from whipple_kick.simulation import Scenario, run
+    from whipple_kick.simulate.simulation import Scenario, run
 
     result = run(Scenario())
     formats = {"both": ("mp4", "gif"), "none": ()}.get(args.format, (args.format,))

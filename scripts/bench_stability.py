@@ -25,7 +25,8 @@ import numpy as np
 
 def _steady(symmetric, speed=4.0):
     import whipple_kick as wk
-    from whipple_kick import simulation, slip, steady
+    from whipple_kick.model import slip
+    from whipple_kick.simulate import simulation, steady
     sc = simulation.Scenario(symmetric_tyres=symmetric, speed=speed)
     moore, design, _ = wk.assembly.build_bicycle(sc)
     rear, front, _ = wk.assembly.build_tyres(sc)
@@ -43,7 +44,7 @@ def _per_call(fun, calls):
 
 def bench_linearisation(repeats):
     """One call of slip.heading_linearisation, slip.linearize and CompiledRHS, interleaved rounds."""
-    from whipple_kick import slip
+    from whipple_kick.model import slip
     for label, symmetric in (("symmetric T03, 4 m/s (upright)", True), ("measured T03, 4 m/s (steady turn)", False)):
         st = _steady(symmetric)
         rhs = slip.CompiledRHS(st.params)
@@ -63,8 +64,9 @@ def bench_linearisation(repeats):
 
 def bench_sweep(repeats):
     """analyse() over 0.5:10:0.05 in one process (warm), against one RHS call and the old linearisation."""
-    from whipple_kick import slip, stability
-    from whipple_kick.simulation import Scenario
+    from whipple_kick.model import slip
+    from whipple_kick.simulate.simulation import Scenario
+    from whipple_kick.studies import stability
     speeds = stability.parse_speeds("0.5:10:0.05")
     scenario = Scenario(symmetric_tyres=True)
     stability.analyse(scenario, speeds)   # warm: caches, LQR designs, imports

@@ -49,7 +49,7 @@ def parallel_ceiling(workers=2, n=10_000_000):
 
 
 def _warm_up():
-    from whipple_kick import simulation
+    from whipple_kick.simulate import simulation
     simulation.run(simulation.Scenario(duration=0.3))
 
 
@@ -65,7 +65,7 @@ def bench_nine(repeats, duration):
     import pandas as pd
 
     import whipple_kick as wk
-    from whipple_kick import simulation
+    from whipple_kick.simulate import simulation
     base = simulation.Scenario(duration=duration)
     times = {}
     for workers in (1, 2):
@@ -97,7 +97,7 @@ def bench_many(n, duration, workers, folder):
     import numpy as np
 
     import whipple_kick as wk
-    from whipple_kick import simulation
+    from whipple_kick.simulate import simulation
     # A pressure x load grid of about n cases (interpolated tyres between the measured pressures).
     n_p = max(1, int(round(np.sqrt(n / 1.6))))
     n_f = max(1, int(round(n / n_p)))

@@ -3,9 +3,9 @@
 Usage:
     python scripts/bench_validate.py [--repeats 3] [--workers 2]
 
-Times :func:`whipple_kick.validation.validate` (the sweep with its process
+Times :func:`whipple_kick.studies.validation.validate` (the sweep with its process
 pool started afresh, the trajectories loaded, the yaw rates processed as the
-recordings were), then :func:`whipple_kick.validation.write` (CSV files and
+recordings were), then :func:`whipple_kick.studies.validation.write` (CSV files and
 the figure) and the whole ``validate`` command in a fresh process (imports
 included). "Warm": the compiled model is already in the on-disk cache (one
 throw-away case builds it first). The issue's acceptance: at most 2 minutes
@@ -25,7 +25,7 @@ def main():
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--workers", type=int, default=2)
     args = parser.parse_args()
-    from whipple_kick import sweep_engine, validation
+    from whipple_kick.studies import sweep_engine, validation
     validation.validate(validation.base_scenario(duration=0.3), directions=("right",), workers=1)   # warm
     runs, writes = [], []
     for _ in range(args.repeats):

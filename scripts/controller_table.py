@@ -20,8 +20,9 @@ import sys
 import numpy as np
 
 import whipple_kick as wk
-from whipple_kick import classic, control
 from whipple_kick.errors import InputError
+from whipple_kick.model import classic
+from whipple_kick.simulate import control
 
 #: Thesis Table 8.3: rider label, mass [kg] and the front load [N] implied by
 #: its 25/75 estimate (33 kg bicycle with 19 kg on the rear wheel, g = 9.81).

@@ -35,8 +35,9 @@ import time
 import numpy as np
 
 import whipple_kick as wk
-from whipple_kick import lsoda, simulation, slip, steady
-from whipple_kick.simulation import Scenario
+from whipple_kick.model import slip
+from whipple_kick.simulate import lsoda, simulation, steady
+from whipple_kick.simulate.simulation import Scenario
 
 SPEEDS = (1.5, 1.92, 2.0, 2.2, 2.4, 2.5, 2.6, 2.7, 3.0, 4.0, 6.0, 8.0)
 PRESSURES = (300.0, 400.0, 500.0)

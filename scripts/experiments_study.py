@@ -4,8 +4,8 @@ Usage:
     python scripts/experiments_study.py [--workers 2] [--forms contact_patch slip_lag force_lag]
 
 For each tyre transient form (default: every one of
-``whipple_kick.transient.TRANSIENTS``, the default form first) it runs
-``whipple_kick.validation.validate`` (nine cases x two kick directions, the
+``whipple_kick.model.transient.TRANSIENTS``, the default form first) it runs
+``whipple_kick.studies.validation.validate`` (nine cases x two kick directions, the
 experiments' set-up) and prints, as Markdown: the model against the measured
 metrics per case, the mean |error| per metric, the slow swing, and the best
 pressure per load by each rule and direction; then the printed
@@ -28,8 +28,9 @@ def _fmt(value, fmt):
 
 def main():
     import whipple_kick as wk
-    from whipple_kick import experiments, validation
-    from whipple_kick.scenario import Scenario
+    from whipple_kick.library import experiments
+    from whipple_kick.simulate.scenario import Scenario
+    from whipple_kick.studies import validation
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--forms", nargs="+", default=None)

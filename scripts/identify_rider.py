@@ -4,7 +4,7 @@ Each candidate model (a combination of mechanisms: the arms on the bar, a
 leaning upper body, a delayed reflex, with the carcass tyre's stiffness and
 damping free in every one) is run on the measured cases of the FITTED loads
 (570 and 635 N, 300/400/500 kPa; thesis Tables 8.6-8.8), processed as the
-recordings were (:func:`whipple_kick.validation.recorded_metrics`), and
+recordings were (:func:`whipple_kick.studies.validation.recorded_metrics`), and
 scored against the printed metrics. The best parameters of each combination
 are then run, without refitting, on the HELD-OUT load (701 N, Table 8.8).
 
@@ -42,7 +42,8 @@ import time
 import numpy as np
 
 import whipple_kick as wk
-from whipple_kick import experiments, validation
+from whipple_kick.library import experiments
+from whipple_kick.studies import validation
 
 FITTED_LOADS = (570.0, 635.0)
 HELD_OUT_LOADS = (701.0,)
@@ -297,7 +298,9 @@ def goal_lines(result):
 
 def main_stops(args):
     """What stops the best combination from meeting the goal: its closed loop's modes and the slow swing vs the gains."""
-    from whipple_kick import assembly, inputs, slip
+    from whipple_kick.library import inputs
+    from whipple_kick.model import slip
+    from whipple_kick.simulate import assembly
 
     path = pathlib.Path(args.folder)
     payload = json.loads((path if path.is_file() else path / "identification.json").read_text())

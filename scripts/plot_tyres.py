@@ -5,7 +5,7 @@ Fz 500/600/700 N, camber 0 and +-5 deg), extended to +-40 deg of slip, where
 the kick takes the rear tyre. Middle row: the same tyre at one load for
 several pressures (measured ones solid, interpolated dashed). Bottom row:
 the contact-patch transient's relaxation length, sigma0 * max(g_sec, G_MIN),
-with g_sec the secant ratio of the pure-slip curve (whipple_kick.transient).
+with g_sec the secant ratio of the pure-slip curve (whipple_kick.model.transient).
 
 The shaded band is the slip range the fits were measured over: up to 6 deg
 ("> |6| degrees, the maximum value tested in this study", thesis Section

@@ -15,7 +15,7 @@ HERE = pathlib.Path(__file__).resolve().parent
 
 def main(argv=None):
     import whipple_kick as wk
-    from whipple_kick.simulation import Scenario, run
+    from whipple_kick.simulate.simulation import Scenario, run
 
     path = pathlib.Path(argv[0]) if argv else HERE.parent / "docs" / "kick.gif"
     result = run(Scenario(pressure_kpa=400.0, fz_n=635.0))

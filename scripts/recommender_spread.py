@@ -25,8 +25,8 @@ import sys
 import numpy as np
 
 import whipple_kick as wk
-from whipple_kick import simulation
-from whipple_kick.simulation import Scenario
+from whipple_kick.simulate import simulation
+from whipple_kick.simulate.simulation import Scenario
 
 PRESSURES = (300.0, 400.0, 500.0)
 LOADS = (570.0, 635.0, 701.0)

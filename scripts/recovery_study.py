@@ -1,6 +1,6 @@
 """What sets the time the rider needs to recover from the thesis kick.
 
-The recovery time (``whipple_kick.analysis.recovery``) is when yaw, roll and
+The recovery time (``whipple_kick.simulate.analysis.recovery``) is when yaw, roll and
 steer rates have all settled: each stays within 5 % of its first peak after
 the kick. A yaw rate back within 5 % in 2 s was once asked for; the thesis'
 own rider and every rider tried here need longer. This script measures what
@@ -42,8 +42,10 @@ import scipy.linalg as sl
 import scipy.optimize as so
 
 import whipple_kick as wk
-from whipple_kick import control, simulation, slip, steady, tyres
-from whipple_kick.simulation import Scenario
+from whipple_kick.library import tyres
+from whipple_kick.model import slip
+from whipple_kick.simulate import control, simulation, steady
+from whipple_kick.simulate.simulation import Scenario
 
 RIDER_STATES = ("q4", "q7", "u4", "u7")
 SIGNALS = ("yaw_rate", "roll_rate", "steer_rate")

@@ -75,7 +75,7 @@ def _write_kick_table(path):
 def cases():
     """{name: Scenario}: the nine thesis cases, controller off, a 40 m/s^2 kick, and one case per variant:
     the thesis preset, the plate friction mode, the smooth and the tabulated kicks, T04, 350 kPa, 5 m/s."""
-    from whipple_kick.simulation import Scenario
+    from whipple_kick.simulate.simulation import Scenario
     base = Scenario(output_rate=RATE_HZ)    # defaults: LQR rider, T03, 3 m/s, 150 mm in 0.150 s, 6 s
     out = {}
     for fz in (570, 635, 701):
@@ -103,7 +103,7 @@ def runnable(scenario, folder=OUT):
 
 def write_case(name, scenario, path):
     """Run ``scenario`` and store its trajectory in ``path`` (NPZ)."""
-    from whipple_kick import simulation
+    from whipple_kick.simulate import simulation
     result = simulation.run(runnable(scenario, path.parent))
     df = result.trajectory
     arrays = {c: df[c].to_numpy(dtype=np.float32) for c in COLUMNS if c in df.columns}
@@ -116,7 +116,7 @@ def write_case(name, scenario, path):
 
 def rewrite_pinned(name, folder=THESIS_FORM):
     """Rerun the stored scenario of ``<folder>/<name>.npz`` and rewrite it (its columns and scenario kept)."""
-    from whipple_kick import simulation
+    from whipple_kick.simulate import simulation
     path = folder / f"{name}.npz"
     if not path.exists():
         raise SystemExit(f"no pinned reference {name!r} in {folder}")

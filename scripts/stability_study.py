@@ -38,8 +38,10 @@ import pathlib
 import numpy as np
 
 import whipple_kick as wk
-from whipple_kick import simulation, stability, tyres
-from whipple_kick.simulation import Scenario
+from whipple_kick.library import tyres
+from whipple_kick.simulate import simulation
+from whipple_kick.simulate.simulation import Scenario
+from whipple_kick.studies import stability
 
 BASE = Scenario(symmetric_tyres=True)
 STUDY_SPEEDS = stability.parse_speeds("2:8:0.05")
@@ -58,7 +60,7 @@ class ModifiedTyre:
 
     Parameters
     ----------
-    tyre : whipple_kick.tyres.Tyre
+    tyre : whipple_kick.library.tyres.Tyre
     camber_scale : float
         Multiplies the camber shifts of F_y (a8, a11): the camber stiffness scales with it.
     moment : {"on", "off", "no_camber"}

@@ -24,8 +24,9 @@ import sys
 
 import numpy as np
 
-from whipple_kick import simulation, slip
-from whipple_kick.simulation import Scenario
+from whipple_kick.model import slip
+from whipple_kick.simulate import simulation
+from whipple_kick.simulate.simulation import Scenario
 
 LIMITS = (60.0, 75.0, 90.0, 180.0, None)   # [deg]; None: no steer limit
 NINE_CASES = [(p, fz) for fz in (570.0, 635.0, 701.0) for p in (300.0, 400.0, 500.0)]

@@ -1,7 +1,7 @@
 """Reproduce the kick-plate figures of the thesis' Chapter 8 as PNGs.
 
 Each figure is one command; the runs use the thesis' presets
-(:meth:`whipple_kick.simulation.Scenario.thesis`: the authors' bicycle+rider
+(:meth:`whipple_kick.simulate.simulation.Scenario.thesis`: the authors' bicycle+rider
 set ``balanceassist_635N``, Table 8.4 gains for 635 N, T03 with the
 ``chapter8`` coefficients and the ``thesis`` friction mode, LSODA rtol 1e-12)
 unless ``--project`` asks for the project's defaults (balanceassist_v1 +
@@ -21,7 +21,7 @@ import time
 
 import whipple_kick as wk
 from whipple_kick.errors import InputError
-from whipple_kick.simulation import Scenario, run
+from whipple_kick.simulate.simulation import Scenario, run
 
 HERE = pathlib.Path(__file__).resolve().parent
 PRESSURES = (300.0, 400.0, 500.0)

@@ -36,9 +36,9 @@ import sys
 import numpy as np
 
 import whipple_kick as wk
-from whipple_kick import transient
-from whipple_kick.assembly import build_tyres
-from whipple_kick.simulation import Scenario, run
+from whipple_kick.model import transient
+from whipple_kick.simulate.assembly import build_tyres
+from whipple_kick.simulate.simulation import Scenario, run
 
 BASE = Scenario(pressure_kpa=400.0, fz_n=635.0)
 
@@ -97,8 +97,8 @@ def gmin():
 @contextlib.contextmanager
 def _secant_floor(value):
     """Compile and use the model with ``transient.G_MIN = value`` (its own cache entry)."""
-    from whipple_kick import cache, slip
-    from whipple_kick.symbolic import slip_build
+    from whipple_kick.model import cache, slip
+    from whipple_kick.model.symbolic import slip_build
     original, hash_function = transient.G_MIN, cache.source_hash
 
     def keyed(sources, extra=""):
@@ -188,7 +188,8 @@ def steady():
     print(f"T6c = {st['rear_wheel_torque_n_m']:+.5f} N m ({st['rear_wheel_torque_role']}); steady powers [W]: "
           + ", ".join(f"{k} {v:+.4f}" for k, v in st["steady_power_w"].items()))
     # What positive T6c does: integrate the steady state with T6c = 0 for 20 s (no kick).
-    from whipple_kick import lsoda, slip
+    from whipple_kick.model import slip
+    from whipple_kick.simulate import lsoda
     moore, design, _ = wk.assembly.build_bicycle(BASE)
     gains, _ = wk.assembly.controller_gains(BASE, design)
     rear, front, _ = build_tyres(BASE)
@@ -301,7 +302,7 @@ def sliding_laws():
 
 def peak_slips():
     """T03 table7_9's peak slip and peak force per pressure and load (the carcass tyre's friction limit)."""
-    from whipple_kick import carcass as carcass_module
+    from whipple_kick.model import carcass as carcass_module
     print(r"| pressure [kPa] | C | load [N] | peak slip [deg] | peak \|F_y\| [N] | \|F_y\| at 33 deg / peak "
           r"| \|F_y\| at 80 deg (cap) / at 89.9 deg |")
     print("|" + "---|" * 7)

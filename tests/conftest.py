@@ -2,8 +2,8 @@
 import pytest
 
 import whipple_kick as wk
-from whipple_kick.scenario import Scenario
-from whipple_kick.simulation import run
+from whipple_kick.simulate.scenario import Scenario
+from whipple_kick.simulate.simulation import run
 
 
 @pytest.fixture(scope="session")

@@ -17,8 +17,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from whipple_kick import analysis as an
 from whipple_kick.errors import InputError
+from whipple_kick.simulate import analysis as an
 
 ZETA, FN = 0.07, 5.5  # like the thesis' yaw rate: lightly damped, ~5.5 Hz
 WN = 2 * math.pi * FN

@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 
 import whipple_kick as wk
-from whipple_kick import animation, simulation
 from whipple_kick.errors import InputError
+from whipple_kick.figures import animation
+from whipple_kick.simulate import simulation
 
 
 @pytest.fixture(scope="module")

@@ -3,10 +3,12 @@ import numpy as np
 import pytest
 
 import whipple_kick as wk
-from whipple_kick import assembly, inputs, slip
 from whipple_kick.errors import InputError
-from whipple_kick.scenario import Scenario
-from whipple_kick.simulation import run
+from whipple_kick.library import inputs
+from whipple_kick.model import slip
+from whipple_kick.simulate import assembly
+from whipple_kick.simulate.scenario import Scenario
+from whipple_kick.simulate.simulation import run
 
 
 def test_assemble_hands_over_a_finished_model():
@@ -81,7 +83,7 @@ def test_yaw_angle_gain_needs_straight_steady_running():
 def test_upright_start_without_a_steady_motion_is_judged_about_upright_running(monkeypatch):
     """With no steady motion for these tyres (forced here), an upright start still runs; stability and
     recovery are then judged about upright running with the offsets removed, and the summary says so."""
-    from whipple_kick import steady
+    from whipple_kick.simulate import steady
 
     def none(*args, **kwargs):
         raise steady.NoSteadyMotion("no steady motion (forced by the test)")

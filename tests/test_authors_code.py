@@ -13,9 +13,10 @@ import numpy as np
 import pytest
 
 import whipple_kick as wk
-from whipple_kick import authors_code, slip
 from whipple_kick.errors import InputError
-from whipple_kick.simulation import Scenario, run
+from whipple_kick.model import slip
+from whipple_kick.simulate.simulation import Scenario, run
+from whipple_kick.studies import authors_code
 
 DATA = pathlib.Path(__file__).parent / "data" / "authors_model"
 

@@ -3,8 +3,8 @@
 import pytest
 
 import whipple_kick as wk
-from whipple_kick.benchmark import BENCHMARK_NAMES, MOORE_NAMES, from_moore, to_moore
 from whipple_kick.errors import InputError
+from whipple_kick.model.benchmark import BENCHMARK_NAMES, MOORE_NAMES, from_moore, to_moore
 
 SHIPPED = ("balanceassist_v1", "benchmark", "balanceassist_635N", "balanceassist_701N",
            "browser_with_rider")
@@ -88,7 +88,7 @@ GOOD = (wk.bicycles.BICYCLE_DIR / "benchmark.toml").read_text()
     (lambda t: t.replace('[parameters]', '[parameters'), "not valid TOML"),
 ])
 def test_malformed_file_is_an_input_error_naming_file_and_key(tmp_path, edit, message):
-    """One line, ``<file>: <key>: <problem>`` (the one format of :mod:`whipple_kick.parameters`)."""
+    """One line, ``<file>: <key>: <problem>`` (the one format of :mod:`whipple_kick.library.parameters`)."""
     path = tmp_path / "broken.toml"
     text = edit(GOOD)
     assert text != GOOD

@@ -5,8 +5,8 @@ import sys
 
 import pytest
 
-from whipple_kick import cache, slip
 from whipple_kick.errors import CacheError, InputError
+from whipple_kick.model import cache, slip
 
 
 def test_cache_folder_is_private(tmp_path, monkeypatch):
@@ -75,7 +75,7 @@ def test_every_generator_is_part_of_its_own_cache_key():
     """A module that writes generated code is hashed into that code's key: editing what it writes
     rebuilds the entry (classic.py was not in its own key, so a change to _generate_source reused the
     stale module unless someone remembered to bump a layout string)."""
-    from whipple_kick import classic, geometry
+    from whipple_kick.model import classic, geometry
     slip_modules = tuple(f"slip/{p.stem}" for p in (cache._PACKAGE_DIR / "slip").glob("*.py"))
     for module, name in ((classic, "classic"), (geometry, "geometry"), (slip, "symbolic/slip_build"),
                          *((slip, m) for m in slip_modules)):

@@ -10,10 +10,11 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import whipple_kick as wk
-from whipple_kick import carcass, slip, steady
-from whipple_kick.scenario import Scenario
-from whipple_kick.simulation import run
-from whipple_kick.symbolic import slip_build
+from whipple_kick.model import carcass, slip
+from whipple_kick.model.symbolic import slip_build
+from whipple_kick.simulate import steady
+from whipple_kick.simulate.scenario import Scenario
+from whipple_kick.simulate.simulation import run
 
 RUNS = {"default": {}, "left kick": {"kick_direction": "left"}, "40 m/s^2": {"kick_accel": 40.0},
         "controller off": {"controller": "off"}}
@@ -216,7 +217,7 @@ def test_carcass_damper_dissipates_and_the_balance_closes():
 
 @pytest.mark.parametrize(("law", "damping"), [("curve", 0.0), ("peak", 75.0), ("curve", 75.0)])
 def test_options_agree_with_the_python_block(rider_bike, gains, t03, law, damping):
-    """C against the independent Python block (:func:`whipple_kick.carcass.reference_block`) for the
+    """C against the independent Python block (:func:`whipple_kick.model.carcass.reference_block`) for the
     sliding laws and the damper, at 60 random states on and past the limit. Tolerance 1e-8 relative: two
     exact inversions of the curve near its peak agree to ~eps F / (dF/da)."""
     par = slip.model_parameters(rider_bike, t03, t03, gains=gains, carcass_sliding=law, carcass_damping=damping,

@@ -4,7 +4,7 @@ import pytest
 import sympy as sm
 
 import whipple_kick as wk
-from whipple_kick import benchmark, classic
+from whipple_kick.model import benchmark, classic
 
 
 @pytest.fixture(scope="module")
@@ -143,7 +143,7 @@ def test_every_symbol_is_described():
 
 
 def test_derivation_uses_only_registered_symbols():
-    from whipple_kick.symbolic import derivation
+    from whipple_kick.model.symbolic import derivation
     eom = derivation.classic_equations()
     t = sm.Symbol("t")
     names = set()

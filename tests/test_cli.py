@@ -387,7 +387,7 @@ def test_animate_without_an_encoder_writes_a_gif(tmp_path, capsys, monkeypatch):
     """No ffmpeg: the same animation as a GIF (Pillow), with a note saying how to get mp4."""
     from PIL import Image
 
-    from whipple_kick import animation
+    from whipple_kick.figures import animation
 
     monkeypatch.setattr(animation, "video_encoder", lambda: None)
     out = tmp_path / "run"

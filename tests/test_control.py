@@ -12,8 +12,9 @@ import pytest
 from scipy.linalg import expm, solve_continuous_are
 
 import whipple_kick as wk
-from whipple_kick import classic, control
 from whipple_kick.errors import InputError
+from whipple_kick.model import classic
+from whipple_kick.simulate import control
 
 DESIGN_SPEED = 3.0  # m/s, the thesis' design speed
 THESIS_LOADS = (570, 635, 701)  # N, Table 8.3 rear-tyre loads

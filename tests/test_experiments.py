@@ -9,8 +9,9 @@ import math
 
 import pytest
 
-from whipple_kick import analysis, experiments
 from whipple_kick.errors import InputError
+from whipple_kick.library import experiments
+from whipple_kick.simulate import analysis
 
 # Printed rows, columns 300 / 400 / 500 kPa, then the two % variations of the last column.
 TABLE_8_6 = {   # F_z = 570 N; % variation 300 vs 400 (300 vs 500)

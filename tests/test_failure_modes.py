@@ -16,10 +16,12 @@ import time
 import numpy as np
 import pytest
 
-from whipple_kick import cache, cli, fileio, inputs, slip
+from whipple_kick import cli, fileio
 from whipple_kick.cli import simulate_main
 from whipple_kick.errors import BuildError, InputError
-from whipple_kick.symbolic import slip_build
+from whipple_kick.library import inputs
+from whipple_kick.model import cache, slip
+from whipple_kick.model.symbolic import slip_build
 
 
 def _simulate(argv, capsys):
@@ -274,7 +276,7 @@ def test_interrupted_run_in_an_existing_folder_removes_only_its_own_files(tmp_pa
     out = tmp_path / "run"
     out.mkdir()
     (out / "notes.txt").write_text("mine\n")
-    from whipple_kick import plotting
+    from whipple_kick.figures import plotting
 
     def interrupt(*args, **kwargs):
         raise KeyboardInterrupt
@@ -338,7 +340,7 @@ def test_kick_table_in_mm_read_as_metres_is_implausible(tmp_path, capsys, monkey
 
 
 def test_kick_table_held_to_the_built_in_velocity_cap(tmp_path):
-    from whipple_kick.scenario import Scenario
+    from whipple_kick.simulate.scenario import Scenario
     table = _write(tmp_path / "plate.csv", "time,y\n0,0\n0.001,0.5\n0.002,0\n")     # 0.5 m in 1 ms and back
     with pytest.raises(InputError, match=r"peak plate velocity = \d+(\.\d+)? m/s is implausible; allowed \[0, 31.62\] m/s"):
         inputs.kick_of(Scenario(kick_profile="table", kick_table=str(table)))
@@ -444,7 +446,7 @@ def test_second_sweep_on_the_same_folder_is_refused_in_one_line(tmp_path):
 
 def test_lock_of_a_dead_process_is_taken_over(tmp_path):
     """The lock is the operating system's (flock): it goes with its holder, whatever the file says."""
-    from whipple_kick import sweep_store
+    from whipple_kick.studies import sweep_store
     folder = tmp_path / "sweep"
     folder.mkdir()
     dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)

@@ -11,10 +11,12 @@ import numpy as np
 import pytest
 
 import whipple_kick as wk
-from whipple_kick import animation, geometry, simulation
-from whipple_kick import symbols as S
 from whipple_kick.errors import InputError
-from whipple_kick.symbolic import derivation
+from whipple_kick.figures import animation
+from whipple_kick.model import geometry
+from whipple_kick.model import symbols as S
+from whipple_kick.model.symbolic import derivation
+from whipple_kick.simulate import simulation
 
 
 @pytest.fixture(scope="module")

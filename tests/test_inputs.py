@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 import whipple_kick as wk
-from whipple_kick import inputs
 from whipple_kick.errors import InputError
-from whipple_kick.inputs import kick_of
-from whipple_kick.scenario import Scenario
+from whipple_kick.library import inputs
+from whipple_kick.library.inputs import kick_of
+from whipple_kick.simulate.scenario import Scenario
 
 
 def _write_table(path, t, y, header="time,y"):

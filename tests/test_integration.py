@@ -5,10 +5,10 @@ import numpy as np
 import pytest
 
 import whipple_kick as wk
-from whipple_kick import integration
 from whipple_kick.errors import SimulationError
-from whipple_kick.scenario import Scenario
-from whipple_kick.simulation import run
+from whipple_kick.simulate import integration
+from whipple_kick.simulate.scenario import Scenario
+from whipple_kick.simulate.simulation import run
 
 
 def _finite_partial(result):
@@ -185,7 +185,7 @@ def test_work_counters_are_the_sum_over_the_pieces(changes, monkeypatch):
     keep_speeds runs reported njev = 0 and evaluations = 0: their two pieces were
     merged by hand without those counters (now lsoda.join merges every run's pieces).
     """
-    from whipple_kick import lsoda
+    from whipple_kick.simulate import lsoda
     pieces = []
     integrate = lsoda.integrate
 
@@ -202,7 +202,7 @@ def test_work_counters_are_the_sum_over_the_pieces(changes, monkeypatch):
 
 
 def test_join_concatenates_samples_sums_counters_and_ends_as_the_last_piece():
-    from whipple_kick import lsoda
+    from whipple_kick.simulate import lsoda
     n = len(wk.slip.STATE_NAMES)
     a = lsoda.StateHistory(np.array([0.0, 1.0]), np.zeros((2, n)), False, None, 10, "a", end_state=np.zeros(n),
                          njev=2, evaluations=30)

@@ -3,7 +3,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from whipple_kick import energy, kane
+from whipple_kick.model import energy, kane
 
 
 def test_impulsive_projection_of_two_masses_whose_relative_speed_is_imposed():

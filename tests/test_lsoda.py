@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from whipple_kick import lsoda, slip
+from whipple_kick.model import slip
+from whipple_kick.simulate import lsoda
 
 N = len(slip.STATE_NAMES)
 ROLL, ROLL_RATE = slip.X["q4"], slip.X["u4"]

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 import sympy as sm
 
-from whipple_kick import magic_formula as mf
-from whipple_kick import tyres
+from whipple_kick.library import tyres
+from whipple_kick.model import magic_formula as mf
 
 DEG = np.pi / 180.0
 # Offsets (Sh: a9, a10; Sv: a12, a13) are the fit's zero-slip force at zero

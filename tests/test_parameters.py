@@ -4,8 +4,8 @@ import pathlib
 import pytest
 
 import whipple_kick as wk
-from whipple_kick import parameters
 from whipple_kick.errors import InputError
+from whipple_kick.library import parameters
 
 REPOSITORY_PARAMETERS = pathlib.Path(__file__).resolve().parents[1] / "parameters"
 

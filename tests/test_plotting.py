@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 import whipple_kick as wk
-from whipple_kick import plotting, simulation
+from whipple_kick.figures import plotting
+from whipple_kick.simulate import simulation
 
 
 @pytest.fixture(scope="module")

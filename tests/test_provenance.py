@@ -8,7 +8,7 @@ import sys
 import pytest
 
 import whipple_kick as wk
-from whipple_kick import provenance
+from whipple_kick.simulate import provenance
 
 REPO = pathlib.Path(__file__).resolve().parent.parent
 

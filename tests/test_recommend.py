@@ -9,7 +9,7 @@ import pytest
 
 import whipple_kick as wk
 from whipple_kick.errors import InputError
-from whipple_kick.scenario import Scenario
+from whipple_kick.simulate.scenario import Scenario
 
 # Short runs: the sweep machinery, not the physics, is under test here.
 BASE = Scenario(duration=3.0, settle=0.1, output_rate=200.0, fz_n=635.0)
@@ -182,8 +182,8 @@ def test_a_sweep_whose_every_case_fails_is_an_error_not_a_verdict(monkeypatch):
     """Before: the verdict "none recovered" and, from the command line, exit status 0."""
     import concurrent.futures as cf
 
-    from whipple_kick import simulation
-    from whipple_kick.sweep_engine import SweepFailed
+    from whipple_kick.simulate import simulation
+    from whipple_kick.studies.sweep_engine import SweepFailed
 
     def broken(scenario):
         raise ZeroDivisionError("a bug")
@@ -197,7 +197,7 @@ def test_a_sweep_whose_every_case_fails_is_an_error_not_a_verdict(monkeypatch):
 
 def test_recommend_pressure_reports_a_sweep_whose_every_case_failed_in_one_line_exit_1(monkeypatch, capsys):
     from whipple_kick import cli
-    from whipple_kick.sweep_engine import SweepFailed
+    from whipple_kick.studies.sweep_engine import SweepFailed
 
     def failed(*args, **kwargs):
         raise SweepFailed("all 3 cases failed (...); the first, case 0123, with ZeroDivisionError: a bug")

@@ -11,7 +11,7 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 from scipy.signal import argrelextrema
 
-from whipple_kick import reflex
+from whipple_kick.model import reflex
 
 TAU = 0.04  # s, a human reflex delay
 

@@ -39,7 +39,7 @@ import numpy as np
 import pytest
 
 import whipple_kick as wk
-from whipple_kick import simulation
+from whipple_kick.simulate import simulation
 
 DATA = pathlib.Path(__file__).parent / "data" / "regression"
 THESIS_FORM = DATA / "thesis_form"

@@ -7,10 +7,11 @@ import numpy as np
 import pytest
 
 import whipple_kick as wk
-from whipple_kick import results, slip
 from whipple_kick.errors import SimulationError
-from whipple_kick.scenario import Scenario
-from whipple_kick.simulation import run
+from whipple_kick.model import slip
+from whipple_kick.simulate import results
+from whipple_kick.simulate.scenario import Scenario
+from whipple_kick.simulate.simulation import run
 
 
 def test_every_column_has_one_unit_from_one_source():

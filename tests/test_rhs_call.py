@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 import whipple_kick as wk
-from whipple_kick import lsoda, rhs_call, slip
+from whipple_kick.model import rhs_call, slip
+from whipple_kick.simulate import lsoda
 
 
 @pytest.fixture(scope="module")

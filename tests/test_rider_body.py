@@ -11,10 +11,12 @@ import pytest
 from scipy.linalg import solve_continuous_lyapunov
 
 import whipple_kick as wk
-from whipple_kick import assembly, benchmark, classic, control, inputs, lsoda, riders, slip, steady
-from whipple_kick.benchmark import steer_axis_tilt
 from whipple_kick.errors import InputError
-from whipple_kick.symbolic import slip_build
+from whipple_kick.library import inputs, riders
+from whipple_kick.model import benchmark, classic, slip
+from whipple_kick.model.benchmark import steer_axis_tilt
+from whipple_kick.model.symbolic import slip_build
+from whipple_kick.simulate import assembly, control, lsoda, steady
 
 
 @pytest.fixture(scope="module")

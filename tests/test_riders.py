@@ -4,8 +4,8 @@ import pytest
 import yeadon
 
 import whipple_kick as wk
-from whipple_kick.benchmark import from_moore
 from whipple_kick.errors import InputError
+from whipple_kick.model.benchmark import from_moore
 
 # Jason seated on the balance-assist bicycle v1 as computed by Moore's
 # BicycleParameters (file JasonBalanceassistv1Benchmark.txt, github.com/moorepants/BicycleParameters).
@@ -192,8 +192,9 @@ def test_rider_file_has_95_measurements_in_metres():
 
 def test_a_load_sweep_seats_the_probe_rider_once(monkeypatch):
     # The rear-load range (a probe rider seated) does not depend on the load: found once per process.
-    from whipple_kick import assembly, bicycles, riders
-    from whipple_kick.scenario import Scenario
+    from whipple_kick.library import bicycles, riders
+    from whipple_kick.simulate import assembly
+    from whipple_kick.simulate.scenario import Scenario
 
     calls = []
     probe = riders.rear_load_range

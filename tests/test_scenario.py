@@ -5,14 +5,15 @@ import re
 import pytest
 
 from whipple_kick.errors import InputError
-from whipple_kick.scenario import Scenario
+from whipple_kick.simulate.scenario import Scenario
 
 
 def test_defaults_are_the_thesis_settings_and_validate_returns_the_scenario():
     """What the defaults do, not what they are: the thesis' kick (150 mm in 0.150 s at a constant
     13.3 m/s^2, Dell'Orto 2025, Section 8.2), a rider seated for 635 N on the rear tyre, the LQR rider
     designed at the run's speed, T03 at 400 kPa on both wheels."""
-    from whipple_kick import assembly, inputs
+    from whipple_kick.library import inputs
+    from whipple_kick.simulate import assembly
     sc = Scenario()
     assert sc.validate() is sc
     kick = inputs.kick_of(sc)
@@ -21,7 +22,7 @@ def test_defaults_are_the_thesis_settings_and_validate_returns_the_scenario():
     rear, front, notes = assembly.build_tyres(sc)
     assert (rear.name, rear.pressure_kpa, front.pressure_kpa, notes) == ("T03", 400.0, 400.0, [])
     assert sc.lqr_design_speed == sc.speed == 3.0
-    from whipple_kick.simulation import run
+    from whipple_kick.simulate.simulation import run
     bike = run(sc.with_changes(duration=0.2)).summary["bicycle"]
     assert bike["bicycle"] == "balanceassist_v1" and bike["static_load_rear_n"] == pytest.approx(635.0, abs=1e-6)
     assert Scenario(speed=5.0).lqr_design_speed == 5.0 and Scenario(design_speed=3.0, speed=5.0).lqr_design_speed == 3.0
@@ -129,7 +130,7 @@ def test_every_field_is_in_exactly_one_group():
     the groups' views hold the values; construction stays flat."""
     import dataclasses
 
-    from whipple_kick.scenario import FIELD_GROUPS
+    from whipple_kick.simulate.scenario import FIELD_GROUPS
     fields = [f.name for f in dataclasses.fields(Scenario)]
     grouped = [name for names in FIELD_GROUPS.values() for name in names]
     assert sorted(grouped) == sorted(fields) and len(grouped) == len(set(grouped))

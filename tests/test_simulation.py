@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import whipple_kick as wk
-from whipple_kick.simulation import Scenario, SimulationError, run
+from whipple_kick.simulate.simulation import Scenario, SimulationError, run
 
 
 def _recovery(result):
@@ -684,7 +684,8 @@ def test_steady_rear_wheel_torque_is_a_brake_fed_by_the_tyres():
     assert abs(sum(power.values())) < 1e-9
     assert "drive_torque_n_m" not in st
     # Without the brake the tyres speed the bicycle up.
-    from whipple_kick import lsoda, slip, steady
+    from whipple_kick.model import slip
+    from whipple_kick.simulate import lsoda, steady
     sc = r.scenario
     moore, design, _ = wk.assembly.build_bicycle(sc)
     gains, _ = wk.assembly.controller_gains(sc, design)

@@ -4,8 +4,9 @@ import numpy as np
 import pytest
 
 import whipple_kick as wk
-from whipple_kick import benchmark, classic, lsoda, slip, steady
-from whipple_kick.symbolic import slip_build
+from whipple_kick.model import benchmark, classic, slip
+from whipple_kick.model.symbolic import slip_build
+from whipple_kick.simulate import lsoda, steady
 
 
 def _outputs(rhs, trajectory):

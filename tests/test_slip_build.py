@@ -5,8 +5,9 @@ import numpy as np
 import pytest
 
 import whipple_kick as wk
-from whipple_kick import cache, slip, steady
-from whipple_kick.symbolic import slip_build
+from whipple_kick.model import cache, slip
+from whipple_kick.model.symbolic import slip_build
+from whipple_kick.simulate import steady
 
 # Spread of the random tyre states: forces [N] and moments [N m] for the
 # thesis' form, patch slip and camber angles [rad] for the contact forms, carcass

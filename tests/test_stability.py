@@ -8,8 +8,10 @@ import pandas as pd
 import pytest
 
 import whipple_kick as wk
-from whipple_kick import classic, cli, slip, stability
-from whipple_kick.simulation import Scenario
+from whipple_kick import cli
+from whipple_kick.model import classic, slip
+from whipple_kick.simulate.simulation import Scenario
+from whipple_kick.studies import stability
 
 #: The default case of the stability command: T03 at 400 kPa, 635 N, offsets removed.
 DEFAULT = Scenario(symmetric_tyres=True)
@@ -462,8 +464,8 @@ def _split_sweep(speeds):
     3.87 + (0.9 - sqrt(0.8)) / 2 m/s. Every eigenvector is named by roll: the
     pair is the weave, the real eigenvalues capsize.
     """
-    from whipple_kick.stability import summary
-    from whipple_kick.stability import sweep as sweep_module
+    from whipple_kick.studies.stability import summary
+    from whipple_kick.studies.stability import sweep as sweep_module
 
     def eigen_at(v, k=None):
         return np.linalg.eig(np.array([[3.82 - v, 1.0], [v - 3.87, 3.82 - v]]))
@@ -571,7 +573,7 @@ def test_pressure_load_figure_draws_the_nine_case_table(tmp_path):
     raised a ValueError before (three loads zipped strictly against four colours)."""
     import pandas as pd
 
-    from whipple_kick.stability.pressure_load import pressure_load_figure
+    from whipple_kick.studies.stability.pressure_load import pressure_load_figure
 
     rows = [{"fz_n": fz, "pressure_kpa": p, "at_speed_m_s": 2.0, "weave_speed_m_s": 3.8, "capsize_speed_m_s": 3.9,
              "noslip_weave_speed_m_s": 4.1, "noslip_capsize_speed_m_s": 6.0, "closed_weave_damping_ratio": 0.5,

@@ -5,8 +5,9 @@ import numpy as np
 import pytest
 
 import whipple_kick as wk
-from whipple_kick import control, slip, steady
-from whipple_kick.simulation import Scenario
+from whipple_kick.model import slip
+from whipple_kick.simulate import control, steady
+from whipple_kick.simulate.simulation import Scenario
 
 
 def _params(pressure=400.0, fz=635.0, design_speed=3.0, symmetric=False):

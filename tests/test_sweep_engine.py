@@ -9,7 +9,7 @@ from conftest import SWEEP_BASE as BASE
 from conftest import SWEEP_GRID as GRID
 import whipple_kick as wk
 from whipple_kick.errors import InputError
-from whipple_kick.scenario import Scenario
+from whipple_kick.simulate.scenario import Scenario
 
 
 def test_table_has_one_row_per_case_with_inputs_and_metrics(default_run):
@@ -40,7 +40,7 @@ def test_sweep_results_equal_a_direct_run(default_run):
     # The per-process cache of rider and LQR must not change any number.
     _, table = default_run
     direct = wk.run(BASE.with_changes(pressure_kpa=400.0)).summary
-    flat = wk.sweep_engine.flatten_summary(direct)
+    flat = wk.results.flatten_summary(direct)
     row = table.iloc[1]
     assert flat["last_peak_time_s"] is not None
     for key, value in flat.items():
@@ -60,7 +60,7 @@ def test_a_case_thinned_to_200_hz_keeps_the_summary_of_every_sample():
     spec = wk.sweep_engine._trajectory_spec(wk.sweep_engine.DEFAULT_TRAJECTORY_COLUMNS, "float32", 200.0)
     record = wk.sweep_engine.run_case(scenario, "x", spec)
     assert record["trajectory"]["time"].size == 1 + int(round((1.5 + 0.1) * 200))
-    direct = wk.sweep_engine.flatten_summary(wk.run(scenario).summary)
+    direct = wk.results.flatten_summary(wk.run(scenario).summary)
     volatile = set(wk.sweep_engine.VOLATILE_COLUMNS)
     assert {k: v for k, v in record["results"].items() if k not in volatile} == \
         {k: v for k, v in direct.items() if k not in volatile}

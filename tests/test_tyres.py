@@ -6,8 +6,9 @@ import warnings
 import numpy as np
 import pytest
 
-from whipple_kick import magic_formula, tyres
 from whipple_kick.errors import InputError
+from whipple_kick.library import tyres
+from whipple_kick.model import magic_formula
 
 DEG = np.pi / 180.0
 
@@ -330,9 +331,10 @@ def test_linear_tyre_is_linear_without_camber_force_or_moment():
 def test_a_tyre_without_moment_data_is_told_by_its_flag_not_by_a_message(monkeypatch):
     """assembly.build_tyres decided "no M_z data" by finding "aligning-moment" in an error's text:
     any rewording of that message made T04 runs fail. It now reads Tyre.has_aligning_moment."""
-    from whipple_kick import assembly, tyres
     from whipple_kick.errors import InputError
-    from whipple_kick.scenario import Scenario
+    from whipple_kick.library import tyres
+    from whipple_kick.simulate import assembly
+    from whipple_kick.simulate.scenario import Scenario
 
     def reworded(self, mz):
         if mz is not None:

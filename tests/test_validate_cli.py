@@ -8,7 +8,7 @@ import pytest
 
 from conftest import run_console
 from whipple_kick.cli import validate_main
-from whipple_kick.scenario import Scenario
+from whipple_kick.simulate.scenario import Scenario
 
 
 def _validate(argv, capsys):

@@ -6,8 +6,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from whipple_kick import analysis, experiments, recommend, validation
 from whipple_kick.errors import InputError
+from whipple_kick.library import experiments
+from whipple_kick.simulate import analysis
+from whipple_kick.studies import recommend, validation
 
 F_HZ, DECAY = 5.0, 1.5        # a damped 5 Hz sine: period 0.2 s, log decrement DECAY * 0.2 = 0.3 per period
 OMEGA = 2 * math.pi * F_HZ
@@ -193,7 +195,7 @@ def test_recommend_variants_names_answers_within_the_spread(monkeypatch):
         return [recommend.Recommendation(fz, "T03", 500.0 if right else 300.0, None, "settling", 0.1 if right else 0.5,
                                          0.218, "no clear optimum" if right else "clear", None) for fz in loads]
     monkeypatch.setattr(recommend, "recommend_pressures", fake)
-    from whipple_kick.scenario import Scenario
+    from whipple_kick.simulate.scenario import Scenario
     variants = {(d, "contact_patch"): Scenario(kick_direction=d) for d in ("right", "left")}
     recs, verdicts = recommend.recommend_variants([570.0], variants)
     assert set(recs) == set(variants)
@@ -207,7 +209,7 @@ def test_the_kick_is_the_measured_one():
     The quintic's peak acceleration is 10/sqrt(3) D/T^2 (at t/T = 1/2 -+ sqrt(3)/6); the thesis' kick lasted
     about 0.15 s and the wheel stayed on the plate 0.2-0.22 s (Section 8.5).
     """
-    from whipple_kick import inputs
+    from whipple_kick.library import inputs
     kick = inputs.kick_of(validation.base_scenario().validate())
     assert kick.duration == pytest.approx(math.sqrt(10 / math.sqrt(3) * 0.150 / 35.0), rel=1e-9)
     assert 0.15 < kick.duration < experiments.load().conditions["wheel_on_plate_min"]

@@ -7,10 +7,12 @@ The public API is small (``__all__``)::
     result.trajectory, result.summary                           # time histories, metrics
     table = wk.sweep({"pressure_kpa": [300, 400, 500]})         # many runs in parallel
 
-A run follows the data flow scenario -> inputs -> assembly -> integration
--> results (the modules of those names, :func:`whipple_kick.simulation.run`
-reads it top-down); analysis, plots, animation, the linear stability
-(``wk.stability``), sweeps and the command-line tools sit on top.
+The package is five wings, each importing only the ones below it:
+``model`` (the equations, the generated code, the tyre formulas) <
+``library`` (parameter sets) < ``simulate`` (one scenario to one result;
+:func:`whipple_kick.simulate.simulation.run` reads it top-down) <
+``figures`` < ``studies`` (sweeps, recommendation, validation, stability)
+< ``cli``; ``errors`` and ``fileio`` sit beneath them all.
 
 Names and submodules are imported lazily on first attribute access
 (``wk.Scenario``, ``wk.tyres``, ``wk.stability`` ...), so importing the
@@ -23,31 +25,39 @@ __version__ = "0.1.0"
 
 #: The public names and the module each lives in.
 _EXPORTS = {
-    "Scenario": "scenario",
-    "Result": "results",
-    "run": "simulation",
-    "sweep": "sweep_engine",
+    "Scenario": "simulate.scenario",
+    "Result": "simulate.results",
+    "run": "simulate.simulation",
+    "sweep": "studies.sweep_engine",
     "InputError": "errors",
     "SimulationError": "errors",
 }
 __all__ = ["InputError", "Result", "Scenario", "SimulationError", "__version__", "run", "sweep"]
 
-_SUBMODULES = (
-    "analysis", "animation", "assembly", "authors_code", "benchmark", "bicycles", "cache", "classic", "cli",
-    "carcass", "control", "energy", "errors", "experiments", "fileio", "geometry", "inputs",
-    "integration", "kane", "lsoda", "magic_formula", "parameters", "plotting", "provenance", "recommend", "reflex",
-    "results",
-    "riders", "scenario", "simulation",
-    "slip", "stability", "steady", "symbolic", "sweep_engine", "sweep_store", "symbols", "transient", "tyres",
-    "validation",
-)
+#: The modules by their short names (``wk.tyres``, ``wk.stability``, ``wk.plotting`` ...) and their
+#: homes in the wings: model < library < simulate < figures < studies < cli.
+_SUBMODULES = {
+    **{name: f"model.{name}" for name in (
+        "benchmark", "cache", "carcass", "classic", "energy", "geometry", "kane", "magic_formula", "reflex",
+        "rhs_call", "slip", "symbolic", "symbols", "transient")},
+    **{name: f"library.{name}" for name in (
+        "bicycles", "experiments", "inputs", "parameters", "riders", "tyres")},
+    **{name: f"simulate.{name}" for name in (
+        "analysis", "assembly", "control", "integration", "lsoda", "provenance", "results", "scenario",
+        "simulation", "steady")},
+    **{name: f"figures.{name}" for name in ("animation", "plotting")},
+    **{name: f"studies.{name}" for name in (
+        "authors_code", "recommend", "stability", "sweep_engine", "sweep_store", "validation")},
+    **{name: name for name in ("cli", "errors", "fileio")},
+    **{name: name for name in ("model", "library", "simulate", "figures", "studies")},
+}
 
 
 def __getattr__(name):
     if name in _EXPORTS:
         value = getattr(importlib.import_module(f"{__name__}.{_EXPORTS[name]}"), name)
     elif name in _SUBMODULES:
-        value = importlib.import_module(f"{__name__}.{name}")
+        value = importlib.import_module(f"{__name__}.{_SUBMODULES[name]}")
     else:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     globals()[name] = value

@@ -62,7 +62,7 @@ def _benchmark(argv):
     parser.add_argument("--speeds", type=float, nargs="+", default=list(range(11)),
                         metavar="M/S", help="forward speeds in m/s (default 0..10)")
     args = parser.parse_args(argv)
-    from . import benchmark, classic
+    from whipple_kick.model import benchmark, classic
     moore = benchmark.to_moore(benchmark.meijaard2007_parameters())
     speeds = [float(v) for v in args.speeds]
     eigs = classic.eigenvalues(moore, speeds)
@@ -132,10 +132,17 @@ def _model_options(p, symmetric_flag=True, design_default="the run's --speed", c
     arms and reflex, ``--carcass-stiffness-scale`` and ``--lqr-model``.
     Returns the "riding and control" group, for the caller's speed option.
     """
-    from . import tyres
-    from .carcass import SLIDING_LAWS
-    from .scenario import CAMBER_SIGNS, CONTROLLERS, LQR_MODELS, SLIP_SPEEDS, TYRE_TRANSIENTS, Scenario
-    from .transient import DEFAULT_TRANSIENT
+    from whipple_kick.library import tyres
+    from whipple_kick.model.carcass import SLIDING_LAWS
+    from whipple_kick.model.transient import DEFAULT_TRANSIENT
+    from whipple_kick.simulate.scenario import (
+        CAMBER_SIGNS,
+        CONTROLLERS,
+        LQR_MODELS,
+        SLIP_SPEEDS,
+        TYRE_TRANSIENTS,
+        Scenario,
+    )
 
     def default(field):
         return Scenario.__dataclass_fields__[field].default
@@ -219,7 +226,7 @@ def _model_options(p, symmetric_flag=True, design_default="the run's --speed", c
 
 def _body_options(p, default):
     """The "rider's body" option group (:func:`_model_options`); ``default(field)`` is the Scenario's default."""
-    from .scenario import ARMS, RIDER_BODIES
+    from whipple_kick.simulate.scenario import ARMS, RIDER_BODIES
     g = p.add_argument_group("rider's body", "the Yeadon rider split into legs, forearms and a leaning upper body "
                                              "(a bicycle-only set such as balanceassist_v1), arms and reflex")
     g.add_argument("--rider-body", choices=RIDER_BODIES, default=default("rider_body"),
@@ -248,8 +255,8 @@ def _body_options(p, default):
 
 
 def _simulate_parser():
-    from .inputs import DIRECTIONS, PROFILES
-    from .scenario import KICK_HEADINGS, PLATE_STOPS, START_PITCHES, STARTS
+    from whipple_kick.library.inputs import DIRECTIONS, PROFILES
+    from whipple_kick.simulate.scenario import KICK_HEADINGS, PLATE_STOPS, START_PITCHES, STARTS
     p = _OneLineParser(
         prog="simulate", allow_abbrev=False,
         description="Kick-plate test on the nonlinear Carvallo-Whipple bicycle-rider model with "
@@ -348,7 +355,7 @@ def _animation_options(args):
             flag = "--" + next(iter(given)).replace("_", "-")
             raise InputError(f"{flag} sets the animation; add --animate")
         return None
-    from . import animation
+    from whipple_kick.figures import animation
     options = {**_ANIMATION_DEFAULTS, **given}
     animation.check_options(**options)
     return options
@@ -418,7 +425,7 @@ def _check_loads(bicycle, loads):
     """
     if not loads:
         return   # nothing to check (the bicycle itself is checked with the scenario)
-    from . import bicycles, riders
+    from whipple_kick.library import bicycles, riders
     bike = bicycles.load(bicycle)
     if bike.includes_rider:
         return   # refused later in one line (the preset already includes its rider)
@@ -429,7 +436,7 @@ def _check_loads(bicycle, loads):
 
 def _scenario_from_args(args, given=()):
     """The scenario of the parsed flags; with ``--compat``, the preset with the ``given`` flags' fields changed."""
-    from .scenario import Scenario
+    from whipple_kick.simulate.scenario import Scenario
     fields = _model_fields(args)
     profile = args.kick_profile
     if args.kick_table is not None:
@@ -581,7 +588,7 @@ def _claim(job, force, previous):
 
 
 def _print_summary(result, out, files):
-    from . import results
+    from whipple_kick.simulate import results
     s = result.summary
     sc, bike, ctl, kick, st = s["scenario"], s["bicycle"], s["controller"], s["kick"], s["steady_state"]
     deg = 180.0 / np.pi
@@ -656,12 +663,12 @@ def _print_summary(result, out, files):
 def _data_warnings(prog, quiet):
     """Print each tyre file's data warning once, as one line on stderr (none with ``quiet``; summary.json lists them).
 
-    Python's own warning of it (:class:`whipple_kick.tyres.DataQualityWarning`)
+    Python's own warning of it (:class:`whipple_kick.library.tyres.DataQualityWarning`)
     is silenced: it would print the source line and repeat per call site.
     """
     import warnings
 
-    from . import tyres
+    from whipple_kick.library import tyres
     warnings.filterwarnings("ignore", category=tyres.DataQualityWarning)
 
     def report(summary):
@@ -671,7 +678,7 @@ def _data_warnings(prog, quiet):
 
 
 def _simulate(argv):
-    from . import assembly
+    from whipple_kick.simulate import assembly
     args = _simulate_parser().parse_args(argv)
     report_data_warnings = _data_warnings("simulate", args.quiet)
     given = _flags_given(argv) if args.compat is not None or args.scenario is not None else ()
@@ -705,7 +712,7 @@ def _simulate_into(args, scenario, movie_options, out, written):
     Returns (result, files, note): the run's result, the written files'
     descriptions and a note for the user or None.
     """
-    from . import simulation
+    from whipple_kick.simulate import simulation
     result = simulation.run(scenario)
     files = result.save(out)
     written.extend(files)
@@ -713,14 +720,14 @@ def _simulate_into(args, scenario, movie_options, out, written):
         # A warning, not a failure: the run is valid (the bicycle may well fall).
         print(f"simulate: warning: {result.summary['linear_stability']['message']}", file=sys.stderr)
     if not args.no_plot:
-        from . import plotting
+        from whipple_kick.figures import plotting
         plotting.response_figure([("", result)], out / "response.png", title=plotting.result_title(result),
                                  kick=plotting.kick_band(result))
         files.append("response.png")
         written.append("response.png")
     note = None
     if movie_options is not None:
-        from . import animation
+        from whipple_kick.figures import animation
         suffix = "mp4" if animation.video_encoder() else "gif"
         if suffix == "gif":
             note = "no video encoder installed: wrote a GIF (pip install 'whipple_kick[video]' for mp4)"
@@ -743,7 +750,8 @@ def simulate_main(argv=None):
 # ------------------------------------------------------------ recommend-pressure
 
 def _recommend(argv):
-    from . import recommend, tyres
+    from whipple_kick.library import tyres
+    from whipple_kick.studies import recommend
     p = _OneLineParser(
         prog="recommend-pressure",
         description="Recommend the tyre inflation pressure with the fastest recovery after a "
@@ -778,8 +786,8 @@ def _recommend(argv):
                    help="sweep folder keeping every run (re-running with it resumes)")
     p.add_argument("--extend", action="store_true",
                    help="with --out: add these runs to a folder that holds another sweep")
-    from .inputs import DIRECTIONS
-    from .scenario import TYRE_TRANSIENTS, Scenario
+    from whipple_kick.library.inputs import DIRECTIONS
+    from whipple_kick.simulate.scenario import TYRE_TRANSIENTS, Scenario
     p.add_argument("--kick-direction", choices=(*DIRECTIONS, "both"), default="right",
                    help="direction the plate moves (default right); both: run each direction and say whether "
                         "the best pressure depends on it (twice the runs)")
@@ -821,7 +829,7 @@ def _recommend(argv):
 
         import pandas as pd
 
-        from . import plotting
+        from whipple_kick.figures import plotting
         metric = recommend.CRITERIA[recommend.criterion_key(args.criterion)][0]
         for (direction, form), by_load in recs.items():
             name = SWEEP_FIGURE if len(variants) == 1 else SWEEP_FIGURE.replace(".png", f"_{direction}_{form}.png")
@@ -839,7 +847,7 @@ SWEEP_FIGURE = "recommendation.png"
 
 def recommend_main(argv=None):
     """Console script ``recommend-pressure`` (see ``recommend-pressure --help``)."""
-    from .sweep_engine import SweepFailed, SweepInterrupted
+    from whipple_kick.studies.sweep_engine import SweepFailed, SweepInterrupted
     try:
         status = _run(_recommend, argv, "recommend-pressure",
                       "finished cases are kept in the --out folder (if given); run again on it to resume")
@@ -868,7 +876,8 @@ def _compare(argv):
     p.add_argument("--labels", nargs="+", metavar="LABEL", help="one legend entry per run (default: the folder names)")
     _output_options(p.add_argument_group("output"), "compare.png")
     args = p.parse_args(argv)
-    from . import plotting, results
+    from whipple_kick.figures import plotting
+    from whipple_kick.simulate import results
     runs = [results.Result.load(folder) for folder in args.runs]
     labels = args.labels or [pathlib.Path(folder).resolve().name for folder in args.runs]
     if args.labels is None and len(set(labels)) < len(labels):
@@ -898,7 +907,7 @@ def compare_main(argv=None):
 # ------------------------------------------------------------------ stability
 
 def _stability_parser():
-    from . import stability
+    from whipple_kick.studies import stability
     start, stop, step = stability.DEFAULT_SPEEDS
     p = _OneLineParser(
         prog="stability", allow_abbrev=False,
@@ -928,8 +937,9 @@ def _stability_parser():
 def _stability(argv):
     import time
 
-    from . import assembly, provenance, stability
-    from .scenario import Scenario
+    from whipple_kick.simulate import assembly, provenance
+    from whipple_kick.simulate.scenario import Scenario
+    from whipple_kick.studies import stability
     args = _stability_parser().parse_args(argv)
     started = time.perf_counter()
     speeds = stability.parse_speeds(args.speeds)
@@ -968,7 +978,7 @@ _VALIDATE_FILES = ("validation.csv", "summary.json", "validation.png")
 
 
 def _validate_parser():
-    from . import validation
+    from whipple_kick.studies import validation
     p = _OneLineParser(
         prog="validate", allow_abbrev=False,
         description="The model against the thesis' kick-plate measurements (Dell'Orto 2025, Section 8.5, "
@@ -1011,7 +1021,8 @@ def _validate_parser():
 def _validate(argv):
     import time
 
-    from . import assembly, validation
+    from whipple_kick.simulate import assembly
+    from whipple_kick.studies import validation
     args = _validate_parser().parse_args(argv)
     started = time.perf_counter()
     if args.workers is not None and args.workers < 1:

@@ -64,7 +64,7 @@ class SimulationError(RuntimeError):
 
     Attributes
     ----------
-    partial : whipple_kick.results.Result or None
+    partial : whipple_kick.simulate.results.Result or None
         What was computed before the failure (trajectory up to it, summary
         with ``status`` "failed"), when there is anything.
     """
@@ -83,7 +83,7 @@ class BuildError(RuntimeError):
 
 
 class CacheError(OSError):
-    """The cache of generated code cannot be used (:mod:`whipple_kick.cache`).
+    """The cache of generated code cannot be used (:mod:`whipple_kick.model.cache`).
 
     The message is one line naming the folder, what is wrong with it and how
     to fix it (e.g. set ``WHIPPLE_KICK_CACHE`` to a private writable folder).

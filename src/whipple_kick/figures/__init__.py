@@ -1,0 +1,1 @@
+"""Figures: the response plots and the animation of a run."""

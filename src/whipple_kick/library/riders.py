@@ -1,0 +1,699 @@
+"""Yeadon riders: build, scale, seat on a bicycle, and size to a rear-tyre load.
+
+The rider is a Yeadon (1990) human-body model (the ``yeadon`` package) built
+from the 95 measurements in ``parameters/riders/<name>.toml``, scaled to the
+requested mass (and optionally height), seated on the bicycle the way Moore's
+BicycleParameters seats a rider, and lumped rigidly into the rear frame.
+
+Seating (the method of BicycleParameters' ``rider_on_bike``, re-derived and
+written here from yeadon's segment kinematics):
+
+* the Yeadon origin (centre of the bottom of the pelvis) sits at the top of
+  the seat post, ``lst + lsp`` up the seat tube from the bottom bracket;
+* the trunk keeps the rider file's configuration (somersault = forward lean);
+* each leg (hip flexion, knee flexion) is bent so that the point of the
+  shank-foot segment at Yeadon level 6 (``Lj6L`` beyond the ankle; Yeadon's
+  foot is in line with the shank) lies on the bottom bracket (crank axle);
+* each arm (shoulder extension, adduction, rotation and elbow extension) puts
+  the hand point at Yeadon level 5 (``La5L`` beyond the wrist) on its grip,
+  ``whb/2`` beside the mid-plane, ``LhbR`` from the rear and ``LhbF`` from the
+  front wheel centre, with the elbow's hinge axis horizontal (the fourth
+  condition that makes the arm posture unique);
+* left and right limbs mirror each other (the model is left-right averaged,
+  yeadon's ``symmetric=True``).
+
+Frames: yeadon's global frame has x to the rider's left, y backward, z up;
+the bicycle's benchmark frame has x forward, y right, z down. So
+``v_bike = YEADON_TO_BIKE @ v_yeadon``.
+"""
+from collections.abc import Mapping
+import copy
+import dataclasses
+import functools
+import math
+import types
+from typing import NamedTuple
+
+import numpy as np
+from scipy.optimize import fsolve
+
+from whipple_kick.errors import InputError, check_range
+from whipple_kick.model import benchmark as _benchmark
+
+from . import parameters
+from .bicycles import Bicycle
+
+#: Folder of the shipped rider files.
+RIDER_DIR = parameters.shipped("riders")
+
+FORMAT = "whipple_kick rider, version 1"
+
+#: Largest rider mass accepted anywhere [kg] (a rider over 200 kg is refused).
+MAX_RIDER_MASS_KG = 200.0
+
+#: Rotation taking yeadon-frame components to benchmark-frame components.
+YEADON_TO_BIKE = np.array([[0.0, -1.0, 0.0],
+                           [-1.0, 0.0, 0.0],
+                           [0.0, 0.0, -1.0]])
+
+#: Ankle-joint height as a fraction of standing height: Drillis & Contini
+#: (1966) segment proportions (as reproduced in Winter, "Biomechanics and
+#: Motor Control of Human Movement", Fig. 4.1). Yeadon measures no foot
+#: height, so this is how a standing height is estimated from the model.
+ANKLE_HEIGHT_FRACTION = 0.039
+
+# Trunk angles the seating solution assumes to be zero: with them the pelvis
+# turns about its x axis only, so the legs move in a sagittal plane.
+_MUST_BE_ZERO = ("tilt", "twist", "PTbending", "TCspinalTorsion", "PJ1adduction", "PK1abduction")
+
+
+@dataclasses.dataclass(frozen=True)
+class YeadonRider:
+    """A Yeadon rider, scaled, not yet seated.
+
+    Attributes
+    ----------
+    name : str
+        Rider file name.
+    mass_kg : float
+        Mass the body is scaled to [kg].
+    height_m : float
+        Standing height [m], estimated from the (scaled) measurements by
+        :func:`standing_height`.
+    length_scale : float
+        Factor applied to all 95 measurements of the file (1 unless a height
+        was requested).
+    measurements : Mapping
+        The 95 Yeadon measurements after length scaling [m].
+    configuration : Mapping
+        The file's seated configuration [rad] (limb angles are solved when
+        seating).
+    source : str
+        The rider file's sources.
+    """
+
+    name: str
+    mass_kg: float
+    height_m: float
+    length_scale: float
+    measurements: Mapping
+    configuration: Mapping
+    source: str
+
+    def human(self, configuration=None):
+        """Return a new ``yeadon.Human`` of this rider, scaled to :attr:`mass_kg`.
+
+        Parameters
+        ----------
+        configuration : mapping, optional
+            Joint angles [rad] (all 21 yeadon names); default the file's.
+        """
+        import yeadon
+
+        # yeadon keeps a reference to the dict and averages limbs in place.
+        human = yeadon.Human(dict(self.measurements), symmetric=True)
+        # scale_human_by_mass() rescales yeadon's class-level density table in
+        # place, which would leak into every later Human; give this instance
+        # its own copy first. Only the density ratios (Dempster's) matter.
+        human.segmental_densities = copy.deepcopy(type(human).segmental_densities)
+        for _ in range(3):  # one pass is exact to round-off; repeat if not
+            human.scale_human_by_mass(self.mass_kg)
+            if abs(human.mass - self.mass_kg) <= 1e-12 * self.mass_kg:
+                break
+        human.set_CFG_dict(dict(configuration or self.configuration))
+        return human
+
+
+def available():
+    """Names of the shipped rider files, sorted."""
+    return list(parameters.toml_files(RIDER_DIR))
+
+
+def standing_height(measurements):
+    """Standing height [m] estimated from Yeadon measurements.
+
+    Top of head to hip centre (``Ls5L + Ls8L``) plus hip centre to ankle (mean
+    of ``Lj5L`` and ``Lk5L``) is the stature less the ankle height, taken as
+    :data:`ANKLE_HEIGHT_FRACTION` of the stature.
+    """
+    m = measurements
+    head_to_ankle = m["Ls5L"] + m["Ls8L"] + 0.5 * (m["Lj5L"] + m["Lk5L"])
+    return head_to_ankle / (1.0 - ANKLE_HEIGHT_FRACTION)
+
+
+def _read_rider_file(name):
+    """Parse and validate ``parameters/riders/<name>.toml``, once per process and content (shared: read only)."""
+    names = available()
+    if name not in names:
+        raise InputError(f"unknown rider {name!r}; available: {', '.join(names)}")
+    path = RIDER_DIR / f"{name}.toml"
+    return _parse_rider_file(path, parameters.file_bytes(path))
+
+
+@functools.lru_cache(maxsize=64)
+def _parse_rider_file(path, content):
+    import yeadon
+
+    data = parameters.parse_toml(path, content)
+    if data.get("format") != FORMAT:
+        parameters.fail(path, "format", f"must be {FORMAT!r}, got {data.get('format')!r}")
+    if data.get("model") != "yeadon":
+        parameters.fail(path, "model", f"must be 'yeadon', got {data.get('model')!r}")
+    sources = data.get("sources")
+    if not isinstance(sources, dict) or not sources:
+        parameters.fail(path, "sources", "must map keys to citation strings")
+    out = {}
+    for table, unit, names_wanted in (("measurements", "m", yeadon.Human.measnames),
+                                      ("configuration", "rad", yeadon.Human.CFGnames)):
+        tab = parameters.table(path, table, data.get(table))
+        values = parameters.table(path, f"{table}.values", tab.get("values"))
+        if tab.get("unit") != unit:
+            parameters.fail(path, f"{table}.unit", f"must be {unit!r}, got {tab.get('unit')!r}")
+        if tab.get("source") not in sources:
+            parameters.fail(path, f"{table}.source", f"{tab.get('source')!r} is not a key of [sources]")
+        unknown = sorted(set(values) - set(names_wanted))
+        missing = [k for k in names_wanted if k not in values]
+        if unknown or missing:
+            parameters.fail(path, f"{table}.values", f"unknown keys {unknown}, missing keys {missing}")
+        out[table] = {k: parameters.number(path, f"{table}.values.{k}", values[k]) for k in names_wanted}
+    for key, value in out["measurements"].items():
+        parameters.at_least(path, f"measurements.values.{key}", value, "m", 0.0, low_open=True)
+    for key, (low, high) in zip(yeadon.Human.CFGnames, yeadon.Human.CFGbounds, strict=True):
+        value = out["configuration"][key]
+        if not low <= value <= high:
+            parameters.fail(path, f"configuration.values.{key}", f"value {value!r} rad is outside "
+                                                                 f"[{low:g}, {high:g}] rad")
+    for key in _MUST_BE_ZERO:
+        if out["configuration"][key] != 0.0:
+            parameters.fail(path, f"configuration.values.{key}", "must be 0 rad for seating on a bicycle (the "
+                            f"legs must move in the mid-plane), got {out['configuration'][key]!r}")
+    out["mass"] = parameters.quantity(path, "mass", data.get("mass"), "kg", sources=sources,
+                                      low=0.0, low_open=True)[0]
+    out["source"] = "\n".join(f"{k}: {v}" for k, v in sources.items())
+    return out
+
+
+def yeadon_rider(name="jason", mass_kg=None, height_m=None):
+    """Build a Yeadon rider from a rider file, scaled to a mass (and height).
+
+    Parameters
+    ----------
+    name : str
+        Rider file in ``parameters/riders/`` (see :func:`available`).
+    mass_kg : float, optional
+        Rider mass [kg], in (0, 200]; default the file's measured mass.
+        The body's densities are scaled uniformly, so the mass is met to
+        round-off and, at fixed geometry, inertia is proportional to mass.
+    height_m : float, optional
+        Standing height [m], in [1.2, 2.3]. All 95 lengths are scaled by
+        ``height_m / standing_height(file measurements)`` first, then the
+        mass is imposed. Default: the file's body unchanged.
+
+    Returns
+    -------
+    YeadonRider
+    """
+    data = _read_rider_file(name)
+    mass = data["mass"] if mass_kg is None else check_range(
+        "rider mass", mass_kg, 0.0, MAX_RIDER_MASS_KG, "kg", low_open=True)
+    meas = data["measurements"]
+    base_height = standing_height(meas)
+    scale = 1.0
+    if height_m is not None:
+        scale = check_range("rider height", height_m, 1.2, 2.3, "m") / base_height
+        meas = {k: v * scale for k, v in meas.items()}
+    return YeadonRider(
+        name=name, mass_kg=mass, height_m=standing_height(meas), length_scale=scale,
+        measurements=types.MappingProxyType(meas),
+        configuration=types.MappingProxyType(data["configuration"]),
+        source=data["source"],
+    )
+
+
+@dataclasses.dataclass(frozen=True)
+class SeatedRider:
+    """A rider placed on a bicycle, in the bicycle's benchmark frame.
+
+    Attributes
+    ----------
+    mass : float
+        [kg]
+    com : numpy.ndarray, shape (3,)
+        Mass centre [m] from the rear contact point, x forward, y right, z down.
+    inertia : numpy.ndarray, shape (3, 3)
+        Inertia tensor [kg m^2] about the mass centre in benchmark axes.
+    configuration : Mapping
+        The full seated yeadon configuration [rad].
+    seat, bottom_bracket, left_grip : numpy.ndarray, shape (3,)
+        The seating points used [m], benchmark frame.
+    """
+
+    mass: float
+    com: np.ndarray
+    inertia: np.ndarray
+    configuration: Mapping
+    seat: np.ndarray
+    bottom_bracket: np.ndarray
+    left_grip: np.ndarray
+
+    def benchmark(self):
+        """The rider alone as benchmark rear-frame entries (mB, xB, yB, zB, IB..)."""
+        i = self.inertia
+        return {"mB": self.mass, "xB": float(self.com[0]), "yB": float(self.com[1]),
+                "zB": float(self.com[2]), "IBxx": float(i[0, 0]), "IByy": float(i[1, 1]),
+                "IBzz": float(i[2, 2]), "IBxz": float(i[0, 2])}
+
+
+def _seating_points(bench, geometry, bike_name):
+    """Seat, bottom bracket and left grip in the benchmark frame (x fwd, y right, z down)."""
+    g = geometry
+    rR, rF, w = bench["rR"], bench["rF"], bench["w"]
+    # Bottom bracket: hbb above the ground, lcs from the rear wheel centre.
+    dz = rR - g["hbb"]
+    if g["lcs"] <= abs(dz):
+        raise InputError(f"bicycle {bike_name!r}: chain stay lcs = {g['lcs']} m must exceed "
+                         f"|rR - hbb| = {abs(dz):g} m")
+    bottom_bracket = np.array([math.sqrt(g["lcs"] ** 2 - dz ** 2), 0.0, -g["hbb"]])
+    seat_tube = g["lst"] + g["lsp"]
+    seat = bottom_bracket + seat_tube * np.array([-math.cos(g["lamst"]), 0.0, -math.sin(g["lamst"])])
+    # Grip: in-plane distances from the wheel centres, then the upper
+    # intersection of the two circles in the x-z plane.
+    half = 0.5 * g["whb"]
+    if g["LhbR"] <= half or g["LhbF"] <= half:
+        raise InputError(f"bicycle {bike_name!r}: LhbR and LhbF must exceed whb/2 = {half:g} m")
+    a_r = math.sqrt(g["LhbR"] ** 2 - half ** 2)
+    a_f = math.sqrt(g["LhbF"] ** 2 - half ** 2)
+    rear_c, front_c = np.array([0.0, -rR]), np.array([w, -rF])
+    span = float(np.linalg.norm(front_c - rear_c))
+    along = (a_r ** 2 - a_f ** 2 + span ** 2) / (2.0 * span)
+    if a_r ** 2 - along ** 2 <= 0:
+        raise InputError(f"bicycle {bike_name!r}: LhbR = {g['LhbR']} m and LhbF = {g['LhbF']} m "
+                         f"do not locate a grip above the wheel centres (wheel-centre span {span:g} m)")
+    up = math.sqrt(a_r ** 2 - along ** 2)
+    unit = (front_c - rear_c) / span
+    normal = np.array([unit[1], -unit[0]])  # unit rotated toward -z (up) for a level bicycle
+    grip = rear_c + along * unit + up * normal
+    left_grip = np.array([grip[0], -half, grip[1]])
+    return seat, bottom_bracket, left_grip
+
+
+def _rx(angle):
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+
+
+def _body123(a, b, c):
+    """yeadon's body-fixed 1-2-3 rotation (x, then new y, then new z)."""
+    cb, sb, cc, sc = math.cos(b), math.sin(b), math.cos(c), math.sin(c)
+    ry = np.array([[cb, 0.0, sb], [0.0, 1.0, 0.0], [-sb, 0.0, cb]])
+    rz = np.array([[cc, -sc, 0.0], [sc, cc, 0.0], [0.0, 0.0, 1.0]])
+    return _rx(a) @ ry @ rz
+
+
+def place(bike, rider):
+    """Seat a rider on a bicycle (hands on the grips, feet at the bottom bracket).
+
+    Parameters
+    ----------
+    bike : Bicycle
+        A bicycle without rider and with seating geometry (``bike.geometry``).
+    rider : YeadonRider
+
+    Returns
+    -------
+    SeatedRider
+        The rider's mass, mass centre and inertia in the bicycle's benchmark frame.
+
+    Raises
+    ------
+    InputError
+        The bicycle has no seating geometry or already includes a rider, or
+        the rider cannot reach the bottom bracket or the grips.
+    """
+    if not isinstance(bike, Bicycle):
+        raise InputError(f"bike must be a whipple_kick.library.bicycles.Bicycle, got {type(bike).__name__}")
+    if not isinstance(rider, YeadonRider):
+        raise InputError(f"rider must be a YeadonRider (see yeadon_rider()), got {type(rider).__name__}")
+    if bike.includes_rider:
+        raise InputError(f"bicycle {bike.name!r} already includes a rider; seat riders on a "
+                         f"bicycle-only set such as 'balanceassist_v1'")
+    if bike.geometry is None:
+        raise InputError(f"bicycle {bike.name!r} has no [seating] geometry to seat a rider on")
+    seat_pt, bb_pt, grip_pt = _seating_points(bike.benchmark, bike.geometry, bike.name)
+    to_yeadon = YEADON_TO_BIKE.T
+    human = rider.human()  # file configuration: trunk posed, limbs straight
+    # Limb lengths as yeadon uses them: left and right averaged (symmetric=True).
+    m = human.meas
+
+    # Legs: planar two-link chain from the hip to the foot point, in yeadon's
+    # y-z plane. A link at absolute angle t about x points along (0, sin t, -cos t).
+    thigh = m["Lj3L"]
+    shank_foot = m["Lj5L"] - m["Lj3L"] + m["Lj6L"]
+    foot = to_yeadon @ (bb_pt - seat_pt)
+    reach = math.hypot(foot[1], foot[2])
+    if not abs(thigh - shank_foot) < reach < thigh + shank_foot:
+        raise InputError(f"rider {rider.name!r} (height {rider.height_m:.3f} m) cannot reach the "
+                         f"bottom bracket: seat-to-crank distance {reach:.3f} m, leg reach "
+                         f"{thigh + shank_foot:.3f} m")
+    knee = math.acos((reach ** 2 - thigh ** 2 - shank_foot ** 2) / (2.0 * thigh * shank_foot))
+    pelvis = human.CFG["somersault"]
+    hip = (math.atan2(foot[1], -foot[2])
+           - math.atan2(shank_foot * math.sin(knee), thigh + shank_foot * math.cos(knee)) - pelvis)
+
+    # Left arm: shoulder position and chest orientation do not depend on the arm angles.
+    chest = np.asarray(human.C.rot_mat)
+    shoulder = np.asarray(human.A1.pos).ravel()
+    upper = m["La2L"]
+    fore = m["La4L"] + m["La5L"] - m["La2L"]
+    hand = to_yeadon @ (grip_pt - seat_pt)
+    if np.linalg.norm(hand - shoulder) >= upper + fore:
+        raise InputError(f"rider {rider.name!r} (height {rider.height_m:.3f} m) cannot reach the "
+                         f"grips: shoulder-to-grip {np.linalg.norm(hand - shoulder):.3f} m, arm "
+                         f"reach {upper + fore:.3f} m")
+
+    def arm_residual(q):
+        upper_rot = chest @ _body123(q[0], q[1], q[2])
+        fore_rot = upper_rot @ _rx(q[3])
+        # yeadon builds limb segments toward their local -z.
+        tip = shoulder - upper * upper_rot[:, 2] - fore * fore_rot[:, 2]
+        # Fourth condition: elbow hinge (upper arm's x axis) horizontal.
+        return np.r_[tip - hand, upper_rot[2, 0]]
+
+    # Start from a bent-elbow, arm-forward posture (the branch a rider uses).
+    guess = np.radians([-15.0, 2.0, 2.0, -40.0])
+    arm, _, ok, _ = fsolve(arm_residual, guess, full_output=True, xtol=1e-13)
+    arm = (np.asarray(arm) + math.pi) % (2.0 * math.pi) - math.pi
+    if ok != 1 or np.max(np.abs(arm_residual(arm))) > 1e-9:
+        raise RuntimeError(f"arm posture for rider {rider.name!r} on {bike.name!r} did not converge")
+
+    cfg = dict(rider.configuration)
+    cfg.update(PJ1extension=hip, PK1extension=hip, J1J2flexion=knee, K1K2flexion=knee,
+               CA1extension=arm[0], CA1adduction=arm[1], CA1rotation=arm[2], A1A2extension=arm[3],
+               CB1extension=arm[0], CB1abduction=-arm[1], CB1rotation=-arm[2],
+               B1B2extension=arm[3])
+    import yeadon
+
+    for key, (low, high) in zip(yeadon.Human.CFGnames, yeadon.Human.CFGbounds, strict=True):
+        if not low <= cfg[key] <= high:
+            raise InputError(f"rider {rider.name!r} (height {rider.height_m:.3f} m) does not fit "
+                             f"bicycle {bike.name!r}: seated {key} = {cfg[key]:.3f} rad is outside "
+                             f"yeadon's joint range [{low:g}, {high:g}] rad")
+    human.set_CFG_dict(cfg)
+
+    # Check the posture with yeadon's own segment geometry (not our kinematics).
+    yeadon_foot = np.asarray(human.J2.solids[3].end_pos).ravel()   # level j6 (proximal end of j6-j7)
+    yeadon_hand = np.asarray(human.A2.solids[2].pos).ravel()       # level a5 (distal end of a4-a5)
+    yeadon_rhand = np.asarray(human.B2.solids[2].pos).ravel()
+    mirror = np.array([-1.0, 1.0, 1.0])
+    errors = (abs(yeadon_foot[1] - foot[1]), abs(yeadon_foot[2] - foot[2]),
+              *np.abs(yeadon_hand - hand), *np.abs(yeadon_rhand - mirror * hand))
+    if max(errors) > 1e-8:
+        raise RuntimeError(f"seated posture misses its targets by {max(errors):.3g} m")
+
+    com = seat_pt + YEADON_TO_BIKE @ np.asarray(human.center_of_mass).ravel()
+    inertia = YEADON_TO_BIKE @ np.asarray(human.inertia) @ YEADON_TO_BIKE.T
+    # Mid-plane symmetry: no lateral offset, no xy/yz products of inertia.
+    scale = max(1.0, float(np.max(np.abs(inertia))))
+    if abs(com[1]) > 1e-9 or max(abs(inertia[0, 1]), abs(inertia[1, 2])) > 1e-9 * scale:
+        raise RuntimeError("seated rider is not symmetric about the bicycle's mid-plane")
+    com[1] = 0.0
+    inertia[0, 1] = inertia[1, 0] = inertia[1, 2] = inertia[2, 1] = 0.0
+    return SeatedRider(mass=float(human.mass), com=com, inertia=inertia,
+                       configuration=types.MappingProxyType(cfg), seat=seat_pt,
+                       bottom_bracket=bb_pt, left_grip=grip_pt)
+
+
+def lump_into_rear_frame(bench, mass, com, inertia):
+    """Add a rigid body to the rear frame B of a benchmark-form set (:func:`lump_into_frame` with ``"B"``)."""
+    return lump_into_frame(bench, "B", mass, com, inertia)
+
+
+def lump_into_frame(bench, frame, mass, com, inertia):
+    """Add a rigid body to the benchmark body ``frame`` ("B" rear frame, "H" front frame) of a benchmark set.
+
+    Parameters
+    ----------
+    bench : mapping
+        Benchmark parameters.
+    frame : {"B", "H"}
+        The body it is added to.
+    mass : float
+        Added mass [kg].
+    com : sequence of 3 floats
+        Its mass centre [m] (benchmark frame; y must be 0).
+    inertia : array_like, shape (3, 3)
+        Its inertia tensor [kg m^2] about its own mass centre, benchmark axes.
+
+    Returns
+    -------
+    dict
+        Benchmark parameters with the combined body (m<frame>, x<frame>, z<frame>, I<frame>..).
+    """
+    f = frame
+    out = dict(bench)
+    m_b, m_r = bench[f"m{f}"], float(mass)
+    m = m_b + m_r
+    x = (m_b * bench[f"x{f}"] + m_r * com[0]) / m
+    z = (m_b * bench[f"z{f}"] + m_r * com[2]) / m
+
+    def shifted(m_i, ixx, iyy, izz, ixz, xi, zi):
+        # Parallel-axis theorem to the combined mass centre; a tensor's xz entry is -sum(m x z).
+        dx, dz = xi - x, zi - z
+        return (ixx + m_i * dz * dz, iyy + m_i * (dx * dx + dz * dz),
+                izz + m_i * dx * dx, ixz - m_i * dx * dz)
+
+    a = shifted(m_b, bench[f"I{f}xx"], bench[f"I{f}yy"], bench[f"I{f}zz"], bench[f"I{f}xz"], bench[f"x{f}"],
+                bench[f"z{f}"])
+    i = np.asarray(inertia, dtype=float)
+    b = shifted(m_r, i[0, 0], i[1, 1], i[2, 2], i[0, 2], com[0], com[2])
+    out.update({f"m{f}": m, f"x{f}": x, f"z{f}": z, f"I{f}xx": a[0] + b[0], f"I{f}yy": a[1] + b[1],
+                f"I{f}zz": a[2] + b[2], f"I{f}xz": a[3] + b[3]})
+    return out
+
+
+def _with_rider(bike, rider, seated, bench, name, how):
+    """The :class:`Bicycle` of ``bike`` with ``rider`` seated (``seated``, :func:`place`'s) as ``bench`` has it.
+
+    ``name`` is added to the set's name, ``how`` says in the description where the rider went.
+    """
+    return Bicycle(
+        name=f"{bike.name}+{rider.name}({rider.mass_kg:g} kg{name})",
+        benchmark=bench, parameterisation="benchmark", includes_rider=True,
+        source=f"{bike.source}\nrider {rider.name}:\n{rider.source}",
+        description=f"{bike.description} With Yeadon rider {rider.name!r} "
+                    f"({rider.mass_kg:g} kg, {rider.height_m:.3f} m){how}",
+        uncertainties={}, geometry=bike.geometry, tyre_placeholders=bike.tyre_placeholders,
+        rider={"name": rider.name, "mass_kg": rider.mass_kg, "height_m": rider.height_m,
+               **{f"rider_{k}": v for k, v in seated.benchmark().items()}},
+    )
+
+
+def seat(bike, rider):
+    """Bicycle with the rider rigidly lumped into its rear frame.
+
+    Parameters
+    ----------
+    bike : Bicycle
+        Bicycle-only set with seating geometry (e.g. ``"balanceassist_v1"``).
+    rider : YeadonRider
+
+    Returns
+    -------
+    Bicycle
+        Moore-parameter mapping of bicycle + rider (``includes_rider`` True,
+        ``rider`` metadata: name, mass_kg, height_m and the rider's own
+        benchmark-form entries).
+    """
+    seated = place(bike, rider)
+    bench = lump_into_rear_frame(bike.benchmark, seated.mass, seated.com, seated.inertia)
+    return _with_rider(bike, rider, seated, bench, "", " lumped into the rear frame.")
+
+
+def static_loads(params):
+    """Static normal forces on the tyres of the upright bicycle [N].
+
+    Exact rigid-contact statics with knife-edge wheels on level ground: the
+    vertical forces balance the weight and its moment about the rear contact,
+    ``rear = m g (w - x) / w``, ``front = m g x / w``, with ``m`` the total
+    mass, ``x`` the total mass centre ahead of the rear contact and ``g`` the
+    parameter set's own gravity.
+
+    Parameters
+    ----------
+    params : mapping
+        Moore parameters (a :class:`Bicycle` or a dict with Moore names).
+
+    Returns
+    -------
+    (float, float)
+        (rear, front) normal forces [N].
+    """
+    bench = _benchmark.from_moore(params)
+    w = bench["w"]
+    masses = (bench["mR"], bench["mB"], bench["mH"], bench["mF"])
+    xs = (0.0, bench["xB"], bench["xH"], w)
+    m = sum(masses)
+    x = sum(mi * xi for mi, xi in zip(masses, xs, strict=True)) / m
+    weight = m * bench["g"]
+    return weight * (w - x) / w, weight * x / w
+
+
+class RearLoadSolution(NamedTuple):
+    """Result of :func:`for_rear_load`; unpacks as ``(combined, rider_mass_kg)``.
+
+    ``rear_n`` and ``front_n`` are the static tyre loads of ``combined`` [N].
+    """
+
+    combined: Bicycle
+    rider_mass_kg: float
+
+    @property
+    def rear_n(self):
+        return static_loads(self.combined)[0]
+
+    @property
+    def front_n(self):
+        return static_loads(self.combined)[1]
+
+
+def rear_load_range(bike, rider="jason", height_m=None):
+    """Static rear-tyre loads a rider can produce on ``bike``: (low, high, per_kg).
+
+    ``low`` is the bicycle's own rear load [N] (a rider of no mass, excluded),
+    ``high`` that with a :data:`MAX_RIDER_MASS_KG` rider [N], ``per_kg`` the
+    rear load one kilogram of rider adds [N/kg] (the seated posture, hence
+    the rider's mass centre, does not depend on the mass).
+    """
+    probe = yeadon_rider(rider, height_m=height_m)
+    x_rider = place(bike, probe).com[0]
+    bench = bike.benchmark
+    rear_bike, _ = static_loads(bike)
+    per_kg = bench["g"] * (bench["w"] - x_rider) / bench["w"]
+    return rear_bike, rear_bike + MAX_RIDER_MASS_KG * per_kg, per_kg
+
+
+def within_rear_load_range(bike, fz_n, low, high):
+    """``float(fz_n)`` if ``low < fz_n <= high`` (the :func:`rear_load_range` of ``bike``), else one-line InputError."""
+    fz = check_range("rear-tyre load fz", fz_n, None, None, "N")  # a finite number
+    if not low < fz <= high:
+        raise InputError(f"rear-tyre load fz = {fz_n!r} N is outside the allowed range "
+                         f"({low:.2f}, {high:.2f}] N for {bike.name!r}: the bicycle alone puts "
+                         f"{low:.2f} N on its rear tyre and a {MAX_RIDER_MASS_KG:g} kg "
+                         f"rider {high:.2f} N")
+    return fz
+
+
+def for_rear_load(bike, fz_n, rider="jason", height_m=None, load_range=None):
+    """Seat the rider whose mass gives the bicycle a static rear-tyre load ``fz_n``.
+
+    The seated posture does not depend on the rider's mass (only on the
+    lengths), so the rider's mass centre is fixed and the rear load is affine
+    in the rider mass: ``rear(m) = rear_bike + m g (w - x_rider) / w``. The
+    mass follows in closed form and is checked on the seated result.
+
+    Parameters
+    ----------
+    bike : Bicycle
+        Bicycle-only set with seating geometry; its ``g`` is used (9.80665
+        m/s^2 for ``balanceassist_v1``, the value of its source).
+    fz_n : float
+        Required static rear-tyre normal force [N]; between the bicycle's own
+        rear load (exclusive) and that with a 200 kg rider (:func:`rear_load_range`).
+    rider : str
+        Rider file name.
+    height_m : float, optional
+        Rider height [m] (see :func:`yeadon_rider`).
+    load_range : tuple, optional
+        :func:`rear_load_range` of this bicycle and rider if already known
+        (it seats a probe rider, ~10 ms, and does not depend on the load).
+
+    Returns
+    -------
+    RearLoadSolution
+        ``combined, rider_mass = for_rear_load(...)``; ``.front_n`` and
+        ``.rear_n`` give the static loads [N].
+    """
+    rear_bike, high, per_kg = rear_load_range(bike, rider, height_m) if load_range is None else load_range
+    fz = within_rear_load_range(bike, fz_n, rear_bike, high)
+    mass = (fz - rear_bike) / per_kg
+    combined = seat(bike, yeadon_rider(rider, mass_kg=mass, height_m=height_m))
+    achieved = static_loads(combined)[0]
+    if abs(achieved - fz) > 1e-6:
+        raise RuntimeError(f"rear load {achieved} N misses the requested {fz} N")
+    return RearLoadSolution(combined=combined, rider_mass_kg=mass)
+
+
+#: Yeadon segments of the upper body that leans on the saddle: pelvis, thorax, chest-head and
+#: the upper arms; the forearms and hands too unless they move with the bar. The legs stay in the rear frame.
+UPPER_BODY_SEGMENTS = ("P", "T", "C", "A1", "B1")
+#: Forearm-hand segments: with the arms on the bar they move with the front frame (their inertia about the
+#: steer axis is the arms' inertia moving with the bar), else with the upper body.
+FOREARM_SEGMENTS = ("A2", "B2")
+LEG_SEGMENTS = ("J1", "J2", "K1", "K2")
+
+
+def _segments(human, seat_pt, names):
+    """Mass [kg], mass centre [m] and inertia [kg m^2] of yeadon segments ``names`` in the benchmark frame."""
+    mass, com, inertia = human.combine_inertia(tuple(names))
+    com = seat_pt + YEADON_TO_BIKE @ np.asarray(com).ravel()
+    inertia = YEADON_TO_BIKE @ np.asarray(inertia) @ YEADON_TO_BIKE.T
+    com[1] = 0.0   # mid-plane symmetry (checked for the whole rider by place())
+    inertia[0, 1] = inertia[1, 0] = inertia[1, 2] = inertia[2, 1] = 0.0
+    return float(mass), com, inertia
+
+
+def seat_with_body(bike, rider, arms_on_bar=True):
+    """Seat a rider whose upper body leans on the saddle and whose forearms move with the bar.
+
+    The rider is seated as by :func:`place`. The legs are lumped into the
+    rear frame; with ``arms_on_bar`` the forearms and hands are lumped into
+    the front frame (they turn with the bar); the rest (pelvis, trunk,
+    head, upper arms, and the forearms without ``arms_on_bar``) is the upper
+    body G, hinged at the seat point (the top of the seat post, where
+    yeadon's origin sits) about a horizontal axis along the bicycle's
+    heading. This is Moore's (2012, ch. 4, "Leaning rider extension")
+    upper-body hinge near the saddle, with the segments taken from the
+    rider's own Yeadon model.
+
+    Parameters
+    ----------
+    bike : Bicycle
+        Bicycle-only set with seating geometry.
+    rider : YeadonRider
+    arms_on_bar : bool
+
+    Returns
+    -------
+    combined : Bicycle
+        The bicycle with the legs (and forearms) lumped in; its ``rider`` metadata as :func:`seat`'s.
+    body : dict
+        The upper body's parameters by name (:data:`whipple_kick.model.slip.parameters.BODY_NAMES`: ``hip_tilt``,
+        ``lh1``, ``lh3``, ``mt``, ``lt1``, ``lt3``, ``it11``, ``it22``, ``it33``, ``it31``), in Moore's
+        rear frame C from the rear wheel centre, with ``hip_locked`` 0.
+    """
+    seated = place(bike, rider)
+    human = rider.human(seated.configuration)
+    seat_pt = seated.seat
+    legs = _segments(human, seat_pt, LEG_SEGMENTS)
+    m_t, com_t, i_t = _segments(human, seat_pt, UPPER_BODY_SEGMENTS + (() if arms_on_bar else FOREARM_SEGMENTS))
+    bench = lump_into_frame(bike.benchmark, "B", *legs)
+    total = legs[0] + m_t
+    if arms_on_bar:
+        forearms = _segments(human, seat_pt, FOREARM_SEGMENTS)
+        bench = lump_into_frame(bench, "H", *forearms)
+        total += forearms[0]
+    if abs(total - seated.mass) > 1e-9 * seated.mass:
+        raise RuntimeError(f"the rider's segments sum to {total} kg, not {seated.mass} kg")
+    lam = bike.benchmark["lam"]
+    # Moore's rear frame C (C.x, C.z in benchmark x, z), from the rear wheel centre (0, 0, -rR). Turning C
+    # about C.y by -lam gives H.x = X: a horizontal hinge.
+    c_x, c_z = _benchmark._pitch_matrix(lam)
+    hip = (seat_pt - np.array([0.0, 0.0, -bike.benchmark["rR"]]))[[0, 2]]
+    arm = com_t - seat_pt
+    body = {"hip_locked": 0.0, "hip_tilt": -lam, "lh1": float(hip @ c_x), "lh3": float(hip @ c_z),
+            "mt": m_t, "lt1": float(arm[0]), "lt3": float(arm[2]),
+            "it11": float(i_t[0, 0]), "it22": float(i_t[1, 1]), "it33": float(i_t[2, 2]), "it31": float(i_t[0, 2])}
+    where = "forearms and hands in the front frame, " if arms_on_bar else ""
+    combined = _with_rider(bike, rider, seated, bench, ", body",
+                           f": legs in the rear frame, {where}the rest a leaning upper body.")
+    return combined, body

@@ -1,0 +1,172 @@
+"""Calling the compiled model: parameters by name, :class:`CompiledRHS` (right-hand side, outputs, Jacobian)."""
+import ctypes
+import math
+
+import numpy as np
+
+from whipple_kick.errors import InputError
+from whipple_kick.model import transient
+
+from . import compiled
+from .layout import DEPENDENT, JACOBIAN_EVALUATIONS, OUTPUT_NAMES, PARAMETER_NAMES, SPEEDS, STATE_NAMES, P
+
+
+def parameter_vector(params):
+    """Parameter array for the compiled model, looked up by name.
+
+    Raises
+    ------
+    InputError
+        If a name is missing or unknown.
+    """
+    missing = [n for n in PARAMETER_NAMES if n not in params]
+    if missing:
+        raise InputError(f"slip-model parameters are missing: {', '.join(missing[:8])}"
+                         + (" ..." if len(missing) > 8 else ""))
+    unknown = [n for n in params if n not in P]
+    if unknown:
+        raise InputError(f"unknown slip-model parameters: {', '.join(sorted(unknown)[:8])}")
+    return np.array([float(params[n]) for n in PARAMETER_NAMES])
+
+
+class CompiledRHS:
+    """Callable ``f(t, x) -> dx/dt`` backed by the C library, for one parameter set.
+
+    Parameters
+    ----------
+    params : mapping
+        Every name in :data:`PARAMETER_NAMES`.
+
+    Example
+    -------
+    >>> rhs = CompiledRHS(steady.params)           # doctest: +SKIP
+    >>> dx = rhs(0.0, steady.x)                    # doctest: +SKIP
+    """
+
+    def __init__(self, params):
+        self.lib = compiled.library()
+        self.p = np.ascontiguousarray(parameter_vector(params))
+        self._p_ptr = self.p.ctypes.data
+        self._dx = np.empty(len(STATE_NAMES))
+        self._dx_ptr = self._dx.ctypes.data
+        self._out = np.empty(len(OUTPUT_NAMES))
+        self._out_ptr = self._out.ctypes.data
+        self.fast = self.guarded()   # f(t, x): one foreign call (what the integrators call)
+
+    @property
+    def transient(self):
+        """Name of the tyre transient form of these parameters."""
+        return transient.TRANSIENTS[int(self.p[P["tyre_transient"]])]
+
+    def __call__(self, t, x):
+        return self.fast(t, x)
+
+    def guarded(self, index=0, limit=math.inf, exception=None, index2=0, limit2=math.inf):
+        """A fast ``f(t, x)`` that raises ``exception`` once ``|x[index]| > limit`` or ``|x[index2]| > limit2``.
+
+        Where the Python headers are available this is an object of the
+        compiled :mod:`whipple_kick.model.rhs_call` extension: one foreign call,
+        no Python code, per evaluation (the integrator's hot path, about 1e4
+        calls per run). Otherwise one Python frame with everything bound
+        locally around the ctypes call. Without ``exception`` nothing is checked.
+        """
+        native = compiled._native_call()
+        if native is not None:
+            address = ctypes.cast(self.lib.wk_slip_rhs, ctypes.c_void_p).value
+            return native.Rhs(address, self.p, len(STATE_NAMES), _raise_status, exception, index, limit, index2,
+                              limit2)
+        fn, p_ptr, dx_ptr, dx = self.lib.wk_slip_rhs, self._p_ptr, self._dx_ptr, self._dx
+        if exception is None:
+            limit = limit2 = math.inf
+
+        def f(t, x):
+            if abs(x[index]) > limit or abs(x[index2]) > limit2:
+                raise exception
+            x = np.ascontiguousarray(x, dtype=float)
+            status = fn(t, x.ctypes.data, p_ptr, dx_ptr, None)
+            if status:
+                _raise_status(status, t)
+            return dx.copy()
+        return f
+
+    def jacobian_function(self, scale):
+        """``J(t, x)``: Jacobian d(dx/dt)/dx by forward differences in C (quadrature columns exactly 0).
+
+        Parameters
+        ----------
+        scale : array_like
+            Typical size of each state; the step is ``1.5e-8 max(|x_j|, scale_j)``.
+
+        Returns
+        -------
+        callable
+            ``jac(t, x)``; its ``evaluations`` attribute is the number of
+            right-hand-side evaluations one call makes (:data:`JACOBIAN_EVALUATIONS`:
+            dynamic states + 1, less the :data:`IGNORABLE` columns).
+        """
+        scale = np.ascontiguousarray(scale, dtype=float)
+        n = len(STATE_NAMES)
+        fn, p_ptr, s_ptr = self.lib.wk_slip_jacobian, self._p_ptr, scale.ctypes.data
+
+        def jac(t, x):
+            x = np.ascontiguousarray(x, dtype=float)
+            J = np.empty((n, n))
+            status = fn(t, x.ctypes.data, p_ptr, s_ptr, J.ctypes.data)
+            if status:
+                _raise_status(status, t)
+            return J
+        jac.scale = scale   # keeps the array alive with the closure
+        jac.evaluations = JACOBIAN_EVALUATIONS   # right-hand-side evaluations per call (the budget counts them)
+        return jac
+
+    def impulse_terms(self, t, x):
+        """Mass matrix M (10, 10), constraint matrix A (3, 10) and offset a0 (3,) at ``(t, x)``."""
+        x = np.ascontiguousarray(x, dtype=float)
+        n, m = len(SPEEDS), len(DEPENDENT)
+        M, A, a0 = np.empty((n, n)), np.empty((m, n)), np.empty(m)
+        self.lib.wk_slip_impulse_terms(t, x.ctypes.data, self._p_ptr, M.ctypes.data, A.ctypes.data,
+                                       a0.ctypes.data)
+        return M, A, a0
+
+    def outputs_at(self, t, X):
+        """Named outputs (:data:`OUTPUT_NAMES`) at many samples, in one C call.
+
+        Parameters
+        ----------
+        t : array_like, shape (n,)
+            Times [s].
+        X : array_like, shape (n, len(STATE_NAMES))
+            States.
+
+        Returns
+        -------
+        ndarray, shape (n, len(OUTPUT_NAMES))
+        """
+        t = np.ascontiguousarray(t, dtype=float)
+        X = np.ascontiguousarray(X, dtype=float)
+        if X.shape != (t.size, len(STATE_NAMES)):
+            raise ValueError(f"states must have shape ({t.size}, {len(STATE_NAMES)}), got {X.shape}")
+        out = np.empty((t.size, len(OUTPUT_NAMES)))
+        status = self.lib.wk_slip_outputs(t.size, t.ctypes.data, X.ctypes.data, self._p_ptr, out.ctypes.data)
+        if status:
+            raise FloatingPointError(_STATUS.get(status, f"status {status}") + " while evaluating outputs")
+        return out
+
+    def outputs(self, t, x):
+        """Derivatives and named outputs (:data:`OUTPUT_NAMES`) at one state."""
+        x = np.ascontiguousarray(x, dtype=float)
+        status = self.lib.wk_slip_rhs(t, x.ctypes.data, self._p_ptr, self._dx_ptr, self._out_ptr)
+        if status:
+            _raise_status(status, t)
+        return self._dx.copy(), self._out.copy()
+
+
+_STATUS = {
+    1: "singular constraint or mass matrix in the slip model",
+    2: "non-finite derivative in the slip model",
+}
+
+
+def _raise_status(status, t):
+    """Raise the model's error for a nonzero status of its C function at time ``t`` [s]."""
+    raise FloatingPointError(_STATUS.get(status, f"status {status}") + f" at t = {t:.6g} s")

@@ -1,0 +1,104 @@
+"""The compiled library: the C compiler, the cache entry (built on a miss), loading it once per process."""
+import ctypes
+import functools
+import json
+import os
+import shutil
+
+from whipple_kick.errors import InputError
+from whipple_kick.model import cache, rhs_call
+
+from .layout import _SOURCES, DYNAMIC_STATES, OUTPUT_NAMES, PARAMETER_NAMES, STATE_NAMES
+
+
+def _compiler():
+    """Path of the C compiler: $CC if set (must exist), else cc, gcc or clang on PATH."""
+    requested = os.environ.get("CC")
+    if requested:
+        cc = shutil.which(requested)
+        if not cc:
+            raise InputError(f"CC={requested!r} is not an executable C compiler; install gcc or fix CC")
+        return cc
+    cc = shutil.which("cc") or shutil.which("gcc") or shutil.which("clang")
+    if not cc:
+        raise InputError("no C compiler found (looked for cc, gcc, clang on PATH): install gcc or set CC")
+    return cc
+
+
+_CFLAGS = ("-O2", "-fPIC", "-shared", "-std=c99")
+
+
+@functools.cache
+def _native_call():
+    """The compiled call extension (:func:`whipple_kick.model.rhs_call.module`), or None; looked up once per process."""
+    return rhs_call.module(_compiler())
+
+
+def layout():
+    """The layouts the running code expects of the compiled library (as its metadata records them)."""
+    return {"states": list(STATE_NAMES), "parameters": list(PARAMETER_NAMES), "outputs": list(OUTPUT_NAMES),
+            "dynamic_states": len(DYNAMIC_STATES)}
+
+
+def _metadata_matches(path):
+    """Whether the metadata file at ``path`` exists, is private and records the running code's layouts."""
+    try:
+        cache.check_private_file(path)
+        return json.loads(path.read_text()).get("layout") == layout()
+    except (OSError, ValueError, AttributeError):
+        return False
+
+
+def library_path():
+    """Path of the compiled slip model in the cache, built first on a cache miss.
+
+    The cache entry is ``slip_<key>.so`` with its C source and plain-data
+    metadata (``slip_<key>.json``) beside it, the key hashing the package
+    sources it is generated from, the SymPy version, the compiler and its
+    flags. A miss runs :func:`whipple_kick.model.symbolic.slip_build.build_library` (SymPy,
+    20-30 s, one line on stderr). An entry whose metadata is missing or
+    records other layouts (states, parameters, outputs) is built again.
+    """
+    cc = _compiler()
+    key = cache.source_hash(_SOURCES, extra=f"{os.path.basename(cc)} {' '.join(_CFLAGS)}")
+    name = f"slip_{key}.so"
+
+    def build(tmp):
+        from whipple_kick.model.symbolic import slip_build  # SymPy and the derivation: only on a cache miss
+        slip_build.build_library(tmp, key, cc, _CFLAGS)
+
+    lib_path = cache.build_once(name, build)
+    if not _metadata_matches(lib_path.with_suffix(".json")):
+        with cache.locked(lib_path):
+            lib_path.unlink(missing_ok=True)
+        lib_path = cache.build_once(name, build)
+        if not _metadata_matches(lib_path.with_suffix(".json")):
+            raise RuntimeError(f"the compiled slip model {lib_path} has no matching metadata; remove the cache folder")
+    return lib_path
+
+
+def model_hash():
+    """Name of the compiled slip model in use (``slip_<key>``, its cache entry): what a sweep folder records."""
+    return os.path.splitext(os.path.basename(library()._name))[0]
+
+
+@functools.cache
+def library():
+    """The compiled slip model (ctypes library of :func:`library_path`), loaded once per process."""
+    lib = ctypes.CDLL(str(library_path()))
+    pointer = ctypes.c_void_p
+    lib.wk_slip_rhs.restype = ctypes.c_int
+    lib.wk_slip_rhs.argtypes = [ctypes.c_double, pointer, pointer, pointer, pointer]
+    lib.wk_slip_outputs.restype = ctypes.c_int
+    lib.wk_slip_outputs.argtypes = [ctypes.c_int, pointer, pointer, pointer, pointer]
+    lib.wk_slip_jacobian.restype = ctypes.c_int
+    lib.wk_slip_jacobian.argtypes = [ctypes.c_double, pointer, pointer, pointer, pointer]
+    lib.wk_slip_impulse_terms.restype = ctypes.c_int
+    lib.wk_slip_impulse_terms.argtypes = [ctypes.c_double, pointer, pointer, pointer, pointer, pointer]
+    lib.wk_slip_cornering_stiffness.restype = ctypes.c_int
+    lib.wk_slip_cornering_stiffness.argtypes = [ctypes.c_double, ctypes.c_double, pointer, pointer]
+    sizes = (ctypes.c_int * 4)()
+    lib.wk_slip_sizes(sizes)
+    if tuple(sizes) != (len(STATE_NAMES), len(PARAMETER_NAMES), len(OUTPUT_NAMES), len(DYNAMIC_STATES)):
+        raise RuntimeError(f"compiled slip model has sizes {tuple(sizes)}; rebuild the cache")
+    return lib

@@ -1,0 +1,162 @@
+"""The model's parameters by name: the tyres', the bicycle's, the rider's gains, the kick's, the options'."""
+
+import numpy as np
+
+from whipple_kick.errors import InputError
+from whipple_kick.model import carcass, magic_formula, transient
+from whipple_kick.model import symbols as S
+
+# ------------------------------------------------------- parameters and steady state
+
+#: Magic-Formula coefficients that shift the curves at zero slip and camber
+#: (Sh and Sv terms not multiplied by camber). "Symmetric tyres" zero them.
+FY_OFFSET_INDICES = magic_formula.FY_OFFSET_INDICES
+MZ_OFFSET_INDICES = magic_formula.MZ_OFFSET_INDICES
+GAIN_NAMES = ("kq3", "kq4", "kq7", "ku3", "ku4", "ku7", "kq11", "ku11")
+#: The state each gain of the rider's voluntary law multiplies (``T7 = -sum(gain * state)``).
+GAIN_STATES = {"kq3": "q3", "kq4": "q4", "kq7": "q7", "ku3": "u3", "ku4": "u4", "ku7": "u7", "kq11": "q11",
+               "ku11": "u11"}
+#: The rider's body by parameter name, with the rigid rider's values: the hip locked, the
+#: upper body's mass in the rear frame (mt 0), no arm impedance, no reflex.
+RIGID_BODY = {"hip_locked": 1.0, "hip_tilt": 0.0, "lh1": 0.0, "lh3": 0.0, "mt": 0.0, "lt1": 0.0, "lt3": 0.0,
+              "it11": 0.0, "it22": 0.0, "it33": 0.0, "it31": 0.0, "kh": 0.0, "ch": 0.0, "ka": 0.0, "ca": 0.0,
+              "rq4": 0.0, "rq7": 0.0, "ru4": 0.0, "ru7": 0.0, "reflex_delay": 0.0}
+BODY_NAMES = tuple(RIGID_BODY)
+
+
+def tyre_parameters(tyre, wheel, symmetric=False, lateral=True, reverse_camber=False):
+    """Slip-model parameters of one tyre, by name.
+
+    Parameters
+    ----------
+    tyre : whipple_kick.library.tyres.Tyre
+        A loaded tyre (its ``blend`` gives one or two coefficient sets).
+    wheel : {"r", "f"}
+        Rear or front.
+    symmetric : bool
+        Zero the zero-slip offsets (:data:`FY_OFFSET_INDICES`, :data:`MZ_OFFSET_INDICES`).
+    lateral : bool
+        False switches the tyre's lateral force and moment off.
+    reverse_camber : bool
+        Evaluate the curves at the opposite camber
+        (:func:`whipple_kick.model.magic_formula.camber_reversed`): the thesis
+        authors' published code, whose camber thrust pushes a leaning wheel
+        away from the lean. Not physical; for comparisons only.
+    """
+    if wheel not in ("r", "f"):
+        raise ValueError(f"wheel must be 'r' or 'f', got {wheel!r}")
+    sets = list(tyre.blend)
+    if len(sets) == 1:
+        # The second slot gets weight 0; filling it with the same (finite)
+        # coefficients keeps 0 * value finite.
+        sets = [sets[0], (0.0, sets[0][1], sets[0][2])]
+    out = {
+        f"rt{wheel}": tyre.crown_radius, f"kz{wheel}": tyre.vertical_stiffness,
+        f"cz{wheel}": tyre.vertical_damping, f"sig{wheel}": tyre.relaxation_length,
+        f"w{wheel}": sets[1][0], f"mu{wheel}": tyre.friction_scale,
+        f"lam{wheel}": tyre.curve_scale if lateral else 0.0,
+    }
+    for k, (_, fy, mz) in enumerate(sets, start=1):
+        fy, mz = np.array(fy, dtype=float), np.array(mz, dtype=float)
+        if symmetric:
+            fy[list(FY_OFFSET_INDICES)] = 0.0
+            mz[list(MZ_OFFSET_INDICES)] = 0.0
+        if reverse_camber:
+            fy, mz = magic_formula.camber_reversed(fy, "fy"), magic_formula.camber_reversed(mz, "mz")
+        out.update({f"a{wheel}{k}_{i}": v for i, v in enumerate(fy)})
+        out.update({f"c{wheel}{k}_{i}": v for i, v in enumerate(mz)})
+    return out
+
+
+#: Whose forward speed the tyres' slip angle and relaxation use (:func:`model_parameters`), by the
+#: value of the parameter ``slip_speed_point``.
+SLIP_SPEEDS = ("wheel_centre", "contact_point")
+
+
+def model_parameters(moore, rear_tyre, front_tyre, gains=None, kick=None,
+                     symmetric=False, lateral=True, drive_torque=0.0,
+                     tyre_transient=transient.DEFAULT_TRANSIENT, reverse_camber=False,
+                     carcass_sliding=carcass.DEFAULT_SLIDING, carcass_damping=0.0,
+                     carcass_viscosity=carcass.SLIDING_VISCOSITY, slip_speed="wheel_centre", body=None,
+                     carcass_stiffness_scale=1.0):
+    """Assemble the slip model's parameters by name.
+
+    Parameters
+    ----------
+    moore : mapping
+        Moore parameters of the bicycle (with rider).
+    rear_tyre, front_tyre : whipple_kick.library.tyres.Tyre
+        Loaded tyres.
+    gains : mapping, optional
+        Steer-torque gains by name (:data:`GAIN_NAMES`); missing ones are 0.
+        ``T7 = -(kq4 q4 + kq7 q7 + ku4 u4 + ku7 u7 + kq3 q3 + ku3 u3)``.
+    kick : mapping, optional
+        ``t0`` [s], ``duration`` [s], ``displacement`` [m, + to the right],
+        ``profile`` (0 constant acceleration, 1 minimum jerk, 2 one cubic
+        segment ``c0 + c1 tau + c2 tau^2 + c3 tau^3`` with ``tau = t - t0``,
+        given as ``coefficients`` = (c0, c1, c2, c3) in m, m/s, m/s^2, m/s^3;
+        see :func:`whipple_kick.library.inputs.cubic_segments`). Default: no kick.
+    symmetric, lateral, reverse_camber : bool
+        See :func:`tyre_parameters`.
+    drive_torque : float
+        Constant rear-wheel torque T6c [N m] about the rear frame's C.y axis
+        (+ opposes forward rolling); the steady-state solver sets it.
+    tyre_transient : str
+        One of :data:`whipple_kick.model.transient.TRANSIENTS` (default ``carcass``).
+    carcass_sliding : {"peak", "curve"}
+        The carcass tyre's friction limit past the peak (:mod:`whipple_kick.model.carcass`).
+    carcass_damping : float
+        Lateral damping of both carcasses [N s/m], parallel to their stiffness
+        (default 0).
+    carcass_viscosity : float
+        :data:`whipple_kick.model.carcass.SLIDING_VISCOSITY` [N s/m]: the
+        regularisation of an undamped carcass' Coulomb plateau. The stiffnesses ``ccr``/``ccf`` are set by
+        :func:`steady_state` (or :func:`upright_state`) from the loads of the
+        state found: ``C_Fa(F_z0) / sigma0``.
+    slip_speed : {"wheel_centre", "contact_point"}
+        Whose forward speed along the wheel's heading the slip angle
+        ``atan(vsy / |vx|)`` and the relaxation ``sigma / |vx|`` use: the
+        wheel centre's (default) or the geometric contact point's, as the
+        thesis authors' published code takes it (parameter ``slip_speed_point``).
+    carcass_stiffness_scale : float
+        Factor on the carcass stiffnesses the steady state sets (default 1).
+    body : mapping, optional
+        The rider's body by parameter name (:data:`BODY_NAMES`: the upper
+        body's placement and inertia, hip and arm spring-dampers, reflex gains
+        and delay; :func:`whipple_kick.library.riders.body_parameters` makes them).
+        Default: the rigid rider (hip locked, no upper body of its own, no
+        arms, no reflex), which is the model without a body exactly.
+    """
+    if slip_speed not in SLIP_SPEEDS:
+        raise InputError(f"slip speed {slip_speed!r} is unknown; choose one of {', '.join(SLIP_SPEEDS)}")
+    params = {n: float(moore[n]) for n in S.CLASSIC_CONSTANTS}
+    params.update(tyre_parameters(rear_tyre, "r", symmetric, lateral, reverse_camber))
+    params.update(tyre_parameters(front_tyre, "f", symmetric, lateral, reverse_camber))
+    gains = dict(gains or {})
+    unknown = set(gains) - set(GAIN_NAMES)
+    if unknown:
+        raise InputError(f"unknown controller gains {sorted(unknown)}; known: {', '.join(GAIN_NAMES)}")
+    params.update({n: float(gains.get(n, 0.0)) for n in GAIN_NAMES})
+    kick = dict(kick or {})
+    params.update({
+        "kick_t0": float(kick.get("t0", 0.0)),
+        "kick_T": float(kick.get("duration", 0.15)),
+        "kick_D": float(kick.get("displacement", 0.0)),
+        "kick_profile": float(kick.get("profile", 0)),
+        **{f"kick_c{i}": float(c) for i, c in enumerate(kick.get("coefficients", (0.0, 0.0, 0.0, 0.0)))},
+        "T6c": float(drive_torque),
+        "tyre_transient": float(transient.check(tyre_transient)),
+        "vsx_r": 0.0,
+        "slip_speed_point": float(SLIP_SPEEDS.index(slip_speed)),
+        "ccr": 0.0, "ccf": 0.0,   # set from the steady loads (_steady_tyre_states)
+        "dcr": float(carcass_damping), "dcf": float(carcass_damping),
+        "carcass_sliding": float(carcass.check_sliding(carcass_sliding)),
+        "carcass_viscosity": float(carcass_viscosity),
+        "carcass_stiffness_scale": float(carcass_stiffness_scale),
+    })
+    body = dict(body or {})
+    unknown = set(body) - set(BODY_NAMES)
+    if unknown:
+        raise InputError(f"unknown rider-body parameters {sorted(unknown)}; known: {', '.join(BODY_NAMES)}")
+    params.update({n: float(body.get(n, RIGID_BODY[n])) for n in BODY_NAMES})
+    return params

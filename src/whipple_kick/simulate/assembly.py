@@ -1,0 +1,568 @@
+"""Assembly: bicycle, rider, tyres and the rider's gains -> the slip model's parameters and its steady motion.
+
+The second step of a run (:func:`whipple_kick.simulate.simulation.run`): from a
+validated :class:`~whipple_kick.simulate.scenario.Scenario` and its kick
+(:mod:`whipple_kick.library.inputs`), :func:`assemble` seats the Yeadon rider on
+the bicycle (:func:`build_bicycle`), loads the tyres (:func:`build_tyres`),
+designs or looks up the rider's steer-torque gains (:func:`controller_gains`),
+names every parameter of the compiled model
+(:func:`whipple_kick.model.slip.model_parameters`), finds the steady motion the
+run starts from (:func:`whipple_kick.simulate.steady.start_state`) and judges whether the rider is
+linearly stable about it (:func:`linear_stability`). The result is one
+:class:`Assembly`, handed to the integration.
+"""
+import copy
+from dataclasses import dataclass
+import functools
+import pathlib
+
+import numpy as np
+
+from whipple_kick.errors import InputError, check_range
+from whipple_kick.model import slip
+from whipple_kick.simulate import steady
+
+from .scenario import LOW_INERTIA_KEYS, THESIS_DESIGN_SPEED
+
+#: |steady yaw rate| [rad/s] below which steady running counts as straight (a yaw-angle gain needs it).
+STRAIGHT_YAW_RATE = 1e-9
+
+
+@dataclass
+class Assembly:
+    """Everything a run integrates and reports about its set-up.
+
+    Attributes
+    ----------
+    rear, front : whipple_kick.library.tyres.Tyre
+        The tyres (or the caller's tyre objects).
+    tyre_notes : list of str
+        What the summary says about them (missing M_z data, custom tyres).
+    moore : dict
+        Moore parameters of the bicycle with rider (low-inertia change applied).
+    bicycle : dict
+        The summary's ``bicycle`` section: rider mass [kg], static loads [N], total mass [kg].
+    gains : dict
+        Steer-torque gains by name (N m/rad, N m s/rad).
+    design_poles : ndarray or None
+        The LQR design's closed-loop poles at its design speed [1/s].
+    controller : str
+        ``lqr``, ``thesis``, ``off`` or ``custom gains``.
+    params : dict
+        The compiled model's parameters (the steady drive torque T6c included).
+    found : whipple_kick.simulate.steady.Found
+        The steady motion stability is judged about, and how it was found.
+    start : whipple_kick.simulate.steady.SteadyState
+        The state the run starts from (the steady motion, or an upright start).
+    stability : dict
+        :func:`linear_stability`'s verdict.
+    """
+
+    rear: object
+    front: object
+    tyre_notes: list
+    moore: dict
+    bicycle: dict
+    gains: dict
+    design_poles: np.ndarray | None
+    controller: str
+    params: dict
+    found: object
+    start: object
+    stability: dict
+
+    @property
+    def reference(self):
+        """The steady motion recovery is measured back to (upright running when the tyres allow none)."""
+        return self.start if self.found.route == steady.SYMMETRIC_ROUTE else self.found.steady
+
+
+def assemble(scenario, kick, *, tyres=None, gains=None) -> Assembly:
+    """Build the model of one run: tyres, bicycle with rider, gains, parameters, steady motion, stability.
+
+    Parameters
+    ----------
+    scenario : whipple_kick.simulate.scenario.Scenario
+        Validated.
+    kick : whipple_kick.library.inputs.Kick
+        The plate motion (its first piece enters the parameters).
+    tyres : (rear, front), optional
+        Tyre objects instead of the scenario's tyre and pressures.
+    gains : mapping, optional
+        Steer-torque gains by name instead of the scenario's controller.
+
+    Returns
+    -------
+    Assembly
+
+    Raises
+    ------
+    InputError
+        A tyre, bicycle, rider or gain the scenario names is unknown or out
+        of range; no steady motion to start from
+        (:class:`whipple_kick.simulate.steady.NoSteadyMotion`); a yaw-angle gain with
+        a steady turn.
+    """
+    custom = None if gains is None else custom_gains(gains)
+    # Tyres first: a pressure outside the measured range is the commonest mistake and cheap to find.
+    if tyres is None:
+        rear, front, notes = build_tyres(scenario)
+    else:
+        rear, front = tyres
+        notes = [f"custom tyre objects (the scenario's tyre and pressures are not used): "
+                 f"rear {rear!r}, front {front!r}"]
+    moore, design, info = build_bicycle(scenario)
+    if custom is None and scenario.controller == "lqr" and scenario.lqr_model == "simulated":
+        gains, poles = (_cached_simulated_design(scenario) if tyres is None
+                        else lqr_on_simulated_model(scenario, moore, design, info, rear, front))
+        controller = scenario.controller
+    elif custom is None:
+        gains, poles = controller_gains(scenario, design)
+        controller = scenario.controller
+    else:
+        gains, poles, controller = custom, None, "custom gains"
+    params = slip.model_parameters(moore, rear, front, gains=gains, symmetric=scenario.symmetric_tyres,
+                                   kick=kick.model_kick(), tyre_transient=scenario.tyre_transient,
+                                   reverse_camber=scenario.camber_sign == "reversed",
+                                   carcass_sliding=scenario.carcass_sliding, carcass_damping=scenario.carcass_damping,
+                                   carcass_viscosity=scenario.carcass_viscosity, slip_speed=scenario.slip_speed,
+                                   body=rider_body(scenario, info),
+                                   carcass_stiffness_scale=scenario.carcass_stiffness_scale)
+    found, start = steady.start_state(params, scenario, advice=_steady_advice(scenario, controller))
+    stability = linear_stability(scenario, moore, gains, found, controller)
+    steady_yaw_rate = float(start.x[slip.X["u3"]])
+    if gains.get("kq3", 0.0) and abs(steady_yaw_rate) > STRAIGHT_YAW_RATE:
+        # In a steady turn the yaw angle grows without bound, and so would kq3's torque.
+        raise InputError(f"a yaw-angle gain kq3 needs straight steady running, but the steady yaw rate is "
+                         f"{steady_yaw_rate:.3g} rad/s (allowed |yaw rate| <= {STRAIGHT_YAW_RATE:g} rad/s): "
+                         f"use tyres without zero-slip offsets (symmetric_tyres=True)")
+    return Assembly(rear, front, notes, moore, info, gains, poles, controller, start.params, found, start, stability)
+
+
+# ------------------------------------------------------------------ the parts
+
+def build_bicycle(scenario):
+    """Bicycle with rider for ``scenario``: (moore parameters, design parameters, info dict).
+
+    The info holds the rider mass [kg] and the static loads [N] of the
+    unmodified bicycle; ``moore`` has the low-inertia change applied if asked.
+    ``design`` is the unmodified set the LQR is designed on: the whole rider
+    lumped into the rear frame, also when ``moore`` splits it into a body. Cached per
+    process on the fields it reads (a sweep over pressures, speeds or kicks
+    seats the Yeadon rider once); callers get their own copies.
+    """
+    key = (scenario.bicycle, _file_stamp(scenario.bicycle), scenario.fz_n, scenario.rider_mass_kg,
+           scenario.rider, scenario.low_inertia, scenario.rider_body != "rigid" or scenario.arms == "on",
+           scenario.arms == "on")
+    return copy.deepcopy(_bicycle_setup(*key))
+
+
+def _file_stamp(name):
+    """Modification time of a parameter file given by path (so an edited file is re-read)."""
+    path = pathlib.Path(str(name))
+    return path.stat().st_mtime_ns if path.suffix == ".toml" and path.is_file() else None
+
+
+@functools.lru_cache(maxsize=256)
+def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia, split=False, arms_on_bar=False):
+    from whipple_kick.library import bicycles, riders
+    from whipple_kick.model import benchmark
+
+    bike = bicycles.load(bicycle)
+    if split and bike.includes_rider:
+        raise _lumped_rider_error(bike)
+    if bike.includes_rider:
+        if fz_n is not None or rider_mass_kg is not None:
+            raise InputError(f"bicycle {bike.name!r} already includes its rider; "
+                             "do not give a rear-tyre load fz or a rider mass with it")
+        combined, rider_mass = bike, None
+    elif rider_mass_kg is not None:
+        rider = riders.yeadon_rider(rider_name, mass_kg=rider_mass_kg)
+        combined, rider_mass = riders.seat(bike, rider), float(rider_mass_kg)
+    else:
+        fz = 635.0 if fz_n is None else fz_n
+        combined, rider_mass = riders.for_rear_load(bike, fz, rider=rider_name,
+                                                    load_range=_rear_load_range(bicycle, _stamp, rider_name))
+    # The static loads and the Whipple model the LQR is designed on are the whole rider's: the split below
+    # moves the upper body out of the bicycle's parameters, not out of the statics or the rider's mass.
+    rear_n, front_n = riders.static_loads(combined)
+    design = dict(combined.moore)
+    body = None
+    if split:
+        # The same rider, split into legs (rear frame), forearms (front frame, when on the bar) and upper body.
+        rider = riders.yeadon_rider(rider_name, mass_kg=rider_mass)
+        combined, body = riders.seat_with_body(bike, rider, arms_on_bar=arms_on_bar)
+    moore = dict(combined.moore)
+    if low_inertia:
+        bench = dict(combined.benchmark)
+        for key in LOW_INERTIA_KEYS:
+            bench[key] *= 0.5
+        moore = benchmark.to_moore(bench)
+    info = {"bicycle": bike.name, "includes_rider_preset": bike.includes_rider,
+            "rider_mass_kg": rider_mass, "static_load_rear_n": rear_n, "static_load_front_n": front_n,
+            "total_mass_kg": sum(float(combined.benchmark[k]) for k in ("mR", "mB", "mH", "mF"))
+            + (body["mt"] if body else 0.0), "body": body}
+    return moore, design, info
+
+
+def _lumped_rider_error(bike):
+    return InputError(f"bicycle {bike.name!r} has its rider lumped in already: a leaning rider or arms on the "
+                      "bar need a bicycle-only set with a Yeadon rider (e.g. 'balanceassist_v1')")
+
+
+@functools.lru_cache(maxsize=64)
+def _rear_load_range(bicycle, _stamp, rider_name):
+    # The rear loads a rider can give the bicycle (a probe rider seated, ~10 ms) do not depend on the load:
+    # a sweep over loads finds them once per process.
+    from whipple_kick.library import bicycles, riders
+    return riders.rear_load_range(bicycles.load(bicycle), rider_name)
+
+
+@functools.lru_cache(maxsize=256)
+def _lqr(design_items, speed):
+    # A sweep over pressures or kicks designs the same rider once per process.
+    from . import control
+    K, poles = control.lqr_gains(dict(design_items), speed)
+    return tuple(np.ravel(K)), tuple(np.ravel(poles))
+
+
+@functools.lru_cache(maxsize=256)
+def _classic_poles(moore_items, speed, gains_items):
+    # The no-slip model's poles depend on the bicycle, speed and gains only: a sweep over tyres or kicks
+    # computes them once per process (~3 ms a case).
+    from . import control
+    return tuple(control.closed_loop_poles(dict(moore_items), speed, dict(gains_items)))
+
+
+def rider_body(scenario, info):
+    """The rider's body parameters by name (:data:`whipple_kick.model.slip.parameters.BODY_NAMES`) for ``scenario``.
+
+    The rigid rider without arms is :data:`~whipple_kick.model.slip.parameters.RIGID_BODY`; otherwise the upper
+    body of :func:`build_bicycle` (locked at the hip for the rigid rider with arms on the bar), the hip's and
+    arms' spring-dampers and the reflex.
+    """
+    body = dict(slip.parameters.RIGID_BODY)
+    if info.get("body"):
+        body.update(info["body"])
+        body["hip_locked"] = 0.0 if scenario.rider_body == "leaning" else 1.0
+    body.update(kh=scenario.hip_stiffness if scenario.rider_body == "leaning" else 0.0,
+                ch=scenario.hip_damping if scenario.rider_body == "leaning" else 0.0,
+                ka=scenario.arm_stiffness if scenario.arms == "on" else 0.0,
+                ca=scenario.arm_damping if scenario.arms == "on" else 0.0,
+                rq4=scenario.reflex_roll, ru4=scenario.reflex_roll_rate, rq7=scenario.reflex_steer,
+                ru7=scenario.reflex_steer_rate, reflex_delay=scenario.reflex_delay)
+    return body
+
+
+#: Fields the design on the simulated model does not read (the kick, the run's length and numerics).
+_NOT_IN_DESIGN = ("kick_displacement", "kick_duration", "kick_accel", "kick_profile", "kick_table", "kick_direction",
+                  "settle", "duration", "rtol", "output_rate", "fall_angle_deg", "steer_limit_deg", "piecewise")
+
+
+def _cached_simulated_design(scenario):
+    """:func:`lqr_on_simulated_model` of ``scenario``, once per process for the fields the design reads.
+
+    Both kick directions (or any kick) of a case share one design.
+    """
+    from dataclasses import fields
+
+    key = scenario.with_changes(**{f.name: f.default for f in fields(scenario) if f.name in _NOT_IN_DESIGN})
+    gains, poles = _simulated_design(key)
+    return dict(gains), np.array(poles)
+
+
+@functools.lru_cache(maxsize=256)
+def _simulated_design(scenario):
+    rear, front, _ = build_tyres(scenario)
+    moore, design, info = build_bicycle(scenario)
+    gains, poles = lqr_on_simulated_model(scenario, moore, design, info, rear, front)
+    return tuple(gains.items()), tuple(poles)
+
+
+def lqr_on_simulated_model(scenario, moore, design, info, rear, front):
+    """The LQR rider designed on the model the run simulates (``lqr_model="simulated"``).
+
+    The model of the run (its tyres, carcass, body, arms and reflex) with
+    symmetric tyres, linearised about upright straight running at the design
+    speed at constant speed (:func:`whipple_kick.model.slip.heading_linearisation`);
+    the law feeds back roll, steer and their rates, and the upper body's lean
+    and its rate when it leans (:data:`whipple_kick.model.slip.parameters.GAIN_STATES`),
+    with gains LQR-optimal for that law (identity weights on those states,
+    1 on the torque, as the Whipple design), found from the Whipple design's
+    gains by :func:`whipple_kick.simulate.control.output_feedback_lqr`. Where the
+    Whipple gains do not stabilise the model, the arms' and the reflex's
+    gains are brought in from 0 in steps, each design starting from the last.
+
+    Returns
+    -------
+    gains : dict
+        By name (:data:`whipple_kick.model.slip.parameters.GAIN_NAMES`), times ``gain_scale``.
+    poles : ndarray
+        The design's closed-loop eigenvalues.
+    """
+    from . import control
+
+    speed = float(scenario.lqr_design_speed)
+    body = rider_body(scenario, info)
+    felt = (["kq4", "kq7", "ku4", "ku7"] + (["kq11", "ku11"] if scenario.rider_body == "leaning" else [])
+            + (["kq3"] if scenario.lqr_heading else []))
+    K = np.r_[_lqr(tuple(sorted(design.items())), speed)[0], np.zeros(len(felt) - 4)]
+    if scenario.lqr_heading:   # start from the Whipple model's heading design (its yaw gain holds the heading)
+        whipple = dict(zip(control.HEADING_GAIN_ORDER, control.heading_lqr_gains(design, speed)[0], strict=True))
+        K = np.array([whipple.get(name, 0.0) for name in felt])
+    scaled = ("ka", "ca", "rq4", "rq7", "ru4", "ru7")
+    models = {}
+
+    def model(share):
+        """(A, b, C) of the design model with ``share`` of the ``scaled`` gains, built once per share."""
+        if share not in models:
+            models[share] = _linear_design_model(scenario, moore, rear, front, body, felt, share, scaled)
+        return models[share]
+
+    def stabilises(gains, share):
+        A, b, C = model(share)
+        return bool(np.max(np.linalg.eigvals(A - b @ gains[None, :] @ C).real) < 0.0)
+
+    # Continuation: the share of the arms' and reflex's gains grows while the gains still stabilise the
+    # next model; where they do not, they are re-optimised at the last share they did (a larger margin).
+    done, step = (1.0, 1.0) if stabilises(K, 1.0) else (0.0, 0.25)
+    if not stabilises(K, done):   # the body alone (forearms on the bar, a leaning trunk) defeats the Whipple design
+        K = control.stabilising_gains(*model(done), K)
+    optimised_at = None
+    while done < 1.0:
+        share = min(1.0, done + step)
+        if stabilises(K, share):
+            done, step = share, step * 2.0
+        elif optimised_at != done:
+            K, _ = control.output_feedback_lqr(*model(done), K0=K)
+            optimised_at = done
+        elif step < 1e-3:
+            raise InputError(f"no stabilising LQR rider was found on the model simulated at {speed:g} m/s "
+                             f"(the design lost stability at {share:.1%} of the arms' and reflex's gains)")
+        else:
+            step /= 2.0
+    K, poles = control.output_feedback_lqr(*model(1.0), K0=K)
+    gains = dict.fromkeys(slip.GAIN_NAMES, 0.0)
+    gains.update({name: float(scenario.gain_scale * k) for name, k in zip(felt, K, strict=True)})
+    return gains, poles
+
+
+def _linear_design_model(scenario, moore, rear, front, body, felt, share, scaled):
+    """(A, b, C) of the design model with ``share`` of the ``scaled`` body gains (C picks the ``felt`` states)."""
+    part = {k: (v * share if k in scaled else v) for k, v in body.items()}
+    params = slip.model_parameters(moore, rear, front, symmetric=True, tyre_transient=scenario.tyre_transient,
+                                   carcass_sliding=scenario.carcass_sliding,
+                                   carcass_damping=scenario.carcass_damping,
+                                   carcass_viscosity=scenario.carcass_viscosity, slip_speed=scenario.slip_speed,
+                                   body=part, carcass_stiffness_scale=scenario.carcass_stiffness_scale)
+    up = steady.upright_state(params, float(scenario.lqr_design_speed))
+    rhs = slip.CompiledRHS(up.params)
+    A, b = slip.heading_linearisation(rhs, up.x)
+    names = list(slip.LINEAR_STATES) + list(slip.linear.body_states(rhs.p))
+    keep = [i for i, n in enumerate(names) if n != "v_fwd"]   # constant speed
+    A, b = A[np.ix_(keep, keep)], b[keep]
+    names = [names[i] for i in keep]
+    if "kq3" in felt:   # the heading q3 as a state: dq3/dt = u3 (nothing else depends on it)
+        n = len(names)
+        A = np.block([[A, np.zeros((n, 1))], [np.eye(n)[[names.index("u3")]], np.zeros((1, 1))]])
+        b = np.vstack([b, [[0.0]]])
+        names.append("q3")
+    C = np.zeros((len(felt), len(names)))
+    for row, gain in enumerate(felt):
+        C[row, names.index(slip.GAIN_STATES[gain])] = 1.0
+    return A, b, C
+
+
+def controller_gains(scenario, design):
+    """Steer-torque gains by name, and the LQR design's closed-loop poles at its design speed (or None).
+
+    The LQR rider is designed at :attr:`Scenario.lqr_design_speed` (the run's
+    speed unless ``design_speed`` is given).
+    """
+    from . import control
+
+    if scenario.controller == "off":
+        return dict.fromkeys(control.GAIN_ORDER, 0.0), None
+    if scenario.controller == "thesis":
+        gains = control.thesis_gains(thesis_load(scenario))
+        return {k: scenario.gain_scale * v for k, v in gains.items()}, None
+    K, poles = _lqr(tuple(sorted(design.items())), float(scenario.lqr_design_speed))
+    return control.gains_dict(K, scenario.gain_scale), np.asarray(poles)
+
+
+def thesis_load(scenario):
+    """Rear load [N] whose Table 8.4 row ``controller="thesis"`` uses.
+
+    ``thesis_load_n`` if given, else ``fz_n``, else the load a preset with
+    rider is labelled with (``balanceassist_635N``: 635 N), else 635 N for a
+    bicycle whose rider is seated for the default load.
+    """
+    from whipple_kick.library import bicycles
+
+    if scenario.thesis_load_n is not None:
+        return scenario.thesis_load_n
+    if scenario.fz_n is not None:
+        return scenario.fz_n
+    bike = bicycles.load(scenario.bicycle)
+    if bike.includes_rider and bike.thesis_rear_load_n is not None:
+        return bike.thesis_rear_load_n
+    if scenario.rider_mass_kg is None and not bike.includes_rider:
+        return 635.0
+    raise InputError("controller thesis uses Table 8.4 gains for a rear load of 570, 635 or 701 N: give fz (N), "
+                     "or thesis_load_n (--thesis-load N) for a rider given by mass or a preset with rider")
+
+
+def thesis_gains_warning(scenario):
+    """One line when ``controller="thesis"`` uses the Table 8.4 gains of another load than the run's, else None.
+
+    The run's load: the one a preset with rider is labelled with, or ``fz_n``.
+    """
+    from whipple_kick.library import bicycles
+
+    if scenario.controller != "thesis":
+        return None
+    bike = bicycles.load(scenario.bicycle)
+    own, what = ((bike.thesis_rear_load_n, f"bicycle {bike.name!r} is labelled") if bike.includes_rider
+                 else (scenario.fz_n, "the rider is seated for"))
+    gains = thesis_load(scenario)
+    if own is None or abs(own - gains) < 1e-9:
+        return None
+    return (f"the Table 8.4 gains in use are those for {gains:g} N, but {what} a rear load of {own:g} N "
+            f"(thesis_load_n = {gains:g} N; leave it unset for the gains of {own:g} N)")
+
+
+def build_tyres(scenario):
+    """(rear, front) tyres and a list of notes about them."""
+    from whipple_kick.library import tyres
+
+    notes = []
+    rear_p, front_p = scenario.pressures
+    loaded = []
+    for p in (rear_p, front_p):
+        # missing_moment="zero" changes nothing for a tyre with M_z data (its flag says which it is).
+        tyre = tyres.load(scenario.tyre, p, coefficient_set=scenario.coefficient_set,
+                          friction=scenario.friction, missing_moment="zero")
+        loaded.append(tyre)
+        if not tyre.has_aligning_moment:
+            # Tyres without published M_z data: run with M_z = 0 and say so.
+            note = f"{scenario.tyre} has no published aligning-moment data: M_z = 0"
+            if note not in notes:
+                notes.append(note)
+    return loaded[0], loaded[1], notes
+
+
+def preflight(scenario):
+    """Cheap checks of everything a user can get wrong, before any long work.
+
+    Field ranges, tyre name and pressure range, bicycle name and rider
+    conflicts (a preset with its rider lumped in cannot lean or hold the bar), the Table 8.4 row of ``controller="thesis"``. Raises
+    :class:`InputError`; returns ``scenario``.
+    """
+    from whipple_kick.library import bicycles
+    from whipple_kick.simulate import control
+
+    scenario.validate()
+    build_tyres(scenario)
+    bike = bicycles.load(scenario.bicycle)
+    if bike.includes_rider and (scenario.fz_n is not None or scenario.rider_mass_kg is not None):
+        raise InputError(f"bicycle {bike.name!r} already includes its rider; "
+                         "do not give a rear-tyre load fz or a rider mass with it")
+    if bike.includes_rider and (scenario.rider_body != "rigid" or scenario.arms == "on"):
+        raise _lumped_rider_error(bike)
+    if scenario.controller == "thesis":
+        control.thesis_gains(thesis_load(scenario))
+    return scenario
+
+
+#: A closed-loop pole whose real part exceeds this [1/s] makes the rider linearly unstable
+#: (slower growth, by less than 1 % over a 10 s run, is not reported).
+UNSTABLE_REAL_PART = 1e-3
+
+
+def who_rides(scenario, controller_type):
+    """How the summary and the messages name the rider in use."""
+    if controller_type == "lqr":
+        on = " on the model simulated" if scenario.lqr_model == "simulated" else ""
+        return f"the LQR rider designed{on} at {scenario.lqr_design_speed:g} m/s"
+    if controller_type == "thesis":
+        return f"the thesis' Table 8.4 rider (designed at {THESIS_DESIGN_SPEED:g} m/s)"
+    if controller_type == "off":
+        return "the bicycle without steer control"
+    return "the rider with the given gains"
+
+
+def _steady_advice(scenario, controller_type):
+    """What a user can change when there is no steady motion (for the one-line error)."""
+    if controller_type == "lqr" and scenario.design_speed is not None:
+        return (f"the rider is designed at {scenario.design_speed:g} m/s: choose another design speed "
+                "(--design-speed; by default the run's speed) or another speed")
+    if controller_type == "thesis":
+        return (f"Table 8.4's rider was designed at {THESIS_DESIGN_SPEED:g} m/s: choose controller lqr "
+                "(designed at the run's speed) or another speed")
+    return "choose another speed, rider or tyre pressure, or symmetric tyres"
+
+
+def linear_stability(scenario, moore, gains, found, controller_type):
+    """Is the rider in use linearly stable at the run's speed?
+
+    Poles of the slip model linearised about the steady motion at constant
+    speed (:func:`whipple_kick.simulate.steady.lateral_poles`; decisive) and of the
+    no-slip classic model of the same bicycle with the same gains
+    (:func:`whipple_kick.simulate.control.closed_loop_poles`). A yaw-angle gain breaks
+    the slip linearisation's heading invariance: then the classic model decides.
+
+    Returns
+    -------
+    dict
+        ``stable``, ``message`` (one line, None when stable), ``slowest_pole_1_s``,
+        ``model`` (which linearisation decided), ``poles_slip_model_1_s``,
+        ``poles_no_slip_model_1_s`` (each as [real, imag] pairs), ``criterion``.
+    """
+    from . import steady
+
+    classic = np.asarray(_classic_poles(tuple(sorted(moore.items())), float(scenario.speed),
+                                        tuple(sorted(gains.items()))))
+    slip_poles = None
+    if not gains.get("kq3", 0.0):
+        try:
+            slip_poles = steady.lateral_poles(found.steady.params, found.steady.x)
+        except FloatingPointError:   # the linearisation's pitch solve failed: the classic model decides
+            slip_poles = None
+    about = steady.SYMMETRIC_ABOUT if found.route == steady.SYMMETRIC_ROUTE else "the steady motion"
+    decisive, model = ((slip_poles, f"slip model about {about}, constant speed")
+                       if slip_poles is not None else (classic, "no-slip classic model"))
+    slowest = decisive[0]
+    stable = bool(slowest.real <= UNSTABLE_REAL_PART)
+    message = None
+    if not stable:
+        message = (f"{who_rides(scenario, controller_type)} is linearly unstable at {scenario.speed:g} m/s: "
+                   f"slowest closed-loop pole {_pole_text(slowest)} 1/s ({model}; no-slip model "
+                   f"{_pole_text(classic[0])} 1/s)")
+    pairs = lambda poles: None if poles is None else [[float(p.real), float(p.imag)] for p in poles]
+    return {"stable": stable, "message": message, "slowest_pole_1_s": pairs([slowest])[0], "model": model,
+            "poles_slip_model_1_s": pairs(slip_poles), "poles_no_slip_model_1_s": pairs(classic),
+            "criterion": f"unstable when a closed-loop pole has real part > {UNSTABLE_REAL_PART:g} 1/s"}
+
+
+def _pole_text(pole):
+    text = f"{pole.real:+.3f}"
+    return text + (f" +- {abs(pole.imag):.3f}j" if abs(pole.imag) > 1e-9 else "")
+
+
+def custom_gains(gains):
+    """Check user-given steer-torque gains (by name) and fill the missing ones with 0."""
+    from whipple_kick.model import symbols
+    from whipple_kick.simulate import control
+
+    unknown = sorted(set(gains) - set(slip.GAIN_NAMES))
+    if unknown:
+        raise InputError(f"unknown steer-torque gain(s) {unknown}; known: {list(slip.GAIN_NAMES)}")
+    # The four of the thesis' law always; the yaw gains only when given.
+    names = control.GAIN_ORDER + tuple(n for n in ("kq3", "ku3") if n in gains)
+    return {name: check_range(f"gain {name}", gains.get(name, 0.0), None, None, symbols.info(name).unit)
+            for name in names}
+
+
+def control_law(gains):
+    """``T7 = -(kq4 q4 + ...)`` with the gains in use (gain k<x> multiplies state <x>), for the summary."""
+    return "T7 = -(" + " + ".join(f"{name} {name[1:]}" for name in gains) + ")"

@@ -1,0 +1,81 @@
+"""One kick-plate run end to end: scenario in, time histories and summary out.
+
+:func:`run` reads top-down as the run's data flow, each step handing a
+finished object to the next:
+
+1. the scenario is checked and its kick described (:mod:`whipple_kick.simulate.scenario`,
+   :mod:`whipple_kick.library.inputs`),
+2. the model is assembled: bicycle with rider, tyres, gains, parameters,
+   steady motion (:mod:`whipple_kick.simulate.assembly`),
+3. it is integrated across the kick (:mod:`whipple_kick.simulate.integration`),
+4. the results are tabulated and summarised (:mod:`whipple_kick.simulate.results`).
+
+Time is measured from the start of the kick: the run starts at ``-settle``
+(steady running shown before the kick) and ends at ``duration`` (or at the
+fall). docs/simulate.md lists every decision.
+"""
+from collections.abc import Mapping
+import time
+
+from whipple_kick.errors import SimulationError
+from whipple_kick.library import inputs
+from whipple_kick.simulate import assembly, integration, results
+
+from .results import Result
+from .scenario import Scenario
+
+__all__ = ["Result", "Scenario", "SimulationError", "run"]
+
+
+def run(scenario: Scenario, *, tyres: tuple | None = None, gains: Mapping | None = None) -> Result:
+    """Run one kick-plate simulation.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        What to run (validated here).
+    tyres : (rear, front), optional
+        Tyre objects to use instead of the scenario's tyre and pressures,
+        e.g. :func:`whipple_kick.library.tyres.linear_tyre` or a :class:`~whipple_kick.library.tyres.Tyre`
+        loaded with other options. The summary names them.
+    gains : mapping, optional
+        Steer-torque gains by name (``kq4 kq7 ku4 ku7``, and the yaw gains
+        ``kq3 ku3``; N m/rad, N m s/rad; missing ones are 0) instead of the
+        scenario's controller; the law is still ``T7 = -K x``.
+        ``scenario.gain_scale`` does not apply to them. A yaw-angle gain
+        (e.g. from :func:`whipple_kick.simulate.control.heading_lqr_gains`) needs a
+        straight steady motion, so tyres without zero-slip offsets.
+
+    Returns
+    -------
+    Result
+
+    Raises
+    ------
+    InputError
+        A field is out of range, unknown or conflicting;
+        :class:`whipple_kick.simulate.steady.NoSteadyMotion` (an InputError) when
+        there is no steady motion to start from, with the physical reason.
+    SimulationError
+        The integration failed numerically (never NaN in a result): e.g. it
+        stalled beyond :data:`whipple_kick.simulate.lsoda.DEFAULT_BUDGET`. Its
+        ``partial`` holds the result up to the failure.
+
+    Example
+    -------
+    >>> import whipple_kick as wk
+    >>> result = wk.run(wk.Scenario(duration=1.0))
+    >>> result.summary["outcome"], result.summary["linear_stability"]["stable"]
+    ('completed', True)
+    """
+    started = time.perf_counter()
+    kick = inputs.kick_of(scenario.validate())
+    model = assembly.assemble(scenario, kick, tyres=tyres, gains=gains)
+    solution = integration.integrate_run(model, scenario, kick)
+    frame = results.trajectory_frame(solution, scenario.tyre_transient)
+    summary = results.summarise(scenario, kick, model, solution, frame, custom_tyres=tyres is not None)
+    summary["numerics"]["wall_s"] = time.perf_counter() - started
+    result = Result(scenario=scenario, trajectory=frame, summary=summary)
+    if solution.states.failed:
+        raise SimulationError(solution.states.message, partial=result)
+    return result
