@@ -7,7 +7,7 @@ Usage:
 
 Writes ``tests/data/regression/<name>.npz`` for the cases in :func:`cases`
 (the project's default model) and appends a line (date, model hash, reason)
-to ``tests/data/regression/CHANGELOG.md``. ``tests/test_regression.py``
+to ``tests/data/regression/CHANGELOG.md``. ``tests/simulate/test_regression.py``
 reruns each stored scenario and compares.
 
 ``tests/data/regression/contact_patch/`` holds the references of the

@@ -25,7 +25,7 @@ leading minus signs of :func:`lateral_force_model` /
     M_z,model(slip, camber, F_z) = -M_z,formula(alpha = +slip [deg], gamma = -camber [deg], F_z [kN])
 
 Why (derived from physics and the fitted data, proved by
-``tests/test_magic_formula.py``):
+``tests/model/test_magic_formula.py``):
 
 * ``slip = atan(v_y / |v_x|)`` > 0 means the contact slides to the right.
   Friction then pushes it to the LEFT, so ``F_y,model < 0``. All fitted sets

@@ -4,7 +4,7 @@ State ``x = [q4, q7, u4, u7]`` (roll, steer, roll rate, steer rate), input
 the steer torque ``T7``. The law is ``T7 = -K x`` (python-control's
 ``lqr`` convention), ``K = [kq4, kq7, ku4, ku7]``. Thesis eq. 8.4 prints the
 law without the minus sign; with the signs of its Table 8.4 gains (kq4 < 0,
-kq7 > 0) only ``-K x`` stabilises, which ``tests/test_control.py`` proves on
+kq7 > 0) only ``-K x`` stabilises, which ``tests/simulate/test_control.py`` proves on
 the linear and the nonlinear model.
 
 The design solves the continuous algebraic Riccati equation with SciPy
@@ -13,7 +13,7 @@ python-control costs more than a second to import and is not needed at run
 time. It stays the library of the control-analysis API
 (:meth:`whipple_kick.studies.stability.LinearModel.state_space` returns a
 ``control.StateSpace``) and the tests' oracle: ``control.lqr`` gives the
-same gains (``tests/test_control.py``).
+same gains (``tests/simulate/test_control.py``).
 """
 import numpy as np
 

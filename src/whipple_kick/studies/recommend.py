@@ -10,7 +10,7 @@ best and whether that margin is clear of the model's own spread. The
 Example
 -------
 Skipped as a doctest: three 6 s kick runs in a process pool, several seconds
-(``tests/test_recommend.py`` runs it).
+(``tests/studies/test_recommend.py`` runs it).
 
 >>> from whipple_kick import recommend
 >>> rec = recommend.recommend_pressure(635)              # doctest: +SKIP

@@ -189,7 +189,7 @@ def heading_linearisation(rhs, x, t=0.0):
     ``v_lat' = u2' - u3 u1``. About 25 right-hand-side evaluations' worth of
     time instead of about 110 (``scripts/bench_stability.py``); agrees with
     :func:`linearize` to 1e-7 of each column's largest entry
-    (``tests/test_stability.py``).
+    (``tests/studies/test_stability.py``).
 
     With a leaning rider or a delayed reflex, the states of :func:`body_states`
     follow :data:`LINEAR_STATES` in ``A`` and ``B``.

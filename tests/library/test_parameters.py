@@ -7,7 +7,7 @@ import whipple_kick as wk
 from whipple_kick.errors import InputError
 from whipple_kick.library import parameters
 
-REPOSITORY_PARAMETERS = pathlib.Path(__file__).resolve().parents[1] / "parameters"
+REPOSITORY_PARAMETERS = pathlib.Path(__file__).resolve().parents[2] / "parameters"
 
 
 @pytest.mark.parametrize("kind", parameters.KINDS)

@@ -41,10 +41,10 @@ import pytest
 import whipple_kick as wk
 from whipple_kick.simulate import simulation
 
-DATA = pathlib.Path(__file__).parent / "data" / "regression"
+DATA = pathlib.Path(__file__).resolve().parents[1] / "data" / "regression"
 THESIS_FORM = DATA / "thesis_form"
 CONTACT_PATCH = DATA / "contact_patch"
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "scripts"))
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "scripts"))
 import regenerate_regression
 
 TOLERANCE = 1e-4      # of each column's largest |reference value|

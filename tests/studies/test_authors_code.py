@@ -18,7 +18,7 @@ from whipple_kick.model import slip
 from whipple_kick.simulate.simulation import Scenario, run
 from whipple_kick.studies import authors_code
 
-DATA = pathlib.Path(__file__).parent / "data" / "authors_model"
+DATA = pathlib.Path(__file__).resolve().parents[1] / "data" / "authors_model"
 
 
 @pytest.fixture(scope="module")

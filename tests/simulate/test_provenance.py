@@ -10,7 +10,7 @@ import pytest
 import whipple_kick as wk
 from whipple_kick.simulate import provenance
 
-REPO = pathlib.Path(__file__).resolve().parent.parent
+REPO = pathlib.Path(__file__).resolve().parents[2]
 
 
 def test_summary_carries_the_provenance(base):
