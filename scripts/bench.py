@@ -328,8 +328,9 @@ def bench_compare(args):
     # method for both libraries. The call from Python: this checkout's as the integrator makes it
     # (slip.CompiledRHS.fast), the other's as its CompiledRHS.__call__ did (contiguous input,
     # x.ctypes, ctypes call, copy).
-    from whipple_kick.model import rhs_call, slip
-    native = rhs_call.module(slip._compiler())
+    from whipple_kick.model import rhs_call
+    from whipple_kick.model.slip import compiled
+    native = rhs_call.module(compiled._compiler())
 
     def c_alone(label, n):
         lib, x, p, _ = libs[label]

@@ -234,7 +234,7 @@ def module(compiler):
     Parameters
     ----------
     compiler : str
-        Path of the C compiler (:func:`whipple_kick.model.slip._compiler`).
+        Path of the C compiler (:func:`whipple_kick.model.slip.compiled._compiler`).
 
     Returns
     -------
