@@ -79,7 +79,7 @@ def test_every_generator_is_part_of_its_own_cache_key():
     from whipple_kick.model import classic, geometry
     slip_modules = tuple(f"slip/{p.stem}" for p in (cache._PACKAGE_DIR / "slip").glob("*.py"))
     # (the slip package's name ``layout`` is the function compiled.layout: the module is read by its full name)
-    from whipple_kick.model.slip.layout import _SOURCES as slip_sources
+    from whipple_kick.model.slip.layout import _SOURCES as SLIP_SOURCES
     for sources, name in ((classic._SOURCES, "classic"), (geometry._SOURCES, "geometry"),
-                          (slip_sources, "symbolic/slip_build"), *((slip_sources, m) for m in slip_modules)):
+                          (SLIP_SOURCES, "symbolic/slip_build"), *((SLIP_SOURCES, m) for m in slip_modules)):
         assert name in sources, name
