@@ -190,7 +190,8 @@ def _model_options(p, symmetric_flag=True, design_default="the run's --speed", c
     g = p.add_argument_group("bicycle and rider")
     g.add_argument("--bicycle", default="balanceassist_v1", metavar="NAME",
                    help="bicycle parameter set or .toml path (default balanceassist_v1; presets "
-                        "with the rider included: balanceassist_635N, balanceassist_701N, browser_with_rider)")
+                        "with the rider included: balanceassist_635N, balanceassist_701N, browser_with_rider), "
+                        "or a BicycleParameters bicycle folder (<data>/bicycles/<Name>) or <Name>Benchmark.txt")
     if case_options:
         who = g.add_mutually_exclusive_group()
         who.add_argument("--fz", type=_number("N"), metavar="N",

@@ -98,11 +98,15 @@ class Bicycle(Mapping):
         For the authors' presets with rider: the rear-tyre load [N] the set
         is labelled with (thesis Table 8.3), which selects the Table 8.4
         gains; None otherwise.
+    defaults : Mapping
+        What the set's source lacks and was taken from a default: name ->
+        (value or None, source). Empty for the shipped sets; see
+        :mod:`whipple_kick.library.bicycleparameters`.
     """
 
     def __init__(self, *, name, benchmark=None, moore=None, parameterisation,
                  includes_rider, source, description="", uncertainties=None,
-                 geometry=None, tyre_placeholders=None, rider=None, thesis_rear_load_n=None):
+                 geometry=None, tyre_placeholders=None, rider=None, thesis_rear_load_n=None, defaults=None):
         if (benchmark is None) == (moore is None):
             raise InputError(f"bicycle {name!r}: give exactly one of benchmark or moore parameters")
         if benchmark is not None:
@@ -125,6 +129,7 @@ class Bicycle(Mapping):
         self.tyre_placeholders = types.MappingProxyType(dict(tyre_placeholders or {}))
         self.rider = None if rider is None else types.MappingProxyType(dict(rider))
         self.thesis_rear_load_n = None if thesis_rear_load_n is None else float(thesis_rear_load_n)
+        self.defaults = types.MappingProxyType(dict(defaults or {}))
 
     def __getitem__(self, key):
         return self._moore[key]
@@ -157,8 +162,10 @@ def load(name):
     Parameters
     ----------
     name : str or os.PathLike
-        A shipped set (see :func:`available`), or the path of a ``.toml``
-        file in the same format.
+        A shipped set (see :func:`available`), the path of a ``.toml``
+        file in the same format, or an existing BicycleParameters bicycle
+        folder or ``<Name>Benchmark.txt`` (read by
+        :func:`whipple_kick.library.bicycleparameters.load`).
 
     Returns
     -------
@@ -171,6 +178,9 @@ def load(name):
         Unknown name, or a malformed file (naming file, key and problem).
     """
     text = str(name)
+    from . import bicycleparameters  # it builds on this module: imported here, not at the top
+    if not text.endswith(".toml") and bicycleparameters.is_bicycleparameters_path(text):
+        return bicycleparameters.load(text)
     if text.endswith(".toml") or "/" in text or "\\" in text:
         path = text
     else:

@@ -159,7 +159,10 @@ def build_bicycle(scenario):
 
 def _file_stamp(name):
     """Modification time of a parameter file given by path (so an edited file is re-read)."""
+    from whipple_kick.library import bicycleparameters
     path = pathlib.Path(str(name))
+    if path.suffix != ".toml" and bicycleparameters.is_bicycleparameters_path(name):
+        return bicycleparameters.stamp(name)
     return path.stat().st_mtime_ns if path.suffix == ".toml" and path.is_file() else None
 
 
@@ -199,6 +202,8 @@ def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia
             bench[key] *= 0.5
         moore = benchmark.to_moore(bench)
     info = {"bicycle": bike.name, "includes_rider_preset": bike.includes_rider,
+            # What the bicycle's source lacked, from defaults (a BicycleParameters set): name -> [value, source].
+            "defaults": {k: [v, source] for k, (v, source) in bike.defaults.items()},
             "rider_mass_kg": rider_mass, "static_load_rear_n": rear_n, "static_load_front_n": front_n,
             "total_mass_kg": sum(float(combined.benchmark[k]) for k in ("mR", "mB", "mH", "mF"))
             + (body["mt"] if body else 0.0), "body": body}
