@@ -426,8 +426,8 @@ def _check_loads(bicycle, loads):
     """
     if not loads:
         return   # nothing to check (the bicycle itself is checked with the scenario)
-    from whipple_kick.library import bicycles, riders
-    bike = bicycles.load(bicycle)
+    from whipple_kick.library import bicycleparameters, riders
+    bike = bicycleparameters.load_bicycle(bicycle)
     if bike.includes_rider:
         return   # refused later in one line (the preset already includes its rider)
     low, high, _ = riders.rear_load_range(bike)

@@ -87,7 +87,7 @@ def test_benchmark_file_reads_values_and_uncertainties(bench_folder):
 def test_folder_with_measured_seating_is_the_shipped_bicycle(v1_folder):
     """balanceassist_v1 written in its source format reads back as the shipped set: values, seating, stds."""
     ship = bicycles.load("balanceassist_v1")
-    bike = bicycles.load(str(v1_folder / "bicycles" / "Balanceassistv1"))   # bicycles.load dispatches
+    bike = bp.load_bicycle(str(v1_folder / "bicycles" / "Balanceassistv1"))   # what a scenario's name goes through
     assert dict(bike.benchmark) == dict(ship.benchmark)
     assert dict(bike.geometry) == dict(ship.geometry)
     assert dict(bike.uncertainties) == dict(ship.uncertainties)
@@ -182,13 +182,13 @@ def test_not_a_bicycleparameters_folder(tmp_path, capsys):
     """A data folder (not one bicycle) and a folder without Parameters/ are refused saying what to give."""
     _write_benchmark(tmp_path, "Bench", benchmark.meijaard2007_parameters())
     with pytest.raises(InputError, match=r"data folder; give one bicycle's folder.*\(here: Bench\)"):
-        bicycles.load(str(tmp_path))
+        bp.load_bicycle(str(tmp_path))
     empty = tmp_path / "empty"
     empty.mkdir()
     status, _, err = _cli(["--bicycle", str(empty)], capsys)
     assert status == 2 and "not a BicycleParameters bicycle folder" in err and len(err.strip().splitlines()) == 1
     # A shipped name still names the shipped TOML set.
-    assert bicycles.load("benchmark").name == "benchmark"
+    assert bp.load_bicycle("benchmark").name == "benchmark"
 
 
 # ----------------------------------------------------------------- runs

@@ -204,6 +204,30 @@ def is_bicycleparameters_path(text):
     return path.is_dir() or (path.suffix == ".txt" and path.is_file())
 
 
+def load_bicycle(name):
+    """The bicycle a scenario names: a BicycleParameters folder or file (:func:`load`), else :func:`bicycles.load`.
+
+    Parameters
+    ----------
+    name : str or os.PathLike
+        A shipped set's name, a ``.toml`` path, or an existing BicycleParameters
+        bicycle folder or ``<Name>Benchmark.txt``.
+
+    Returns
+    -------
+    Bicycle
+
+    Example
+    -------
+    >>> load_bicycle("balanceassist_v1").name
+    'balanceassist_v1'
+    """
+    text = str(name)
+    if not text.endswith(".toml") and is_bicycleparameters_path(text):
+        return load(text)
+    return bicycles.load(text)
+
+
 def stamp(text):
     """Modification times of the files :func:`load` reads for ``text`` (a cache key: an edited file is re-read)."""
     path = pathlib.Path(str(text))
@@ -291,7 +315,11 @@ def load(path, rider=None, includes_rider=None):
 
     Example
     -------
-    >>> bike = load(folder)  # doctest: +SKIP
+    >>> import tempfile
+    >>> folder = write_folder(bicycles.load("benchmark"), tempfile.mkdtemp(), name="Bench")
+    >>> bike = load(folder)
+    >>> bike.benchmark["w"], bike.includes_rider, sorted(bike.defaults)   # the benchmark's rider is lumped in
+    (1.02, True, ['tyres'])
     """
     name, bench_path, measured, data = _bicycle_files(path)
     values, stds, lines = read_text(bench_path, {**bicycles.BENCHMARK_UNITS, **EXTRA_UNITS})

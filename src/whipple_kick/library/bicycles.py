@@ -162,10 +162,10 @@ def load(name):
     Parameters
     ----------
     name : str or os.PathLike
-        A shipped set (see :func:`available`), the path of a ``.toml``
-        file in the same format, or an existing BicycleParameters bicycle
-        folder or ``<Name>Benchmark.txt`` (read by
-        :func:`whipple_kick.library.bicycleparameters.load`).
+        A shipped set (see :func:`available`), or the path of a ``.toml``
+        file in the same format. (A scenario's bicycle may also be a
+        BicycleParameters folder: :func:`whipple_kick.library.bicycleparameters.load_bicycle`
+        reads either.)
 
     Returns
     -------
@@ -178,9 +178,6 @@ def load(name):
         Unknown name, or a malformed file (naming file, key and problem).
     """
     text = str(name)
-    from . import bicycleparameters  # it builds on this module: imported here, not at the top
-    if not text.endswith(".toml") and bicycleparameters.is_bicycleparameters_path(text):
-        return bicycleparameters.load(text)
     if text.endswith(".toml") or "/" in text or "\\" in text:
         path = text
     else:

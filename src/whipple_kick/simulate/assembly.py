@@ -168,10 +168,10 @@ def _file_stamp(name):
 
 @functools.lru_cache(maxsize=256)
 def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia, split=False, arms_on_bar=False):
-    from whipple_kick.library import bicycles, riders
+    from whipple_kick.library import bicycleparameters, riders
     from whipple_kick.model import benchmark
 
-    bike = bicycles.load(bicycle)
+    bike = bicycleparameters.load_bicycle(bicycle)
     if split and bike.includes_rider:
         raise _lumped_rider_error(bike)
     if bike.includes_rider:
@@ -219,8 +219,8 @@ def _lumped_rider_error(bike):
 def _rear_load_range(bicycle, _stamp, rider_name):
     # The rear loads a rider can give the bicycle (a probe rider seated, ~10 ms) do not depend on the load:
     # a sweep over loads finds them once per process.
-    from whipple_kick.library import bicycles, riders
-    return riders.rear_load_range(bicycles.load(bicycle), rider_name)
+    from whipple_kick.library import bicycleparameters, riders
+    return riders.rear_load_range(bicycleparameters.load_bicycle(bicycle), rider_name)
 
 
 @functools.lru_cache(maxsize=256)
@@ -402,13 +402,13 @@ def thesis_load(scenario):
     rider is labelled with (``balanceassist_635N``: 635 N), else 635 N for a
     bicycle whose rider is seated for the default load.
     """
-    from whipple_kick.library import bicycles
+    from whipple_kick.library import bicycleparameters
 
     if scenario.thesis_load_n is not None:
         return scenario.thesis_load_n
     if scenario.fz_n is not None:
         return scenario.fz_n
-    bike = bicycles.load(scenario.bicycle)
+    bike = bicycleparameters.load_bicycle(scenario.bicycle)
     if bike.includes_rider and bike.thesis_rear_load_n is not None:
         return bike.thesis_rear_load_n
     if scenario.rider_mass_kg is None and not bike.includes_rider:
@@ -422,11 +422,11 @@ def thesis_gains_warning(scenario):
 
     The run's load: the one a preset with rider is labelled with, or ``fz_n``.
     """
-    from whipple_kick.library import bicycles
+    from whipple_kick.library import bicycleparameters
 
     if scenario.controller != "thesis":
         return None
-    bike = bicycles.load(scenario.bicycle)
+    bike = bicycleparameters.load_bicycle(scenario.bicycle)
     own, what = ((bike.thesis_rear_load_n, f"bicycle {bike.name!r} is labelled") if bike.includes_rider
                  else (scenario.fz_n, "the rider is seated for"))
     gains = thesis_load(scenario)
@@ -463,12 +463,12 @@ def preflight(scenario):
     conflicts (a preset with its rider lumped in cannot lean or hold the bar), the Table 8.4 row of ``controller="thesis"``. Raises
     :class:`InputError`; returns ``scenario``.
     """
-    from whipple_kick.library import bicycles
+    from whipple_kick.library import bicycleparameters
     from whipple_kick.simulate import control
 
     scenario.validate()
     build_tyres(scenario)
-    bike = bicycles.load(scenario.bicycle)
+    bike = bicycleparameters.load_bicycle(scenario.bicycle)
     if bike.includes_rider and (scenario.fz_n is not None or scenario.rider_mass_kg is not None):
         raise InputError(f"bicycle {bike.name!r} already includes its rider; "
                          "do not give a rear-tyre load fz or a rider mass with it")
