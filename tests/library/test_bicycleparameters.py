@@ -214,8 +214,9 @@ def test_benchmark_folder_through_simulate_and_stability(bench_folder, tmp_path,
     summary = json.loads((out / "summary.json").read_text())
     assert summary["fell"] is False
     # The summary names what came from defaults, with the source.
-    assert summary["bicycle"]["defaults"]["seating.lst"][1] == bp.DEFAULT_SOURCES["seating"]
-    assert summary["bicycle"]["defaults"]["tyres"] == [None, bp.DEFAULT_SOURCES["tyres"]]
+    lst = bicycles.load("balanceassist_v1").geometry["lst"]
+    assert summary["bicycle"]["defaults"]["seating.lst"] == f"{lst!r} m: {bp.DEFAULT_SOURCES['seating']}"
+    assert summary["bicycle"]["defaults"]["tyres"] == bp.DEFAULT_SOURCES["tyres"]
     status, _, err = run_console(stability_main, ["--bicycle", str(bench_folder), "--rider-mass", "70",
                                                   "--speeds", "3,5", "--out", str(tmp_path / "stab"),
                                                   "--no-plot", "--quiet"], capsys)

@@ -267,6 +267,21 @@ def _rider_benchmark(path):
     return values["mB"], np.array([values["xB"], 0.0, values["zB"]]), inertia
 
 
+def describe_defaults(bike):
+    """``bike.defaults`` as text for a run's summary: name -> ``"<value> <unit>: <source>"`` (or the source).
+
+    Example
+    -------
+    >>> describe_defaults(bicycles.load("balanceassist_v1"))   # a shipped set lacks nothing
+    {}
+    """
+    out = {}
+    for key, (value, source) in bike.defaults.items():
+        unit = bicycles.SEATING_UNITS.get(key.removeprefix("seating."), "")
+        out[key] = source if value is None else f"{value!r} {unit}: {source}"
+    return out
+
+
 def _warn_defaults(name, defaults):
     kinds = sorted({key.split(".", 1)[0] for key in defaults})
     warnings.warn(f"BicycleParameters bicycle {name!r}: {', '.join(kinds)} from defaults: "

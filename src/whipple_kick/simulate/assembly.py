@@ -202,8 +202,8 @@ def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia
             bench[key] *= 0.5
         moore = benchmark.to_moore(bench)
     info = {"bicycle": bike.name, "includes_rider_preset": bike.includes_rider,
-            # What the bicycle's source lacked, from defaults (a BicycleParameters set): name -> [value, source].
-            "defaults": {k: [v, source] for k, (v, source) in bike.defaults.items()},
+            # What the bicycle's source lacked, from defaults (a BicycleParameters set): name -> "value unit: source".
+            "defaults": bicycleparameters.describe_defaults(bike),
             "rider_mass_kg": rider_mass, "static_load_rear_n": rear_n, "static_load_front_n": front_n,
             "total_mass_kg": sum(float(combined.benchmark[k]) for k in ("mR", "mB", "mH", "mF"))
             + (body["mt"] if body else 0.0), "body": body}
