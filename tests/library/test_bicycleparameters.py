@@ -326,3 +326,54 @@ def test_uncertainties_by_name_for_the_study(bench_folder):
     out = bp.parameter_uncertainties(bp.load(bench_folder))
     assert all(isinstance(v, tuple) and len(v) == 2 and v[1] > 0 and math.isfinite(v[0]) for v in out.values())
     assert {k for k in out if not k.startswith("seating.")} == set(STDS)
+
+
+def test_their_leaning_rider_set_lumped_is_their_whipple_set(bpk):
+    """MooreRiderLean2012's Browser + Jason with the upper body held rigid is their Meijaard2007 Browser + Jason:
+    the reading of d4, l5, l6 and ig.. (hinge d4 below the rear wheel centre, G's centre l5 ahead and l6 below
+    it, inertia in level axes) checked against their own other set. The two dicts were derived separately
+    (different roundings): measured 1.2e-5 m in xB, 3.8e-5 m in zB, 4.4e-4 kg m^2 in IBxx and IByy; bounds
+    1e-4 m and 1e-3 kg m^2."""
+    from bicycleparameters import parameter_dicts
+    from bicycleparameters.parameter_sets import MooreRiderLean2012ParameterSet
+    lumped = bp.from_bicycleparameters(MooreRiderLean2012ParameterSet(parameter_dicts.mooreriderlean2012_browser_jason))
+    whipple = parameter_dicts.meijaard2007_browser_jason
+    assert lumped.includes_rider
+    assert lumped.benchmark["mB"] == pytest.approx(whipple["mB"], rel=1e-12)
+    for key in ("xB", "zB"):
+        assert lumped.benchmark[key] == pytest.approx(whipple[key], abs=1e-4), key
+    for key in ("IBxx", "IByy", "IBzz", "IBxz"):
+        assert lumped.benchmark[key] == pytest.approx(whipple[key], abs=1e-3), key
+
+
+@pytest.mark.parametrize(("k9", "c9"), [(None, None), (128.0, 50.0)])
+def test_their_leaning_rider_set_in_our_slip_model(bpk, k9, c9):
+    """Their named leaning-rider set (Browser + Jason; its own k9 = c9 = 0, then Moore's 128 and 50) read by
+    leaning_rider() into our slip model with stiff tyres has the eigenvalues of their MooreRiderLean2012Model:
+    the Richardson limit of kappa = 1e3 and 1e5 (error first order in 1/kappa) to 5e-6 relative, as for the
+    body seated by the project (tests/simulate/test_rider_body.py). Measured: 2.7e-4 to 1.8e-3 at kappa = 1e3,
+    2.7e-6 to 1.8e-5 at 1e5, limit 1.1e-8 to 7.3e-8; bounds 1e-3 and 5e-6."""
+    from bicycleparameters import parameter_dicts
+    from bicycleparameters.models import MooreRiderLean2012Model
+    from bicycleparameters.parameter_sets import MooreRiderLean2012ParameterSet
+    from whipple_kick.model import slip
+    from whipple_kick.simulate import steady
+    par = dict(parameter_dicts.mooreriderlean2012_browser_jason)
+    if k9 is not None:
+        par.update(k9=k9, c9=c9)
+    obj = MooreRiderLean2012ParameterSet(par)
+    bike, body = bp.leaning_rider(obj)
+    model = MooreRiderLean2012Model(obj)
+    keep = [3, 5, 7, 8, 10, 11]                             # q4, q7, q9, u4, u7, u9 of their 12 states
+    for speed in (2.0, 5.0):
+        A, _ = model.form_state_space_matrices(v=speed)
+        ref = np.linalg.eigvals(A[np.ix_(keep, keep)])
+        ours = []
+        for kappa in (1e3, 1e5):
+            tyre = wk.tyres.linear_tyre(kappa, 1.0 / kappa, 1e5 * kappa)
+            ss = steady.steady_state(slip.model_parameters(dict(bike.moore), tyre, tyre, body=body), speed)
+            ev = np.linalg.eigvals(slip.linear.heading_linearisation(slip.CompiledRHS(ss.params), ss.x)[0])
+            ours.append(np.array([ev[np.argmin(np.abs(ev - r))] for r in ref]))
+        limit = (100.0 * ours[1] - ours[0]) / 99.0
+        errors = [float(np.max(np.abs(o - ref) / np.abs(ref))) for o in (*ours, limit)]
+        assert errors[1] < 1e-3 and errors[2] < 5e-6, (speed, errors)

@@ -423,11 +423,20 @@ def from_bicycleparameters(obj, name=None):
         what = f"bicycleparameters.Bicycle {name!r}" + (f" with rider {obj.riderName!r}" if includes_rider else "")
     elif hasattr(obj, "parameters") and isinstance(obj.parameters, Mapping):
         params = obj.parameters
-        if not set(_benchmark.BENCHMARK_NAMES) <= set(params) and hasattr(obj, "to_parameterization"):
-            params = obj.to_parameterization("Meijaard2007").parameters
+        includes_rider = bool(getattr(obj, "includes_rider", False))
+        if set(LEAN_NAMES) <= set(params):                 # MooreRiderLean2012: the upper body held rigid
+            bike_only, body = leaning_rider(obj)
+            from . import riders
+            params = riders.lump_into_rear_frame(bike_only.benchmark, *_body_in_benchmark(bike_only, body))
+            includes_rider = True
+        elif set(_benchmark.MOORE_NAMES) <= set(params) and not set(_benchmark.BENCHMARK_NAMES) <= set(params):
+            params = _benchmark.from_moore({k: _nominal(params[k])[0] for k in _benchmark.MOORE_NAMES})
+        elif not set(_benchmark.BENCHMARK_NAMES) <= set(params) and hasattr(obj, "to_parameterization"):
+            converted = obj.to_parameterization("Meijaard2007")
+            params = converted.parameters
+            includes_rider = bool(getattr(converted, "includes_rider", includes_rider))
         pairs = {k: _nominal(v) for k, v in params.items()}
         name = name or kind
-        includes_rider = bool(getattr(obj, "includes_rider", False))
         measured = {}
         what = f"bicycleparameters {kind}"
     else:
@@ -454,6 +463,58 @@ def from_bicycleparameters(obj, name=None):
         description=f"From {what}", uncertainties=uncertainties, geometry=geometry, defaults=defaults)
     _warn_defaults(name, defaults)
     return bike
+
+
+#: The leaning rider's entries of BicycleParameters' MooreRiderLean2012ParameterSet (Moore 2012, "Leaning rider
+#: extension"): hip spring k9 [N m/rad] and damper c9 [N m s/rad]; the horizontal hinge d4 [m] below the rear
+#: wheel centre; the upper body G's mass mg [kg], its mass centre l5 [m] ahead of the rear wheel centre and l6
+#: [m] below the hinge, its inertia ig.. [kg m^2] about it in axes level with the ground (x forward, z down).
+LEAN_NAMES = ("k9", "c9", "d4", "l5", "l6", "mg", "ig11", "ig22", "ig33", "ig31")
+
+
+def leaning_rider(obj):
+    """A ``MooreRiderLean2012ParameterSet`` as the project's bicycle and leaning body.
+
+    Parameters
+    ----------
+    obj : bicycleparameters.parameter_sets.MooreRiderLean2012ParameterSet
+        Or any object whose ``parameters`` hold Moore's names and :data:`LEAN_NAMES`.
+
+    Returns
+    -------
+    bike : Bicycle
+        The bicycle with the rider's legs (Moore's C, D, E, F).
+    body : dict
+        :func:`whipple_kick.library.riders.seat_with_body`'s body (hinge horizontal, ``hip_tilt = -lam``; the
+        hinge point taken above the rear wheel centre, any point of the line will do), with ``kh = k9``,
+        ``ch = c9`` and ``hip_locked`` 0: pass it to ``slip.model_parameters(..., body=body)``.
+    """
+    params = {k: _nominal(v)[0] for k, v in obj.parameters.items()}
+    missing = [n for n in (*_benchmark.MOORE_NAMES, *LEAN_NAMES) if n not in params]
+    if missing:
+        raise InputError(f"bicycleparameters {type(obj).__name__}: missing {', '.join(missing)}")
+    bike = bicycles.Bicycle(name=type(obj).__name__, moore={k: params[k] for k in _benchmark.MOORE_NAMES},
+                            parameterisation="moore", includes_rider=True,
+                            source=f"bicycleparameters {type(obj).__name__} (Moore 2012)",
+                            description="Moore's leaning-rider set: the bicycle with the rider's legs")
+    lam = bike.benchmark["lam"]
+    c_x, c_z = _benchmark._pitch_matrix(lam)
+    hinge = np.array([0.0, params["d4"]])              # (x, z) from the rear wheel centre, benchmark axes
+    body = {"hip_locked": 0.0, "hip_tilt": -lam, "lh1": float(hinge @ c_x), "lh3": float(hinge @ c_z),
+            "mt": params["mg"], "lt1": params["l5"], "lt3": params["l6"], "it11": params["ig11"],
+            "it22": params["ig22"], "it33": params["ig33"], "it31": params["ig31"],
+            "kh": params["k9"], "ch": params["c9"]}
+    return bike, body
+
+
+def _body_in_benchmark(bike, body):
+    """The leaning body's mass [kg], mass centre (3,) [m] and inertia (3, 3) [kg m^2] in the benchmark frame."""
+    c_x, c_z = _benchmark._pitch_matrix(bike.benchmark["lam"])
+    hinge = body["lh1"] * c_x + body["lh3"] * c_z       # from the rear wheel centre (0, -rR)
+    com = np.array([hinge[0] + body["lt1"], 0.0, -bike.benchmark["rR"] + hinge[1] + body["lt3"]])
+    inertia = np.array([[body["it11"], 0.0, body["it31"]], [0.0, body["it22"], 0.0],
+                        [body["it31"], 0.0, body["it33"]]])
+    return body["mt"], com, inertia
 
 
 def write_folder(bike, data, name=None):
