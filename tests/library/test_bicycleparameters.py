@@ -356,6 +356,7 @@ def test_their_leaning_rider_set_in_our_slip_model(bpk, k9, c9):
     from bicycleparameters import parameter_dicts
     from bicycleparameters.models import MooreRiderLean2012Model
     from bicycleparameters.parameter_sets import MooreRiderLean2012ParameterSet
+
     from whipple_kick.model import slip
     from whipple_kick.simulate import steady
     par = dict(parameter_dicts.mooreriderlean2012_browser_jason)
