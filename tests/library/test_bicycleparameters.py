@@ -178,7 +178,7 @@ def _cli(argv, capsys):
     return run_console(simulate_main, argv, capsys)
 
 
-def test_not_a_bicycleparameters_folder(tmp_path, capsys):
+def test_not_a_bicycleparameters_folder(tmp_path, capsys, monkeypatch):
     """A data folder (not one bicycle) and a folder without Parameters/ are refused saying what to give."""
     _write_benchmark(tmp_path, "Bench", benchmark.meijaard2007_parameters())
     with pytest.raises(InputError, match=r"data folder; give one bicycle's folder.*\(here: Bench\)"):
@@ -187,7 +187,9 @@ def test_not_a_bicycleparameters_folder(tmp_path, capsys):
     empty.mkdir()
     status, _, err = _cli(["--bicycle", str(empty)], capsys)
     assert status == 2 and "not a BicycleParameters bicycle folder" in err and len(err.strip().splitlines()) == 1
-    # A shipped name still names the shipped TOML set.
+    # A shipped name still names the shipped TOML set, even beside a folder of that name.
+    (tmp_path / "benchmark").mkdir()
+    monkeypatch.chdir(tmp_path)
     assert bp.load_bicycle("benchmark").name == "benchmark"
 
 

@@ -205,7 +205,8 @@ def is_bicycleparameters_path(text):
 
 
 def load_bicycle(name):
-    """The bicycle a scenario names: a BicycleParameters folder or file (:func:`load`), else :func:`bicycles.load`.
+    """The bicycle a scenario names: a shipped set, else a BicycleParameters folder or file (:func:`load`), else a
+    ``.toml`` path (:func:`bicycles.load`).
 
     Parameters
     ----------
@@ -223,7 +224,8 @@ def load_bicycle(name):
     'balanceassist_v1'
     """
     text = str(name)
-    if not text.endswith(".toml") and is_bicycleparameters_path(text):
+    # A shipped name wins over a folder of that name in the working directory (a run's output folder, say).
+    if text not in bicycles.available() and not text.endswith(".toml") and is_bicycleparameters_path(text):
         return load(text)
     return bicycles.load(text)
 
