@@ -305,18 +305,18 @@ def load(path, rider=None, includes_rider=None):
         ``<data>/bicycles/<Name>`` (its ``Parameters/<Name>Benchmark.txt``,
         and the seating lengths of ``RawData/<Name>Measured.txt`` if there)
         or the ``Benchmark.txt`` file itself.
-    includes_rider : bool, optional
-        Whether the benchmark file's rear frame already holds a rider.
-        Default: BicycleParameters' own assumption that a bicycle is loaded
-        without rider, unless the file's first line is :data:`RIDER_MARK`
-        (a comment to BicycleParameters; :func:`write_folder` writes it for a
-        set with rider).
     rider : str, optional
         A rider folder of the same data folder (``<data>/riders/<rider>``):
         its ``Parameters/<rider><Name>Benchmark.txt`` (the rider BicycleParameters
         seated on this bicycle) is lumped rigidly into the rear frame, as
         BicycleParameters' ``add_rider`` does. The rear frame's values then
         have no standard deviation (the rider file gives none).
+    includes_rider : bool, optional
+        Whether the benchmark file's rear frame already holds a rider.
+        Default: BicycleParameters' own assumption that a bicycle is loaded
+        without rider, unless the file's first line is :data:`RIDER_MARK`
+        (a comment to BicycleParameters; :func:`write_folder` writes it for a
+        set with rider).
 
     Returns
     -------
