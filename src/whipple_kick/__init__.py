@@ -41,7 +41,7 @@ _SUBMODULES = {
         "benchmark", "cache", "carcass", "classic", "energy", "geometry", "kane", "magic_formula", "reflex",
         "rhs_call", "slip", "symbolic", "symbols", "transient")},
     **{name: f"library.{name}" for name in (
-        "bicycles", "experiments", "inputs", "parameters", "riders", "tyres")},
+        "bicycleparameters", "bicycles", "experiments", "inputs", "parameters", "riders", "tyres")},
     **{name: f"simulate.{name}" for name in (
         "analysis", "assembly", "control", "integration", "lsoda", "provenance", "results", "scenario",
         "simulation", "steady")},

@@ -190,7 +190,8 @@ def _model_options(p, symmetric_flag=True, design_default="the run's --speed", c
     g = p.add_argument_group("bicycle and rider")
     g.add_argument("--bicycle", default="balanceassist_v1", metavar="NAME",
                    help="bicycle parameter set or .toml path (default balanceassist_v1; presets "
-                        "with the rider included: balanceassist_635N, balanceassist_701N, browser_with_rider)")
+                        "with the rider included: balanceassist_635N, balanceassist_701N, browser_with_rider), "
+                        "or a BicycleParameters bicycle folder (<data>/bicycles/<Name>) or <Name>Benchmark.txt")
     if case_options:
         who = g.add_mutually_exclusive_group()
         who.add_argument("--fz", type=_number("N"), metavar="N",
@@ -425,8 +426,8 @@ def _check_loads(bicycle, loads):
     """
     if not loads:
         return   # nothing to check (the bicycle itself is checked with the scenario)
-    from whipple_kick.library import bicycles, riders
-    bike = bicycles.load(bicycle)
+    from whipple_kick.library import bicycleparameters, riders
+    bike = bicycleparameters.load_bicycle(bicycle)
     if bike.includes_rider:
         return   # refused later in one line (the preset already includes its rider)
     low, high, _ = riders.rear_load_range(bike)

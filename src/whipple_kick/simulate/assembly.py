@@ -159,16 +159,19 @@ def build_bicycle(scenario):
 
 def _file_stamp(name):
     """Modification time of a parameter file given by path (so an edited file is re-read)."""
+    from whipple_kick.library import bicycleparameters
     path = pathlib.Path(str(name))
+    if path.suffix != ".toml" and bicycleparameters.is_bicycleparameters_path(name):
+        return bicycleparameters.stamp(name)
     return path.stat().st_mtime_ns if path.suffix == ".toml" and path.is_file() else None
 
 
 @functools.lru_cache(maxsize=256)
 def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia, split=False, arms_on_bar=False):
-    from whipple_kick.library import bicycles, riders
+    from whipple_kick.library import bicycleparameters, riders
     from whipple_kick.model import benchmark
 
-    bike = bicycles.load(bicycle)
+    bike = bicycleparameters.load_bicycle(bicycle)
     if split and bike.includes_rider:
         raise _lumped_rider_error(bike)
     if bike.includes_rider:
@@ -199,6 +202,8 @@ def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia
             bench[key] *= 0.5
         moore = benchmark.to_moore(bench)
     info = {"bicycle": bike.name, "includes_rider_preset": bike.includes_rider,
+            # What the bicycle's source lacked, from defaults (a BicycleParameters set): name -> "value unit: source".
+            "defaults": bicycleparameters.describe_defaults(bike),
             "rider_mass_kg": rider_mass, "static_load_rear_n": rear_n, "static_load_front_n": front_n,
             "total_mass_kg": sum(float(combined.benchmark[k]) for k in ("mR", "mB", "mH", "mF"))
             + (body["mt"] if body else 0.0), "body": body}
@@ -214,8 +219,8 @@ def _lumped_rider_error(bike):
 def _rear_load_range(bicycle, _stamp, rider_name):
     # The rear loads a rider can give the bicycle (a probe rider seated, ~10 ms) do not depend on the load:
     # a sweep over loads finds them once per process.
-    from whipple_kick.library import bicycles, riders
-    return riders.rear_load_range(bicycles.load(bicycle), rider_name)
+    from whipple_kick.library import bicycleparameters, riders
+    return riders.rear_load_range(bicycleparameters.load_bicycle(bicycle), rider_name)
 
 
 @functools.lru_cache(maxsize=256)
@@ -397,13 +402,13 @@ def thesis_load(scenario):
     rider is labelled with (``balanceassist_635N``: 635 N), else 635 N for a
     bicycle whose rider is seated for the default load.
     """
-    from whipple_kick.library import bicycles
+    from whipple_kick.library import bicycleparameters
 
     if scenario.thesis_load_n is not None:
         return scenario.thesis_load_n
     if scenario.fz_n is not None:
         return scenario.fz_n
-    bike = bicycles.load(scenario.bicycle)
+    bike = bicycleparameters.load_bicycle(scenario.bicycle)
     if bike.includes_rider and bike.thesis_rear_load_n is not None:
         return bike.thesis_rear_load_n
     if scenario.rider_mass_kg is None and not bike.includes_rider:
@@ -417,11 +422,11 @@ def thesis_gains_warning(scenario):
 
     The run's load: the one a preset with rider is labelled with, or ``fz_n``.
     """
-    from whipple_kick.library import bicycles
+    from whipple_kick.library import bicycleparameters
 
     if scenario.controller != "thesis":
         return None
-    bike = bicycles.load(scenario.bicycle)
+    bike = bicycleparameters.load_bicycle(scenario.bicycle)
     own, what = ((bike.thesis_rear_load_n, f"bicycle {bike.name!r} is labelled") if bike.includes_rider
                  else (scenario.fz_n, "the rider is seated for"))
     gains = thesis_load(scenario)
@@ -458,12 +463,12 @@ def preflight(scenario):
     conflicts (a preset with its rider lumped in cannot lean or hold the bar), the Table 8.4 row of ``controller="thesis"``. Raises
     :class:`InputError`; returns ``scenario``.
     """
-    from whipple_kick.library import bicycles
+    from whipple_kick.library import bicycleparameters
     from whipple_kick.simulate import control
 
     scenario.validate()
     build_tyres(scenario)
-    bike = bicycles.load(scenario.bicycle)
+    bike = bicycleparameters.load_bicycle(scenario.bicycle)
     if bike.includes_rider and (scenario.fz_n is not None or scenario.rider_mass_kg is not None):
         raise InputError(f"bicycle {bike.name!r} already includes its rider; "
                          "do not give a rear-tyre load fz or a rider mass with it")
