@@ -566,6 +566,8 @@ class Scenario:
             raise InputError(f"{label} does not exist") from None
         except IsADirectoryError:
             raise InputError(f"{label} is a folder, not a file") from None
+        except OSError as exc:   # no permission, an I/O error: the input cannot be read
+            raise InputError(f"{label} cannot be read: {exc.strerror or exc}") from None
         except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
             raise InputError(f"{label} is not valid TOML: {exc}") from None
         types = {f.name: f.type for f in fields(cls)}
