@@ -444,6 +444,21 @@ def test_data_warning_is_one_line_silenced_by_quiet_and_kept_in_the_summary(tmp_
     assert base["tyres"]["data_warnings"] == summary["tyres"]["data_warnings"]
 
 
+def test_the_cli_does_not_drop_data_warnings_for_the_rest_of_the_process(tmp_path, capsys):
+    """Issue 31 item 16: simulate called ``warnings.filterwarnings("ignore", DataQualityWarning)`` for the whole
+    process, so a library caller running the CLI in-process never saw the warning again."""
+    import warnings
+
+    from whipple_kick.library import tyres
+    filters = list(warnings.filters)
+    status, _, err = _simulate(["--tyre", "T02", "--duration", "0.3", "--no-plot", "--quiet",
+                                "--out", str(tmp_path / "q")], capsys)
+    assert status == 0 and err == ""
+    assert warnings.filters == filters
+    with pytest.warns(tyres.DataQualityWarning, match="T02"):
+        tyres.load("T02", 300)
+
+
 # ------------------------------------------------------------ sweeps
 
 def _children(pid):
