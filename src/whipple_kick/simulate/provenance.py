@@ -101,9 +101,10 @@ def sha256(path) -> str:
     Example
     -------
     >>> import tempfile
-    >>> path = pathlib.Path(tempfile.mkdtemp()) / "empty.csv"
-    >>> _ = path.write_bytes(b"")
-    >>> sha256(path)[:16]
+    >>> with tempfile.TemporaryDirectory() as folder:   # removed afterwards
+    ...     path = pathlib.Path(folder) / "empty.csv"
+    ...     _ = path.write_bytes(b"")
+    ...     sha256(path)[:16]
     'e3b0c44298fc1c14'
     """
     digest = hashlib.sha256()

@@ -512,9 +512,10 @@ class Scenario:
         Example
         -------
         >>> import pathlib, tempfile
-        >>> path = pathlib.Path(tempfile.mkdtemp()) / "scenario.toml"
-        >>> Scenario(pressure_kpa=300.0, design_speed=3.0).to_file(path)
-        >>> Scenario.from_file(path) == Scenario(pressure_kpa=300.0, design_speed=3.0)
+        >>> with tempfile.TemporaryDirectory() as folder:   # removed afterwards
+        ...     path = pathlib.Path(folder) / "scenario.toml"
+        ...     Scenario(pressure_kpa=300.0, design_speed=3.0).to_file(path)
+        ...     Scenario.from_file(path) == Scenario(pressure_kpa=300.0, design_speed=3.0)
         True
         """
         import json
