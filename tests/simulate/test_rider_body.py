@@ -388,6 +388,34 @@ def test_output_feedback_lqr_on_a_subset_improves_the_start_and_is_a_local_optim
         assert _cost(A, b, C, nudged, X0) >= best * (1.0 - 1e-12)
 
 
+def test_output_feedback_lqr_checks_the_gradient_not_bfgs_status(whipple_moore, monkeypatch):
+    """Issue 31 item 11: the optimiser's result was used whatever it said. Now the relative gradient at the gains
+    returned (|g| max(|K|, 1) / J) decides: a design that stops short (here BFGS held to 2 iterations) warns with
+    ConvergenceWarning naming the gradient and the tolerance; one that converges does not warn, even where BFGS
+    reports "precision loss" (scripts/output_feedback_convergence.py: 12 of 14 designs, largest 2.5e-6)."""
+    import warnings
+
+    import scipy.optimize
+
+    from whipple_kick.errors import ConvergenceWarning
+    A, B = classic.linear_state_space(whipple_moore, 5.0)
+    b, C = B[:, [1]], np.eye(4)[[0, 2]]
+    start = control.lqr_gains(whipple_moore, 5.0)[0][[0, 2]]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ConvergenceWarning)
+        found, _ = control.output_feedback_lqr(A, b, C, K0=start)   # converged: no warning
+    minimize = scipy.optimize.minimize
+
+    def two_steps(*args, **kwargs):
+        return minimize(*args, **{**kwargs, "options": {**kwargs["options"], "maxiter": 2}})
+    monkeypatch.setattr(scipy.optimize, "minimize", two_steps)
+    with pytest.warns(ConvergenceWarning) as caught:
+        stopped, poles = control.output_feedback_lqr(A, b, C, K0=start)
+    text = str(caught[0].message)
+    assert "did not converge: relative gradient" in text and f"> {control.GRADIENT_TOLERANCE:g}" in text
+    assert poles.real.max() < 0.0 and not np.allclose(stopped, found)
+
+
 # ----------------------------------------------------------------- 8. steady lean
 
 @pytest.mark.parametrize("lqr_model", ["whipple", "simulated"])

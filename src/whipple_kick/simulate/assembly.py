@@ -542,11 +542,27 @@ def linear_stability(scenario, moore, gains, found, controller_type):
     if not stable:
         message = (f"{who_rides(scenario, controller_type)} is linearly unstable at {scenario.speed:g} m/s: "
                    f"slowest closed-loop pole {_pole_text(slowest)} 1/s ({model}; no-slip model "
-                   f"{_pole_text(classic[0])} 1/s)")
+                   f"{_pole_text(classic[0])} 1/s)" + _stabilising_advice(scenario, controller_type))
     pairs = lambda poles: None if poles is None else [[float(p.real), float(p.imag)] for p in poles]
     return {"stable": stable, "message": message, "slowest_pole_1_s": pairs([slowest])[0], "model": model,
             "poles_slip_model_1_s": pairs(slip_poles), "poles_no_slip_model_1_s": pairs(classic),
             "criterion": f"unstable when a closed-loop pole has real part > {UNSTABLE_REAL_PART:g} 1/s"}
+
+
+def _stabilising_advice(scenario, controller_type):
+    """What may make an unstable rider stable, as the end of :func:`linear_stability`'s message ("" if nothing)."""
+    if controller_type != "lqr":
+        return ""
+    changes = []
+    if scenario.lqr_model == "whipple" and (scenario.rider_body != "rigid" or scenario.arms == "on"):
+        body = " and ".join(part for part, used in (("a leaning upper body", scenario.rider_body != "rigid"),
+                                                    ("arms on the bar", scenario.arms == "on")) if used)
+        changes.append(f"the rider is designed on the Whipple model without {body}: design it on the model "
+                       "simulated (--lqr-model simulated, lqr_model='simulated')")
+    if scenario.design_speed is not None and scenario.design_speed != scenario.speed:
+        changes.append(f"it is designed at {scenario.design_speed:g} m/s: leave the design speed unset (the run's "
+                       "speed)")
+    return "; " + "; or ".join(changes) if changes else ""
 
 
 def _pole_text(pole):

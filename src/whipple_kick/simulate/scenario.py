@@ -512,9 +512,10 @@ class Scenario:
         Example
         -------
         >>> import pathlib, tempfile
-        >>> path = pathlib.Path(tempfile.mkdtemp()) / "scenario.toml"
-        >>> Scenario(pressure_kpa=300.0, design_speed=3.0).to_file(path)
-        >>> Scenario.from_file(path) == Scenario(pressure_kpa=300.0, design_speed=3.0)
+        >>> with tempfile.TemporaryDirectory() as folder:   # removed afterwards
+        ...     path = pathlib.Path(folder) / "scenario.toml"
+        ...     Scenario(pressure_kpa=300.0, design_speed=3.0).to_file(path)
+        ...     Scenario.from_file(path) == Scenario(pressure_kpa=300.0, design_speed=3.0)
         True
         """
         import json
@@ -566,6 +567,8 @@ class Scenario:
             raise InputError(f"{label} does not exist") from None
         except IsADirectoryError:
             raise InputError(f"{label} is a folder, not a file") from None
+        except OSError as exc:   # no permission, an I/O error: the input cannot be read
+            raise InputError(f"{label} cannot be read: {exc.strerror or exc}") from None
         except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
             raise InputError(f"{label} is not valid TOML: {exc}") from None
         types = {f.name: f.type for f in fields(cls)}

@@ -16,8 +16,9 @@ fall). docs/simulate.md lists every decision.
 """
 from collections.abc import Mapping
 import time
+import warnings
 
-from whipple_kick.errors import SimulationError
+from whipple_kick.errors import SimulationError, UnstableRiderWarning
 from whipple_kick.library import inputs
 from whipple_kick.simulate import assembly, integration, results
 
@@ -61,6 +62,12 @@ def run(scenario: Scenario, *, tyres: tuple | None = None, gains: Mapping | None
         stalled beyond :data:`whipple_kick.simulate.lsoda.DEFAULT_BUDGET`. Its
         ``partial`` holds the result up to the failure.
 
+    Warns
+    -----
+    UnstableRiderWarning
+        Before the integration, when the rider in use is linearly unstable at
+        the run's speed (``summary["linear_stability"]`` holds the same line).
+
     Example
     -------
     >>> import whipple_kick as wk
@@ -71,6 +78,9 @@ def run(scenario: Scenario, *, tyres: tuple | None = None, gains: Mapping | None
     started = time.perf_counter()
     kick = inputs.kick_of(scenario.validate())
     model = assembly.assemble(scenario, kick, tyres=tyres, gains=gains)
+    if not model.stability["stable"]:
+        # Said before the long part, the integration; a valid run all the same (the bicycle may well fall).
+        warnings.warn(model.stability["message"], UnstableRiderWarning, stacklevel=2)
     solution = integration.integrate_run(model, scenario, kick)
     frame = results.trajectory_frame(solution, scenario.tyre_transient)
     summary = results.summarise(scenario, kick, model, solution, frame, custom_tyres=tyres is not None)
