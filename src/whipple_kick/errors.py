@@ -119,6 +119,10 @@ class ConvergenceWarning(WhippleKickWarning):
     """An optimiser stopped away from a stationary point (its gradient above the stated tolerance)."""
 
 
+class DefaultValueWarning(WhippleKickWarning):
+    """Values the input does not give were taken from the project's defaults (each named with its source)."""
+
+
 class PerformanceWarning(WhippleKickWarning):
     """Results are unaffected, but a slower path is taken (e.g. the ctypes call into the compiled model)."""
 

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import whipple_kick as wk
-from whipple_kick.errors import InputError
+from whipple_kick.errors import DefaultValueWarning, InputError
 from whipple_kick.library import bicycleparameters as bp
 from whipple_kick.library import bicycles, riders
 from whipple_kick.model import benchmark, classic
@@ -62,7 +62,7 @@ def v1_folder(tmp_path_factory):
 
 def test_benchmark_file_reads_values_and_uncertainties(bench_folder):
     """Every value is read exactly (repr round-trip), each +/- is kept by name, the rest come from defaults."""
-    with pytest.warns(UserWarning, match="seating, tyres from defaults") as record:
+    with pytest.warns(DefaultValueWarning, match="seating, tyres from defaults") as record:
         bike = bp.load(bench_folder)
     assert "balanceassist_v1" in str(record[0].message)   # the default's source is named
     expected = benchmark.meijaard2007_parameters()
@@ -209,10 +209,11 @@ def test_benchmark_folder_through_simulate_and_stability(bench_folder, tmp_path,
     from conftest import run_console
     from whipple_kick.cli import stability_main
     out = tmp_path / "run"
-    with pytest.warns(UserWarning, match="seating, tyres from defaults"):
-        status, _, err = _cli(["--bicycle", str(bench_folder), "--rider-mass", "70", "--duration", "0.3",
-                               "--out", str(out)], capsys)
+    status, _, err = _cli(["--bicycle", str(bench_folder), "--rider-mass", "70", "--duration", "0.3",
+                           "--out", str(out)], capsys)
     assert status == 0, err
+    # The command shows each warning once, as one line on stderr (it does not leave them to the caller).
+    assert sum("seating, tyres from defaults" in line for line in err.splitlines()) == 1, err
     summary = json.loads((out / "summary.json").read_text())
     assert summary["fell"] is False
     # The summary names what came from defaults, with the source.

@@ -43,7 +43,7 @@ import warnings
 
 import numpy as np
 
-from whipple_kick.errors import InputError
+from whipple_kick.errors import DefaultValueWarning, InputError
 from whipple_kick.model import benchmark as _benchmark
 
 from . import bicycles, parameters
@@ -287,7 +287,7 @@ def describe_defaults(bike):
 def _warn_defaults(name, defaults):
     kinds = sorted({key.split(".", 1)[0] for key in defaults})
     warnings.warn(f"BicycleParameters bicycle {name!r}: {', '.join(kinds)} from defaults: "
-                  + "; ".join(f"{k}: {DEFAULT_SOURCES[k]}" for k in kinds), UserWarning, stacklevel=3)
+                  + "; ".join(f"{k}: {DEFAULT_SOURCES[k]}" for k in kinds), DefaultValueWarning, stacklevel=3)
 
 
 def _marked_with_rider(path):
