@@ -13,6 +13,7 @@ current code.
 """
 import os
 import pathlib
+import re
 import sys
 
 import whipple_kick
@@ -99,3 +100,52 @@ html_theme = "furo"
 html_title = f"whipple_kick {release}"
 html_static_path = []
 # The figures the Markdown pages show (kick.gif, stability.png ...) sit beside them and are copied as images.
+
+
+def _napoleon_except_data(app, what, name, obj, options, lines):
+    """Napoleon, except on the one-line ``#:`` comments of module constants and attributes.
+
+    Napoleon reads such a docstring's first line as ``type: description``, and the project's
+    comments say ``Rider models: the LQR ...`` (a label, not a type): it rendered "Rider models"
+    as the constant's type and dropped it from the summary.
+    """
+    from sphinx.ext import napoleon
+
+    if what not in ("data", "attribute"):
+        napoleon._process_docstring(app, what, name, obj, options, lines)
+        lines[:] = _split_shared_fields(lines)
+
+
+def _split_shared_fields(lines):
+    """One ``:ivar:`` entry per name where an Attributes section gives several (``fz_n, rider_mass_kg : float``).
+
+    Sphinx reads ``:ivar fz_n, rider_mass_kg:`` as the variable ``rider_mass_kg`` of type ``fz_n,``;
+    each name gets the shared description and type instead (Parameters sections are split by napoleon).
+    """
+    out, i = [], 0
+    while i < len(lines):
+        shared = re.match(r":(ivar|vartype) (\w+(?:, \w+)+):(.*)$", lines[i])
+        if shared is None:
+            out.append(lines[i])
+            i += 1
+            continue
+        field, names, text = shared.groups()
+        end = i + 1
+        while end < len(lines) and lines[end].startswith(" "):   # the description's continuation lines
+            end += 1
+        for one in names.split(", "):
+            out += [f":{field} {one}:{text}", *lines[i + 1:end]]
+        i = end
+    return out
+
+
+def setup(app):
+    from sphinx.ext import napoleon
+
+    ours = [listener.id for listener in app.events.listeners["autodoc-process-docstring"]
+            if listener.handler is napoleon._process_docstring]
+    if not ours:   # a Sphinx that wires napoleon differently: fail here, not with wrongly typed constants
+        raise RuntimeError("docs/conf.py: napoleon's autodoc-process-docstring listener was not found")
+    for listener_id in ours:
+        app.disconnect(listener_id)
+    app.connect("autodoc-process-docstring", _napoleon_except_data)

@@ -77,3 +77,21 @@ def test_gallery_scraper_shows_each_bare_figure_once_and_leaves_pyplot_figures()
     plt.close(managed)   # closed by pyplot (no manager now): still not taken for a bare figure
     saved, rst = scrape({"fig": bare, "other": managed})
     assert saved == [] and rst == ""
+
+
+def test_attributes_sharing_a_description_get_one_entry_each():
+    """``fz_n, rider_mass_kg : float or None`` under Attributes: Sphinx would read ``fz_n,`` as a type."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("docs_conf", DOCS / "conf.py")
+    conf = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(conf)
+    sys.path.remove(str(DOCS))   # conf.py puts docs/ on the path for the gallery's scraper
+    lines = [":ivar bicycle: Bicycle set.", ":vartype bicycle: str",
+             ":ivar fz_n, rider_mass_kg: Rear load [N] or", "    the rider's mass [kg].",
+             ":vartype fz_n, rider_mass_kg: float or None", "Notes"]
+    assert conf._split_shared_fields(lines) == [
+        ":ivar bicycle: Bicycle set.", ":vartype bicycle: str",
+        ":ivar fz_n: Rear load [N] or", "    the rider's mass [kg].",
+        ":ivar rider_mass_kg: Rear load [N] or", "    the rider's mass [kg].",
+        ":vartype fz_n: float or None", ":vartype rider_mass_kg: float or None", "Notes"]
