@@ -48,7 +48,8 @@ exclude_patterns = ["_build", "Thumbs.db", ".DS_Store", "examples/README.txt", "
                     "auto_examples/*.json", "auto_examples/*.md5", "auto_examples/*.codeobj.json"]
 
 # --- MyST: the Markdown pages --------------------------------------------------------------------------
-myst_enable_extensions = ["dollarmath", "colon_fence"]
+# CommonMark plus tables, as GitHub renders the pages; no $...$ math, so a dollar sign stays a dollar sign.
+myst_enable_extensions = []
 # Headings get anchors so that "page.md#heading" links resolve (as GitHub renders them).
 myst_heading_anchors = 4
 
