@@ -378,7 +378,7 @@ class Tyre:
         The tyre file's warning about its data.
     measured : dict or None
         The ranges the fits were measured over, from the file's ``[measured]``
-        table: ``slip_deg`` (|slip|, deg), ``load_min``, ``load_max`` (N).
+        table: ``slip_deg`` (``|slip|``, deg), ``load_min``, ``load_max`` (N).
     """
 
     def __init__(self, data, pressure_kpa, coefficient_set, friction, missing_moment):

@@ -24,7 +24,7 @@ from whipple_kick.simulate import steady
 
 from .scenario import LOW_INERTIA_KEYS, THESIS_DESIGN_SPEED
 
-#: |steady yaw rate| [rad/s] below which steady running counts as straight (a yaw-angle gain needs it).
+#: ``|steady yaw rate|`` [rad/s] below which steady running counts as straight (a yaw-angle gain needs it).
 STRAIGHT_YAW_RATE = 1e-9
 
 

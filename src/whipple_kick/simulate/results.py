@@ -588,7 +588,7 @@ def _carcass_section(scenario, assembly, start_outputs):
 def extrapolation(frame, rear, front):
     """Where a run leaves the ranges its tyre fits were measured over (after the kick start).
 
-    Per wheel: the measured |slip| and load range (the tyre file's
+    Per wheel: the measured ``|slip|`` and load range (the tyre file's
     ``[measured]`` table, None when it has none) and the time [s] the patch
     slip (the slip the steady curve is evaluated at), the kinematic slip and
     the normal load spend outside them, with their extremes.

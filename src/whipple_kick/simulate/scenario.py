@@ -140,9 +140,9 @@ class Scenario:
     output_rate : float
         Samples per second of the trajectory [Hz].
     fall_angle_deg : float
-        |roll| [deg] that counts as a fall and ends the run.
+        ``|roll|`` [deg] that counts as a fall and ends the run.
     steer_limit_deg : float or None
-        |steer| [deg] that also ends the run as lost (``fall_reason``
+        ``|steer|`` [deg] that also ends the run as lost (``fall_reason``
         "steer"): past 90 deg the front wheel rolls backwards, which the tyre
         model (forward rolling, pneumatic trail behind the contact) does not
         describe, and no rider recovers from a fork turned over. Without
@@ -259,6 +259,8 @@ class Scenario:
         relative to its contact (rolling, pitching, steering); the
         trajectory's ``rolling_speed_*`` columns are the speed in use.
 
+    Notes
+    -----
     The fields fall in four groups (:data:`FIELD_GROUPS`; :attr:`physics`,
     :attr:`run`, :attr:`numerics`, :attr:`compatibility` give each as a
     dict): the **physics** of the bicycle, rider, tyres, control and kick;

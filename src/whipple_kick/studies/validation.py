@@ -84,7 +84,7 @@ TIME_ORIGINS = ("first_peak", "kick")
 CSV_COLUMNS = ("case", "fz_n", "pressure_kpa", "direction", "source", "last_peak_time_s", "n_peaks", "period_s",
                "log_dec_13", "log_dec_24", "log_dec_35", "dominant_frequency_hz", "slow_swing_ratio",
                "last_peak_from_kick_s", "recovery_time_s", "status", "error")
-#: Metrics compared in the summary (mean |model - measured|), with their units.
+#: Metrics compared in the summary (mean ``|model - measured|``), with their units.
 COMPARED = {"last_peak_time_s": "s", "n_peaks": "-", "period_s": "s", "log_dec_13": "-", "log_dec_24": "-",
             "log_dec_35": "-", "dominant_frequency_hz": "Hz"}
 #: Rules for the best pressure: the thesis' (shortest last-peak time, Table 8.9) and the recommender's
@@ -323,7 +323,7 @@ def best_by_rule(table, rule, direction):
 
 
 def compare(table, experiment, directions=DIRECTIONS):
-    """Model against measurement: mean |error| per metric, agreement with Table 8.9, best pressures.
+    """Model against measurement: mean ``|error|`` per metric, agreement with Table 8.9, best pressures.
 
     Returns
     -------
