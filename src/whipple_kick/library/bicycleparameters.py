@@ -332,8 +332,7 @@ def load(path, rider=None, includes_rider=None):
 
     Example
     -------
-    >>> import tempfile
-    >>> folder = write_folder(bicycles.load("benchmark"), tempfile.mkdtemp(), name="Bench")
+    >>> folder = write_folder(bicycles.load("benchmark"), "bp_data", name="Bench")   # (in a temporary folder)
     >>> bike = load(folder)
     >>> bike.benchmark["w"], bike.includes_rider, sorted(bike.defaults)   # the benchmark's rider is lumped in
     (1.02, True, ['tyres'])
