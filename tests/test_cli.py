@@ -625,3 +625,13 @@ def test_stability_takes_the_rider_body_flags(tmp_path, capsys):
     assert status == 0, err
     summary = json.loads((out / "summary.json").read_text())
     assert "lean" in json.dumps(summary)
+
+
+def test_item15_help_gives_the_reflex_gains_sign(capsys):
+    """Issue 31 item 15: a positive --reflex-roll steers against the roll (and the bicycle falls); --help said
+    nothing of the sign."""
+    with pytest.raises(SystemExit):
+        simulate_main(["--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "T = -(gain x state)" in text and "a positive --reflex-roll steers out of the lean, against the roll" in text
+    assert "T = -gain x roll (a positive gain steers against the roll)" in text
