@@ -96,8 +96,8 @@ def _machine():
                 break
     except OSError:
         pass
-    load = f", load average {os.getloadavg()[0]:.1f}" if hasattr(os, "getloadavg") else ""
-    return f"{os.cpu_count()} x {model} ({platform.system()}{load})"
+    load = f"; load average {os.getloadavg()[0]:.1f} when recorded" if hasattr(os, "getloadavg") else ""
+    return f"{os.cpu_count()} CPUs, {model} ({platform.system()}{load})"
 
 
 def _record(key, value, script, digits=1):
