@@ -606,12 +606,17 @@ def test_rider_body_flags_reach_the_run_and_a_scenario_file(tmp_path, capsys):
     rows = np.loadtxt(out / "trajectory.csv", delimiter=",", skiprows=1)
     assert np.abs(rows[:, lean]).max() > 1e-3   # the upper body really leans (steady lean and the kick)
     again = tmp_path / "again"
+    # A reflex delay needs a reflex gain (a delay alone would be ignored: refused).
     status, _, err = _simulate(["--scenario", str(out / "scenario.toml"), "--reflex-delay", "0.05",
-                                "--duration", "0.2", "--no-plot", "--quiet", "--out", str(again)], capsys)
+                                "--reflex-steer-rate", "0.5", "--duration", "0.2", "--no-plot", "--quiet",
+                                "--out", str(again)], capsys)
     assert status == 0, err
     sc = wk.Result.load(again).summary["scenario"]
     assert (sc["rider_body"], sc["lqr_model"], sc["hip_damping"], sc["reflex_delay"], sc["duration"]) == (
         "leaning", "simulated", 40.0, 0.05, 0.2)
+    status, _, err = _simulate(["--scenario", str(out / "scenario.toml"), "--reflex-delay", "0.05",
+                                "--out", str(tmp_path / "refused")], capsys)
+    assert status == 2 and "reflex_delay = 0.05 is read only by the reflex" in err
 
 
 def test_stability_takes_the_rider_body_flags(tmp_path, capsys):
@@ -693,3 +698,13 @@ def test_a_fall_before_the_kick_is_a_clean_result_and_warned_first(tmp_path, cap
     assert "--lqr-model simulated" in err and "Traceback" not in err
     assert "BEFORE the kick start" in stdout
     assert wk.Result.load(out).summary["outcome"] == "fell"
+
+
+def test_item15_help_gives_the_reflex_gains_sign(capsys):
+    """Issue 31 item 15: a positive --reflex-roll steers against the roll (and the bicycle falls); --help said
+    nothing of the sign."""
+    with pytest.raises(SystemExit):
+        simulate_main(["--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "T = -(gain x state)" in text and "a positive --reflex-roll steers out of the lean, against the roll" in text
+    assert "T = -gain x roll (a positive gain steers against the roll)" in text

@@ -282,7 +282,12 @@ def _body_options(p, default):
     """The "rider's body" option group (:func:`_model_options`); ``default(field)`` is the Scenario's default."""
     from whipple_kick.simulate.scenario import ARMS, RIDER_BODIES
     g = p.add_argument_group("rider's body", "the Yeadon rider split into legs, forearms and a leaning upper body "
-                                             "(a bicycle-only set such as balanceassist_v1), arms and reflex")
+                                             "(a bicycle-only set such as balanceassist_v1), arms and reflex. "
+                                             "The reflex steer torque is T = -(gain x state), delayed: a positive "
+                                             "gain steers against its state (a positive --reflex-roll steers out "
+                                             "of the lean, against the roll, and the bicycle falls; steering into "
+                                             "the lean takes a negative one). Not with --controller off (no rider "
+                                             "torque at all)")
     g.add_argument("--rider-body", choices=RIDER_BODIES, default=default("rider_body"),
                    help="rigid (default: the rider lumped into the rear frame) or leaning (the upper body leans on "
                         "the saddle on the hip spring-damper)")
@@ -298,7 +303,8 @@ def _body_options(p, default):
                                                                             "(with --arms on)"),
             ("--reflex-delay", "reflex_delay", "s", "S",
              "delay of the rider's reflex steer torque (a Pade filter; at most 0.5 s)"),
-            ("--reflex-roll", "reflex_roll", "N m/rad", "N_M_PER_RAD", "reflex steer-torque gain on roll"),
+            ("--reflex-roll", "reflex_roll", "N m/rad", "N_M_PER_RAD",
+             "reflex steer-torque gain on roll, T = -gain x roll (a positive gain steers against the roll)"),
             ("--reflex-roll-rate", "reflex_roll_rate", "N m s/rad", "N_M_S_PER_RAD",
              "reflex steer-torque gain on roll rate"),
             ("--reflex-steer", "reflex_steer", "N m/rad", "N_M_PER_RAD", "reflex steer-torque gain on steer"),

@@ -562,8 +562,10 @@ def test_arm_steer_mode_frequency_rises_with_arm_stiffness():
 
 
 def test_reflex_filter_poles_are_named_reflex_delay():
-    sc = DEFAULT.with_changes(controller="off", reflex_delay=0.1, reflex_roll=20.0, reflex_roll_rate=5.0)
-    res = stability.analyse(sc, [3.5, 4.0, 4.5])
+    # The open loop keeps the reflex (the body's, not the voluntary law's); controller "off" refuses a reflex
+    # (no rider torque at all), so the scenario keeps its rider.
+    sc = DEFAULT.with_changes(reflex_delay=0.1, reflex_roll=20.0, reflex_roll_rate=5.0)
+    res = stability.analyse(sc, [3.5, 4.0, 4.5], loops=("open",))
     assert len(_named(res.eigenvalues, 4.0, ["reflex_delay"])) >= 1
     model = res.models["open", 1]
     assert model.states[-4:] == slip.REFLEX_STATES and model.matrix.shape == (18, 18)

@@ -103,7 +103,7 @@ def assemble(scenario, kick, *, tyres=None, gains=None) -> Assembly:
         (:class:`whipple_kick.simulate.steady.NoSteadyMotion`); a yaw-angle gain with
         a steady turn.
     """
-    custom = None if gains is None else custom_gains(gains)
+    custom = None if gains is None else custom_gains(gains, scenario)
     # Tyres first: a pressure outside the measured range is the commonest mistake and cheap to find.
     if tyres is None:
         rear, front, notes = build_tyres(scenario)
@@ -121,15 +121,9 @@ def assemble(scenario, kick, *, tyres=None, gains=None) -> Assembly:
         controller = scenario.controller
     else:
         gains, poles, controller = custom, None, "custom gains"
-    params = slip.model_parameters(moore, rear, front, gains=gains, symmetric=scenario.symmetric_tyres,
-                                   kick=kick.model_kick(), tyre_transient=scenario.tyre_transient,
-                                   reverse_camber=scenario.camber_sign == "reversed",
-                                   carcass_sliding=scenario.carcass_sliding, carcass_damping=scenario.carcass_damping,
-                                   carcass_viscosity=scenario.carcass_viscosity, slip_speed=scenario.slip_speed,
-                                   body=rider_body(scenario, info),
-                                   carcass_stiffness_scale=scenario.carcass_stiffness_scale)
+    params = model_parameters(scenario, kick, moore, info, rear, front, gains)
     found, start = steady.start_state(params, scenario, advice=_steady_advice(scenario, controller))
-    stability = linear_stability(scenario, moore, gains, found, controller)
+    stability = linear_stability(scenario, no_slip_plant(moore, design, info), gains, found, controller)
     steady_yaw_rate = float(start.x[slip.X["u3"]])
     if gains.get("kq3", 0.0) and abs(steady_yaw_rate) > STRAIGHT_YAW_RATE:
         # In a steady turn the yaw angle grows without bound, and so would kq3's torque.
@@ -140,6 +134,17 @@ def assemble(scenario, kick, *, tyres=None, gains=None) -> Assembly:
 
 
 # ------------------------------------------------------------------ the parts
+
+def model_parameters(scenario, kick, moore, info, rear, front, gains):
+    """The compiled model's parameters of ``scenario`` (before the steady motion's drive torque is found)."""
+    return slip.model_parameters(moore, rear, front, gains=gains, symmetric=scenario.symmetric_tyres,
+                                 kick=kick.model_kick(), tyre_transient=scenario.tyre_transient,
+                                 reverse_camber=scenario.camber_sign == "reversed",
+                                 carcass_sliding=scenario.carcass_sliding, carcass_damping=scenario.carcass_damping,
+                                 carcass_viscosity=scenario.carcass_viscosity, slip_speed=scenario.slip_speed,
+                                 body=rider_body(scenario, info),
+                                 carcass_stiffness_scale=scenario.carcass_stiffness_scale)
+
 
 def build_bicycle(scenario):
     """Bicycle with rider for ``scenario``: (moore parameters, design parameters, info dict).
@@ -174,6 +179,7 @@ def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia
     bike = bicycleparameters.load_bicycle(bicycle)
     if split and bike.includes_rider:
         raise _lumped_rider_error(bike)
+    _refuse_rider_file(bike, rider_name)
     if bike.includes_rider:
         if fz_n is not None or rider_mass_kg is not None:
             raise InputError(f"bicycle {bike.name!r} already includes its rider; "
@@ -208,6 +214,27 @@ def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia
             "total_mass_kg": sum(float(combined.benchmark[k]) for k in ("mR", "mB", "mH", "mF"))
             + (body["mt"] if body else 0.0), "body": body}
     return moore, design, info
+
+
+def _refuse_rider_file(bike, rider_name):
+    """A preset with its rider lumped in seats no Yeadon rider: a rider file given with it would be ignored."""
+    from whipple_kick.simulate.scenario import Scenario
+
+    default = Scenario.__dataclass_fields__["rider"].default
+    if bike.includes_rider and rider_name != default:
+        raise InputError(f"bicycle {bike.name!r} already includes its rider; rider {rider_name!r} would be ignored: "
+                         f"leave it at its default {default!r} or choose a bicycle-only set")
+
+
+def no_slip_plant(moore, design, info):
+    """Moore parameters of the whole bicycle with rider, for the no-slip classic model of the run's plant.
+
+    ``moore`` itself for a rider lumped into the rear frame; with a rider's body (``info["body"]``)
+    ``moore`` holds the bicycle without the upper body, whose mass the classic model would leave out, so
+    the lumped ``design`` set (the whole rider, locked at the hip) is the plant. (``low_inertia``, the one
+    change ``design`` lacks, is refused with a body.)
+    """
+    return design if info.get("body") else moore
 
 
 def _lumped_rider_error(bike):
@@ -309,13 +336,8 @@ def lqr_on_simulated_model(scenario, moore, design, info, rear, front):
 
     speed = float(scenario.lqr_design_speed)
     body = rider_body(scenario, info)
-    felt = (["kq4", "kq7", "ku4", "ku7"] + (["kq11", "ku11"] if scenario.rider_body == "leaning" else [])
-            + (["kq3"] if scenario.lqr_heading else []))
-    K = np.r_[_lqr(tuple(sorted(design.items())), speed)[0], np.zeros(len(felt) - 4)]
-    if scenario.lqr_heading:   # start from the Whipple model's heading design (its yaw gain holds the heading)
-        whipple = dict(zip(control.HEADING_GAIN_ORDER, control.heading_lqr_gains(design, speed)[0], strict=True))
-        K = np.array([whipple.get(name, 0.0) for name in felt])
-    scaled = ("ka", "ca", "rq4", "rq7", "ru4", "ru7")
+    felt, K = simulated_design_start(scenario, design)
+    scaled = SCALED_BODY_GAINS
     models = {}
 
     def model(share):
@@ -350,6 +372,24 @@ def lqr_on_simulated_model(scenario, moore, design, info, rear, front):
     gains = dict.fromkeys(slip.GAIN_NAMES, 0.0)
     gains.update({name: float(scenario.gain_scale * k) for name, k in zip(felt, K, strict=True)})
     return gains, poles
+
+
+#: The body's gains (arms, reflex) the design on the simulated model brings in by continuation.
+SCALED_BODY_GAINS = ("ka", "ca", "rq4", "rq7", "ru4", "ru7")
+
+
+def simulated_design_start(scenario, design):
+    """The gains the design on the simulated model feeds back (``felt``) and its starting gains (Whipple design)."""
+    from . import control
+
+    speed = float(scenario.lqr_design_speed)
+    felt = (["kq4", "kq7", "ku4", "ku7"] + (["kq11", "ku11"] if scenario.rider_body == "leaning" else [])
+            + (["kq3"] if scenario.lqr_heading else []))
+    K = np.r_[_lqr(tuple(sorted(design.items())), speed)[0], np.zeros(len(felt) - 4)]
+    if scenario.lqr_heading:   # start from the Whipple model's heading design (its yaw gain holds the heading)
+        whipple = dict(zip(control.HEADING_GAIN_ORDER, control.heading_lqr_gains(design, speed)[0], strict=True))
+        K = np.array([whipple.get(name, 0.0) for name in felt])
+    return felt, K
 
 
 def _linear_design_model(scenario, moore, rear, front, body, felt, share, scaled):
@@ -474,6 +514,7 @@ def preflight(scenario):
                          "do not give a rear-tyre load fz or a rider mass with it")
     if bike.includes_rider and (scenario.rider_body != "rigid" or scenario.arms == "on"):
         raise _lumped_rider_error(bike)
+    _refuse_rider_file(bike, scenario.rider)
     if scenario.controller == "thesis":
         control.thesis_gains(thesis_load(scenario))
     return scenario
@@ -570,16 +611,38 @@ def _pole_text(pole):
     return text + (f" +- {abs(pole.imag):.3f}j" if abs(pole.imag) > 1e-9 else "")
 
 
-def custom_gains(gains):
-    """Check user-given steer-torque gains (by name) and fill the missing ones with 0."""
+#: Scenario fields that choose or shape the rider's voluntary gains: user-given gains replace them all.
+CONTROLLER_FIELDS = ("controller", "design_speed", "gain_scale", "thesis_load_n", "lqr_model", "lqr_heading")
+
+
+def custom_gains(gains, scenario=None):
+    """Check user-given steer-torque gains (by name) and fill the missing ones with 0.
+
+    Every gain given is used (none is dropped): the upper body's lean gains
+    ``kq11``/``ku11`` need ``scenario.rider_body="leaning"`` (a rigid rider has
+    no lean to feed back). With ``scenario``, its fields that the given gains
+    replace (:data:`CONTROLLER_FIELDS`) must be at their defaults.
+    """
+    from dataclasses import fields
+
     from whipple_kick.model import symbols
     from whipple_kick.simulate import control
 
     unknown = sorted(set(gains) - set(slip.GAIN_NAMES))
     if unknown:
         raise InputError(f"unknown steer-torque gain(s) {unknown}; known: {list(slip.GAIN_NAMES)}")
-    # The four of the thesis' law always; the yaw gains only when given.
-    names = control.GAIN_ORDER + tuple(n for n in ("kq3", "ku3") if n in gains)
+    if scenario is not None:
+        defaults = {f.name: f.default for f in fields(scenario)}
+        for name in CONTROLLER_FIELDS:
+            if getattr(scenario, name) != defaults[name]:
+                raise InputError(f"{name} = {getattr(scenario, name)!r} is replaced by the given gains (it would be "
+                                 f"ignored): leave it at its default {defaults[name]!r} with gains=")
+        lean = [n for n in ("kq11", "ku11") if gains.get(n, 0.0) != 0.0]
+        if lean and scenario.rider_body != "leaning":
+            raise InputError(f"gain(s) {lean} feed back the upper body's lean, which only rider_body 'leaning' "
+                             f"has (here {scenario.rider_body!r}); allowed: 0 or a leaning rider")
+    # The four of the thesis' law always; the others (yaw, the upper body's lean) when given.
+    names = control.GAIN_ORDER + tuple(n for n in slip.GAIN_NAMES if n in gains and n not in control.GAIN_ORDER)
     return {name: check_range(f"gain {name}", gains.get(name, 0.0), None, None, symbols.info(name).unit)
             for name in names}
 

@@ -481,7 +481,9 @@ def _energy_summary(df, jumps, scenario):
     residual = np.abs(df[BALANCE_COLUMN].to_numpy())
     return {
         "convention": ("works done ON the bicycle and dissipations, cumulative from the kick start (J); "
-                       "stored = kinetic + potential + tyre springs + carcasses; balance residual = "
+                       "stored = kinetic + potential + springs (vertical tyre springs, and with a rider's body the hip "
+                       "and arm springs) + carcasses; dampers = vertical tyre dampers and, with a body, the hip "
+                       "and arm dampers; balance residual = "
                        "change of stored - (works - dissipations)"),
         **totals,
         "stored_change_after_kick_j": float(stored[-1] - stored[after][0]) if after.any() else 0.0,

@@ -40,10 +40,13 @@ def run(scenario: Scenario, *, tyres: tuple | None = None, gains: Mapping | None
         e.g. :func:`whipple_kick.library.tyres.linear_tyre` or a :class:`~whipple_kick.library.tyres.Tyre`
         loaded with other options. The summary names them.
     gains : mapping, optional
-        Steer-torque gains by name (``kq4 kq7 ku4 ku7``, and the yaw gains
-        ``kq3 ku3``; N m/rad, N m s/rad; missing ones are 0) instead of the
-        scenario's controller; the law is still ``T7 = -K x``.
-        ``scenario.gain_scale`` does not apply to them. A yaw-angle gain
+        Steer-torque gains by name (``kq4 kq7 ku4 ku7``, the yaw gains
+        ``kq3 ku3`` and, for a leaning rider, the upper body's lean gains
+        ``kq11 ku11``; N m/rad, N m s/rad; missing ones are 0) instead of the
+        scenario's controller; the law is still ``T7 = -K x``. The
+        scenario's controller fields (``controller``, ``design_speed``,
+        ``gain_scale``, ``thesis_load_n``, ``lqr_model``, ``lqr_heading``)
+        must stay at their defaults: the gains replace them. A yaw-angle gain
         (e.g. from :func:`whipple_kick.simulate.control.heading_lqr_gains`) needs a
         straight steady motion, so tyres without zero-slip offsets.
 
