@@ -95,7 +95,13 @@ def cases():
 
 
 def runnable(scenario, folder=OUT):
-    """``scenario`` with a kick table named relative to ``folder`` made a path (as stored it is a name)."""
+    """``scenario`` as it runs today: a kick table named relative to ``folder`` made a path (as stored it is a
+    name), and fields its mechanisms never read (stored before such fields were refused, e.g. a thesis preset's
+    design speed with the controller off) put back to their defaults: they did not act on the stored run."""
+    unused = scenario.unused_fields()
+    if unused:
+        defaults = {f.name: f.default for f in dataclasses.fields(scenario)}
+        scenario = dataclasses.replace(scenario, **{name: defaults[name] for name in unused})
     if scenario.kick_table is None or pathlib.Path(scenario.kick_table).is_absolute():
         return scenario
     return dataclasses.replace(scenario, kick_table=str(folder / scenario.kick_table))
