@@ -732,7 +732,9 @@ def numpy_rhs(t, x, p, with_outputs=False):
         r_in = mod.reflex_input([t], q, u, p)[0][0]
         t_reflex = reflex.output(z, r_in, tau)
         M, f0, G, b, kin = mod.stage2([t], q, u, [t_reflex], p)
-        block = _carcass_block(kin, s, p) if name == "carcass" else getattr(mod, f"tyre_{name}")([t], kin, s, p)[0]
+        branches = {"r": {}, "f": {}}   # each wheel's curve scanned once per camber (block and limit share it)
+        block = (_carcass_block(kin, s, p, branches) if name == "carcass"
+                 else getattr(mod, f"tyre_{name}")([t], kin, s, p)[0])
         applied = block[:4]
         f = f0 + G @ applied
         udot = _PARTITION.accelerations(M, f, A, b, locked=locked)
@@ -747,7 +749,7 @@ def numpy_rhs(t, x, p, with_outputs=False):
             rates[QUADRATURE_STATES.index("W_plate")] += kane.constraint_power(M, f, u, udot)
         dx = np.concatenate([u, udot[_PARTITION.ind], block[4:8], reflex.rates(z, r_in, tau), rates])
         if with_outputs:
-            limits = [_reference_limit(p, w, kin, applied[k]) for k, w in enumerate("rf")]
+            limits = [_reference_limit(p, w, kin, applied[k], branches[w]) for k, w in enumerate("rf")]
             outputs = mod.outputs([t], q, u, kin, applied, np.concatenate([block[8:], limits]), [t_reflex, r_in],
                                   p)[0]
             return dx, np.concatenate([u, outputs])
@@ -782,7 +784,7 @@ def _kin_of(kin, wheel):
     return tuple(float(kin[_KINEMATICS.index(f"{n}_{wheel}")]) for n in ("vsy", "vx", "camber", "fz"))
 
 
-def _carcass_block(kin, s, p):
+def _carcass_block(kin, s, p, branches):
     """Both wheels' carcass blocks by :func:`whipple_kick.model.carcass.reference_block`, in the C block's layout."""
     sliding = carcass.SLIDING_LAWS[int(p[P["carcass_sliding"]])]
     extras = dict.fromkeys(_BLOCK_EXTRAS, 0.0)
@@ -792,7 +794,8 @@ def _carcass_block(kin, s, p):
         vsy, vx, camber, fz = _kin_of(kin, wheel)
         cc, dc = p[P[f"cc{wheel}"]], p[P[f"dc{wheel}"]]
         o = carcass.reference_block(fy, mz, vsy, vx, camber, fz, s[k], s[k + 2], cc, dc, p[P[f"sig{wheel}"]],
-                                    sliding, viscosity=p[P["carcass_viscosity"]], grip=_grip(p, wheel, camber, fz))
+                                    sliding, viscosity=p[P["carcass_viscosity"]], grip=_grip(p, wheel, camber, fz),
+                                    branches=branches[wheel])
         out[wheel] = o
         f0 = float(fy(0.0, camber, fz)) if fz > 0 else 0.0
         vslide = vsy + o["rate"]
@@ -807,14 +810,17 @@ def _carcass_block(kin, s, p):
                      *(extras[n] for n in _BLOCK_EXTRAS)])
 
 
-def _reference_limit(p, wheel, kin, force):
-    """The friction limit [N] on the side of ``force`` by the reference block's scan (an output)."""
+def _reference_limit(p, wheel, kin, force, branches):
+    """The friction limit [N] on the side of ``force`` by the reference scan (an output; ``branches`` as
+    :func:`whipple_kick.model.carcass.reference_block`'s, shared with the wheel's block)."""
     fy, _ = _reference_curves(p, wheel)
     vsy, vx, camber, fz = _kin_of(kin, wheel)
     if fz <= 0 or not _grip(p, wheel, camber, fz):
         return 0.0
-    ref = carcass.reference_block(fy, lambda *a: 0.0, vsy, vx, camber, fz, 0.0, camber, 1.0, 0.0, 1.0)
-    return ref["fmax"] if force >= 0 else -ref["fmin"]
+    if (camber, fz) not in branches:
+        branches[camber, fz] = carcass.reference_branch(fy, camber, fz)
+    lo, hi = branches[camber, fz]
+    return float(fy(lo, camber, fz)) if force >= 0 else -float(fy(hi, camber, fz))
 
 
 # ------------------------------------------------------------------ the build
