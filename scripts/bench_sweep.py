@@ -3,6 +3,7 @@
 Usage:
     python scripts/bench_sweep.py split           # per-case split: integration, outputs, summary, the rest
     python scripts/bench_sweep.py nine            # 9 thesis cases, 1 vs 2 workers, interleaved repeats
+    python scripts/bench_sweep.py blend           # a blended pressure (350 kPa) against a measured one (400 kPa)
     python scripts/bench_sweep.py many --n 1000   # an n-case sweep into a temporary folder
     python scripts/bench_sweep.py all
 
@@ -28,6 +29,10 @@ load on a shared machine falls on all variants alike.
   each worker has answered, :func:`pool_startup`), and a first sweep on a
   fresh pool is timed for one and two workers (a nine-case sweep must not
   take longer on two).
+* ``blend``: 350 kPa (T03's 300 and 400 kPa fits blended) against 400 kPa in
+  this process: the integration's wall time per evaluation that LSODA counts
+  (``numerics.evaluations``, Jacobian columns included), and the compiled
+  right-hand side alone at the samples of each run (:func:`bench_blend`).
 """
 import argparse
 import os
@@ -204,6 +209,53 @@ def bench_nine(repeats, duration):
     return statistics.median(efficiency)
 
 
+def bench_blend(repeats, duration):
+    """Print what a blended pressure costs against a measured one, per evaluation, side by side.
+
+    The integrations alternate (their order rotating); each pair gives a ratio and the median of the
+    ratios is the figure (a neighbour's load drifting between pairs cancels). The right-hand side alone
+    is timed in blocks of 500 samples, alternating between the two runs' models, 20 blocks a repeat.
+    """
+    from whipple_kick.library import inputs
+    from whipple_kick.simulate import assembly, integration, simulation
+    from whipple_kick.studies import sweep_engine
+    pressures = (400.0, 350.0)
+    per_eval, evaluations, models = {p: [] for p in pressures}, {}, {}
+    with sweep_engine._blas_controller().limit(limits=1):
+        for r in range(repeats):
+            for p in _rotated(list(pressures), r):
+                scenario = simulation.Scenario(pressure_kpa=p, fz_n=635.0, duration=duration)
+                kick = inputs.kick_of(scenario.validate())
+                solution = integration.integrate_run(assembly.assemble(scenario, kick), scenario, kick)
+                evaluations[p] = solution.states.evaluations
+                per_eval[p].append(solution.wall_s / evaluations[p])
+                if solution.owner is None:
+                    models[p] = (solution.rhs.fast, solution.states.t, solution.states.x)
+        block_ratios = []
+        if len(models) == 2:
+            for r in range(20 * repeats):
+                start = (r * 500) % max(1, min(m[1].size for m in models.values()) - 500)
+                cost = {}
+                for p in _rotated(list(pressures), r):
+                    f, t, x = models[p]
+                    t0 = time.perf_counter()
+                    for k in range(start, start + 500):
+                        f(t[k], x[k])
+                    cost[p] = time.perf_counter() - t0
+                block_ratios.append(cost[350.0] / cost[400.0])
+    ratios = [b / a for a, b in zip(per_eval[400.0], per_eval[350.0], strict=True)]
+    m = {p: statistics.median(v) for p, v in per_eval.items()}
+    print(f"integration per evaluation (medians of {repeats}): 400 kPa {m[400.0] * 1e6:.2f} us "
+          f"({evaluations[400.0]} evaluations), 350 kPa {m[350.0] * 1e6:.2f} us ({evaluations[350.0]}); "
+          f"ratio per pair {', '.join(f'{q:.2f}' for q in ratios)}: median {statistics.median(ratios):.2f} "
+          f"(target <= 1.3)")
+    if block_ratios:
+        print(f"right-hand side alone at each run's own samples, 350 / 400 kPa: median of {len(block_ratios)} "
+              f"alternating blocks {statistics.median(block_ratios):.2f} (quartiles "
+              f"{', '.join(f'{q:.2f}' for q in statistics.quantiles(block_ratios, n=4))})")
+    return statistics.median(ratios)
+
+
 def bench_many(n, duration, workers, folder):
     import numpy as np
 
@@ -238,7 +290,7 @@ def bench_many(n, duration, workers, folder):
 
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    p.add_argument("what", choices=("split", "nine", "many", "all"))
+    p.add_argument("what", choices=("split", "nine", "blend", "many", "all"))
     p.add_argument("--repeats", type=int, default=3)
     p.add_argument("--n", type=int, default=1000, help="cases of the large sweep")
     p.add_argument("--duration", type=float, default=6.0, help="simulated time after the kick [s]")
@@ -251,6 +303,8 @@ def main(argv=None):
         bench_split(args.repeats, args.duration)
     if args.what in ("nine", "all"):
         bench_nine(args.repeats, args.duration)
+    if args.what in ("blend", "all"):
+        bench_blend(args.repeats, args.duration)
     if args.what in ("many", "all"):
         bench_many(args.n, args.duration, args.workers, args.folder)
     return 0
