@@ -7,10 +7,12 @@ The 350 kPa tyre blends T03's 300 and 400 kPa fits (outputs weighted 1:1).
 The file holds, at the 500 Hz samples of a 0.8 s run through the kick and
 the plate stop (default scenario: carcass tyre, LQR rider), the sample times
 ``t``, the states ``x``, the parameter vector ``p``, and the compiled model's
-derivatives ``dx`` and named outputs ``out`` there. It was written with the
+derivatives ``dx`` and named outputs ``out`` there, with the layouts' names. It was written with the
 compiled model before the blend's patch-slip solve stopped bisecting away
 from exact roots (tests/model/test_carcass.py compares the current model
-with it: the change must stay at round-off).
+with it: the change must stay at round-off). Written by this script run on
+the package before that change (commit 4911fbd); a later change of the state
+or parameter layout retires the file and its test.
 """
 import argparse
 import pathlib
@@ -36,7 +38,8 @@ def main(argv=None):
     rhs, traj = solution.rhs, solution.states
     pairs = [rhs.outputs(t, x) for t, x in zip(traj.t, traj.x, strict=True)]
     np.savez_compressed(args.out, t=traj.t, x=traj.x, p=rhs.p, dx=np.array([d for d, _ in pairs]),
-                        out=np.array([o for _, o in pairs]), output_names=np.array(slip.OUTPUT_NAMES))
+                        out=np.array([o for _, o in pairs]), output_names=np.array(slip.OUTPUT_NAMES),
+                        state_names=np.array(slip.STATE_NAMES), parameter_names=np.array(slip.PARAMETER_NAMES))
     print(f"wrote {args.out}: {traj.t.size} samples")
     return 0
 

@@ -273,7 +273,9 @@ def test_blended_pressure_rhs_is_unchanged_at_every_sample():
     bit for bit)."""
     import pathlib
     ref = np.load(pathlib.Path(__file__).resolve().parents[1] / "data" / "blend" / "rhs_350kPa_635N.npz")
-    assert list(ref["output_names"]) == list(slip.OUTPUT_NAMES)
+    for names, now in (("output_names", slip.OUTPUT_NAMES), ("state_names", slip.STATE_NAMES),
+                       ("parameter_names", slip.PARAMETER_NAMES)):
+        assert list(ref[names]) == list(now), f"the model's layout changed since {names} were stored"
     rhs = slip.CompiledRHS(dict(zip(slip.PARAMETER_NAMES, ref["p"], strict=True)))
     assert rhs.p[slip.P["wr"]] == 0.5 and rhs.p[slip.P["wf"]] == 0.5   # the blend: 300 and 400 kPa, 1:1
     pairs = [rhs.outputs(t, x) for t, x in zip(ref["t"], ref["x"], strict=True)]
