@@ -164,30 +164,36 @@ static void wk_curve_FdF(const wk_curve *c, double a_deg, double *F, double *dF)
     *F = -c->lam * y; *dF = -c->lam * dy;
 }
 
-/* Rising branch of the (blended) curve: [lo, hi] deg, F(lo) the largest, F(hi) the smallest force. */
-static void wk_curve_branch(wk_curve *c, double *lo, double *hi)
+/* One end of the rising branch of the (blended) curve [deg]: side 0 where F is largest (lo), side 1 where
+   it is smallest (hi). Each end is found on its own (the friction limit on a force's side needs one). */
+static double wk_curve_end(wk_curve *c, int side)
 {
     double l1, h1;
     wk_set_branch(c->f1, &c->up[0], &l1, &h1);
-    if (!c->two) { *lo = l1; *hi = h1; return; }
+    if (!c->two) return side ? h1 : l1;
     double l2, h2;
     wk_set_branch(c->f2, &c->up[1], &l2, &h2);
     /* The blend's extreme lies between the sets' own: the root of its slope there (Illinois). */
-    for (int side = 0; side < 2; side++) {
-        double a = side ? fmin(h1, h2) : fmax(l1, l2), b = side ? fmax(h1, h2) : fmin(l1, l2);
-        double ga = wk_curve_dF(c, a), gb = wk_curve_dF(c, b);
-        double x = b;
-        if (ga * gb < 0.0) {
-            for (int i = 0; i < 100; i++) {
-                x = b - gb * (b - a) / (gb - ga);
-                const double g = wk_curve_dF(c, x);
-                if (g == 0.0 || fabs(x - b) <= 1e-11 * (1.0 + fabs(x))) break;
-                if ((g < 0.0) != (gb < 0.0)) { a = b; ga = gb; } else ga *= 0.5;
-                b = x; gb = g;
-            }
-        } else if (fabs(ga) < fabs(gb)) x = a;
-        if (side) *hi = x; else *lo = x;
-    }
+    double a = side ? fmin(h1, h2) : fmax(l1, l2), b = side ? fmax(h1, h2) : fmin(l1, l2);
+    double ga = wk_curve_dF(c, a), gb = wk_curve_dF(c, b);
+    double x = b;
+    if (ga * gb < 0.0) {
+        for (int i = 0; i < 100; i++) {
+            x = b - gb * (b - a) / (gb - ga);
+            const double g = wk_curve_dF(c, x);
+            if (g == 0.0 || fabs(x - b) <= 1e-11 * (1.0 + fabs(x))) break;
+            if ((g < 0.0) != (gb < 0.0)) { a = b; ga = gb; } else ga *= 0.5;
+            b = x; gb = g;
+        }
+    } else if (fabs(ga) < fabs(gb)) x = a;
+    return x;
+}
+
+/* Rising branch of the (blended) curve: [lo, hi] deg, F(lo) the largest, F(hi) the smallest force. */
+static void wk_curve_branch(wk_curve *c, double *lo, double *hi)
+{
+    *lo = wk_curve_end(c, 0);
+    *hi = wk_curve_end(c, 1);
 }
 
 /* alpha in [lo, hi] with F(alpha) - k tan(alpha) = target (decreasing in alpha): safeguarded Newton. */

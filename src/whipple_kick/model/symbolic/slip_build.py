@@ -182,13 +182,14 @@ def _c_limit_functions():
     for wheel in "rf":
         lines += [f"static double wk_fylim_{wheel}(double camber, double fz, double F, const double *p)", "{",
                   "    if (!(fz > 0.0)) return 0.0;",
-                  "    wk_curve c; double lo, hi;", "    c.up[0] = c.up[1] = NAN;",
+                  "    wk_curve c;", "    c.up[0] = c.up[1] = NAN;",
                   f"    c.w = p[{P['w' + wheel]}]; c.lam = p[{P['lam' + wheel]}]; c.two = c.w != 0.0;",
                   f"    wk_fyfac_{wheel}_1(camber, fmax(fz, {carcass.FZ_SHAPE_FLOOR!r}), p, c.f1);",
                   f"    if (c.two) wk_fyfac_{wheel}_2(camber, fmax(fz, {carcass.FZ_SHAPE_FLOOR!r}), p, c.f2);",
                   "    if (!(c.f1[2] > 0.0) || (c.two && !(c.f2[2] > 0.0))) return 0.0;   /* no grip in the fit */",
-                  "    wk_curve_branch(&c, &lo, &hi);",
-                  "    return F >= 0.0 ? wk_curve_F(&c, lo) : -wk_curve_F(&c, hi);", "}"]
+                  "    /* only the end on the force's side (a blend searches each end on its own) */",
+                  "    return F >= 0.0 ? wk_curve_F(&c, wk_curve_end(&c, 0)) : -wk_curve_F(&c, wk_curve_end(&c, 1));",
+                  "}"]
     return lines
 
 
