@@ -1,19 +1,38 @@
-"""Sweep benchmarks: parallel speed-up on the nine thesis cases, and cases/s/core on a large sweep.
+"""Sweep benchmarks: where a case's time goes, parallel efficiency on the nine thesis cases, a large sweep.
 
 Usage:
-    python scripts/bench_sweep.py nine            # 9 thesis cases, 1 vs 2 workers (median of --repeats)
+    python scripts/bench_sweep.py split           # per-case split: integration, outputs, summary, the rest
+    python scripts/bench_sweep.py nine            # 9 thesis cases, 1 vs 2 workers, interleaved repeats
+    python scripts/bench_sweep.py blend           # a blended pressure (350 kPa) against a measured one (400 kPa)
     python scripts/bench_sweep.py many --n 1000   # an n-case sweep into a temporary folder
     python scripts/bench_sweep.py all
 
 "Warm" means the compiled model is already in the on-disk cache and this
-process has imported the package (one throw-away case runs first); the
-default process pool is kept between the sweeps of a process (as in a user's
-session), so the first sweep of each worker count includes its start-up (fork).
-The per-case split comes from the table: ``run.wall_s`` (the case in its
-worker) against ``numerics.integration_wall_s``; the parallel efficiency is
-set against two pure-Python processes measured in the same run. The nine cases are the thesis grid
-300/400/500 kPa x 570/635/701 N with the default scenario (LQR rider, 6 s
-after the kick, rtol 1e-10, 1000 Hz output).
+process has imported the package (one throw-away case runs first). The
+nine cases are the thesis grid 300/400/500 kPa x 570/635/701 N with the
+default scenario (LQR rider, 6 s after the kick, rtol 1e-10, 1000 Hz output).
+
+Every figure is a median over interleaved repeats: each repeat runs every
+variant once, in an order that rotates from repeat to repeat, so a neighbour's
+load on a shared machine falls on all variants alike.
+
+* ``split``: each of the nine cases run piece by piece in this process
+  (:func:`case_split`): assembly, integration, the model's outputs at every
+  sample, the trajectory table around them, the summary. The acceptance
+  figure, ``run.wall_s`` over ``numerics.integration_wall_s``, comes from
+  one-worker sweep tables (``nine``).
+* ``nine``: per repeat a one-worker sweep, a two-worker sweep (the default
+  pool kept between sweeps, as in a user's session) and the machine's
+  pure-Python ceiling (two processes against one, :func:`parallel_ceiling`);
+  the parallel efficiency is the speed-up over the ceiling, per repeat, then
+  the median. The pool's start-up is measured on its own (a fresh pool until
+  each worker has answered, :func:`pool_startup`), and a first sweep on a
+  fresh pool is timed for one and two workers (a nine-case sweep must not
+  take longer on two).
+* ``blend``: 350 kPa (T03's 300 and 400 kPa fits blended) against 400 kPa in
+  this process: the integration's wall time per evaluation that LSODA counts
+  (``numerics.evaluations``, Jacobian columns included), and the compiled
+  right-hand side alone at the samples of each run (:func:`bench_blend`).
 """
 import argparse
 import os
@@ -25,6 +44,12 @@ import time
 
 def _thesis_grid():
     return {"pressure_kpa": [300.0, 400.0, 500.0], "fz_n": [570.0, 635.0, 701.0]}
+
+
+def _thesis_scenarios(duration):
+    from whipple_kick.simulate import simulation
+    return [simulation.Scenario(duration=duration, pressure_kpa=p, fz_n=f)
+            for p in _thesis_grid()["pressure_kpa"] for f in _thesis_grid()["fz_n"]]
 
 
 def _burn(n):
@@ -40,6 +65,7 @@ def parallel_ceiling(workers=2, n=10_000_000):
     """Speed-up ``workers`` independent CPU-bound processes get over one on this machine now.
 
     On shared or virtual cores this is often well below ``workers``; no sweep can beat it.
+    The workers' own loop times are compared (their pool's start-up is left out).
     """
     from concurrent.futures import ProcessPoolExecutor
     one = _burn(n)
@@ -48,12 +74,18 @@ def parallel_ceiling(workers=2, n=10_000_000):
     return workers * one / many
 
 
+def _rotated(items, k):
+    """``items`` rotated by ``k`` (the interleaving order of repeat ``k``)."""
+    k %= len(items)
+    return items[k:] + items[:k]
+
+
 def _warm_up():
     from whipple_kick.simulate import simulation
     simulation.run(simulation.Scenario(duration=0.3))
 
 
-def case_split(table):
+def table_split(table):
     """Per-case medians [s] of a sweep table: the worker's wall time, the integration's, and the rest."""
     wall = table["run.wall_s"]
     integration = table["numerics.integration_wall_s"]
@@ -61,36 +93,167 @@ def case_split(table):
             "cpu": table["run.cpu_s"].median()}
 
 
+def case_split(scenario):
+    """Wall times [s] of one case's pieces, run as :func:`whipple_kick.simulate.simulation.run` runs them."""
+    from whipple_kick.library import inputs
+    from whipple_kick.simulate import assembly, integration, results
+    t0 = time.perf_counter()
+    kick = inputs.kick_of(scenario.validate())
+    model = assembly.assemble(scenario, kick)
+    t1 = time.perf_counter()
+    solution = integration.integrate_run(model, scenario, kick)
+    t2 = time.perf_counter()
+    outputs = solution.outputs()
+    t3 = time.perf_counter()
+    solution.outputs(via_rhs=True)
+    t3b = time.perf_counter()
+    solution.outputs = lambda: outputs   # the table around the outputs already timed
+    frame = results.trajectory_frame(solution, scenario.tyre_transient)
+    t4 = time.perf_counter()
+    results.summarise(scenario, kick, model, solution, frame)
+    t5 = time.perf_counter()
+    rest = (t1 - t0) + (t4 - t3b)
+    return {"integration": t2 - t1, "outputs": t3 - t2, "summary": t5 - t4, "rest": rest,
+            "total": (t2 - t1) + (t3 - t2) + (t5 - t4) + rest,
+            "outputs_via_rhs": t3b - t3}
+
+
+def bench_split(repeats, duration):
+    """Print the per-case split of the nine thesis cases (medians over cases and interleaved repeats)."""
+    from whipple_kick.studies import sweep_engine
+    scenarios = _thesis_scenarios(duration)
+    rows = []
+    with sweep_engine._blas_controller().limit(limits=1):   # as in a sweep's worker
+        for r in range(repeats):
+            rows += [case_split(sc) for sc in _rotated(scenarios, r)]
+    med = {k: statistics.median(row[k] for row in rows) for k in rows[0]}
+    ratio = statistics.median(row["total"] / row["integration"] for row in rows)
+    print(f"per case (medians of {len(rows)}, in this process): integration {med['integration'] * 1e3:.1f} ms, "
+          f"outputs {med['outputs'] * 1e3:.1f} ms, summary {med['summary'] * 1e3:.1f} ms, the rest (assembly, "
+          f"trajectory table) {med['rest'] * 1e3:.1f} ms; total {med['total'] * 1e3:.1f} ms = "
+          f"{ratio:.2f} x integration (median of the ratios); the outputs by the whole right-hand side at "
+          f"each sample (the path before) {med['outputs_via_rhs'] * 1e3:.1f} ms")
+    return med
+
+
+def pool_startup(workers):
+    """Wall time [s] of a fresh default pool of ``workers`` until each worker has answered once."""
+    from whipple_kick.studies import sweep_engine
+    sweep_engine._discard_default_pool(end_workers=True)
+    t0 = time.perf_counter()
+    pool = sweep_engine._default_pool(workers)
+    list(pool.map(_burn, [0] * workers, chunksize=1))
+    return time.perf_counter() - t0
+
+
+def _sweep_time(workers, base, fresh=False):
+    """(wall time [s], table) of the nine-case sweep on ``workers``; ``fresh``: on a new pool."""
+    import whipple_kick as wk
+    from whipple_kick.studies import sweep_engine
+    if fresh:
+        sweep_engine._discard_default_pool(end_workers=True)
+    t0 = time.perf_counter()
+    table = wk.sweep(_thesis_grid(), base=base, workers=workers, progress=False)
+    wall = time.perf_counter() - t0
+    assert (table["status"] == "ok").all(), table["error"].dropna().tolist()
+    return wall, table
+
+
 def bench_nine(repeats, duration):
     import pandas as pd
 
-    import whipple_kick as wk
     from whipple_kick.simulate import simulation
     base = simulation.Scenario(duration=duration)
-    times = {}
-    for workers in (1, 2):
-        runs, tables = [], []
-        for _ in range(repeats):
-            t0 = time.perf_counter()
-            table = wk.sweep(_thesis_grid(), base=base, workers=workers, progress=False)
-            runs.append(time.perf_counter() - t0)
-            assert (table["status"] == "ok").all(), table["error"].dropna().tolist()
-            tables.append(table)
-        times[workers] = runs
-        split = case_split(pd.concat(tables))
-        print(f"9 thesis cases, {workers} worker(s): wall median {statistics.median(runs):.2f} s "
-              f"(runs: {', '.join(f'{t:.2f}' for t in runs)}); per case (median of {9 * repeats}): "
-              f"run.wall_s {split['wall']:.4f} s = integration {split['integration']:.4f} s "
-              f"+ the rest {split['rest']:.4f} s (CPU {split['cpu']:.4f} s); "
-              f"run.wall_s / integration {split['wall'] / split['integration']:.2f} (target <= 1.3 with 1 worker)")
-    speedup = statistics.median(times[1]) / statistics.median(times[2])
-    best = min(times[1]) / min(times[2])
-    ceiling = parallel_ceiling(2)
-    print(f"speed-up 2 workers over 1: {speedup:.2f}x (medians), {best:.2f}x (best runs); "
-          f"target >= 1.7x (nine equal cases on two workers cannot beat 9/5 = 1.8x)")
-    print(f"this machine's ceiling right now (two pure-Python processes vs one): {ceiling:.2f}x; "
-          f"parallel efficiency {speedup / 2:.2f} (sweep) against {ceiling / 2:.2f} (pure Python)")
-    return speedup
+    starts = {1: [], 2: []}
+    first = {1: [], 2: []}
+    for r in range(repeats):   # fresh pools: the start-up alone, then a first sweep on a fresh pool
+        for w in _rotated([1, 2], r):
+            starts[w].append(pool_startup(w))
+        for w in _rotated([1, 2], r):
+            first[w].append(_sweep_time(w, base, fresh=True)[0])
+    times, tables, ceilings, efficiency = {1: [], 2: []}, {1: [], 2: []}, [], []
+    for w in (1, 2):   # warm pools of each size once (a later sweep of the same size reuses its pool)
+        _sweep_time(w, base)
+    for r in range(repeats):
+        done = {}
+        for what in _rotated(["1", "2", "ceiling"], r):
+            if what == "ceiling":
+                done["ceiling"] = parallel_ceiling(2)
+            else:
+                w = int(what)
+                wall, table = _sweep_time(w, base)
+                done[w] = wall
+                times[w].append(wall)
+                tables[w].append(table)
+        ceilings.append(done["ceiling"])
+        efficiency.append((done[1] / done[2]) / done["ceiling"])
+    for w in (1, 2):
+        split = table_split(pd.concat(tables[w]))
+        print(f"9 thesis cases, {w} worker(s): wall median {statistics.median(times[w]):.3f} s "
+              f"(runs: {', '.join(f'{t:.3f}' for t in times[w])}); per case (median of {9 * repeats}): "
+              f"run.wall_s {split['wall'] * 1e3:.1f} ms = integration {split['integration'] * 1e3:.1f} ms "
+              f"+ the rest {split['rest'] * 1e3:.1f} ms (CPU {split['cpu'] * 1e3:.1f} ms); "
+              f"median run.wall_s / median integration {split['wall'] / split['integration']:.2f}"
+              + (" (target <= 1.3)" if w == 1 else ""))
+    speedup = [a / b for a, b in zip(times[1], times[2], strict=True)]
+    print(f"speed-up 2 workers over 1, per repeat: {', '.join(f'{s:.2f}' for s in speedup)} "
+          f"(median {statistics.median(speedup):.2f}x; nine equal cases cannot beat 9/5 = 1.8x)")
+    print(f"pure-Python ceiling beside them (two processes vs one): {', '.join(f'{c:.2f}' for c in ceilings)} "
+          f"(median {statistics.median(ceilings):.2f}x)")
+    print(f"parallel efficiency, speed-up / ceiling per repeat: {', '.join(f'{e:.2f}' for e in efficiency)}; "
+          f"median {statistics.median(efficiency):.2f} (target >= 0.85)")
+    print(f"pool start-up until every worker answered: 1 worker {statistics.median(starts[1]) * 1e3:.0f} ms, "
+          f"2 workers {statistics.median(starts[2]) * 1e3:.0f} ms (medians of {repeats})")
+    print(f"first sweep on a fresh pool: 1 worker {statistics.median(first[1]):.3f} s, 2 workers "
+          f"{statistics.median(first[2]):.3f} s (medians of {repeats}; 2 must not exceed 1)")
+    return statistics.median(efficiency)
+
+
+def bench_blend(repeats, duration):
+    """Print what a blended pressure costs against a measured one, per evaluation, side by side.
+
+    The integrations alternate (their order rotating); each pair gives a ratio and the median of the
+    ratios is the figure (a neighbour's load drifting between pairs cancels). The right-hand side alone
+    is timed in blocks of 500 samples, alternating between the two runs' models, 20 blocks a repeat.
+    """
+    from whipple_kick.library import inputs
+    from whipple_kick.simulate import assembly, integration, simulation
+    from whipple_kick.studies import sweep_engine
+    pressures = (400.0, 350.0)
+    per_eval, evaluations, models = {p: [] for p in pressures}, {}, {}
+    with sweep_engine._blas_controller().limit(limits=1):
+        for r in range(repeats):
+            for p in _rotated(list(pressures), r):
+                scenario = simulation.Scenario(pressure_kpa=p, fz_n=635.0, duration=duration)
+                kick = inputs.kick_of(scenario.validate())
+                solution = integration.integrate_run(assembly.assemble(scenario, kick), scenario, kick)
+                evaluations[p] = solution.states.evaluations
+                per_eval[p].append(solution.wall_s / evaluations[p])
+                if solution.owner is None:
+                    models[p] = (solution.rhs.fast, solution.states.t, solution.states.x)
+        block_ratios = []
+        if len(models) == 2:
+            for r in range(20 * repeats):
+                start = (r * 500) % max(1, min(m[1].size for m in models.values()) - 500)
+                cost = {}
+                for p in _rotated(list(pressures), r):
+                    f, t, x = models[p]
+                    t0 = time.perf_counter()
+                    for k in range(start, start + 500):
+                        f(t[k], x[k])
+                    cost[p] = time.perf_counter() - t0
+                block_ratios.append(cost[350.0] / cost[400.0])
+    ratios = [b / a for a, b in zip(per_eval[400.0], per_eval[350.0], strict=True)]
+    m = {p: statistics.median(v) for p, v in per_eval.items()}
+    print(f"integration per evaluation (medians of {repeats}): 400 kPa {m[400.0] * 1e6:.2f} us "
+          f"({evaluations[400.0]} evaluations), 350 kPa {m[350.0] * 1e6:.2f} us ({evaluations[350.0]}); "
+          f"ratio per pair {', '.join(f'{q:.2f}' for q in ratios)}: median {statistics.median(ratios):.2f} "
+          f"(target <= 1.3)")
+    if block_ratios:
+        print(f"right-hand side alone at each run's own samples, 350 / 400 kPa: median of {len(block_ratios)} "
+              f"alternating blocks {statistics.median(block_ratios):.2f} (quartiles "
+              f"{', '.join(f'{q:.2f}' for q in statistics.quantiles(block_ratios, n=4))})")
+    return statistics.median(ratios)
 
 
 def bench_many(n, duration, workers, folder):
@@ -119,7 +282,7 @@ def bench_many(n, duration, workers, folder):
           f"{ok} ok, {n_cases - ok} failed, {int(table['fell'].fillna(False).astype(bool).sum())} fell; "
           f"per case median {table['run.wall_s'].median():.3f} s in the worker; "
           f"folder {size / 1e6:.0f} MB")
-    split = case_split(table)
+    split = table_split(table)
     print(f"per case (medians): integration {split['integration']:.4f} s + the rest {split['rest']:.4f} s; "
           f"{workers} pure-Python processes get {parallel_ceiling(workers):.2f}x one here now")
     return rate / workers
@@ -127,7 +290,7 @@ def bench_many(n, duration, workers, folder):
 
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    p.add_argument("what", choices=("nine", "many", "all"))
+    p.add_argument("what", choices=("split", "nine", "blend", "many", "all"))
     p.add_argument("--repeats", type=int, default=3)
     p.add_argument("--n", type=int, default=1000, help="cases of the large sweep")
     p.add_argument("--duration", type=float, default=6.0, help="simulated time after the kick [s]")
@@ -136,8 +299,12 @@ def main(argv=None):
     args = p.parse_args(argv)
     print(f"{os.cpu_count()} cores; load average {os.getloadavg()[0]:.2f} before the run")
     _warm_up()
+    if args.what in ("split", "all"):
+        bench_split(args.repeats, args.duration)
     if args.what in ("nine", "all"):
         bench_nine(args.repeats, args.duration)
+    if args.what in ("blend", "all"):
+        bench_blend(args.repeats, args.duration)
     if args.what in ("many", "all"):
         bench_many(args.n, args.duration, args.workers, args.folder)
     return 0

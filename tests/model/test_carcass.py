@@ -30,49 +30,36 @@ def runs(base):
 
 
 def _curve_extremes(tyre, camber, fz, cap_deg=carcass.PATCH_SLIP_CAP_DEG):
-    """Largest and smallest F_y of the steady curve over |slip| <= cap at each (camber, load): a 0.02 deg scan."""
-    slips = np.radians(np.linspace(-cap_deg, cap_deg, 8001))[None, :]
-    hi, lo = np.empty(camber.size), np.empty(camber.size)
-    for start in range(0, camber.size, 200):
-        rows = slice(start, start + 200)
-        f = tyre.lateral_force(slips, camber[rows, None], fz[rows, None])
-        hi[rows], lo[rows] = f.max(axis=1), f.min(axis=1)
-    return hi, lo
+    """Largest and smallest F_y of the steady curve over |slip| <= cap at each (camber, load).
 
-
-@pytest.mark.parametrize("case", list(RUNS))
-def test_carcass_is_passive_and_the_balance_closes(runs, case):
-    """The integrated carcass power is the stored energy c y^2 / 2 of the state at every sample (so never
-    below 0), and the whole energy balance closes to 1e-6 J over 6 s, across the kick start and the plate
-    stop. Measured: stored energy to 9e-7 J at worst (the left kick), balance to 5e-8 J."""
-    result = runs[case]
-    df, carcass_info = result.trajectory, result.summary["tyres"]["carcass"]
-    assert result.scenario.tyre_transient == "carcass"
-    for wheel in ("rear", "front"):
-        energy = df[f"carcass_energy_{wheel}"].to_numpy()
-        stored = 0.5 * carcass_info[f"stiffness_{wheel}_n_per_m"] * df[f"carcass_deflection_{wheel}"].to_numpy() ** 2
-        # The issue's acceptance is 1e-3 J; the bound here is 1e-5 J, ten times the worst measured
-        # (9e-7 J), so a loss of passivity far smaller than the acceptance still fails.
-        np.testing.assert_allclose(energy, stored, rtol=0, atol=1e-5)
-        assert energy.min() > -1e-5
-    assert np.max(np.abs(df[wk.results.BALANCE_COLUMN])) < 1e-6
-    # The tyre's work is not trivially small: the plate feeds 10-65 J, sliding takes most of it.
-    assert df["plate_work"].iloc[-1] > 10.0 and df["sliding_dissipation"].iloc[-1] > 10.0
-
-
-def test_sliding_dissipation_never_decreases_with_symmetric_tyres():
-    """Without zero-slip offsets the patch always slides against its force: -(F - F0) V' >= 0.
-    Measured: smallest step +0.0 J (no decrease beyond round-off)."""
-    df = run(Scenario(pressure_kpa=400.0, fz_n=635.0, symmetric_tyres=True)).trajectory
-    assert np.min(np.diff(df["sliding_dissipation"].to_numpy())) >= -1e-12
+    A 0.5 deg scan of every sample at once, then each extreme refined by zooming in: 33 slips a step
+    around the best one, the bracket 16 times narrower each step, to 1e-11 rad (vectorised over the
+    samples; an extreme at the cap stays there). Independent of the C code's branch search.
+    """
+    cap = np.radians(cap_deg)
+    coarse = np.linspace(-cap, cap, 321)
+    steps = np.linspace(0.0, 1.0, 33)
+    camber, fz = camber[:, None], fz[:, None]
+    force = tyre.lateral_force(coarse[None, :], camber, fz)
+    rows = np.arange(force.shape[0])
+    extremes = []
+    for sign in (1.0, -1.0):
+        k = np.argmax(sign * force, axis=1)
+        a0, a1 = coarse[np.clip(k - 1, 0, None)], coarse[np.clip(k + 1, None, coarse.size - 1)]
+        while np.max(a1 - a0) > 1e-11:
+            fine = a0[:, None] + (a1 - a0)[:, None] * steps
+            j = np.argmax(sign * tyre.lateral_force(fine, camber, fz), axis=1)
+            a0, a1 = fine[rows, np.clip(j - 1, 0, None)], fine[rows, np.clip(j + 1, None, steps.size - 1)]
+        extremes.append(tyre.lateral_force(0.5 * (a0 + a1), camber[:, 0], fz[:, 0]))
+    return tuple(extremes)
 
 
 @pytest.mark.parametrize("case", list(RUNS))
 def test_force_stays_within_the_friction_limit(runs, case):
     """|F_y| <= 1.0001 x the steady curve's extreme on its side at the sample's load and camber (an
-    independent 0.02 deg scan). The regularised plateau carries viscosity x the extra sliding speed
-    above it: measured 1.3e-5 (default) to 5.5e-5 (40 m/s^2); the compiled limit output agrees with
-    the scan to the scan's resolution."""
+    independent scan, refined to 1e-11 rad). The regularised plateau carries viscosity x the extra sliding
+    speed above it: measured 1.3e-5 (default) to 5.5e-5 (40 m/s^2); the compiled limit output agrees with
+    the scan to 1e-9 relative (two searches of a flat extreme: each value within ~eps of the peak)."""
     result = runs[case]
     rear, front, _ = wk.assembly.build_tyres(result.scenario)
     df = result.trajectory
@@ -83,7 +70,7 @@ def test_force_stays_within_the_friction_limit(runs, case):
         hi, lo = _curve_extremes(tyre, df[f"camber_{wheel}"].to_numpy()[loaded], fz[loaded])
         limit = np.where(force[loaded] >= 0.0, hi, -lo)
         assert np.max(np.abs(force[loaded]) / limit) <= 1.0001, wheel
-        np.testing.assert_allclose(df[f"fy_limit_{wheel}"].to_numpy()[loaded], limit, rtol=1e-6)
+        np.testing.assert_allclose(df[f"fy_limit_{wheel}"].to_numpy()[loaded], limit, rtol=1e-9)
 
 
 # ------------------------------------------------------------- the block at a constant slip
@@ -276,3 +263,22 @@ def test_ignorable_columns_of_the_jacobian_are_exactly_zero(runs):
         assert not np.any(jac[:, [slip.X[n] for n in slip.IGNORABLE]])
     # The default rider (hip locked, no delay) skips the hip's and the reflex filter's columns too.
     assert len(slip.DYNAMIC_STATES) + 1 - 4 - 2 - 4 == slip.JACOBIAN_EVALUATIONS == 18
+
+
+def test_blended_pressure_rhs_is_unchanged_at_every_sample():
+    """The blend's patch-slip solve returns at a converged Newton step instead of bisecting away from a root on
+    its bracket's end: derivatives and outputs at every sample of a 350 kPa run (tests/data/blend, written by
+    scripts/make_blend_reference.py before the change) agree to 1e-11 of each column's largest value (the
+    solve's own tolerance is 1e-13 deg; measured 2.3e-13 at worst, at 250 of the 401 samples; the rest are
+    bit for bit)."""
+    import pathlib
+    ref = np.load(pathlib.Path(__file__).resolve().parents[1] / "data" / "blend" / "rhs_350kPa_635N.npz")
+    for names, now in (("output_names", slip.OUTPUT_NAMES), ("state_names", slip.STATE_NAMES),
+                       ("parameter_names", slip.PARAMETER_NAMES)):
+        assert list(ref[names]) == list(now), f"the model's layout changed since {names} were stored"
+    rhs = slip.CompiledRHS(dict(zip(slip.PARAMETER_NAMES, ref["p"], strict=True)))
+    assert rhs.p[slip.P["wr"]] == 0.5 and rhs.p[slip.P["wf"]] == 0.5   # the blend: 300 and 400 kPa, 1:1
+    pairs = [rhs.outputs(t, x) for t, x in zip(ref["t"], ref["x"], strict=True)]
+    for got, want in ((np.array([d for d, _ in pairs]), ref["dx"]), (np.array([o for _, o in pairs]), ref["out"])):
+        scale = np.maximum(np.abs(want).max(axis=0), 1e-300)
+        assert np.max(np.abs(got - want) / scale) <= 1e-11

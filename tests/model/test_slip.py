@@ -471,3 +471,21 @@ def test_kept_speeds_leave_the_rear_sliding_at_the_plate_velocity_times_sin_yaw(
         residual_without_slide = A @ u + a0 + np.array([slide, 0.0, 0.0])
         assert residual_without_slide[0] == pytest.approx(slide, abs=1e-9)
     assert slip.kept_speeds_slide(after, T + 1.0, tr.end_state) == pytest.approx(slide, abs=1e-12)
+
+
+@pytest.mark.parametrize("fields", [
+    {}, {"pressure_kpa": 350.0}, {"tyre_transient": "force_lag"}, {"tyre_transient": "contact_patch"},
+    {"tyre_transient": "slip_lag"}, {"carcass_sliding": "curve", "carcass_damping": 75.0},
+    {"rider_body": "leaning", "arms": "on", "reflex_delay": 0.1, "reflex_roll": 20.0, "plate_stop": "resolve"},
+], ids=["default", "350kPa", "force_lag", "contact_patch", "slip_lag", "damped_curve", "body_arms_reflex"])
+def test_outputs_without_the_dynamics_are_the_right_hand_side_outputs_bit_for_bit(fields):
+    """The outputs function leaves Kane's mass matrix and solve out: at every sample of a run (kick, plate
+    stop, recovery; every piece's own model) its outputs equal the whole right-hand side's exactly (tolerance
+    0: the same C statements, pruned, so the sweep's tables do not move by one bit)."""
+    from whipple_kick.library import inputs
+    from whipple_kick.simulate import assembly, integration
+    scenario = wk.Scenario(duration=1.0, **fields)
+    kick = inputs.kick_of(scenario.validate())
+    solution = integration.integrate_run(assembly.assemble(scenario, kick), scenario, kick)
+    fast, reference = solution.outputs(), solution.outputs(via_rhs=True)
+    assert np.array_equal(fast, reference), np.flatnonzero(np.any(fast != reference, axis=0))

@@ -55,17 +55,21 @@ class Solution:
     jumps: list = field(default_factory=list)
     wall_s: float = 0.0
 
-    def outputs(self) -> np.ndarray:
-        """The compiled model's named outputs (:data:`whipple_kick.model.slip.OUTPUT_NAMES`) at every sample."""
+    def outputs(self, via_rhs=False) -> np.ndarray:
+        """The compiled model's named outputs (:data:`whipple_kick.model.slip.OUTPUT_NAMES`) at every sample.
+
+        ``via_rhs``: from the whole right-hand side at each sample (the reference;
+        :meth:`whipple_kick.model.slip.CompiledRHS.outputs_at`).
+        """
         traj = self.states
         if self.owner is None:
-            return self.rhs.outputs_at(traj.t, traj.x)
+            return self.rhs.outputs_at(traj.t, traj.x, via_rhs)
         # Each piece's compiled model evaluates the samples it produced.
         owner = np.asarray(self.owner)
         outs = np.empty((traj.t.size, len(slip.OUTPUT_NAMES)))
         for k in np.unique(owner):
             rows = owner == k
-            outs[rows] = self.rhs[k].outputs_at(traj.t[rows], traj.x[rows])
+            outs[rows] = self.rhs[k].outputs_at(traj.t[rows], traj.x[rows], via_rhs)
         return outs
 
 

@@ -91,6 +91,8 @@ def library():
     lib.wk_slip_rhs.argtypes = [ctypes.c_double, pointer, pointer, pointer, pointer]
     lib.wk_slip_outputs.restype = ctypes.c_int
     lib.wk_slip_outputs.argtypes = [ctypes.c_int, pointer, pointer, pointer, pointer]
+    lib.wk_slip_outputs_only.restype = ctypes.c_int
+    lib.wk_slip_outputs_only.argtypes = [ctypes.c_int, pointer, pointer, pointer, pointer]
     lib.wk_slip_jacobian.restype = ctypes.c_int
     lib.wk_slip_jacobian.argtypes = [ctypes.c_double, pointer, pointer, pointer, pointer]
     lib.wk_slip_impulse_terms.restype = ctypes.c_int
