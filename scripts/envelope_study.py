@@ -49,12 +49,12 @@ def outcome(scenario):
     t0 = time.perf_counter()
     try:
         result = simulation.run(scenario)
-        return result.summary["outcome"], result.summary, None, time.perf_counter() - t0
     except steady.NoSteadyMotion as exc:
         return "no steady motion", None, str(exc), time.perf_counter() - t0
-    except simulation.SimulationError as exc:
-        summary = exc.partial.summary if exc.partial is not None else None
-        return "failed", summary, str(exc), time.perf_counter() - t0
+    except simulation.SimulationError as exc:   # nothing computed to return
+        return "failed", None, str(exc), time.perf_counter() - t0
+    error = None if result.success else result.message
+    return result.summary["outcome"], result.summary, error, time.perf_counter() - t0
 
 
 def envelope_cases():

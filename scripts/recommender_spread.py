@@ -81,9 +81,9 @@ def perturbations():
 
 def summary(scenario, tyres=None):
     try:
-        return simulation.run(scenario, tyres=tyres).summary
-    except simulation.SimulationError as exc:
-        return exc.partial.summary if exc.partial is not None else None
+        return simulation.run(scenario, tyres=tyres).summary   # a failed run's summary too
+    except simulation.SimulationError:   # nothing computed to return
+        return None
 
 
 def value(s, criterion):

@@ -794,16 +794,11 @@ def _simulate(argv):
     movie_options = _animation_options(args)
     with _output_folder(args.out or _default_out(scenario), args.force, _OUTPUT_FILES) as job:
         out = job.out
-        try:
-            result, files, note = _simulate_into(args, scenario, movie_options, job.dir, job.written)
-        except SimulationError as exc:
-            if exc.partial is None:
-                raise
-            # What ran before the failure is kept for the user to inspect.
-            exc.partial.save(job.dir)
+        result, files, note = _simulate_into(args, scenario, movie_options, job.dir, job.written)
+        if not result.success:
+            # What ran before the numerical failure is kept for the user to inspect; the command fails.
             job.keep = True
-            raise SimulationError(
-                f"{exc}; the run up to t = {exc.partial.summary['end_time_s']:g} s is in {out}") from None
+            raise SimulationError(f"{result.message}; the run up to t = {result.summary['end_time_s']:g} s is in {out}")
     if not args.quiet and result.summary["controller"]["warning"]:
         print(f"simulate: warning: {result.summary['controller']['warning']}", file=sys.stderr)
     if not args.quiet:
@@ -823,6 +818,8 @@ def _simulate_into(args, scenario, movie_options, out, written):
     result = simulation.run(scenario)
     files = result.save(out)
     written.extend(files)
+    if not result.success:   # a numerical failure: the data up to it, no figures of a broken run
+        return result, files, None
     if not args.no_plot:
         from whipple_kick.figures import plotting
         plotting.response_figure([("", result)], out / "response.png", title=plotting.result_title(result),

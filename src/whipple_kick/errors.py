@@ -60,18 +60,14 @@ def check_range(name, value, low, high, unit, *, low_open=False, high_open=False
 
 
 class SimulationError(RuntimeError):
-    """The integration failed numerically (not a user mistake).
+    """Numerical trouble with nothing to return (not a user mistake).
 
-    Attributes
-    ----------
-    partial : whipple_kick.simulate.results.Result or None
-        What was computed before the failure (trajectory up to it, summary
-        with ``status`` "failed"), when there is anything.
+    A run whose integration fails part-way is not an exception: ``wk.run``
+    returns its :class:`~whipple_kick.simulate.results.Result` with
+    ``success`` False, as :func:`scipy.integrate.solve_ivp` does. This is
+    raised only where no result exists: the compiled model failed at the
+    start state, or no finite summary could be made.
     """
-
-    def __init__(self, message, partial=None):
-        super().__init__(message)
-        self.partial = partial
 
 
 class BuildError(RuntimeError):

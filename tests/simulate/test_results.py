@@ -270,3 +270,13 @@ def test_load_refuses_a_malformed_trajectory(edit, fragment, tmp_path):
     with pytest.raises(wk.InputError) as info:
         wk.Result.load(folder)
     assert "\n" not in str(info.value) and fragment in str(info.value), str(info.value)
+
+
+def test_a_fall_is_status_1_and_a_success():
+    """Issue 32 item 5: the Result says how the run ended as SciPy's OdeResult does: a fall is a terminal
+    event (status 1) and a success (the model did what it should); -1 is kept for numerical failure
+    (tests/simulate/test_integration.py) and 0 for a run that reached its end (the Result.status doctest)."""
+    result = wk.run(wk.Scenario(controller="off", duration=2.5, output_rate=200.0))
+    assert result.summary["fell"]
+    assert (result.status, result.success) == (1, True)
+    assert result.message == result.summary["message"] and "\n" not in result.message

@@ -21,7 +21,7 @@ from whipple_kick import cli
 from whipple_kick.errors import InputError
 from whipple_kick.library import inputs
 from whipple_kick.model import slip
-from whipple_kick.simulate import assembly
+from whipple_kick.simulate import assembly, control
 from whipple_kick.simulate.scenario import FIELD_GROUPS, MECHANISM_FIELDS, Scenario
 
 DEFAULTS = {f.name: f.default for f in dataclasses.fields(Scenario)}
@@ -115,9 +115,10 @@ def fingerprint(sc):
     rear, front, _ = assembly.build_tyres(sc)
     moore, design, info = assembly.build_bicycle(sc)
     if sc.controller == "lqr" and sc.lqr_model == "simulated":
-        felt, K = assembly.simulated_design_start(sc, design)
-        A, b, C = assembly._linear_design_model(sc, moore, rear, front, assembly.rider_body(sc, info), felt, 1.0,
-                                                assembly.SCALED_BODY_GAINS)
+        spec = assembly.design_spec(sc)
+        felt, K = control.simulated_design_start(spec, design)
+        A, b, C = control._linear_design_model(spec, moore, rear, front, assembly.rider_body(sc, info), felt, 1.0,
+                                               control.SCALED_BODY_GAINS)
         gains = {"design": (A, b, C, K, sc.gain_scale, sc.lqr_design_speed)}
         params = assembly.model_parameters(sc, kick, moore, info, rear, front, None)
     else:

@@ -20,7 +20,7 @@ import numpy as np
 
 from whipple_kick.errors import InputError, check_range
 from whipple_kick.model import slip
-from whipple_kick.simulate import steady
+from whipple_kick.simulate import control, steady
 
 from .scenario import LOW_INERTIA_KEYS, THESIS_DESIGN_SPEED
 
@@ -114,7 +114,8 @@ def assemble(scenario, kick, *, tyres=None, gains=None) -> Assembly:
     moore, design, info = build_bicycle(scenario)
     if custom is None and scenario.controller == "lqr" and scenario.lqr_model == "simulated":
         gains, poles = (_cached_simulated_design(scenario) if tyres is None
-                        else lqr_on_simulated_model(scenario, moore, design, info, rear, front))
+                        else control.lqr_on_simulated_model(design_spec(scenario), moore, design,
+                                                            rider_body(scenario, info), rear, front))
         controller = scenario.controller
     elif custom is None:
         gains, poles = controller_gains(scenario, design)
@@ -250,22 +251,6 @@ def _rear_load_range(bicycle, _stamp, rider_name):
     return riders.rear_load_range(bicycleparameters.load_bicycle(bicycle), rider_name)
 
 
-@functools.lru_cache(maxsize=256)
-def _lqr(design_items, speed):
-    # A sweep over pressures or kicks designs the same rider once per process.
-    from . import control
-    K, poles = control.lqr_gains(dict(design_items), speed)
-    return tuple(np.ravel(K)), tuple(np.ravel(poles))
-
-
-@functools.lru_cache(maxsize=256)
-def _classic_poles(moore_items, speed, gains_items):
-    # The no-slip model's poles depend on the bicycle, speed and gains only: a sweep over tyres or kicks
-    # computes them once per process (~3 ms a case).
-    from . import control
-    return tuple(control.closed_loop_poles(dict(moore_items), speed, dict(gains_items)))
-
-
 def rider_body(scenario, info):
     """The rider's body parameters by name (:data:`whipple_kick.model.slip.parameters.BODY_NAMES`) for ``scenario``.
 
@@ -292,7 +277,7 @@ _NOT_IN_DESIGN = ("kick_displacement", "kick_duration", "kick_accel", "kick_prof
 
 
 def _cached_simulated_design(scenario):
-    """:func:`lqr_on_simulated_model` of ``scenario``, once per process for the fields the design reads.
+    """:func:`~whipple_kick.simulate.control.lqr_on_simulated_model` of ``scenario``, once per process for the fields the design reads.
 
     Both kick directions (or any kick) of a case share one design.
     """
@@ -307,115 +292,20 @@ def _cached_simulated_design(scenario):
 def _simulated_design(scenario):
     rear, front, _ = build_tyres(scenario)
     moore, design, info = build_bicycle(scenario)
-    gains, poles = lqr_on_simulated_model(scenario, moore, design, info, rear, front)
+    gains, poles = control.lqr_on_simulated_model(design_spec(scenario), moore, design, rider_body(scenario, info),
+                                                  rear, front)
     return tuple(gains.items()), tuple(poles)
 
 
-def lqr_on_simulated_model(scenario, moore, design, info, rear, front):
-    """The LQR rider designed on the model the run simulates (``lqr_model="simulated"``).
-
-    The model of the run (its tyres, carcass, body, arms and reflex) with
-    symmetric tyres, linearised about upright straight running at the design
-    speed at constant speed (:func:`whipple_kick.model.slip.heading_linearisation`);
-    the law feeds back roll, steer and their rates, and the upper body's lean
-    and its rate when it leans (:data:`whipple_kick.model.slip.parameters.GAIN_STATES`),
-    with gains LQR-optimal for that law (identity weights on those states,
-    1 on the torque, as the Whipple design), found from the Whipple design's
-    gains by :func:`whipple_kick.simulate.control.output_feedback_lqr`. Where the
-    Whipple gains do not stabilise the model, the arms' and the reflex's
-    gains are brought in from 0 in steps, each design starting from the last.
-
-    Returns
-    -------
-    gains : dict
-        By name (:data:`whipple_kick.model.slip.parameters.GAIN_NAMES`), times ``gain_scale``.
-    poles : ndarray
-        The design's closed-loop eigenvalues.
-    """
-    from . import control
-
-    speed = float(scenario.lqr_design_speed)
-    body = rider_body(scenario, info)
-    felt, K = simulated_design_start(scenario, design)
-    scaled = SCALED_BODY_GAINS
-    models = {}
-
-    def model(share):
-        """(A, b, C) of the design model with ``share`` of the ``scaled`` gains, built once per share."""
-        if share not in models:
-            models[share] = _linear_design_model(scenario, moore, rear, front, body, felt, share, scaled)
-        return models[share]
-
-    def stabilises(gains, share):
-        A, b, C = model(share)
-        return bool(np.max(np.linalg.eigvals(A - b @ gains[None, :] @ C).real) < 0.0)
-
-    # Continuation: the share of the arms' and reflex's gains grows while the gains still stabilise the
-    # next model; where they do not, they are re-optimised at the last share they did (a larger margin).
-    done, step = (1.0, 1.0) if stabilises(K, 1.0) else (0.0, 0.25)
-    if not stabilises(K, done):   # the body alone (forearms on the bar, a leaning trunk) defeats the Whipple design
-        K = control.stabilising_gains(*model(done), K)
-    optimised_at = None
-    while done < 1.0:
-        share = min(1.0, done + step)
-        if stabilises(K, share):
-            done, step = share, step * 2.0
-        elif optimised_at != done:
-            K, _ = control.output_feedback_lqr(*model(done), K0=K)
-            optimised_at = done
-        elif step < 1e-3:
-            raise InputError(f"no stabilising LQR rider was found on the model simulated at {speed:g} m/s "
-                             f"(the design lost stability at {share:.1%} of the arms' and reflex's gains)")
-        else:
-            step /= 2.0
-    K, poles = control.output_feedback_lqr(*model(1.0), K0=K)
-    gains = dict.fromkeys(slip.GAIN_NAMES, 0.0)
-    gains.update({name: float(scenario.gain_scale * k) for name, k in zip(felt, K, strict=True)})
-    return gains, poles
-
-
-#: The body's gains (arms, reflex) the design on the simulated model brings in by continuation.
-SCALED_BODY_GAINS = ("ka", "ca", "rq4", "rq7", "ru4", "ru7")
-
-
-def simulated_design_start(scenario, design):
-    """The gains the design on the simulated model feeds back (``felt``) and its starting gains (Whipple design)."""
-    from . import control
-
-    speed = float(scenario.lqr_design_speed)
-    felt = (["kq4", "kq7", "ku4", "ku7"] + (["kq11", "ku11"] if scenario.rider_body == "leaning" else [])
-            + (["kq3"] if scenario.lqr_heading else []))
-    K = np.r_[_lqr(tuple(sorted(design.items())), speed)[0], np.zeros(len(felt) - 4)]
-    if scenario.lqr_heading:   # start from the Whipple model's heading design (its yaw gain holds the heading)
-        whipple = dict(zip(control.HEADING_GAIN_ORDER, control.heading_lqr_gains(design, speed)[0], strict=True))
-        K = np.array([whipple.get(name, 0.0) for name in felt])
-    return felt, K
-
-
-def _linear_design_model(scenario, moore, rear, front, body, felt, share, scaled):
-    """(A, b, C) of the design model with ``share`` of the ``scaled`` body gains (C picks the ``felt`` states)."""
-    part = {k: (v * share if k in scaled else v) for k, v in body.items()}
-    params = slip.model_parameters(moore, rear, front, symmetric=True, tyre_transient=scenario.tyre_transient,
-                                   carcass_sliding=scenario.carcass_sliding,
-                                   carcass_damping=scenario.carcass_damping,
-                                   carcass_viscosity=scenario.carcass_viscosity, slip_speed=scenario.slip_speed,
-                                   body=part, carcass_stiffness_scale=scenario.carcass_stiffness_scale)
-    up = steady.upright_state(params, float(scenario.lqr_design_speed))
-    rhs = slip.CompiledRHS(up.params)
-    A, b = slip.heading_linearisation(rhs, up.x)
-    names = list(slip.LINEAR_STATES) + list(slip.linear.body_states(rhs.p))
-    keep = [i for i, n in enumerate(names) if n != "v_fwd"]   # constant speed
-    A, b = A[np.ix_(keep, keep)], b[keep]
-    names = [names[i] for i in keep]
-    if "kq3" in felt:   # the heading q3 as a state: dq3/dt = u3 (nothing else depends on it)
-        n = len(names)
-        A = np.block([[A, np.zeros((n, 1))], [np.eye(n)[[names.index("u3")]], np.zeros((1, 1))]])
-        b = np.vstack([b, [[0.0]]])
-        names.append("q3")
-    C = np.zeros((len(felt), len(names)))
-    for row, gain in enumerate(felt):
-        C[row, names.index(slip.GAIN_STATES[gain])] = 1.0
-    return A, b, C
+def design_spec(scenario):
+    """What the LQR design on the simulated model reads of ``scenario`` (:class:`~.control.DesignSpec`)."""
+    return control.DesignSpec(
+        speed=float(scenario.lqr_design_speed), leaning=scenario.rider_body == "leaning",
+        heading=bool(scenario.lqr_heading), gain_scale=float(scenario.gain_scale),
+        model_options=(("tyre_transient", scenario.tyre_transient), ("carcass_sliding", scenario.carcass_sliding),
+                       ("carcass_damping", scenario.carcass_damping),
+                       ("carcass_viscosity", scenario.carcass_viscosity), ("slip_speed", scenario.slip_speed),
+                       ("carcass_stiffness_scale", scenario.carcass_stiffness_scale)))
 
 
 def controller_gains(scenario, design):
@@ -424,15 +314,13 @@ def controller_gains(scenario, design):
     The LQR rider is designed at :attr:`Scenario.lqr_design_speed` (the run's
     speed unless ``design_speed`` is given).
     """
-    from . import control
-
     if scenario.controller == "off":
         return dict.fromkeys(control.GAIN_ORDER, 0.0), None
     if scenario.controller == "thesis":
         gains = control.thesis_gains(thesis_load(scenario))
         return {k: scenario.gain_scale * v for k, v in gains.items()}, None
-    K, poles = _lqr(tuple(sorted(design.items())), float(scenario.lqr_design_speed))
-    return control.gains_dict(K, scenario.gain_scale), np.asarray(poles)
+    K, poles = control.whipple_lqr(design, float(scenario.lqr_design_speed))
+    return control.gains_dict(K, scenario.gain_scale), poles
 
 
 def thesis_load(scenario):
@@ -504,7 +392,6 @@ def preflight(scenario):
     :class:`InputError`; returns ``scenario``.
     """
     from whipple_kick.library import bicycleparameters
-    from whipple_kick.simulate import control
 
     scenario.validate()
     build_tyres(scenario)
@@ -566,8 +453,7 @@ def linear_stability(scenario, moore, gains, found, controller_type):
     """
     from . import steady
 
-    classic = np.asarray(_classic_poles(tuple(sorted(moore.items())), float(scenario.speed),
-                                        tuple(sorted(gains.items()))))
+    classic = control.classic_closed_loop_poles(moore, float(scenario.speed), gains)
     slip_poles = None
     if not gains.get("kq3", 0.0):
         try:
@@ -626,7 +512,6 @@ def custom_gains(gains, scenario=None):
     from dataclasses import fields
 
     from whipple_kick.model import symbols
-    from whipple_kick.simulate import control
 
     unknown = sorted(set(gains) - set(slip.GAIN_NAMES))
     if unknown:

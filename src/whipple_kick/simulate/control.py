@@ -15,13 +15,15 @@ time. It stays the library of the control-analysis API
 ``control.StateSpace``) and the tests' oracle: ``control.lqr`` gives the
 same gains (``tests/simulate/test_control.py``).
 """
+from dataclasses import dataclass
+import functools
 import math
 import warnings
 
 import numpy as np
 
 from whipple_kick.errors import ConvergenceWarning, InputError, check_range
-from whipple_kick.model import classic
+from whipple_kick.model import classic, slip
 
 GAIN_ORDER = ("kq4", "kq7", "ku4", "ku7")
 #: Gains of :func:`heading_lqr_gains`, whose state adds the yaw angle q3.
@@ -336,3 +338,178 @@ def stabilising_gains(A, b, C, K0, margin=0.05):
         if abscissa(found.x) < -margin:
             return found.x
     raise InputError("no gains of the rider's law were found that stabilise the model it is designed on")
+
+
+# ----------------------------------------------------- the design on the simulated model
+
+@functools.lru_cache(maxsize=256)
+def _whipple_lqr(design_items, speed):
+    K, poles = lqr_gains(dict(design_items), speed)
+    return tuple(np.ravel(K)), tuple(np.ravel(poles))
+
+
+def whipple_lqr(design, speed):
+    """:func:`lqr_gains` of the bicycle with rider ``design`` at ``speed``, once per process for each pair.
+
+    A sweep over pressures or kicks designs the same rider once per process.
+
+    Returns
+    -------
+    K : ndarray, shape (4,)
+        The gains in :data:`GAIN_ORDER`.
+    poles : ndarray
+        The closed loop's eigenvalues.
+    """
+    K, poles = _whipple_lqr(tuple(sorted(design.items())), float(speed))
+    return np.array(K), np.array(poles)
+
+
+@functools.lru_cache(maxsize=256)
+def _classic_poles(moore_items, speed, gains_items):
+    return tuple(closed_loop_poles(dict(moore_items), speed, dict(gains_items)))
+
+
+def classic_closed_loop_poles(moore, speed, gains):
+    """:func:`closed_loop_poles`, once per process for each bicycle, speed and gains.
+
+    The no-slip model's poles depend on those only: a sweep over tyres or
+    kicks computes them once per process (~3 ms a case).
+    """
+    return np.asarray(_classic_poles(tuple(sorted(moore.items())), float(speed), tuple(sorted(gains.items()))))
+
+
+@dataclass(frozen=True)
+class DesignSpec:
+    """What the LQR design on the simulated model reads of a run's scenario, and nothing else.
+
+    Attributes
+    ----------
+    speed : float
+        Design speed [m/s].
+    leaning : bool
+        The rider's upper body leans (its lean and lean rate are fed back).
+    heading : bool
+        The heading is fed back too (yaw-angle gain ``kq3``).
+    gain_scale : float
+        Factor on the designed gains [-].
+    model_options : tuple of (name, value)
+        Keyword options of :func:`whipple_kick.model.slip.model_parameters`
+        (tyre transient, carcass, slip speed).
+    """
+
+    speed: float
+    leaning: bool
+    heading: bool
+    gain_scale: float
+    model_options: tuple
+
+
+def lqr_on_simulated_model(spec, moore, design, body, rear, front):
+    """The LQR rider designed on the model the run simulates (``lqr_model="simulated"``).
+
+    The model of the run (its tyres, carcass, body, arms and reflex) with
+    symmetric tyres, linearised about upright straight running at the design
+    speed at constant speed (:func:`whipple_kick.model.slip.heading_linearisation`);
+    the law feeds back roll, steer and their rates, and the upper body's lean
+    and its rate when it leans (:data:`whipple_kick.model.slip.parameters.GAIN_STATES`),
+    with gains LQR-optimal for that law (identity weights on those states,
+    1 on the torque, as the Whipple design), found from the Whipple design's
+    gains by :func:`whipple_kick.simulate.control.output_feedback_lqr`. Where the
+    Whipple gains do not stabilise the model, the arms' and the reflex's
+    gains are brought in from 0 in steps, each design starting from the last.
+
+    Parameters
+    ----------
+    spec : DesignSpec
+        What the design reads of the run (speed, lean, heading, gain scale, the model's options).
+    moore, design : dict
+        The bicycle as simulated, and with the whole rider lumped (the Whipple design's model).
+    body : dict
+        The rider's body parameters (:func:`whipple_kick.simulate.assembly.rider_body`).
+    rear, front : Tyre
+        The run's tyres.
+
+    Returns
+    -------
+    gains : dict
+        By name (:data:`whipple_kick.model.slip.parameters.GAIN_NAMES`), times ``gain_scale``.
+    poles : ndarray
+        The design's closed-loop eigenvalues.
+    """
+    speed = spec.speed
+    felt, K = simulated_design_start(spec, design)
+    scaled = SCALED_BODY_GAINS
+    models = {}
+
+    def model(share):
+        """(A, b, C) of the design model with ``share`` of the ``scaled`` gains, built once per share."""
+        if share not in models:
+            models[share] = _linear_design_model(spec, moore, rear, front, body, felt, share, scaled)
+        return models[share]
+
+    def stabilises(gains, share):
+        A, b, C = model(share)
+        return bool(np.max(np.linalg.eigvals(A - b @ gains[None, :] @ C).real) < 0.0)
+
+    # Continuation: the share of the arms' and reflex's gains grows while the gains still stabilise the
+    # next model; where they do not, they are re-optimised at the last share they did (a larger margin).
+    done, step = (1.0, 1.0) if stabilises(K, 1.0) else (0.0, 0.25)
+    if not stabilises(K, done):   # the body alone (forearms on the bar, a leaning trunk) defeats the Whipple design
+        K = stabilising_gains(*model(done), K)
+    optimised_at = None
+    while done < 1.0:
+        share = min(1.0, done + step)
+        if stabilises(K, share):
+            done, step = share, step * 2.0
+        elif optimised_at != done:
+            K, _ = output_feedback_lqr(*model(done), K0=K)
+            optimised_at = done
+        elif step < 1e-3:
+            raise InputError(f"no stabilising LQR rider was found on the model simulated at {speed:g} m/s "
+                             f"(the design lost stability at {share:.1%} of the arms' and reflex's gains)")
+        else:
+            step /= 2.0
+    K, poles = output_feedback_lqr(*model(1.0), K0=K)
+    gains = dict.fromkeys(slip.GAIN_NAMES, 0.0)
+    gains.update({name: float(spec.gain_scale * k) for name, k in zip(felt, K, strict=True)})
+    return gains, poles
+
+
+#: The body's gains (arms, reflex) the design on the simulated model brings in by continuation.
+SCALED_BODY_GAINS = ("ka", "ca", "rq4", "rq7", "ru4", "ru7")
+
+
+def simulated_design_start(spec, design):
+    """The gains the design on the simulated model feeds back (``felt``) and its starting gains (Whipple design)."""
+    speed = spec.speed
+    felt = (["kq4", "kq7", "ku4", "ku7"] + (["kq11", "ku11"] if spec.leaning else [])
+            + (["kq3"] if spec.heading else []))
+    K = np.r_[whipple_lqr(design, speed)[0], np.zeros(len(felt) - 4)]
+    if spec.heading:   # start from the Whipple model's heading design (its yaw gain holds the heading)
+        whipple = dict(zip(HEADING_GAIN_ORDER, heading_lqr_gains(design, speed)[0], strict=True))
+        K = np.array([whipple.get(name, 0.0) for name in felt])
+    return felt, K
+
+
+def _linear_design_model(spec, moore, rear, front, body, felt, share, scaled):
+    """(A, b, C) of the design model with ``share`` of the ``scaled`` body gains (C picks the ``felt`` states)."""
+    part = {k: (v * share if k in scaled else v) for k, v in body.items()}
+    from . import steady
+
+    params = slip.model_parameters(moore, rear, front, symmetric=True, body=part, **dict(spec.model_options))
+    up = steady.upright_state(params, spec.speed)
+    rhs = slip.CompiledRHS(up.params)
+    A, b = slip.heading_linearisation(rhs, up.x)
+    names = list(slip.LINEAR_STATES) + list(slip.linear.body_states(rhs.p))
+    keep = [i for i, n in enumerate(names) if n != "v_fwd"]   # constant speed
+    A, b = A[np.ix_(keep, keep)], b[keep]
+    names = [names[i] for i in keep]
+    if "kq3" in felt:   # the heading q3 as a state: dq3/dt = u3 (nothing else depends on it)
+        n = len(names)
+        A = np.block([[A, np.zeros((n, 1))], [np.eye(n)[[names.index("u3")]], np.zeros((1, 1))]])
+        b = np.vstack([b, [[0.0]]])
+        names.append("q3")
+    C = np.zeros((len(felt), len(names)))
+    for row, gain in enumerate(felt):
+        C[row, names.index(slip.GAIN_STATES[gain])] = 1.0
+    return A, b, C

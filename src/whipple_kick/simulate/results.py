@@ -95,6 +95,37 @@ class Result:
     trajectory: "object"
     summary: dict = field(default_factory=dict)
 
+    #: :attr:`status` by ``summary["outcome"]``, as :func:`scipy.integrate.solve_ivp` numbers its ends: 0 the
+    #: run reached its end, 1 a termination event ended it (the fall), -1 the integration failed.
+    STATUS = {"completed": 0, "fell": 1, "failed": -1}  # noqa: RUF012 -- a constant table, never changed
+
+    @property
+    def status(self) -> int:
+        """How the run ended: 0 it reached its end, 1 the bicycle fell (an event), -1 the integration failed.
+
+        Example
+        -------
+        >>> import whipple_kick as wk
+        >>> result = wk.run(wk.Scenario(duration=0.5))
+        >>> result.status, result.success, result.message
+        (0, True, 'completed')
+        """
+        return self.STATUS[self.summary["outcome"]]
+
+    @property
+    def success(self) -> bool:
+        """False when the integration failed numerically (then the result holds the run up to the failure).
+
+        A fall is a success in this sense, as a terminal event is for
+        :func:`scipy.integrate.solve_ivp`: the model did what it should.
+        """
+        return self.status >= 0
+
+    @property
+    def message(self) -> str:
+        """One line on how the run ended ("completed", the fall and its time, or the numerical failure)."""
+        return self.summary["message"]
+
     def save(self, folder) -> list:
         """Write the run into ``folder`` as ``simulate`` does: trajectory.csv, summary.json, scenario.toml.
 

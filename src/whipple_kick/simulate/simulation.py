@@ -53,6 +53,12 @@ def run(scenario: Scenario, *, tyres: tuple | None = None, gains: Mapping | None
     Returns
     -------
     Result
+        Also when the integration failed numerically (never NaN in a
+        result): e.g. it stalled beyond
+        :data:`whipple_kick.simulate.lsoda.DEFAULT_BUDGET`. Then
+        ``result.success`` is False, ``result.message`` says where and why,
+        and the trajectory and summary hold the run up to the failure
+        (``result.status``: 0 completed, 1 fell, -1 failed).
 
     Raises
     ------
@@ -61,9 +67,8 @@ def run(scenario: Scenario, *, tyres: tuple | None = None, gains: Mapping | None
         :class:`whipple_kick.simulate.steady.NoSteadyMotion` (an InputError) when
         there is no steady motion to start from, with the physical reason.
     SimulationError
-        The integration failed numerically (never NaN in a result): e.g. it
-        stalled beyond :data:`whipple_kick.simulate.lsoda.DEFAULT_BUDGET`. Its
-        ``partial`` holds the result up to the failure.
+        Only where nothing could be computed to return: the compiled model
+        failed at the start state, or no finite summary could be made.
 
     Warns
     -----
@@ -88,7 +93,4 @@ def run(scenario: Scenario, *, tyres: tuple | None = None, gains: Mapping | None
     frame = results.trajectory_frame(solution, scenario.tyre_transient)
     summary = results.summarise(scenario, kick, model, solution, frame, custom_tyres=tyres is not None)
     summary["numerics"]["wall_s"] = time.perf_counter() - started
-    result = Result(scenario=scenario, trajectory=frame, summary=summary)
-    if solution.states.failed:
-        raise SimulationError(solution.states.message, partial=result)
-    return result
+    return Result(scenario=scenario, trajectory=frame, summary=summary)

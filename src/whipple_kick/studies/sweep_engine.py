@@ -205,7 +205,8 @@ def run_case(scenario, case_id, trajectory=None):
         or None), ``results`` (flat, :func:`flatten_summary`), ``summary``
         (JSON text), ``trajectory`` ({column: array} or None) and ``run``
         (start/end time stamps, wall time, worker host:pid). A numerical
-        failure (:class:`~whipple_kick.simulate.simulation.SimulationError`) keeps the
+        failure (a :class:`~whipple_kick.simulate.results.Result` whose ``success`` is
+        False; error ``"SimulationError: <its message>"``, as before) keeps the
         results, summary and trajectory of the run up to the failure.
     """
     _preload()
@@ -224,13 +225,12 @@ def run_case(scenario, case_id, trajectory=None):
         with _blas_controller().limit(limits=1), warnings.catch_warnings():
             warnings.simplefilter("ignore", UnstableRiderWarning)
             result = simulation.run(scenario)
-        _keep(record, result, trajectory)
+        _keep(record, result, trajectory)   # a numerical failure keeps what ran before it
+        if not result.success:
+            record.update(status="failed", error=f"SimulationError: {result.message}")
     except Exception as exc:
         record.update(status="failed", error=f"{type(exc).__name__}: {exc}", results={},
                       summary=None, trajectory=None)
-        partial = getattr(exc, "partial", None)   # a numerical failure keeps what ran before it
-        if partial is not None:
-            _keep(record, partial, trajectory)
     record["run"] = {
         "started": datetime.datetime.fromtimestamp(started, datetime.timezone.utc).isoformat(),
         "finished": datetime.datetime.now(datetime.timezone.utc).isoformat(),

@@ -6,7 +6,7 @@ import numpy as np
 from whipple_kick.errors import InputError, check_range
 from whipple_kick.model import slip
 from whipple_kick.model.transient import DEFAULT_TRANSIENT
-from whipple_kick.simulate import assembly, results
+from whipple_kick.simulate import assembly, control, results
 
 from ._constants import LOOPS
 
@@ -249,7 +249,7 @@ def _loop_params(setup, speed, loop, base=None):
     """Slip-model parameters at ``speed`` for ``loop`` (the rider's gains designed for that speed).
 
     With ``lqr_model="simulated"`` the LQR rider is designed on the model
-    simulated (:func:`whipple_kick.simulate.assembly.lqr_on_simulated_model`), once
+    simulated (:func:`whipple_kick.simulate.control.lqr_on_simulated_model`), once
     per design speed.
     """
     params = dict(_base_params(setup) if base is None else base)
@@ -266,8 +266,9 @@ def _rider_gains(setup, speed):
     key = float(sc.lqr_design_speed)
     if key not in setup.designs:
         try:
-            setup.designs[key] = assembly.lqr_on_simulated_model(sc, setup.moore, setup.design, setup.info,
-                                                                 *setup.tyres)[0]
+            setup.designs[key] = control.lqr_on_simulated_model(
+                assembly.design_spec(sc), setup.moore, setup.design, assembly.rider_body(sc, setup.info),
+                *setup.tyres)[0]
         except InputError as exc:
             setup.designs[key] = NoRiderDesign(f"no LQR rider designed on the model simulated at {key:g} m/s: "
                                                f"{exc}")
