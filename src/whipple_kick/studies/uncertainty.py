@@ -107,7 +107,8 @@ class UncertaintyStudy:
     outcomes : pandas.DataFrame
         One row per run: ``sample``, ``block``, ``fz_n``, ``pressure_kpa``, ``outcome``
         (recovered/not recovered/fell/failed per criterion is derived from these), both criteria's
-        columns, ``fell``, ``status``, ``error``, ``run.wall_s``, ``numerics.integration_wall_s``.
+        columns, ``fell``, ``status``, ``error``, ``run.wall_s``, ``run.cpu_s`` (the run in its worker) and
+        ``numerics.integration_wall_s`` (its integration).
     p_best : pandas.DataFrame
         ``fz_n``, ``criterion``, ``pressure_kpa`` (NaN: the ``none`` share), ``p``, ``low``, ``high``,
         ``rows`` (rows used), ``rows_failed`` (left out), ``measured_best``.
@@ -279,7 +280,7 @@ def analyse(spec, samples, seed, unit, blocks, keys, ids, table, duration):
     from whipple_kick.library import experiments
     inputs = pd.DataFrame([{"sample": r, "block": blocks[r], **spec.labels(u)} for r, u in enumerate(unit)])
     by_id = table.set_index("case_id")
-    wanted = ["status", "error", "fell", *CRITERIA.values(), "run.wall_s", "numerics.integration_wall_s"]
+    wanted = ["status", "error", "fell", *CRITERIA.values(), "run.wall_s", "run.cpu_s", "numerics.integration_wall_s"]
     for col in wanted:
         if col not in by_id:
             by_id[col] = np.nan
