@@ -217,3 +217,38 @@ def test_cli_writes_tables_and_figures(tiny, tmp_path, capsys):
     assert "P(best) by settling" in text and "635 N: " in text
     for name in ("p_best.csv", "outcomes.csv", "sobol.csv", "verdict.txt", *wk.cli.UNCERTAINTY_FIGURES):
         assert (out / name).stat().st_size > 0, name
+
+
+def test_falls_and_failures_are_counted_never_dropped(tiny):
+    """The rules on a made-up sweep table (2 pressures, N = 2: 8 rows, 4 of them A/B rows): a fall ranks
+    after a recovery, a row where nothing recovered is the 'none' share, a failed run leaves its row out
+    of P(best) with a note, and the Sobol analysis counts every lost run as censored at the duration."""
+    spec = uncertain.load(tiny)
+    unit, blocks = uncertainty.sample(spec, 2, 0)
+    cases, keys = uncertainty.study_cases(spec, unit, [635.0], [300.0, 500.0])
+    ids = [f"c{k}" for k in range(len(keys))]
+    rows = []
+    for k, (r, _, p) in enumerate(keys):
+        row = {"case_id": ids[k], "status": "ok", "error": None, "fell": False, "recovery.time_s": 2.0 + r / 10,
+               "last_peak_time_s": 1.0, "run.wall_s": 0.1, "run.cpu_s": 0.1, "numerics.integration_wall_s": 0.05}
+        if p == 300.0:
+            row["recovery.time_s"] -= 0.5          # 300 kPa faster ...
+        if r == 0 and p == 300.0:                  # ... except row 0 (A): 300 kPa fell
+            row.update(fell=True)
+        if r == 3:                                 # row 3 (B of base point 0): neither recovered
+            row["recovery.time_s"] = math.nan      # row 3: neither recovered
+        if r == 4 and p == 500.0:                  # row 4 (A of base point 1): 500 kPa failed
+            row.update(status="failed", error="SimulationError: test", **{"recovery.time_s": math.nan})
+        rows.append(row)
+    study = uncertainty.analyse(spec, 2, 0, unit, blocks, keys, ids, pd.DataFrame(rows), 3.0)
+    assert blocks[:4] == ["A", "AB1", "AB2", "B"]
+    pb = study.p_best[study.p_best["criterion"] == "settling"]
+    p = dict(zip(pb["pressure_kpa"].fillna(-1.0), pb["p"], strict=True))   # -1: the 'none' share
+    # A/B rows 0, 3, 4, 7; row 4 failed (left out): row 0 -> 500 (300 fell), row 3 -> none, row 7 -> 300.
+    assert (pb["rows"] == 3).all() and (pb["rows_failed"] == 1).all()
+    assert np.allclose([p[300.0], p[500.0], p[-1.0]], [1 / 3, 1 / 3, 1 / 3])
+    rates = study.rates.set_index("pressure_kpa")
+    assert rates.loc[300.0, "fell"] == 1 and rates.loc[500.0, "failed"] == 1
+    assert rates.loc[300.0, "not_recovered_settling"] == 1 and rates.loc[500.0, "not_recovered_settling"] == 1
+    assert any("1 of 4 rows left out of P(best)" in n for n in study.notes)
+    assert any("4 of 16 runs censored at 3 s" in n for n in study.notes)

@@ -56,6 +56,7 @@ from whipple_kick.errors import InputError, check_range
 from whipple_kick.library import uncertain
 from whipple_kick.simulate.scenario import Scenario
 
+from .recommend import _num
 from .sweep_engine import check_some_ok, make_cases, sweep
 
 #: Thesis Chapter 8's pressures [kPa] and rear loads [N] (Tables 8.6-8.8).
@@ -508,10 +509,3 @@ def format_study(study):
                      f"{int(r['failed'])} of {int(r['runs'])}")
     lines += ["", *study.notes, "", *study.verdict]
     return "\n".join(lines)
-
-
-def _num(value):
-    try:
-        return float(value)
-    except (TypeError, ValueError):
-        return math.nan
