@@ -111,7 +111,8 @@ def test_p_best_of_a_synthetic_ranking_lands_in_its_interval():
 def test_every_pressure_and_load_gets_the_same_inputs_of_a_row():
     spec = uncertain.load()
     unit, _ = uncertainty.sample(spec, 2, 0)
-    cases, keys = uncertainty.study_cases(spec, unit, [570.0, 701.0], [300.0, 400.0, 500.0])
+    cases, keys = uncertainty.study_cases(spec, unit, [570.0, 701.0], [300.0, 400.0, 500.0],
+                                          BASE.with_changes(**spec.fixed))
     assert len(cases) == len(unit) * 2 * 3
     scenarios = [c[1] for c in wk.sweep_engine.make_cases(cases=cases, base=BASE)]
     by_row = {}
@@ -120,6 +121,10 @@ def test_every_pressure_and_load_gets_the_same_inputs_of_a_row():
         by_row.setdefault(row, set()).add(sc.with_changes(fz_n=None, pressure_kpa=0.0))
     assert len(by_row) == len(unit) and all(len(s) == 1 for s in by_row.values())
     assert len({next(iter(s)) for s in by_row.values()}) > 1   # rows differ from each other
+    # The hip stiffness is set only in the rows with the leaning body (elsewhere the run ignores it).
+    for case in cases:
+        assert ("hip_stiffness" in case) == (case["rider_body"] == "leaning")
+    assert any(c["rider_body"] == "leaning" for c in cases) and any(c["rider_body"] == "rigid" for c in cases)
 
 
 def test_the_same_seed_gives_the_same_samples():
@@ -225,7 +230,7 @@ def test_falls_and_failures_are_counted_never_dropped(tiny):
     of P(best) with a note, and the Sobol analysis counts every lost run as censored at the duration."""
     spec = uncertain.load(tiny)
     unit, blocks = uncertainty.sample(spec, 2, 0)
-    cases, keys = uncertainty.study_cases(spec, unit, [635.0], [300.0, 500.0])
+    cases, keys = uncertainty.study_cases(spec, unit, [635.0], [300.0, 500.0], BASE)
     ids = [f"c{k}" for k in range(len(keys))]
     rows = []
     for k, (r, _, p) in enumerate(keys):

@@ -213,10 +213,26 @@ def sample(spec, samples, seed):
     return unit, blocks
 
 
-def study_cases(spec, unit, loads, pressures):
+def row_values(spec, unit_row, base):
+    """The scenario fields of one sample row, less those the row's own mechanism does not use.
+
+    A conditional input (the hip stiffness with the leaning body) is sampled in every row, as the
+    Sobol design needs, but set only in the rows whose mechanism uses it: elsewhere it keeps the base
+    value, so no run is given a field it ignores (and a row's runs do not differ by an unused field).
+    """
+    values = spec.values(unit_row)
+    for field in list(values):
+        if field in _USED_ONLY_WITH:
+            decider, using = _USED_ONLY_WITH[field]
+            if values.get(decider, getattr(base, decider)) not in using:
+                del values[field]
+    return values
+
+
+def study_cases(spec, unit, loads, pressures, base):
     """The sweep's overrides: every row at every load and pressure, and the (row, load, pressure) of each."""
     cases, keys = [], []
-    rows = [spec.values(u) for u in unit]
+    rows = [row_values(spec, u, base) for u in unit]
     for fz in loads:
         for r, values in enumerate(rows):
             for p in pressures:
@@ -259,7 +275,7 @@ def run_study(spec=uncertain.DEFAULT, samples=64, seed=0, loads=LOADS, pressures
     if not loads or len(pressures) < 2:
         raise InputError("the study needs at least one rear load and two pressures")
     unit, blocks = sample(spec, samples, seed)
-    cases, keys = study_cases(spec, unit, loads, pressures)
+    cases, keys = study_cases(spec, unit, loads, pressures, base)
     for k in range(0, len(cases), len(pressures)):   # one per row and load: the pressures do not change validity
         try:
             base.with_changes(**cases[k]).validate()
