@@ -50,25 +50,29 @@ def main(argv=None):
         wall = time.perf_counter() - t0
         study.write(out)
     print(uncertainty.format_study(study))
-    runs = study.outcomes
-    n = len(runs)
+    n = len(study.outcomes)
+    runs = study.outcomes.drop_duplicates("case_id")   # a repeated design row is one case, run once
+    distinct = len(runs)
     case_wall = runs["run.wall_s"].to_numpy(dtype=float)
     case_cpu = runs["run.cpu_s"].to_numpy(dtype=float)
     integ = runs["numerics.integration_wall_s"].to_numpy(dtype=float)
     ok = np.isfinite(case_wall) & np.isfinite(integ) & np.isfinite(case_cpu)
-    per_run = wall * args.workers / n
+    per_run = wall * args.workers / distinct
     rows = args.extrapolate * (len(spec.inputs) + 2)
     total = rows * len(uncertainty.PRESSURES) * len(uncertainty.LOADS)
     print(f"\ncost: {n} runs ({len(study.inputs)} rows x {len(uncertainty.PRESSURES)} pressures x "
-          f"{len(uncertainty.LOADS)} loads) in {wall:.1f} s wall on {args.workers} workers"
+          f"{len(uncertainty.LOADS)} loads; {distinct} distinct cases, each run once) in {wall:.1f} s wall on "
+          f"{args.workers} workers"
           + (" (resumed from --out: the wall time is not the study's)" if args.out and wall < 0.05 * n else ""))
     print(f"  per run in its worker: wall mean {case_wall[ok].mean():.3f} s, median {np.median(case_wall[ok]):.3f} s; "
           f"CPU mean {case_cpu[ok].mean():.3f} s; its integration: wall mean {integ[ok].mean():.3f} s, median "
           f"{np.median(integ[ok]):.3f} s ({100 * integ[ok].sum() / case_wall[ok].sum():.0f} % of the run's wall)")
-    print(f"  cost per run on this machine (study wall x workers / runs): {per_run:.3f} s")
-    print(f"  N = {args.extrapolate}: {rows} rows, {total} runs: about {total * per_run / args.workers / 3600:.1f} h "
-          f"wall on {args.workers} workers at this cost; {total * case_cpu[ok].mean() / args.workers / 3600:.1f} h "
-          f"at the measured CPU per run on {args.workers} otherwise idle cores")
+    print(f"  cost per distinct case on this machine (study wall x workers / cases): {per_run:.3f} s")
+    share = distinct / n
+    print(f"  N = {args.extrapolate}: {rows} rows, {total} runs (about {total * share:.0f} distinct at this share): "
+          f"about {total * share * per_run / args.workers / 3600:.1f} h wall on {args.workers} workers at this cost; "
+          f"{total * share * case_cpu[ok].mean() / args.workers / 3600:.1f} h at the measured CPU per run on "
+          f"{args.workers} otherwise idle cores")
 
 
 if __name__ == "__main__":

@@ -29,7 +29,7 @@ def _figure(n_panels, height=3.6):
 def p_best_figure(p_best, path=None, title=None, dpi=120):
     """P(best) per pressure, one panel per rear load, both criteria side by side, 95 % intervals as bars.
 
-    The measured best pressure (thesis Table 8.9) is marked with a star under its bars.
+    The measured best pressure (thesis Table 8.9) is marked with a star above its bars.
     """
     loads = list(dict.fromkeys(p_best["fz_n"]))
     fig, axes = _figure(len(loads))
@@ -48,10 +48,10 @@ def p_best_figure(p_best, path=None, title=None, dpi=120):
         measured = [i for i, pr in enumerate(pressures)
                     if bool(at[at["pressure_kpa"] == pr]["measured_best"].any())]
         for i in measured:
-            ax.plot(i, -0.06, marker="*", color="k", markersize=11, clip_on=False)
+            ax.plot(i, 0.95, marker="*", color="k", markersize=12)
         ax.set_xticks(x, [f"{pr:g}" for pr in pressures])
         ax.set_ylim(0, 1)
-        ax.set_xlabel("pressure [kPa]  (* measured best, Table 8.9)")
+        ax.set_xlabel("pressure [kPa]  (star: measured best, Table 8.9)")
         ax.set_title(f"rear load {fz:g} N")
     axes[0].set_ylabel("P(best)")
     axes[0].legend(fontsize=8, loc="upper left")

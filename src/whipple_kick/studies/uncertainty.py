@@ -106,8 +106,9 @@ class UncertaintyStudy:
         One row per sample row: ``sample``, ``block`` (``A``, ``B`` or ``AB<i>``), each input's value
         (a choice's label).
     outcomes : pandas.DataFrame
-        One row per run: ``sample``, ``block``, ``fz_n``, ``pressure_kpa``, ``outcome``
-        (recovered/not recovered/fell/failed per criterion is derived from these), both criteria's
+        One row per (sample row, load, pressure): ``sample``, ``fz_n``, ``pressure_kpa``, ``block``,
+        ``case_id`` (the sweep's: a design row that repeats another, e.g. a choice column swapped for
+        the same option, is one case, run once), ``status``, ``error``, ``fell``, both criteria's
         columns, ``fell``, ``status``, ``error``, ``run.wall_s``, ``run.cpu_s`` (the run in its worker) and
         ``numerics.integration_wall_s`` (its integration).
     p_best : pandas.DataFrame
@@ -303,7 +304,7 @@ def analyse(spec, samples, seed, unit, blocks, keys, ids, table, duration):
             by_id[col] = np.nan
     rows = by_id.loc[ids, wanted].reset_index(drop=True)
     outcomes = pd.concat([pd.DataFrame(keys, columns=["sample", "fz_n", "pressure_kpa"]),
-                          pd.DataFrame({"block": [blocks[r] for r, _, _ in keys]}), rows], axis=1)
+                          pd.DataFrame({"block": [blocks[r] for r, _, _ in keys], "case_id": ids}), rows], axis=1)
     outcomes["fell"] = outcomes["fell"].map(lambda v: v is True or _num(v) == 1.0)
     loads = list(dict.fromkeys(k[1] for k in keys))
     pressures = list(dict.fromkeys(k[2] for k in keys))
@@ -446,8 +447,10 @@ def sobol_indices(spec, y, seed=0):
 
 def _sobol(spec, y, seed):
     from SALib.analyze import sobol as sobol_analyze
+    # SALib seeds its bootstrap only when ``if seed:`` holds: seed 0 would draw from NumPy's global state
+    # (intervals that change from run to run). Seed s is passed as s + 1.
     res = sobol_analyze.analyze(spec.problem(), y, calc_second_order=False, conf_level=CONFIDENCE,
-                                seed=int(seed), print_to_console=False)
+                                seed=int(seed) + 1, print_to_console=False)
     return [(name, float(res["S1"][k]), float(res["S1_conf"][k]), float(res["ST"][k]), float(res["ST_conf"][k]))
             for k, name in enumerate(spec.names)]
 
