@@ -6,7 +6,7 @@ rear load on inputs sampled from an uncertainty file
 
 * **P(best)** per pressure per load, for both criteria (the recovery time
   ``recovery.time_s`` and the thesis' last-peak time ``last_peak_time_s``),
-  with a 95 % percentile-bootstrap interval over the sample rows;
+  with a 95 % Wilson score interval (:func:`p_best_interval` says why);
 * the recovery-time distribution per pressure, the **paired differences**
   between pressures, and the fall, not-recovered and failure rates;
 * **Sobol indices** (first order and total, with SALib's 95 % intervals) of the
@@ -64,7 +64,7 @@ PRESSURES = (300.0, 400.0, 500.0)
 LOADS = (570.0, 635.0, 701.0)
 #: The two recovery criteria and their table columns (as :data:`whipple_kick.studies.recommend.CRITERIA`).
 CRITERIA = {"settling": "recovery.time_s", "last_peak": "last_peak_time_s"}
-#: Bootstrap resamples of the P(best) and difference intervals.
+#: Bootstrap resamples of the paired differences' intervals.
 BOOTSTRAP = 2000
 #: Confidence level of every interval.
 CONFIDENCE = 0.95
@@ -338,11 +338,11 @@ def analyse(spec, samples, seed, unit, blocks, keys, ids, table, duration):
             share = _best_share(times[use])
             winners[fz, criterion] = (np.flatnonzero(use), share)
             rng = np.random.default_rng(rng_seed)
-            boot = _bootstrap_means(share, rng)
+            mean, low, high = p_best_interval(share)
             for k, p in enumerate([*pressures, math.nan]):
                 p_best.append({"fz_n": fz, "criterion": criterion, "pressure_kpa": p,
-                               "p": float(share[:, k].mean()) if len(share) else math.nan,
-                               "low": boot[0][k], "high": boot[1][k], "rows": int(use.sum()),
+                               "p": float(mean[k]), "low": float(low[k]), "high": float(high[k]),
+                               "rows": int(use.sum()),
                                "rows_failed": int((base_rows & row_failed).sum()),
                                "measured_best": bool(best_p == p)})
             for k, p in enumerate(pressures):
@@ -409,17 +409,28 @@ def _best_share(times):
     return out
 
 
-def p_best_interval(share, seed=0):
-    """Mean share per column and its percentile-bootstrap interval over rows: ``(p, low, high)`` arrays.
+def p_best_interval(share):
+    """Mean share per column and its Wilson score interval (:data:`CONFIDENCE`): ``(p, low, high)`` arrays.
 
-    The bootstrap (rows resampled with replacement, :data:`BOOTSTRAP` times,
-    a fixed seed) is used rather than a Wilson interval because a tie splits
-    a row's credit (the share is not a 0/1 outcome) and the pressures of a
-    row are not independent trials.
+    Each pressure's P(best) is a proportion of rows, so the Wilson interval
+    fits it (a tie's half credit counts as half a success). It is used rather
+    than a bootstrap because at the study's small N a pressure that is never
+    (or always) best would get a bootstrap interval of zero width, [0, 0],
+    where Wilson's says how large the probability could still be (0.19 for 0
+    of 16 rows). The rows are quasi-random (Sobol') points, not independent
+    draws; their error is smaller than independent sampling's, so the interval
+    is conservative.
     """
+    from scipy import stats
     share = np.asarray(share, dtype=float)
-    low, high = _bootstrap_means(share, np.random.default_rng(seed))
-    return share.mean(axis=0), np.asarray(low), np.asarray(high)
+    n = share.shape[0]
+    p = share.mean(axis=0) if n else np.full(share.shape[1], math.nan)
+    z = stats.norm.ppf(0.5 + CONFIDENCE / 2.0)
+    if not n:
+        return p, p.copy(), p.copy()
+    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+    half = z * np.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    return p, np.clip(centre - half, 0.0, 1.0), np.clip(centre + half, 0.0, 1.0)
 
 
 def _bootstrap_means(values, rng):
@@ -472,10 +483,10 @@ def _against_measurement(winners, criterion, loads, pressures, measured, p_best,
         out.append({"criterion": criterion, "fz_n": fz, "measured_best_kpa": best, "p": p,
                     "low": float(row["low"].iloc[0]), "high": hi, "admitted": bool(hi >= ADMIT_PROBABILITY)})
     if joint:
-        values = np.array(list(joint.values()))[:, None]
-        lo, hi = _bootstrap_means(values, np.random.default_rng(seed))
+        p, lo, hi = p_best_interval(np.array(list(joint.values()))[:, None])
         out.append({"criterion": criterion, "fz_n": math.nan, "measured_best_kpa": math.nan,
-                    "p": float(values.mean()), "low": lo[0], "high": hi[0], "admitted": bool(hi[0] >= ADMIT_PROBABILITY)})
+                    "p": float(p[0]), "low": float(lo[0]), "high": float(hi[0]),
+                    "admitted": bool(hi[0] >= ADMIT_PROBABILITY)})
     return out
 
 
@@ -514,7 +525,7 @@ def format_study(study):
     lines = [f"uncertainty study: {study.spec.name}, N = {study.samples} base samples, {len(study.inputs)} rows "
              f"(seed {study.seed}); every row runs at every pressure and load"]
     for criterion in CRITERIA:
-        lines.append(f"\nP(best) by {criterion} ({CRITERIA[criterion]}), 95 % bootstrap interval; * measured best")
+        lines.append(f"\nP(best) by {criterion} ({CRITERIA[criterion]}), 95 % Wilson interval; * measured best")
         pb = study.p_best[study.p_best["criterion"] == criterion]
         for fz, rows in pb.groupby("fz_n", sort=False):
             cells = []
