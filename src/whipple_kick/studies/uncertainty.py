@@ -313,6 +313,14 @@ def analyse(spec, samples, seed, unit, blocks, keys, ids, table, duration):
     measured = experiments.load().best
     rng_seed = int(seed)
     p_best, dists, diffs, rates, sobol, meas, notes = [], [], [], [], [], [], []
+    a_rows = np.array([b == "A" for b in blocks])
+    b_rows = np.array([b == "B" for b in blocks])
+    for k, inp in enumerate(spec.inputs):
+        # A choice whose option is the same in A and B of every base point is never varied by the design
+        # (at a small N the Sobol' sequence can do that: the shipped file's friction column at N = 8).
+        if np.array_equal(inp.ppf(unit[a_rows, k]), inp.ppf(unit[b_rows, k])):
+            notes.append(f"{inp.name}: the design never varies it at N = {samples} (the same value in A and B of "
+                         "every base point): its Sobol indices are 0 by construction, not a finding; use a larger N")
     winners = {}
     for fz in loads:
         at = outcomes[outcomes["fz_n"] == fz]
