@@ -1,4 +1,5 @@
-"""The uncertainty study's figures draw from its tables (made up here: the figures, not the study, are tested)."""
+"""figures/uncertainty.py (named apart from tests/studies/test_uncertainty.py: test basenames must differ): the
+uncertainty study's figures draw from its tables (made up here: the figures, not the study, are tested)."""
 import math
 
 import pandas as pd
