@@ -33,7 +33,7 @@ def test_distribution_and_sobol_figures(tmp_path):
                               "last_peak_time_s": 0.3, "fell": r == 3, "status": "ok"}
                              for r in range(6) for p in (300.0, 500.0)])
     fig = figures.distribution_figure(outcomes, "settling")
-    assert "17 % lost" in [t.get_text() for t in fig.axes[0].texts]   # 1 of 6 rows fell
+    assert "17 % not recovered" in [t.get_text() for t in fig.axes[0].texts]   # 1 of 6 rows fell
     sobol = pd.DataFrame([{"fz_n": 635.0, "criterion": "settling", "pressure_a_kpa": 300.0, "pressure_b_kpa": 500.0,
                            "input": name, "S1": 0.1, "S1_conf": 0.05, "ST": 0.2, "ST_conf": 0.05}
                           for name in ("speed", "rider")])

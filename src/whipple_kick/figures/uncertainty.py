@@ -64,7 +64,7 @@ def p_best_figure(p_best, path=None, title=None, dpi=120):
 def distribution_figure(outcomes, criterion="settling", path=None, title=None, dpi=120):
     """Recovery-time distribution per pressure (violins of the recovered runs), one panel per load.
 
-    The share of runs that did not recover (fell, not settled, failed) is written above each violin.
+    The share of runs that did not recover (fell, not settled within the run, failed) is written above each violin.
     """
     col = _COLUMNS[criterion]
     loads = list(dict.fromkeys(outcomes["fz_n"]))
@@ -86,7 +86,7 @@ def distribution_figure(outcomes, criterion="settling", path=None, title=None, d
             ax.violinplot([data[k] for k in drawable], positions=positions[drawable], showmedians=True)
         top = max((np.nanmax(d) for d in data if np.isfinite(d).any()), default=1.0)
         for k, share in enumerate(lost):
-            ax.text(positions[k], top * 1.05, f"{100 * share:.0f} % lost", ha="center", fontsize=8)
+            ax.text(positions[k], top * 1.05, f"{100 * share:.0f} % not recovered", ha="center", fontsize=8)
         ax.set_ylim(0, top * 1.15)
         ax.set_xticks(positions, [f"{p:g}" for p in pressures])
         ax.set_xlabel("pressure [kPa]")
