@@ -194,6 +194,11 @@ def test_inputs_naming_nothing_or_ignored_are_refused(tmp_path, block, message):
     assert "\n" not in str(info.value)
 
 
+def test_pressures_outside_the_tyres_range_are_refused(tiny):
+    with pytest.raises(InputError, match=r"pressure of tyre T03 = 600(\.0)? kPa is outside the allowed range \[300, 500\] kPa"):
+        uncertainty.run_study(tiny, samples=2, pressures=[300.0, 600.0], base=BASE)
+
+
 def test_the_shipped_file_passes_the_checks():
     spec = uncertain.load()
     uncertainty.check_inputs(spec, Scenario().with_changes(**spec.fixed))

@@ -56,7 +56,7 @@ from whipple_kick.errors import InputError, check_range
 from whipple_kick.library import uncertain
 from whipple_kick.simulate.scenario import Scenario
 
-from .recommend import _num
+from .recommend import _num, pressure_grid
 from .sweep_engine import check_some_ok, make_cases, sweep
 
 #: Thesis Chapter 8's pressures [kPa] and rear loads [N] (Tables 8.6-8.8).
@@ -271,8 +271,9 @@ def run_study(spec=uncertain.DEFAULT, samples=64, seed=0, loads=LOADS, pressures
         spec = uncertain.load(spec)
     base = (Scenario() if base is None else base).with_changes(**spec.fixed)
     check_inputs(spec, base)
-    loads = [check_range("rear-tyre load fz", f, 0.0, None, "N", low_open=True) for f in loads]
-    pressures = sorted({check_range("pressure", p, 0.0, None, "kPa", low_open=True) for p in pressures})
+    loads = list(dict.fromkeys(check_range("rear-tyre load fz", f, 0.0, None, "N", low_open=True) for f in loads))
+    # Within the tyre's measured range (checked here: inside the sweep a bad pressure would fail every run at it).
+    pressures = pressure_grid(base.tyre, list(pressures), coefficient_set=base.coefficient_set)[0]
     if not loads or len(pressures) < 2:
         raise InputError("the study needs at least one rear load and two pressures")
     unit, blocks = sample(spec, samples, seed)
