@@ -8,6 +8,9 @@ Usage:
     python scripts/bench.py cli        # end to end: `simulate --pressure 400 --fz 635 --out NEW --quiet`, warm cache
     python scripts/bench.py transient  # each tyre transient form against contact_patch: RHS call and 6 s run
     python scripts/bench.py all
+    python scripts/bench.py build cli --record [--machine "TEXT"]
+                                       # also record the medians in docs/timings.json (the README's timings,
+                                       # checked by scripts/doc_numbers.py), with the machine and the date
     python scripts/bench.py compare --against DIR [--against-cache DIR]
                                        # this checkout against another one (e.g. main) in the same session:
                                        # RHS call cost, the C function alone and the call from Python (both
@@ -18,6 +21,7 @@ Usage:
 import argparse
 import os
 import pathlib
+import platform
 import shutil
 import statistics
 import subprocess
@@ -77,6 +81,40 @@ def bench_rhs(repeats):
     print(f"speed-up C / NumPy: {n / c:.0f}x")
 
 
+#: Where ``--record`` keeps the medians the README states (scripts/doc_numbers.py checks the README against it).
+TIMINGS = pathlib.Path(__file__).resolve().parents[1] / "docs" / "timings.json"
+RECORD = {"on": False, "machine": None}
+
+
+def _machine():
+    """CPU model and count (and the load at the start), for the record: timings depend on the machine."""
+    model = platform.machine()
+    try:
+        for line in pathlib.Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                model = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    load = f"; load average {os.getloadavg()[0]:.1f} when recorded" if hasattr(os, "getloadavg") else ""
+    return f"{os.cpu_count()} CPUs, {model} ({platform.system()}{load})"
+
+
+def _record(key, value, script, digits=1):
+    """Keep ``value`` [s] as the latest output of ``script`` in :data:`TIMINGS` (with ``--record`` only)."""
+    import datetime
+    import json
+
+    if not RECORD["on"]:
+        return
+    record = json.loads(TIMINGS.read_text()) if TIMINGS.is_file() else {}
+    record[key] = {"value": round(float(value), digits), "digits": digits, "script": script,
+                   "machine": RECORD["machine"] or _machine(),
+                   "date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d")}
+    TIMINGS.write_text(json.dumps(record, indent=1) + "\n")
+    print(f"recorded {key} = {value:.{digits}f} s in {TIMINGS}")
+
+
 def _fresh(cache, code):
     env = dict(os.environ, WHIPPLE_KICK_CACHE=cache)
     t0 = time.perf_counter()
@@ -96,6 +134,7 @@ def bench_build(repeats):
     print(f"cold build (derive + generate C + compile): median {statistics.median(cold):.2f} s  runs {[round(v, 2) for v in cold]}")
     print(f"warm start (load cached library):           median {statistics.median(warm):.2f} s  runs {[round(v, 2) for v in warm]}")
     print(f"baseline (python + numpy + scipy + sympy import): median {base:.2f} s")
+    _record("build_cold_s", statistics.median(cold), "scripts/bench.py build", digits=0)
 
 
 def bench_run(repeats):
@@ -254,6 +293,7 @@ def bench_cli(repeats):
     print(f"simulate --pressure 400 --fz 635 --quiet (warm cache, fresh process): "
           f"median {median:.2f} s  runs {[round(v, 2) for v in times]}")
     print(f"baseline python -c '{_BASELINE}': median {baseline:.2f} s  runs {[round(v, 2) for v in base]}")
+    _record("simulate_warm_s", median, "scripts/bench.py cli")
     print(f"simulate - baseline: {median - baseline:.2f} s (bound 0.6 s); simulate / baseline: "
           f"{median / baseline:.2f}")
     print("stages of a warm run in one process (medians):")
@@ -328,8 +368,9 @@ def bench_compare(args):
     # method for both libraries. The call from Python: this checkout's as the integrator makes it
     # (slip.CompiledRHS.fast), the other's as its CompiledRHS.__call__ did (contiguous input,
     # x.ctypes, ctypes call, copy).
-    from whipple_kick.model import rhs_call, slip
-    native = rhs_call.module(slip._compiler())
+    from whipple_kick.model import rhs_call
+    from whipple_kick.model.slip import compiled
+    native = rhs_call.module(compiled._compiler())
 
     def c_alone(label, n):
         lib, x, p, _ = libs[label]
@@ -383,22 +424,26 @@ def bench_compare(args):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("what", choices=("rhs", "build", "run", "cli", "all", "compare", "transient"))
+    parser.add_argument("what", choices=("rhs", "build", "run", "cli", "all", "compare", "transient"), nargs="+")
     parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--record", action="store_true",
+                        help="record the build and cli medians in docs/timings.json (the README's timings)")
+    parser.add_argument("--machine", help="the machine in words for the record (default: CPU model and count)")
     parser.add_argument("--against", metavar="DIR", help="checkout to compare with (its src/ is imported)")
     parser.add_argument("--against-cache", metavar="DIR", help="model cache of that checkout (default: a temp dir)")
     args = parser.parse_args()
+    RECORD.update(on=args.record, machine=args.machine)
     np.set_printoptions(precision=4)
-    if args.what == "compare":
+    if "compare" in args.what:
         if not args.against:
             parser.error("compare needs --against DIR")
         bench_compare(args)
         return
-    if args.what == "transient":
+    if "transient" in args.what:
         bench_transient(args.repeats)
         return
     for name, fn in (("rhs", bench_rhs), ("build", bench_build), ("run", bench_run), ("cli", bench_cli)):
-        if args.what in (name, "all"):
+        if name in args.what or "all" in args.what:
             fn(args.repeats)
 
 

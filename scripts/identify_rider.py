@@ -296,21 +296,29 @@ def goal_lines(result):
           f"within 0.08 s in {within} of {len(result['held_out'])}.\n")
 
 
-def main_stops(args):
-    """What stops the best combination from meeting the goal: its closed loop's modes and the slow swing vs the gains."""
+def best_fields(path):
+    """The fields of the combination with the best fitted score in an identification.json (or its folder)."""
+    path = pathlib.Path(path)
+    payload = json.loads((path if path.is_file() else path / "identification.json").read_text())
+    best = min(payload["results"], key=lambda n: payload["results"][n]["fitted_score"])
+    return {"lqr_model": "simulated", **payload["results"][best]["fields"]}
+
+
+#: The states whose content :func:`closed_loop_modes` gives: the angles and their rates (yaw: the rate only).
+MODE_STATES = ("q4", "q7", "q11", "u3", "u4", "u7", "u11")
+
+
+def closed_loop_modes(fields, max_hz=10.0):
+    """Oscillatory modes below ``max_hz`` of the closed loop linearised at 2 m/s (635 N, 400 kPa, no offsets).
+
+    Returns (eigenvalue, {state: |eigenvector entry|}) by increasing frequency. Compare like with like:
+    an angle's entry with another angle's, a rate's with another rate's (a rate is the angle's entry times
+    |eigenvalue|, 43 1/s at 7 Hz).
+    """
     from whipple_kick.library import inputs
     from whipple_kick.model import slip
     from whipple_kick.simulate import assembly
 
-    path = pathlib.Path(args.folder)
-    payload = json.loads((path if path.is_file() else path / "identification.json").read_text())
-    best = min(payload["results"], key=lambda n: payload["results"][n]["fitted_score"])
-    fields = {"lqr_model": "simulated", **payload["results"][best]["fields"]}
-    print(f"Best combination: {best} {fields}\n")
-    print("Its linearised closed loop at 2 m/s (635 N, 400 kPa, offsets removed): oscillatory modes below 10 Hz "
-          "and the content of their eigenvectors (largest = 1)\n")
-    print("| eigenvalue [1/s] | f [Hz] | damping ratio | roll | steer | lean | yaw rate |")
-    print("|---|---|---|---|---|---|---|")
     sc = validation.base_scenario(fz_n=635.0, pressure_kpa=400.0, symmetric_tyres=True, **fields)
     model = assembly.assemble(sc, inputs.kick_of(sc))
     rhs = slip.CompiledRHS(model.params)
@@ -319,14 +327,79 @@ def main_stops(args):
     keep = [i for i, n in enumerate(names) if n != "v_fwd"]
     names = [names[i] for i in keep]
     values, vectors = np.linalg.eig(A[np.ix_(keep, keep)])
+    modes = []
     for k in np.argsort(values.imag):
         lam = values[k]
-        if lam.imag <= 0.0 or lam.imag / (2 * math.pi) > 10.0:
+        if lam.imag <= 0.0 or lam.imag / (2 * math.pi) > max_hz:
             continue
-        content = {n: abs(vectors[names.index(n), k]) if n in names else 0.0 for n in ("q4", "q7", "q11", "u3")}
-        top = max(content.values())
+        modes.append((lam, {n: abs(vectors[names.index(n), k]) if n in names else 0.0 for n in MODE_STATES}))
+    return modes
+
+
+def fast_mode(fields):
+    """The least damped oscillatory mode between 1 and 10 Hz (the 6-7 Hz one): its eigenvalue and rates' content."""
+    lam, content = min(((lam, c) for lam, c in closed_loop_modes(fields) if lam.imag / (2 * math.pi) > 1.0),
+                       key=lambda mode: -mode[0].real / abs(mode[0]))
+    return {"eigenvalue": lam, "rates": {n: content[n] for n in ("u3", "u4", "u7", "u11")}}
+
+
+def last_peaks_by_band(path, loads=FITTED_LOADS + HELD_OUT_LOADS, directions=("right", "left")):
+    """The best combination's last-peak times with the peak search's noise band and with plain sign changes.
+
+    The recordings' peak search (:func:`whipple_kick.simulate.analysis.yaw_rate_peaks`) starts a new
+    half-wave only once the signal leaves a band of +-4 % of its largest value (half the 8 % threshold);
+    ``plain`` starts one at every sign change. Per band: ``runs``, ``in_range`` (last peak by 0.5 s after
+    peak #1), its ``low``-``high`` there, and ``mean_error`` (mean |model - measured| over every run) [s].
+    """
+    from whipple_kick.simulate import analysis
+
+    fields = best_fields(path)
+    exp = experiments.load()
+    proc = exp.processing
+    got = {"band": [], "plain": []}
+    for fz in loads:
+        for pressure in PRESSURES:
+            target = measured(exp, fz, pressure)["last_peak_time_s"]
+            for direction in directions:
+                sc = validation.base_scenario(fz_n=fz, pressure_kpa=pressure, kick_direction=direction,
+                                              duration=DURATION, **fields)
+                run = wk.run(sc)
+                tr = run.trajectory
+                steady = float(run.summary["steady_state"]["yaw_rate_rad_s"])
+                t_rec, y_rec = analysis.as_recorded(tr["time"].to_numpy(), tr["yaw_rate"].to_numpy(), 0.0,
+                                                    proc["imu_rate"], proc["lowpass_cutoff"])
+                for band, hysteresis in (("band", None), ("plain", 0.0)):
+                    peaks = analysis.yaw_rate_peaks(t_rec, y_rec, 0.0, proc["peak_threshold"], baseline=steady,
+                                                    hysteresis=hysteresis)
+                    got[band].append((float(peaks.times[-1] - peaks.times[0]), target))
+    out = {}
+    for band, rows in got.items():
+        early = [v for v, _ in rows if v <= 0.5]
+        out[band] = {"runs": len(rows), "in_range": len(early), "low": min(early), "high": max(early),
+                     "mean_error": float(np.mean([abs(v - m) for v, m in rows]))}
+    return out
+
+
+def main_stops(args):
+    """What stops the best combination from meeting the goal: its closed loop's modes and the slow swing vs the gains."""
+    fields = best_fields(args.folder)
+    print(f"Best combination: {fields}\n")
+    print("Its linearised closed loop at 2 m/s (635 N, 400 kPa, offsets removed): oscillatory modes below 10 Hz "
+          "and the content of their eigenvectors, angles against angles and rates against rates (largest of "
+          "each = 1)\n")
+    print("| eigenvalue [1/s] | f [Hz] | damping ratio | roll | steer | lean | roll rate | steer rate | lean rate "
+          "| yaw rate |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for lam, content in closed_loop_modes(fields):
+        angles, rates = ("q4", "q7", "q11"), ("u4", "u7", "u11", "u3")
+        top_a, top_r = max(content[n] for n in angles), max(content[n] for n in rates)
         print(f"| {lam.real:.2f} {lam.imag:+.2f}j | {lam.imag / (2 * math.pi):.2f} | {-lam.real / abs(lam):.2f} | "
-              + " | ".join(f"{content[n] / top:.2f}" for n in ("q4", "q7", "q11", "u3")) + " |")
+              + " | ".join(f"{content[n] / top_a:.2f}" for n in angles) + " | "
+              + " | ".join(f"{content[n] / top_r:.2f}" for n in rates) + " |")
+    for band, got in last_peaks_by_band(args.folder).items():
+        print(f"\nLast-peak time from peak #1, {band} ({'+-4 % noise band' if band == 'band' else 'plain sign changes'}):"
+              f" {got['in_range']} of {got['runs']} runs by 0.5 s, at {got['low']:.3f}-{got['high']:.3f} s; "
+              f"mean |model - measured| {got['mean_error']:.3f} s")
     print("\nSlow swing (yaw rate 0.5-1 s after the kick / peak #1) against the rider's gains (gain_scale times the "
           "design), 635 N, 400 kPa, kick to the right:\n")
     print("| gain scale | fell | slow swing | peaks | dominant f [Hz] | last peak from the kick [s] |")

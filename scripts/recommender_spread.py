@@ -93,7 +93,8 @@ def value(s, criterion):
     return math.nan if v is None else v
 
 
-def main():
+def measure():
+    """Print the tables and return the spread [s] by criterion (what ``CRITERION_SPREAD_S`` holds)."""
     print(f"slip model {wk.slip.model_hash()}\n")
     base = {(p, fz): summary(Scenario(pressure_kpa=p, fz_n=fz)) for fz in LOADS for p in PRESSURES}
     variants = {f"rtol {rtol:g}": {} for rtol in (1e-8, 1e-12)}
@@ -136,6 +137,11 @@ def main():
         print(f"\nspread ({criterion}): {worst_all:.3f} s; loads whose margin is below it: "
               + (", ".join(f"{fz:g} N" for fz, m in margins.items() if not m >= worst_all) or "none") + "\n")
     print("wk.recommend.CRITERION_SPREAD_S = {" + ", ".join(f'"{k}": {v:.3f}' for k, v in spread.items()) + "}")
+    return spread
+
+
+def main():
+    measure()
     return 0
 
 

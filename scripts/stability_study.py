@@ -42,6 +42,8 @@ from whipple_kick.library import tyres
 from whipple_kick.simulate import simulation
 from whipple_kick.simulate.simulation import Scenario
 from whipple_kick.studies import stability
+from whipple_kick.studies.stability import modes as stability_modes
+from whipple_kick.studies.stability import pressure_load
 
 BASE = Scenario(symmetric_tyres=True)
 STUDY_SPEEDS = stability.parse_speeds("2:8:0.05")
@@ -167,7 +169,7 @@ def _open_loop_row(label, pair, scenario=BASE, speeds=STUDY_SPEEDS):
     s = res.summary["slip"]["open"]
     t = res.eigenvalues[(res.eigenvalues["model"] == "slip")]
     capsize = lambda v: t[np.isclose(t["speed_m_s"], v) & (t["mode"] == "capsize")]["real_1_s"].max()
-    wob = stability._at(t, 3.0, "wobble")
+    wob = pressure_load._at(t, 3.0, "wobble")
     stable = ", ".join(stability.range_text(r) for r in s["stable_speed_ranges"]) or "none"
     wobble = "none" if wob is None else f"{abs(wob.imag) / (2 * math.pi):.2f} Hz, {-wob.real / abs(wob):.3f}"
     print(f"| {label} | {_speed(s['weave_speed_m_s'])} | {_speed(s['capsize_speed_m_s'])} | {stable} | "
@@ -282,7 +284,7 @@ def consistency():
 
 def _named_index(model, lam, vec, mode):
     """Index of the eigenvalue (Im >= 0) named ``mode`` with the largest real part."""
-    wheelbase = stability._wheelbase(wk.assembly.build_bicycle(BASE)[0])
+    wheelbase = stability_modes._wheelbase(wk.assembly.build_bicycle(BASE)[0])
     best = None
     for k in range(lam.size):
         if lam[k].imag < 0:

@@ -607,12 +607,17 @@ def test_rider_body_flags_reach_the_run_and_a_scenario_file(tmp_path, capsys):
     rows = np.loadtxt(out / "trajectory.csv", delimiter=",", skiprows=1)
     assert np.abs(rows[:, lean]).max() > 1e-3   # the upper body really leans (steady lean and the kick)
     again = tmp_path / "again"
+    # A reflex delay needs a reflex gain (a delay alone would be ignored: refused).
     status, _, err = _simulate(["--scenario", str(out / "scenario.toml"), "--reflex-delay", "0.05",
-                                "--duration", "0.2", "--no-plot", "--quiet", "--out", str(again)], capsys)
+                                "--reflex-steer-rate", "0.5", "--duration", "0.2", "--no-plot", "--quiet",
+                                "--out", str(again)], capsys)
     assert status == 0, err
     sc = wk.Result.load(again).summary["scenario"]
     assert (sc["rider_body"], sc["lqr_model"], sc["hip_damping"], sc["reflex_delay"], sc["duration"]) == (
         "leaning", "simulated", 40.0, 0.05, 0.2)
+    status, _, err = _simulate(["--scenario", str(out / "scenario.toml"), "--reflex-delay", "0.05",
+                                "--out", str(tmp_path / "refused")], capsys)
+    assert status == 2 and "reflex_delay = 0.05 is read only by the reflex" in err
 
 
 def test_stability_takes_the_rider_body_flags(tmp_path, capsys):
@@ -626,3 +631,81 @@ def test_stability_takes_the_rider_body_flags(tmp_path, capsys):
     assert status == 0, err
     summary = json.loads((out / "summary.json").read_text())
     assert "lean" in json.dumps(summary)
+
+
+# ------------------------------------------------------------ issue 31: nothing silent
+
+@pytest.mark.parametrize("command, extra", [("stability", ["--speeds", "3"]), ("simulate", ["--duration", "0.3"])])
+def test_an_unreadable_bicycle_is_an_input_error_not_an_output_failure(command, extra, tmp_path, capsys):
+    """Issue 31 item 21: ``--bicycle <a folder>`` said "cannot write the results: [Errno 21] Is a directory"."""
+    from whipple_kick import cli
+    folder = tmp_path / "bike.toml"
+    folder.mkdir()
+    main = {"stability": cli.stability_main, "simulate": cli.simulate_main}[command]
+    status, stdout, err = run_console(main, ["--bicycle", str(folder), *extra, "--no-plot", "--quiet",
+                                             "--out", str(tmp_path / "out")], capsys)
+    assert status == 2 and err.count("\n") == 1, err
+    assert "cannot be read" in err and str(folder) in err and "cannot write" not in err
+    assert not (tmp_path / "out").exists()
+
+
+def test_compare_help_prints_one_percent_sign(capsys):
+    """Issue 31 item 20: argparse does not %-format a description: "5 %%" was printed as it stands."""
+    from whipple_kick.cli import compare_main
+    status, stdout, _ = run_console(compare_main, ["--help"], capsys)
+    assert status == 0 and "5 %" in stdout and "%%" not in stdout
+
+
+def test_compare_reports_a_truncated_run(tmp_path, capsys):
+    """Issue 31 item 3: a run folder whose trajectory.csv was cut short is refused in one line (exit 2), also when
+    it is the only run given (before: plotted as a normal run, or a traceback)."""
+    from whipple_kick.cli import compare_main
+    run_dir = tmp_path / "run"
+    assert _simulate(["--duration", "0.5", "--settle", "0.1", "--no-plot", "--quiet", "--out", str(run_dir)],
+                     capsys)[0] == 0
+    lines = (run_dir / "trajectory.csv").read_text().splitlines(keepends=True)
+    (run_dir / "trajectory.csv").write_text("".join(lines[:250]))
+    status, stdout, err = run_console(compare_main, [str(run_dir), "--out", str(tmp_path / "cmp")], capsys)
+    assert status == 2 and err.count("\n") == 1 and "truncated" in err, err
+    assert not (tmp_path / "cmp").exists()
+
+
+def test_a_closed_stdout_pipe_is_not_a_write_failure(tmp_path):
+    """Issue 31 item 4: ``simulate ... | head`` wrote its results, then exited 2 with "cannot write the
+    results" when head closed the pipe. It now exits as Unix tools do on SIGPIPE (status 141 = 128 + 13: the
+    printing was cut, the results are whole), without a message, and the folder is complete."""
+    out = tmp_path / "run"
+    script = os.path.join(os.path.dirname(sys.executable), "simulate")
+    # The reader closes the pipe before simulate prints anything, whatever the timing.
+    proc = subprocess.Popen([script, "--duration", "0.5", "--no-plot", "--out", str(out)], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    proc.stdout.close()
+    stderr = proc.stderr.read()
+    assert proc.wait(timeout=300) == 141, stderr
+    assert stderr == ""
+    assert sorted(p.name for p in out.iterdir()) == ["scenario.toml", "summary.json", "trajectory.csv"]
+    wk.Result.load(out)
+
+
+def test_a_fall_before_the_kick_is_a_clean_result_and_warned_first(tmp_path, capsys):
+    """Issue 31 item 1: ``simulate --arms on`` died with KeyError 'yaw_rate_peaks_from_steady_rad_s' (status 1)
+    after writing its folder. Now: one warning line (the pole, what to change), the fall before the kick said,
+    status 0, and a folder that loads."""
+    out = tmp_path / "arms"
+    status, stdout, err = _simulate(["--arms", "on", "--duration", "1", "--no-plot", "--out", str(out)], capsys)
+    assert status == 0, err
+    assert err.count("\n") == 1 and err.startswith("simulate: warning: the LQR rider designed at 3 m/s is linearly "
+                                                   "unstable at 3 m/s: slowest closed-loop pole +10.06")
+    assert "--lqr-model simulated" in err and "Traceback" not in err
+    assert "BEFORE the kick start" in stdout
+    assert wk.Result.load(out).summary["outcome"] == "fell"
+
+
+def test_item15_help_gives_the_reflex_gains_sign(capsys):
+    """Issue 31 item 15: a positive --reflex-roll steers against the roll (and the bicycle falls); --help said
+    nothing of the sign."""
+    with pytest.raises(SystemExit):
+        simulate_main(["--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "T = -(gain x state)" in text and "a positive --reflex-roll steers out of the lean, against the roll" in text
+    assert "T = -gain x roll (a positive gain steers against the roll)" in text

@@ -127,3 +127,25 @@ def test_csv_to_significant_digits_is_to_csv_float_format_and_round_trips(tmp_pa
     # Not every bit: this is a rounding, so a repr-exact write differs from it.
     fileio.write_csv(many, path)
     assert np.array_equal(pd.read_csv(path).to_numpy(), exact)
+
+
+def test_docstring_examples_leave_no_temporary_folder(tmp_path, monkeypatch):
+    """Issue 31 item 20: three examples (fileio.atomic_path, provenance.sha256, Scenario.to_file) made a
+    ``tempfile.mkdtemp()`` folder per test run and never removed it. Run with the temporary folder redirected,
+    they leave it empty; and no example in the package calls mkdtemp again."""
+    import doctest
+    import pathlib
+    import tempfile
+
+    import whipple_kick
+    from whipple_kick import fileio
+    from whipple_kick.simulate import provenance, scenario
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path / "tmp"))
+    (tmp_path / "tmp").mkdir()
+    monkeypatch.chdir(tmp_path)
+    for module in (fileio, provenance, scenario):
+        result = doctest.testmod(module, optionflags=doctest.ELLIPSIS)
+        assert result.failed == 0 and result.attempted > 0, module.__name__
+    assert list((tmp_path / "tmp").iterdir()) == []
+    package = pathlib.Path(whipple_kick.__file__).parent
+    assert [p.name for p in package.rglob("*.py") if "mkdtemp(" in p.read_text()] == []

@@ -40,6 +40,47 @@ def test_identification_scores_a_case_as_the_docs_say():
         assert set(names) <= set(ir.BOUNDS)
 
 
+def test_every_stated_number_has_a_group_and_the_timings_are_their_script_s_record():
+    """Issue 31 item 18: every marked number in the docs names a group of scripts/doc_numbers.py that reruns it;
+    the README's timings are the latest record of the script that measured them (docs/timings.json), which
+    exists; the recommender's spread constant is the one the docs state (both from recommender_spread.py)."""
+    import doc_numbers
+
+    found = doc_numbers.markers()
+    assert len(found) > 50
+    assert {key.split(".")[0] for _, key, _ in found} <= set(doc_numbers.GROUPS)
+    assert doc_numbers.compare(doc_numbers.group_timing(), ["timing"]) == []
+    from whipple_kick.studies import recommend
+    stated = {key: text for _, key, text in found if key.startswith("spread.")}
+    assert stated == {f"spread.{k}": f"{v:.3f}" for k, v in recommend.CRITERION_SPREAD_S.items()}
+
+
+def test_a_stale_number_is_caught(tmp_path, monkeypatch):
+    """The check names a marker whose text differs from the rerun, one no group computes, and a computed key
+    that no doc carries."""
+    import doc_numbers
+
+    (tmp_path / "docs").mkdir()
+    (tmp_path / "README.md").write_text("cold <!-- number: timing.x -->20<!-- /number --> s, "
+                                        "<!-- number: bogus.y -->1<!-- /number -->")
+    for name in doc_numbers.DOCS[1:]:
+        (tmp_path / name).write_text("")
+    monkeypatch.setattr(doc_numbers, "ROOT", tmp_path)
+    problems = doc_numbers.compare({"timing.x": "41", "timing.z": "2"}, ["timing"])
+    assert problems == ["README.md: timing.x: the doc says '20', the model gives '41'",
+                        "README.md: bogus.y: no group 'bogus' computes it (known: " + ", ".join(doc_numbers.GROUPS) + ")",
+                        "timing.z: computed but no doc carries it"]
+
+
+@pytest.mark.slow
+def test_the_docs_numbers_match_a_rerun():
+    """Reruns everything the docs state (scripts/doc_numbers.py, about 5-10 minutes on 2 cores) and fails naming
+    each number that no longer matches the model."""
+    import doc_numbers
+
+    assert doc_numbers.main([]) == 0
+
+
 @pytest.mark.slow
 def test_uncertainty_study_reports_its_cost(tmp_path, capsys):
     """scripts/uncertainty_study.py on a two-input file at N = 2 (8 rows x 3 pressures x 3 loads, 3 s runs):

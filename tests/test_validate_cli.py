@@ -7,6 +7,7 @@ import sys
 import pytest
 
 from conftest import run_console
+import whipple_kick as wk
 from whipple_kick.cli import validate_main
 from whipple_kick.simulate.scenario import Scenario
 
@@ -30,6 +31,20 @@ def test_validate_writes_the_comparison(tmp_path, capsys):
                                "log_dec_13,log_dec_24,log_dec_35,dominant_frequency_hz,slow_swing_ratio")
     assert len(lines) == 1 + 9 + 9
     assert not any(cell.lower() in ("nan", "inf", "-inf") for line in lines for cell in line.split(","))
+    # Issue 31 item 20: the summary has the provenance every result has, and each case is a run folder that
+    # Result.load and compare read (it held a bare trajectory.csv).
+    assert summary["provenance"]["versions"]["whipple_kick"] == wk.__version__
+    assert set(summary["provenance"]["input_files"]) >= {"bicycle", "rider", "tyre", "experiment"}
+    assert summary["provenance"]["code_hash"] == wk.provenance.code_hash()
+    cases = sorted((out / "cases").iterdir())
+    run = wk.Result.load(cases[0])
+    assert run.summary["scenario"]["fz_n"] == 570.0 and run.summary["scenario"]["kick_direction"] == "left"
+    assert sorted(p.name for p in cases[0].iterdir()) == ["scenario.toml", "summary.json", "trajectory.csv"]
+    from whipple_kick.cli import compare_main
+    status, stdout, stderr = run_console(compare_main, [str(cases[0]), str(cases[1]), "--no-plot",
+                                                        "--out", str(tmp_path / "cmp")], capsys)
+    assert status == 0, stderr
+    assert "570N_300kPa_left" in stdout and "570N_400kPa_left" in stdout
     # The folder is not overwritten without --force.
     status, _, stderr = _validate(["--out", str(out), "--directions", "left"], capsys)
     assert status == 2 and "exists and is not empty" in stderr

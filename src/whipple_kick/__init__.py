@@ -21,7 +21,7 @@ loaded unless it is used.
 """
 import importlib
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 
 #: The public names and the module each lives in.
 _EXPORTS = {
@@ -41,7 +41,8 @@ _SUBMODULES = {
         "benchmark", "cache", "carcass", "classic", "energy", "geometry", "kane", "magic_formula", "reflex",
         "rhs_call", "slip", "symbolic", "symbols", "transient")},
     **{name: f"library.{name}" for name in (
-        "bicycles", "experiments", "inputs", "parameters", "riders", "tyres", "uncertain")},
+        "bicycleparameters", "bicycles", "experiments", "inputs", "parameters", "riders", "tyres",
+        "uncertain")},
     **{name: f"simulate.{name}" for name in (
         "analysis", "assembly", "control", "integration", "lsoda", "provenance", "results", "scenario",
         "simulation", "steady")},

@@ -24,6 +24,47 @@ from .errors import BuildError, CacheError, InputError, SimulationError, Termina
 EXIT_INTERRUPTED = 130
 #: Exit status of a command ended by SIGTERM (128 + SIGTERM).
 EXIT_TERMINATED = 143
+#: Exit status of a command whose standard output was closed by its reader (``simulate | head``): 128 + SIGPIPE,
+#: what the shell reports for any Unix tool the closed pipe ends. Not 0: the printed text was cut (a script
+#: with ``set -o pipefail`` learns that, as from ``cat``); the results written are whole.
+EXIT_BROKEN_PIPE = 141
+
+
+@contextlib.contextmanager
+def _warnings_as_lines(prog):
+    """Within the block, each warning is printed once, as one line on stderr: ``<prog>: warning: <message>``.
+
+    Python's own format (the file, the line, the source) is for programmers;
+    the package's warnings (:class:`~whipple_kick.errors.WhippleKickWarning`)
+    are for users. The filters and the printer are the caller's again after
+    the block: nothing is changed process-wide.
+    """
+    import warnings
+
+    from .errors import WhippleKickWarning
+    shown = set()
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        text = " ".join(str(message).split())   # one line
+        if text not in shown:
+            shown.add(text)
+            print(f"{prog}: warning: {text}", file=sys.stderr)
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("always", WhippleKickWarning)   # every one reaches show(), which prints each once
+        warnings.showwarning = show
+        yield
+
+
+def _stdout_is_broken():
+    """True when standard output is a pipe whose reader has gone (``poll`` reports an error on it)."""
+    import select
+    try:
+        poller = select.poll()
+        poller.register(sys.stdout.fileno(), select.POLLOUT)
+        return any(events & select.POLLERR for _, events in poller.poll(0))
+    except (OSError, ValueError, AttributeError):   # no file descriptor (a captured stdout), no poll
+        return False
 
 
 def _run(main, argv, prog="whipple_kick", kept="no results were kept"):
@@ -32,8 +73,20 @@ def _run(main, argv, prog="whipple_kick", kept="no results were kept"):
     ``kept`` says what an interrupted (Ctrl-C) or terminated (SIGTERM) command leaves behind.
     """
     try:
-        with terminate_raises():
-            return main(argv)
+        with terminate_raises(), _warnings_as_lines(prog):
+            status = main(argv)
+            sys.stdout.flush()   # text still buffered for a closed pipe fails here, not at the interpreter's exit
+            return status
+    except BrokenPipeError:
+        if not _stdout_is_broken():
+            print(f"{prog}: cannot write the results: broken pipe", file=sys.stderr)
+            return 2
+        # The reader of the printed text closed it (``simulate | head``): what was to be written is written.
+        # Standard output goes to /dev/null, so that Python's own flush at exit has nothing to complain about.
+        import os
+        with contextlib.suppress(OSError, ValueError):
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_BROKEN_PIPE
     except InputError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
@@ -190,7 +243,8 @@ def _model_options(p, symmetric_flag=True, design_default="the run's --speed", c
     g = p.add_argument_group("bicycle and rider")
     g.add_argument("--bicycle", default="balanceassist_v1", metavar="NAME",
                    help="bicycle parameter set or .toml path (default balanceassist_v1; presets "
-                        "with the rider included: balanceassist_635N, balanceassist_701N, browser_with_rider)")
+                        "with the rider included: balanceassist_635N, balanceassist_701N, browser_with_rider), "
+                        "or a BicycleParameters bicycle folder (<data>/bicycles/<Name>) or <Name>Benchmark.txt")
     if case_options:
         who = g.add_mutually_exclusive_group()
         who.add_argument("--fz", type=_number("N"), metavar="N",
@@ -228,7 +282,12 @@ def _body_options(p, default):
     """The "rider's body" option group (:func:`_model_options`); ``default(field)`` is the Scenario's default."""
     from whipple_kick.simulate.scenario import ARMS, RIDER_BODIES
     g = p.add_argument_group("rider's body", "the Yeadon rider split into legs, forearms and a leaning upper body "
-                                             "(a bicycle-only set such as balanceassist_v1), arms and reflex")
+                                             "(a bicycle-only set such as balanceassist_v1), arms and reflex. "
+                                             "The reflex steer torque is T = -(gain x state), delayed: a positive "
+                                             "gain steers against its state (a positive --reflex-roll steers out "
+                                             "of the lean, against the roll, and the bicycle falls; steering into "
+                                             "the lean takes a negative one). Not with --controller off (no rider "
+                                             "torque at all)")
     g.add_argument("--rider-body", choices=RIDER_BODIES, default=default("rider_body"),
                    help="rigid (default: the rider lumped into the rear frame) or leaning (the upper body leans on "
                         "the saddle on the hip spring-damper)")
@@ -244,7 +303,8 @@ def _body_options(p, default):
                                                                             "(with --arms on)"),
             ("--reflex-delay", "reflex_delay", "s", "S",
              "delay of the rider's reflex steer torque (a Pade filter; at most 0.5 s)"),
-            ("--reflex-roll", "reflex_roll", "N m/rad", "N_M_PER_RAD", "reflex steer-torque gain on roll"),
+            ("--reflex-roll", "reflex_roll", "N m/rad", "N_M_PER_RAD",
+             "reflex steer-torque gain on roll, T = -gain x roll (a positive gain steers against the roll)"),
             ("--reflex-roll-rate", "reflex_roll_rate", "N m s/rad", "N_M_S_PER_RAD",
              "reflex steer-torque gain on roll rate"),
             ("--reflex-steer", "reflex_steer", "N m/rad", "N_M_PER_RAD", "reflex steer-torque gain on steer"),
@@ -425,8 +485,8 @@ def _check_loads(bicycle, loads):
     """
     if not loads:
         return   # nothing to check (the bicycle itself is checked with the scenario)
-    from whipple_kick.library import bicycles, riders
-    bike = bicycles.load(bicycle)
+    from whipple_kick.library import bicycleparameters, riders
+    bike = bicycleparameters.load_bicycle(bicycle)
     if bike.includes_rider:
         return   # refused later in one line (the preset already includes its rider)
     low, high, _ = riders.rear_load_range(bike)
@@ -490,12 +550,17 @@ def _discard(out, created, written):
 class _Output:
     """The output folder a command writes into (:func:`_output_folder`).
 
+    ``out`` is the folder the user named (what messages print); ``dir`` is
+    where the command writes: ``out`` itself, or with ``--force`` on an
+    existing folder a hidden staging folder inside it (:data:`STAGING_PREFIX`)
+    whose files replace the earlier run's only when the command succeeds.
     ``written`` lists the files written so far (removed if the command
     fails); ``keep`` set to True keeps them (a partial result for the user).
     """
 
     def __init__(self, out, created):
         self.out, self.created, self.written, self.keep, self.lock = out, created, [], False, None
+        self.dir, self.staging = out, None
 
 
 def _default_out(scenario, prefix="kick"):
@@ -523,6 +588,11 @@ def _new_folder(name):
 OUT_LOCK_FILE = ".whipple_kick.lock"
 
 
+#: Name stem of the hidden folder, inside an existing output folder, that ``--force`` writes the new run into
+#: (``<stem>.<pid>``); its files replace the earlier run's at the end, so a run that stops leaves that run whole.
+STAGING_PREFIX = ".whipple_kick.replacing"
+
+
 @contextlib.contextmanager
 def _output_folder(path, force, previous=()):
     """Create/check the output folder before the (longer) run and hold its lock; yields an :class:`_Output`.
@@ -530,16 +600,20 @@ def _output_folder(path, force, previous=()):
     The lock (:data:`OUT_LOCK_FILE`) keeps a second command from writing
     into the same folder at the same time (it gets one line, exit status
     2); a lock left by a killed command is taken over. Hidden temporaries
-    of ``previous`` left by a killed writer are removed. With ``force``,
-    the files named in ``previous`` (what the command writes) are removed
-    first, so no file of an earlier run (say its response.png beside a new
-    ``--no-plot`` summary) is left to contradict the new one.
+    of ``previous`` left by a killed writer are removed. With ``force`` on
+    an existing folder the command writes into a hidden staging folder
+    inside it (``job.dir``); when it succeeds (or keeps a partial result),
+    the files named in ``previous`` (what the command writes) are replaced
+    by the new ones or removed, so no file of an earlier run (say its
+    response.png beside a new ``--no-plot`` summary) is left to contradict
+    the new one. Until then the earlier run stays whole.
 
     Whatever ends the command before it finishes (a failure, Ctrl-C,
     SIGTERM, from the folder's creation on) removes the folder it created,
-    else the files it wrote, unless ``keep`` was set.
+    else the files it wrote (the staging folder), unless ``keep`` was set.
     """
     import pathlib
+    import shutil
     out = pathlib.Path(path)
     if out.exists() and not out.is_dir():
         raise InputError(f"output folder {str(out)!r} exists and is not a folder")
@@ -548,13 +622,51 @@ def _output_folder(path, force, previous=()):
         _claim(job, force, previous)
         yield job
     except BaseException:
-        if not job.keep:
+        if job.staging is not None and job.keep:
+            _replace_from_staging(job, previous)   # a partial result the command keeps for the user
+        elif job.staging is not None:
+            shutil.rmtree(job.staging, ignore_errors=True)
+        elif not job.keep:
             _discard(out, job.created, job.written)
         raise
+    else:
+        if job.staging is not None:
+            _replace_from_staging(job, previous)
     finally:
         if job.lock is not None:
             # The lock file goes with the lock, so that the folder holds only the results.
             fileio.release_lock(job.lock, out / OUT_LOCK_FILE)
+
+
+def _replace_from_staging(job, previous):
+    """Move the staging folder's entries into ``job.out`` and remove the earlier run's other files of ``previous``.
+
+    Ctrl-C and SIGTERM are held back meanwhile (a few renames), so the
+    folder never mixes two runs' files.
+    """
+    import os
+    import shutil
+    import signal
+    import threading
+
+    main = threading.current_thread() is threading.main_thread()
+    held = {signal.SIGINT, signal.SIGTERM}
+    if main:
+        signal.pthread_sigmask(signal.SIG_BLOCK, held)
+    try:
+        new = {entry.name: entry for entry in job.staging.iterdir()}
+        for name in previous:
+            if name not in new:
+                (job.out / name).unlink(missing_ok=True)
+        for name, entry in new.items():
+            target = job.out / name
+            if target.is_dir() and not target.is_symlink():
+                shutil.rmtree(target)
+            os.replace(entry, target)
+        job.staging.rmdir()
+    finally:
+        if main:
+            signal.pthread_sigmask(signal.SIG_UNBLOCK, held)
 
 
 def _claim(job, force, previous):
@@ -574,17 +686,23 @@ def _claim(job, force, previous):
     except OSError as exc:
         raise InputError(f"output folder {str(out)!r} is not writable: {exc.strerror or exc}") from None
     # Holding the lock, any temporary of ours here is a killed writer's.
+    import os
+    import shutil
     for stale in fileio.stale_temporaries(out, previous):
         stale.unlink(missing_ok=True)
+    for stale in out.glob(f"{STAGING_PREFIX}.*"):   # a killed writer's staging folder
+        shutil.rmtree(stale, ignore_errors=True)
     if not force and any(p.name != OUT_LOCK_FILE for p in out.iterdir()):
         raise InputError(f"output folder {str(out)!r} exists and is not empty; "
                          "use --force to overwrite its files or choose another --out")
     if force and not job.created:
-        for name in previous:
-            try:
-                (out / name).unlink(missing_ok=True)
-            except OSError as exc:
-                raise InputError(f"--force cannot remove {str(out / name)!r}: {exc.strerror or exc}") from None
+        job.staging = out / f"{STAGING_PREFIX}.{os.getpid()}"
+        try:
+            job.staging.mkdir()
+        except OSError as exc:
+            job.staging = None
+            raise InputError(f"output folder {str(out)!r} is not writable: {exc.strerror or exc}") from None
+        job.dir = job.staging
 
 
 def _print_summary(result, out, files):
@@ -626,11 +744,14 @@ def _print_summary(result, out, files):
     if s["fell"]:
         why = (f"|steer| reached {sc['steer_limit_deg']:g} deg: the fork turned over" if s.get("fall_reason") == "steer"
                else f"|roll| reached {sc['fall_angle_deg']:g} deg")
-        print(f"  result: FELL ({why}) {s['fall_time_s']:.3f} s after the kick start")
+        when = (f"{s['fall_time_s']:.3f} s after the kick start" if s["fall_time_s"] >= 0.0 else
+                f"{-s['fall_time_s']:.3f} s BEFORE the kick start: no response to the kick, its metrics are "
+                "unavailable")
+        print(f"  result: FELL ({why}) {when}")
     else:
         print(f"  result: no fall in {sc['duration']:g} s")
     m, rec = s["metrics"], s["recovery"]
-    if m["yaw_rate_peaks_from_steady_rad_s"]:
+    if m.get("yaw_rate_peaks_from_steady_rad_s"):
         print(f"  yaw rate: first peak from steady {m['yaw_rate_peaks_from_steady_rad_s'][0]:+.3f} rad/s "
               f"at {m['yaw_rate_peak_times_s'][0]:.3f} s")
     if not s["fell"]:
@@ -660,43 +781,29 @@ def _print_summary(result, out, files):
     print(f"  wrote {', '.join(files)} in {out}")
 
 
-def _data_warnings(prog, quiet):
-    """Print each tyre file's data warning once, as one line on stderr (none with ``quiet``; summary.json lists them).
-
-    Python's own warning of it (:class:`whipple_kick.library.tyres.DataQualityWarning`)
-    is silenced: it would print the source line and repeat per call site.
-    """
-    import warnings
-
-    from whipple_kick.library import tyres
-    warnings.filterwarnings("ignore", category=tyres.DataQualityWarning)
-
-    def report(summary):
-        for message in summary["tyres"]["data_warnings"] if not quiet else ():
-            print(f"{prog}: warning: {message}", file=sys.stderr)
-    return report
-
-
 def _simulate(argv):
     from whipple_kick.simulate import assembly
     args = _simulate_parser().parse_args(argv)
-    report_data_warnings = _data_warnings("simulate", args.quiet)
+    if args.quiet:   # summary.json lists the tyre files' data warnings (tyres.data_warnings)
+        import warnings
+
+        from whipple_kick.library.tyres import DataQualityWarning
+        warnings.filterwarnings("ignore", category=DataQualityWarning)   # within _run's warnings block only
     given = _flags_given(argv) if args.compat is not None or args.scenario is not None else ()
     scenario = assembly.preflight(_scenario_from_args(args, given))
     movie_options = _animation_options(args)
     with _output_folder(args.out or _default_out(scenario), args.force, _OUTPUT_FILES) as job:
         out = job.out
         try:
-            result, files, note = _simulate_into(args, scenario, movie_options, out, job.written)
+            result, files, note = _simulate_into(args, scenario, movie_options, job.dir, job.written)
         except SimulationError as exc:
             if exc.partial is None:
                 raise
             # What ran before the failure is kept for the user to inspect.
-            exc.partial.save(out)
+            exc.partial.save(job.dir)
             job.keep = True
             raise SimulationError(
                 f"{exc}; the run up to t = {exc.partial.summary['end_time_s']:g} s is in {out}") from None
-    report_data_warnings(result.summary)
     if not args.quiet and result.summary["controller"]["warning"]:
         print(f"simulate: warning: {result.summary['controller']['warning']}", file=sys.stderr)
     if not args.quiet:
@@ -716,9 +823,6 @@ def _simulate_into(args, scenario, movie_options, out, written):
     result = simulation.run(scenario)
     files = result.save(out)
     written.extend(files)
-    if not result.summary["linear_stability"]["stable"]:
-        # A warning, not a failure: the run is valid (the bicycle may well fall).
-        print(f"simulate: warning: {result.summary['linear_stability']['message']}", file=sys.stderr)
     if not args.no_plot:
         from whipple_kick.figures import plotting
         plotting.response_figure([("", result)], out / "response.png", title=plotting.result_title(result),
@@ -934,7 +1038,7 @@ def _compare(argv):
     p = _OneLineParser(
         prog="compare", allow_abbrev=False,
         description="Overlay kick-plate runs (folders written by simulate or Result.save) in one figure, each "
-                    "run's kick, fall, recovery time and 5 %% bands marked (compare.png), and tabulate their "
+                    "run's kick, fall, recovery time and 5 % bands marked (compare.png), and tabulate their "
                     "results side by side (compare.csv, printed).",
         epilog="From Python: wk.plotting.compare(results), wk.results.compare_table(results). See docs/workflow.md.")
     p.add_argument("runs", nargs="+", metavar="RUN_DIR", help="run folders (each with summary.json and trajectory.csv)")
@@ -951,10 +1055,10 @@ def _compare(argv):
     with _output_folder(args.out or _new_folder("compare"), args.force, _COMPARE_FILES) as job:
         out = job.out
         job.written.append("compare.csv")
-        fileio.write_csv(table.reset_index(), out / "compare.csv")
+        fileio.write_csv(table.reset_index(), job.dir / "compare.csv")
         if not args.no_plot:
             job.written.append("compare.png")
-            plotting.compare(runs, out / "compare.png", labels=labels,
+            plotting.compare(runs, job.dir / "compare.png", labels=labels,
                              title=f"{len(runs)} runs compared: " + "; ".join(labels))
     if not args.quiet:
         import pandas as pd
@@ -1017,7 +1121,7 @@ def _stability(argv):
         result = stability.analyse(scenario, speeds)
         result.summary["numerics"] = {"wall_s": time.perf_counter() - started}
         result.summary["provenance"] = provenance.record(provenance.input_files(scenario))
-        files = stability.write(result, out, plot=not args.no_plot)
+        files = stability.write(result, job.dir, plot=not args.no_plot)
     missing = {loop: m["speeds_without_steady_motion"] for loop, m in result.summary["steady_motion"].items()
                if m["speeds_without_steady_motion"]}
     for loop, count in missing.items():
@@ -1110,7 +1214,7 @@ def _validate(argv):
             result = validation.validate(base, directions=args.directions, workers=args.workers,
                                          time_origin=args.time_origin)
         result.summary["wall_s"] = time.perf_counter() - started
-        files = validation.write(result, out, plot=not args.no_plot)
+        files = validation.write(result, job.dir, plot=not args.no_plot)
     if not args.quiet:
         print(f"validate: {len(result.runs)} model runs against the thesis' kick-plate measurements "
               f"(tyre transient {base.tyre_transient}, {base.speed:g} m/s, {base.kick_profile} kick at "

@@ -90,6 +90,43 @@ class CacheError(OSError):
     """
 
 
+class WhippleKickWarning(UserWarning):
+    """Base class of the package's warnings: a library caller filters them all, or one kind, as usual.
+
+    Example
+    -------
+    >>> import warnings
+    >>> with warnings.catch_warnings():
+    ...     warnings.simplefilter("ignore", WhippleKickWarning)   # or one subclass, e.g. UnstableRiderWarning
+    ...     warnings.warn("not shown", UnstableRiderWarning)
+
+    The command-line tools print each warning once, as one line on stderr
+    (``simulate: warning: ...``).
+    """
+
+
+class UnstableRiderWarning(WhippleKickWarning):
+    """The rider in use is linearly unstable at the run's speed (a closed-loop pole with positive real part).
+
+    Issued before the integration (:func:`whipple_kick.simulate.simulation.run`);
+    the run goes on, since an unstable closed loop is a valid experiment
+    (no controller, the thesis' fixed design speed), and its summary's
+    ``linear_stability`` holds the same message.
+    """
+
+
+class ConvergenceWarning(WhippleKickWarning):
+    """An optimiser stopped away from a stationary point (its gradient above the stated tolerance)."""
+
+
+class DefaultValueWarning(WhippleKickWarning):
+    """Values the input does not give were taken from the project's defaults (each named with its source)."""
+
+
+class PerformanceWarning(WhippleKickWarning):
+    """Results are unaffected, but a slower path is taken (e.g. the ctypes call into the compiled model)."""
+
+
 class Terminated(BaseException):
     """SIGTERM reached the process (within :func:`terminate_raises`).
 

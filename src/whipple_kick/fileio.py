@@ -45,10 +45,11 @@ def atomic_path(path, *, private: bool = False) -> Iterator[pathlib.Path]:
     Example
     -------
     >>> import tempfile
-    >>> folder = pathlib.Path(tempfile.mkdtemp())
-    >>> with atomic_path(folder / "table.txt") as tmp:
-    ...     _ = tmp.write_text("a,b\\n")
-    >>> (folder / "table.txt").read_text()
+    >>> with tempfile.TemporaryDirectory() as name:   # removed afterwards, as every example's files
+    ...     folder = pathlib.Path(name)
+    ...     with atomic_path(folder / "table.txt") as tmp:
+    ...         _ = tmp.write_text("a,b\\n")
+    ...     (folder / "table.txt").read_text()
     'a,b\\n'
     """
     path = pathlib.Path(path)

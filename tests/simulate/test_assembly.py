@@ -96,3 +96,22 @@ def test_upright_start_without_a_steady_motion_is_judged_about_upright_running(m
     assert st["yaw_rate_baseline_rad_s"] == 0.0
     with pytest.raises(steady.NoSteadyMotion):
         run(Scenario(duration=0.2))
+
+
+def test_item7_no_slip_poles_of_a_leaning_rider_carry_the_whole_rider():
+    """Issue 31 item 7: the no-slip poles of a leaning rider were computed on the bicycle without its upper body
+    (61.6 kg instead of 101.7 kg), and with a heading gain those poles decide the verdict. The classic model's
+    plant is now the whole bicycle with rider (exact masses: sums of the same parameters, 1e-9 kg)."""
+    from whipple_kick.simulate import control
+
+    sc = Scenario(rider_body="leaning")
+    moore, design, info = assembly.build_bicycle(sc)
+    mass = lambda m: sum(m[k] for k in ("mc", "md", "me", "mf"))
+    assert mass(moore) == pytest.approx(61.6, abs=0.05)                 # the split bicycle: legs only
+    plant = assembly.no_slip_plant(moore, design, info)
+    assert mass(plant) == pytest.approx(101.7, abs=0.05)
+    assert mass(plant) == pytest.approx(info["total_mass_kg"], abs=1e-9)
+    model = assembly.assemble(sc, inputs.kick_of(sc))
+    expected = control.closed_loop_poles(plant, sc.speed, model.gains)
+    got = np.array([complex(*p) for p in model.stability["poles_no_slip_model_1_s"]])
+    np.testing.assert_allclose(got, expected, rtol=1e-12, atol=1e-12)

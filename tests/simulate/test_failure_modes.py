@@ -288,6 +288,81 @@ def test_interrupted_run_in_an_existing_folder_removes_only_its_own_files(tmp_pa
 
 # ------------------------------------------------------------ --force
 
+def _earlier_run(out, capsys):
+    """A finished run in ``out`` (with a user's own file beside it); returns {name: bytes} of the folder."""
+    status, _, err = _simulate(["--duration", "0.3", "--quiet", "--out", str(out)], capsys)
+    assert status == 0, err
+    (out / "notes.txt").write_text("mine\n")
+    return {p.name: p.read_bytes() for p in out.iterdir()}
+
+
+def _folder_bytes(out):
+    return {p.name: p.read_bytes() for p in out.iterdir()}
+
+
+def test_force_replaces_the_earlier_run_only_when_the_new_one_succeeds(tmp_path, capsys, monkeypatch):
+    """Issue 31 item 2: ``--force --out OLD`` removed OLD's results at the start, so a run that then stopped on a
+    user's mistake (exit 2) left OLD empty. Now the new run is written into a hidden staging folder and replaces
+    OLD's files at the end; a run that stops leaves OLD as it was, and no staging folder."""
+    from whipple_kick.simulate import simulation
+    out = tmp_path / "run"
+    before = _earlier_run(out, capsys)
+    assert sorted(before) == ["notes.txt", "response.png", "scenario.toml", "summary.json", "trajectory.csv"]
+
+    def no_steady_motion(*args, **kwargs):   # a user's mistake found during the run (after the folder is claimed)
+        raise InputError("no steady motion at 3 m/s (a stand-in)")
+    monkeypatch.setattr(simulation, "run", no_steady_motion)
+    status, _, err = _simulate(["--duration", "0.4", "--force", "--no-plot", "--out", str(out)], capsys)
+    assert status == 2 and "stand-in" in err
+    assert _folder_bytes(out) == before
+
+    def interrupt(*args, **kwargs):          # Ctrl-C while the figure is drawn: the new run's files half there
+        raise KeyboardInterrupt
+    monkeypatch.undo()
+    from whipple_kick.figures import plotting
+    monkeypatch.setattr(plotting, "response_figure", interrupt)
+    status, _, err = _simulate(["--duration", "0.4", "--force", "--out", str(out)], capsys)
+    assert status == 130
+    assert _folder_bytes(out) == before
+    monkeypatch.undo()
+
+    # Success: the new run's files replace the earlier ones; the earlier response.png goes (--no-plot), the
+    # user's file stays.
+    status, _, err = _simulate(["--duration", "0.4", "--force", "--no-plot", "--quiet", "--out", str(out)], capsys)
+    assert status == 0, err
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt", "scenario.toml", "summary.json", "trajectory.csv"]
+    assert json.loads((out / "summary.json").read_text())["scenario"]["duration"] == 0.4
+    assert (out / "notes.txt").read_text() == "mine\n"
+
+
+def test_sigterm_during_a_forced_rerun_leaves_the_earlier_run_whole(tmp_path, capsys):
+    """Issue 31 item 2 with SIGTERM (a scheduler's time limit) in the middle of the new run."""
+    out = tmp_path / "run"
+    before = _earlier_run(out, capsys)
+    proc = subprocess.Popen(_with_default_signals([_console_script("simulate"), "--duration", "120", "--rtol",
+                                                   "1e-12", "--no-plot", "--force", "--out", str(out)]),
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while not list(out.glob(cli.STAGING_PREFIX + ".*")) and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert proc.poll() is None, proc.communicate()
+    proc.send_signal(signal.SIGTERM)
+    _, stderr = proc.communicate(timeout=120)
+    assert proc.returncode == cli.EXIT_TERMINATED, stderr
+    assert _folder_bytes(out) == before
+
+
+def test_a_killed_forced_rerun_leaves_a_staging_folder_the_next_run_removes(tmp_path, capsys):
+    """SIGKILL cannot be caught: the staging folder stays, hidden, until the next run on the folder removes it."""
+    out = tmp_path / "run"
+    _earlier_run(out, capsys)
+    (out / f"{cli.STAGING_PREFIX}.99999999").mkdir()
+    (out / f"{cli.STAGING_PREFIX}.99999999" / "trajectory.csv").write_text("half")
+    status, _, err = _simulate(["--duration", "0.3", "--force", "--no-plot", "--quiet", "--out", str(out)], capsys)
+    assert status == 0, err
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt", "scenario.toml", "summary.json", "trajectory.csv"]
+
+
 def test_force_removes_the_previous_runs_files(tmp_path, capsys):
     out = tmp_path / "run"
     out.mkdir()
@@ -367,6 +442,21 @@ def test_data_warning_is_one_line_silenced_by_quiet_and_kept_in_the_summary(tmp_
     assert len(summary["tyres"]["data_warnings"]) == 1 and "T02" in summary["tyres"]["data_warnings"][0]
     base = json.loads((out / "summary.json").read_text())
     assert base["tyres"]["data_warnings"] == summary["tyres"]["data_warnings"]
+
+
+def test_the_cli_does_not_drop_data_warnings_for_the_rest_of_the_process(tmp_path, capsys):
+    """Issue 31 item 16: simulate called ``warnings.filterwarnings("ignore", DataQualityWarning)`` for the whole
+    process, so a library caller running the CLI in-process never saw the warning again."""
+    import warnings
+
+    from whipple_kick.library import tyres
+    filters = list(warnings.filters)
+    status, _, err = _simulate(["--tyre", "T02", "--duration", "0.3", "--no-plot", "--quiet",
+                                "--out", str(tmp_path / "q")], capsys)
+    assert status == 0 and err == ""
+    assert warnings.filters == filters
+    with pytest.warns(tyres.DataQualityWarning, match="T02"):
+        tyres.load("T02", 300)
 
 
 # ------------------------------------------------------------ sweeps

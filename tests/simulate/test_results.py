@@ -216,3 +216,57 @@ def test_recovered_says_whether_all_three_rates_settled(base):
     assert short.summary["recovery"]["time_s"] is None
     fell = run(Scenario(controller="off", duration=3.0))
     assert fell.summary["fell"] and fell.summary["recovered"] is False
+
+
+def test_extrapolation_gives_the_true_load_extremes(base):
+    """Issue 31 item 12: min_load_n was ``load.min(initial=0.0)``, always 0 N. Each wheel's extremes are those of
+    the trajectory's own fz column after the kick start (an independent reading of the same samples: exact)."""
+    after = base.trajectory["time"] >= 0.0
+    for wheel in ("rear", "front"):
+        e = base.summary["tyres"]["extrapolation"][wheel]
+        load = base.trajectory.loc[after, f"fz_{wheel}"]
+        assert e["min_load_n"] == float(load.min()) and e["max_load_n"] == float(load.max())
+        assert 0.0 < e["min_load_n"] < e["max_load_n"]
+    # The default run's rear minimum: 525.3 N here; the issue read 523.5 N on its commit. 2.5 N holds both: the
+    # point is a true minimum, 110 N below the static 635 N, not 0 (a model change moves it a little).
+    assert base.summary["tyres"]["extrapolation"]["rear"]["min_load_n"] == pytest.approx(525.3, abs=2.5)
+
+
+def _saved_run(folder, rows=600):
+    """A short run saved in ``folder`` (0.1 s settle + 0.5 s at 1000 Hz: 601 rows)."""
+    result = run(Scenario(duration=0.5, settle=0.1))
+    result.save(folder)
+    return result
+
+
+def test_load_refuses_a_truncated_trajectory(tmp_path):
+    """Issue 31 item 3: a trajectory.csv cut short (a copy interrupted, a full disk) is refused in one line naming
+    the rows and the end time summary.json promises (before: loaded and plotted as a normal run)."""
+    folder = tmp_path / "run"
+    _saved_run(folder)
+    wk.Result.load(folder)                                   # the whole file loads
+    lines = (folder / "trajectory.csv").read_text().splitlines(keepends=True)
+    (folder / "trajectory.csv").write_text("".join(lines[:300]))   # cut at a row boundary
+    with pytest.raises(wk.InputError) as info:
+        wk.Result.load(folder)
+    message = str(info.value)
+    assert "\n" not in message and "truncated" in message and "0.5" in message, message
+    # Cut in the middle of a row: the last row is short (pandas would fill it with NaN).
+    (folder / "trajectory.csv").write_text("".join(lines)[:-40])
+    with pytest.raises(wk.InputError, match=r"trajectory\.csv"):
+        wk.Result.load(folder)
+
+
+@pytest.mark.parametrize("edit, fragment", [
+    (lambda text: text.replace("time [s]", "t [s]", 1), "no time column"),
+    (lambda text: text.replace("\n0.1", "\nabc", 1), "not a number"),
+    (lambda text: "\n".join(line for k, line in enumerate(text.split("\n")) if k != 200), "time"),
+], ids=["time column renamed", "text in a row", "a row missing in the middle"])
+def test_load_refuses_a_malformed_trajectory(edit, fragment, tmp_path):
+    folder = tmp_path / "run"
+    _saved_run(folder)
+    path = folder / "trajectory.csv"
+    path.write_text(edit(path.read_text()))
+    with pytest.raises(wk.InputError) as info:
+        wk.Result.load(folder)
+    assert "\n" not in str(info.value) and fragment in str(info.value), str(info.value)

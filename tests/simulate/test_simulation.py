@@ -723,3 +723,47 @@ def test_upright_start_runs_from_upright_and_judges_stability_about_the_steady_m
     assert np.max(np.abs(df[wk.results.BALANCE_COLUMN])) < 1e-3
 
 
+
+
+def test_a_rider_that_falls_before_the_kick_is_warned_before_the_run_and_gives_a_clean_result(monkeypatch):
+    """Issue 31 item 1: the Whipple-designed LQR rider with forearms on the bar is unstable (+10.06 1/s at 3 m/s
+    on the simulated model's linearisation), falls before the kick, and the run died with a KeyError. Now a
+    warning naming the pole and the fix comes before the integration, and the result says what is missing."""
+    import warnings
+
+    from whipple_kick.errors import UnstableRiderWarning
+    from whipple_kick.simulate import integration
+    integrate = integration.integrate_run
+    seen_before_integration = []
+
+    def integrate_run(*args, **kwargs):
+        seen_before_integration.append(len(caught))
+        return integrate(*args, **kwargs)
+    monkeypatch.setattr(integration, "integrate_run", integrate_run)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = run(Scenario(arms="on", duration=1.0))
+    unstable = [w for w in caught if issubclass(w.category, UnstableRiderWarning)]
+    assert len(unstable) == 1 and seen_before_integration == [1]
+    text = str(unstable[0].message)
+    assert "+10.06" in text and "--lqr-model simulated" in text and "arms on the bar" in text, text
+    s = result.summary
+    assert s["outcome"] == "fell" and s["fall_time_s"] < 0.0 and s["linear_stability"]["message"] == text
+    assert s["recovered"] is False and s["recovery"]["time_s"] is None
+    assert "before the kick start" in s["recovery"]["reason"]
+    # The same metric keys as a run with a response, each unavailable with the reason.
+    assert set(run(Scenario(duration=0.5)).summary["metrics"]) == set(s["metrics"])
+    assert s["metrics"]["yaw_rate_peaks_from_steady_rad_s"] == [] and s["metrics"]["last_peak_time_s"] is None
+    assert all("before the kick start" in reason for reason in s["metrics_unavailable"].values())
+    assert "last_peak_time_s" in s["metrics_unavailable"] and "period_s" in s["metrics_unavailable"]
+
+
+def test_the_simulated_design_with_arms_is_stable_and_does_not_warn():
+    """The fix the warning names: --lqr-model simulated stabilises the same rider (no warning, a kick response)."""
+    import warnings
+
+    from whipple_kick.errors import UnstableRiderWarning
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", UnstableRiderWarning)
+        result = run(Scenario(arms="on", lqr_model="simulated", duration=1.0))
+    assert result.summary["linear_stability"]["stable"] and result.summary["metrics"]["n_peaks"] > 0

@@ -137,13 +137,56 @@ def test_ranking_rules_on_a_synthetic_table():
     one = _rows(pressure_kpa=[300.0, 400.0], **{"recovery.time_s": [np.nan, 3.0]})
     assert wk.recommend._verdict(one, "settling") == (400.0, None, "clear")
     assert wk.recommend._verdict(_rows(pressure_kpa=[300.0, 400.0]), "settling") == (None, None, "none recovered")
+    # A failed case has no result: the verdict is never "clear" (issue 31 item 10; it was).
     failed = _rows(pressure_kpa=[300.0, 400.0], status=["failed", "ok"], **{"recovery.time_s": [1.0, 3.0]})
-    assert wk.recommend._verdict(failed, "settling") == (400.0, None, "clear")
+    assert wk.recommend._verdict(failed, "settling") == (400.0, None, "incomplete")
     assert wk.recommend._verdict(_rows(pressure_kpa=[400.0], **{"recovery.time_s": [3.0]}), "settling") == (
         None, None, "nothing to choose")
     assert wk.recommend.criterion_key("last-peak") == "last_peak"
     with pytest.raises(InputError, match="settling, last-peak"):
         wk.recommend.criterion_key("fastest")
+
+
+def test_a_failed_case_ranks_after_the_falls_and_the_verdict_says_how_many_failed():
+    """Issue 31 item 10: a failing case (no result) was ranked like a fall, among the falls by pressure, and the
+    verdict could still read "clear". Now the failed cases come after every fall and the verdict is
+    "incomplete", naming how many failed."""
+    rows = _rows(pressure_kpa=[300.0, 400.0, 500.0, 600.0], fell=[False, True, False, False],
+                 status=["failed", "ok", "ok", "ok"], **{"recovery.time_s": [np.nan, np.nan, 2.0, 3.0]})
+    rank = list(np.argsort(wk.recommend._rank(rows, "settling")) + 1)
+    assert rank == [4, 3, 1, 2]                    # the failed 300 kPa after the fall at 400 kPa
+    rows["rank"] = rank
+    for col in wk.recommend._RECOMMENDATION_COLUMNS:
+        rows[col] = rows[col] if col in rows else np.nan
+    rows["error"] = ["InputError: a stand-in", None, None, None]
+    best, margin, verdict = wk.recommend._verdict(rows, "settling")
+    assert (best, margin, verdict) == (500.0, 1.0, "incomplete")
+    rec = wk.recommend.Recommendation(635.0, "T03", best, best, "settling", margin, 0.218, verdict, rows, failed=1)
+    text = wk.recommend.format_recommendation(rec)
+    last = text.splitlines()[-1]
+    assert "1 of 4 cases failed (300 kPa" in last and "500 kPa" in last and "clear" not in last, last
+    assert "failed: InputError: a stand-in" in text
+
+
+def test_recommend_pressure_with_a_failing_pressure_is_incomplete(monkeypatch):
+    """End to end through the sweep (in threads, so the stand-in failure reaches the cases): the 400 kPa case
+    fails, the others run."""
+    import concurrent.futures as cf
+
+    from whipple_kick.simulate import simulation
+    run = simulation.run
+
+    def failing_at_400(scenario, **kwargs):
+        if scenario.pressure_kpa == 400.0:
+            raise RuntimeError("a stand-in failure")
+        return run(scenario, **kwargs)
+    monkeypatch.setattr(simulation, "run", failing_at_400)
+    short = Scenario(duration=3.0, settle=0.1, output_rate=200.0)
+    with cf.ThreadPoolExecutor(1) as executor:
+        rec = wk.recommend.recommend_pressure(635, pressures=[300.0, 400.0, 500.0], base=short, executor=executor)
+    assert rec.failed == 1 and rec.verdict == "incomplete"
+    assert rec.table.loc[rec.table["status"] != "ok", "rank"].tolist() == [3]
+    assert "1 of 3 cases failed (400 kPa" in wk.recommend.format_recommendation(rec)
 
 
 def test_one_measured_pressure_leaves_nothing_to_choose():

@@ -12,6 +12,7 @@ from whipple_kick import cli
 from whipple_kick.model import classic, slip
 from whipple_kick.simulate.simulation import Scenario
 from whipple_kick.studies import stability
+from whipple_kick.studies.stability import modes, summary
 
 #: The default case of the stability command: T03 at 400 kPa, 635 N, offsets removed.
 DEFAULT = Scenario(symmetric_tyres=True)
@@ -253,7 +254,7 @@ def test_wobble_exists_and_matches_a_free_response(pressure):
     """
     model = stability.linear_model(Scenario(symmetric_tyres=True, pressure_kpa=pressure), 3.0, "closed")
     lam, vec = np.linalg.eig(model.matrix)
-    wheelbase = stability._wheelbase(wk.assembly.build_bicycle(DEFAULT)[0])
+    wheelbase = modes._wheelbase(wk.assembly.build_bicycle(DEFAULT)[0])
     named = [(k, stability.name_mode(stability.mode_content(model, lam[k], vec[:, k], wheelbase)[0],
                                      lam[k].imag == 0, abs(lam[k].imag) / (2 * math.pi)))
              for k in range(lam.size)]
@@ -414,9 +415,9 @@ def test_cli_controller_off_has_the_open_loop_only(tmp_path, capsys):
 
 def test_root_without_a_bracket_is_not_found_with_a_reason():
     """Before, _root extrapolated linearly outside [a, b] and returned that as the crossing speed."""
-    speed, why = stability._root(lambda v: v + 1.0, 2.0, 3.0)     # +3 and +4: no sign change
+    speed, why = summary._root(lambda v: v + 1.0, 2.0, 3.0)     # +3 and +4: no sign change
     assert speed is None and "does not change sign between 2 and 3 m/s" in why
-    speed, why = stability._root(lambda v: v - 2.5, 2.0, 3.0)
+    speed, why = summary._root(lambda v: v - 2.5, 2.0, 3.0)
     assert speed == pytest.approx(2.5, abs=1e-9) and why is None
 
 
@@ -444,7 +445,7 @@ class _WeaveTurnsIntoAnotherPair:
 
 def test_weave_pair_that_neither_stays_nor_splits_is_not_found_with_a_reason():
     """Before, ``max`` over the empty list of split partners raised ValueError."""
-    speed, why = stability._weave_speed(_WeaveTurnsIntoAnotherPair())
+    speed, why = summary._weave_speed(_WeaveTurnsIntoAnotherPair())
     assert speed is None and "without turning into two real eigenvalues" in why and "wobble" in why
 
 
@@ -484,7 +485,7 @@ def test_weave_crossing_before_the_split_is_the_weave_speed(speeds):
     while unstable, at a split speed interpolated from the samples (3.87 m/s on the 0.1 m/s grid); the
     weave is stable from its crossing, 3.82 m/s, and the capsize eigenvalue crosses zero after the split."""
     sweep = _split_sweep(speeds)
-    weave, how = stability._weave_speed(sweep)
+    weave, how = summary._weave_speed(sweep)
     assert weave == pytest.approx(3.82, abs=1e-8) and "crosses zero" in how
     capsize, how = stability.summary._capsize_speed(sweep, above=weave)
     assert capsize == pytest.approx(3.87 + (0.9 - math.sqrt(0.8)) / 2, abs=1e-8) and "after" in how
@@ -561,8 +562,10 @@ def test_arm_steer_mode_frequency_rises_with_arm_stiffness():
 
 
 def test_reflex_filter_poles_are_named_reflex_delay():
-    sc = DEFAULT.with_changes(controller="off", reflex_delay=0.1, reflex_roll=20.0, reflex_roll_rate=5.0)
-    res = stability.analyse(sc, [3.5, 4.0, 4.5])
+    # The open loop keeps the reflex (the body's, not the voluntary law's); controller "off" refuses a reflex
+    # (no rider torque at all), so the scenario keeps its rider.
+    sc = DEFAULT.with_changes(reflex_delay=0.1, reflex_roll=20.0, reflex_roll_rate=5.0)
+    res = stability.analyse(sc, [3.5, 4.0, 4.5], loops=("open",))
     assert len(_named(res.eigenvalues, 4.0, ["reflex_delay"])) >= 1
     model = res.models["open", 1]
     assert model.states[-4:] == slip.REFLEX_STATES and model.matrix.shape == (18, 18)

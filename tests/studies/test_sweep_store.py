@@ -104,3 +104,67 @@ def test_folder_of_another_sweep_is_refused_unless_extended(default_run, tmp_pat
     wk.sweep({"pressure_kpa": [300]}, base=BASE, folder=small, progress=False)
     both = wk.sweep({"pressure_kpa": [500]}, base=BASE, folder=small, progress=False, extend=True)
     assert list(both["pressure_kpa"]) == [300.0, 500.0]
+
+
+def _first_half(folder):
+    """The first half of a sweep (one 1 s case) in ``folder``; returns its base scenario."""
+    base = BASE.with_changes(duration=1.0)
+    wk.sweep({"pressure_kpa": [300]}, base=base, folder=folder, progress=False)
+    return base
+
+
+def test_a_sweep_folder_refuses_to_resume_under_other_result_code(tmp_path, monkeypatch):
+    """Issue 31 item 9 acceptance: the recovery rule changes from 5 % to 10 % between two halves of a sweep (the
+    issue found both rules side by side in one table). The folder hashes the code and data that make results
+    (provenance.code_hash), so the second half is refused in one line saying what to do, and the folder, its
+    manifest included, is left as the first half wrote it."""
+    from whipple_kick.simulate import analysis, provenance
+    folder = tmp_path / "halves"
+    base = _first_half(folder)
+    manifest = (folder / wk.sweep_store.MANIFEST_FILE).read_bytes()
+    source = analysis.__file__
+    read = provenance._read_source
+    rule = b"\nSETTLING_FRACTION = 0.05"
+    assert rule in read(source)
+
+    def ten_percent(path):
+        text = read(path)
+        return text.replace(rule, b"\nSETTLING_FRACTION = 0.10") if str(path) == source else text
+    monkeypatch.setattr(provenance, "_read_source", ten_percent)
+    provenance.code_hash.cache_clear()
+    try:
+        with pytest.raises(InputError) as info:
+            wk.sweep({"pressure_kpa": [300, 400]}, base=base, folder=folder, extend=True, progress=False)
+    finally:
+        provenance.code_hash.cache_clear()
+    message = str(info.value)
+    assert "\n" not in message and "holds results of other code" in message and "use a new folder" in message
+    assert (folder / wk.sweep_store.MANIFEST_FILE).read_bytes() == manifest
+    assert len(wk.sweep_store.read_log(folder)) == 1
+
+
+def test_a_resumed_sweep_keeps_its_first_provenance_and_adds_each_session(tmp_path):
+    """Issue 31 item 9: the manifest's provenance was written over on every open of the folder."""
+    folder = tmp_path / "halves"
+    base = _first_half(folder)
+    first = wk.sweep_store.read_manifest(folder)
+    assert first["code_hash"] == wk.provenance.code_hash() and len(first["sessions"]) == 1
+    assert first["sessions"][0] == first["provenance"]
+    wk.sweep({"pressure_kpa": [300, 400]}, base=base, folder=folder, extend=True, progress=False)
+    second = wk.sweep_store.read_manifest(folder)
+    assert second["provenance"] == first["provenance"] and len(second["sessions"]) == 2
+    assert second["sessions"][0] == first["sessions"][0]
+
+
+def test_a_folder_of_an_earlier_format_is_refused(tmp_path):
+    """A folder made before the code hash was recorded cannot be told to be this code's: refused in one line."""
+    import json
+    folder = tmp_path / "old"
+    base = _first_half(folder)
+    path = folder / wk.sweep_store.MANIFEST_FILE
+    manifest = json.loads(path.read_text())
+    del manifest["code_hash"]
+    manifest["format"] = 1
+    path.write_text(json.dumps(manifest))
+    with pytest.raises(InputError, match=r"earlier version of whipple_kick \(folder format 1, no code hash\)"):
+        wk.sweep({"pressure_kpa": [300]}, base=base, folder=folder, progress=False)

@@ -6,6 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+import whipple_kick as wk
 from whipple_kick.errors import InputError
 from whipple_kick.library import experiments
 from whipple_kick.simulate import analysis
@@ -163,7 +164,11 @@ def test_nine_cases_both_directions(nine_cases):
             signs.add(np.sign(peaks.values[0]))
         assert signs == {-1.0, 1.0}, c
     assert (out / "validation.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    assert files[:2] == ["validation.csv", "cases/ (18 trajectories)"]
+    assert files[:2] == ["validation.csv", "cases/ (18 run folders)"]
+    # Each case is a run folder (issue 31 item 20): Result.load gives back the run's summary and trajectory.
+    for name, run in result.runs.items():
+        loaded = wk.Result.load(out / "cases" / name)
+        assert loaded.summary == run["summary"] and list(loaded.trajectory.columns) == list(run["trajectory"].columns)
 
 
 def test_summary_compares_and_gives_verdicts(nine_cases):

@@ -64,13 +64,13 @@ def motion_limits(time, values, roll, fall_roll, time_range=None, steer=None, st
     time, values, roll : array_like
         Time [s], the signal, roll angle [rad] at the same samples.
     fall_roll : float
-        |roll| [rad] that counts as a fall.
+        ``|roll|`` [rad] that counts as a fall.
     time_range : (float, float), optional
         Only samples within it count [s].
     steer : array_like, optional
         Steer angle [rad] at the same samples.
     steer_limit : float, optional
-        |steer| [rad] that ends a run (None: no limit).
+        ``|steer|`` [rad] that ends a run (None: no limit).
 
     Returns
     -------

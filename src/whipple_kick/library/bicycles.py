@@ -98,11 +98,15 @@ class Bicycle(Mapping):
         For the authors' presets with rider: the rear-tyre load [N] the set
         is labelled with (thesis Table 8.3), which selects the Table 8.4
         gains; None otherwise.
+    defaults : Mapping
+        What the set's source lacks and was taken from a default: name ->
+        (value or None, source). Empty for the shipped sets; see
+        :mod:`whipple_kick.library.bicycleparameters`.
     """
 
     def __init__(self, *, name, benchmark=None, moore=None, parameterisation,
                  includes_rider, source, description="", uncertainties=None,
-                 geometry=None, tyre_placeholders=None, rider=None, thesis_rear_load_n=None):
+                 geometry=None, tyre_placeholders=None, rider=None, thesis_rear_load_n=None, defaults=None):
         if (benchmark is None) == (moore is None):
             raise InputError(f"bicycle {name!r}: give exactly one of benchmark or moore parameters")
         if benchmark is not None:
@@ -125,6 +129,7 @@ class Bicycle(Mapping):
         self.tyre_placeholders = types.MappingProxyType(dict(tyre_placeholders or {}))
         self.rider = None if rider is None else types.MappingProxyType(dict(rider))
         self.thesis_rear_load_n = None if thesis_rear_load_n is None else float(thesis_rear_load_n)
+        self.defaults = types.MappingProxyType(dict(defaults or {}))
 
     def __getitem__(self, key):
         return self._moore[key]
@@ -158,7 +163,9 @@ def load(name):
     ----------
     name : str or os.PathLike
         A shipped set (see :func:`available`), or the path of a ``.toml``
-        file in the same format.
+        file in the same format. (A scenario's bicycle may also be a
+        BicycleParameters folder: :func:`whipple_kick.library.bicycleparameters.load_bicycle`
+        reads either.)
 
     Returns
     -------

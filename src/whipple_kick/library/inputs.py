@@ -30,16 +30,16 @@ TABLE_PROFILE = "table"
 PROFILES = (*KICK_PROFILES, TABLE_PROFILE)
 #: The compiled model's cubic-segment profile (y = c0 + c1 tau + c2 tau^2 + c3 tau^3).
 SEGMENT_PROFILE = 2
-#: Peak |acceleration| of each profile as a multiple of displacement/duration^2:
+#: Peak ``|acceleration|`` of each profile as a multiple of displacement/duration^2:
 #: constant acceleration 2 D/T^2; minimum-jerk quintic 10/sqrt(3) D/T^2 (at s = 0.2113).
 PEAK_ACCEL_FACTOR = {"constant": 2.0, "smooth": 10.0 / math.sqrt(3.0)}
 DIRECTIONS = ("right", "left")
 #: The thesis' plate travel [m] and travel time [s] (Section 8.3): the defaults.
 DEFAULT_DISPLACEMENT = 0.150
 DEFAULT_DURATION = 0.150
-#: Plausibility caps of the kicks: plate travel [m] and peak |acceleration| [m/s^2] of the
+#: Plausibility caps of the kicks: plate travel [m] and peak ``|acceleration|`` [m/s^2] of the
 #: built-in profiles (the measured plate peaks were 30-40 m/s^2, Dell'Orto 2025 Section 8.4);
-#: peak |velocity| [m/s] is the most a built-in kick within both caps reaches (constant
+#: peak ``|velocity|`` [m/s] is the most a built-in kick within both caps reaches (constant
 #: profile: v = sqrt(a D)). A table is held to the travel and velocity caps, not to the
 #: acceleration cap: the built-in constant profile itself stops the plate instantly, and a
 #: table of it stops it within one row interval (6.9e3 m/s^2 at 1 kHz rows), so a plausible
@@ -62,7 +62,7 @@ class Kick:
     duration : float
         Time the plate moves [s] (a table: its time span).
     peak_acceleration : float
-        Peak |plate acceleration| [m/s^2] (a table: the spline's).
+        Peak ``|plate acceleration|`` [m/s^2] (a table: the spline's).
     displacement : float
         Net plate travel [m], + to the right.
     start : float
@@ -351,7 +351,7 @@ class KickTable:
 
     @property
     def peak_acceleration(self) -> float:
-        """Peak |y''| of the spline [m/s^2].
+        """Peak ``|y''|`` of the spline [m/s^2].
 
         y'' = 2 c2 + 6 c3 tau is linear in each segment, so its extremes are
         at the segment ends.
@@ -360,7 +360,7 @@ class KickTable:
 
     @property
     def peak_velocity(self) -> float:
-        """Peak |y'| of the spline [m/s] (from the roots of y'' in each segment)."""
+        """Peak ``|y'|`` of the spline [m/s] (from the roots of y'' in each segment)."""
         peak = 0.0
         for a, b, c in self.segments:
             taus = [0.0, b - a]

@@ -79,12 +79,14 @@ def file_bytes(path) -> bytes:
     Raises
     ------
     InputError
-        If the file is missing (one line, naming the file).
+        If the file is missing or cannot be read, e.g. it is a folder (one line, naming the file).
     """
     try:
         return pathlib.Path(path).read_bytes()
     except FileNotFoundError:
         raise InputError(f"parameter file {path} does not exist") from None
+    except OSError as exc:   # a folder, no permission: the input cannot be read (not an output failure)
+        raise InputError(f"parameter file {path} cannot be read: {exc.strerror or exc}") from None
 
 
 def parse_toml(path, content: bytes) -> dict:

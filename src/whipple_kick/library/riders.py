@@ -214,19 +214,39 @@ def yeadon_rider(name="jason", mass_kg=None, height_m=None):
     YeadonRider
     """
     data = _read_rider_file(name)
-    mass = data["mass"] if mass_kg is None else check_range(
-        "rider mass", mass_kg, 0.0, MAX_RIDER_MASS_KG, "kg", low_open=True)
-    meas = data["measurements"]
-    base_height = standing_height(meas)
+    return rider_from_measurements(name, data["measurements"], data["configuration"], data["source"],
+                                   mass_kg=data["mass"] if mass_kg is None else mass_kg, height_m=height_m)
+
+
+def rider_from_measurements(name, measurements, configuration, source, mass_kg, height_m=None):
+    """A :class:`YeadonRider` from its 95 measurements [m] and configuration [rad] (:func:`yeadon_rider`'s core).
+
+    Parameters
+    ----------
+    name, source : str
+        The rider's name and where the measurements come from.
+    measurements, configuration : Mapping
+        Yeadon's 95 measurements [m] and 21 joint angles [rad], by yeadon's names.
+    mass_kg : float
+        Rider mass [kg], in (0, 200].
+    height_m : float, optional
+        Standing height [m], in [1.2, 2.3] (see :func:`yeadon_rider`).
+    """
+    mass = check_range("rider mass", mass_kg, 0.0, MAX_RIDER_MASS_KG, "kg", low_open=True)
+    meas = dict(measurements)
     scale = 1.0
     if height_m is not None:
-        scale = check_range("rider height", height_m, 1.2, 2.3, "m") / base_height
+        scale = check_range("rider height", height_m, 1.2, 2.3, "m") / standing_height(meas)
         meas = {k: v * scale for k, v in meas.items()}
+    for key in _MUST_BE_ZERO:
+        if configuration.get(key, 0.0) != 0.0:
+            raise InputError(f"rider {name!r}: configuration {key} = {configuration[key]!r} rad must be 0 rad "
+                             "for seating on a bicycle (the legs must move in the mid-plane)")
     return YeadonRider(
         name=name, mass_kg=mass, height_m=standing_height(meas), length_scale=scale,
         measurements=types.MappingProxyType(meas),
-        configuration=types.MappingProxyType(data["configuration"]),
-        source=data["source"],
+        configuration=types.MappingProxyType(dict(configuration)),
+        source=source,
     )
 
 
@@ -482,7 +502,7 @@ def _with_rider(bike, rider, seated, bench, name, how):
         source=f"{bike.source}\nrider {rider.name}:\n{rider.source}",
         description=f"{bike.description} With Yeadon rider {rider.name!r} "
                     f"({rider.mass_kg:g} kg, {rider.height_m:.3f} m){how}",
-        uncertainties={}, geometry=bike.geometry, tyre_placeholders=bike.tyre_placeholders,
+        uncertainties={}, geometry=bike.geometry, tyre_placeholders=bike.tyre_placeholders, defaults=bike.defaults,
         rider={"name": rider.name, "mass_kg": rider.mass_kg, "height_m": rider.height_m,
                **{f"rider_{k}": v for k, v in seated.benchmark().items()}},
     )

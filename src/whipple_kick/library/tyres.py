@@ -25,7 +25,7 @@ import warnings
 
 import numpy as np
 
-from whipple_kick.errors import InputError, check_range
+from whipple_kick.errors import InputError, WhippleKickWarning, check_range
 from whipple_kick.model import magic_formula as mf
 
 from . import parameters
@@ -324,7 +324,7 @@ def load(name, pressure_kpa, coefficient_set=DEFAULT_COEFFICIENT_SET, friction="
     return Tyre(data, pressure_kpa, coefficient_set, friction, missing_moment)
 
 
-class DataQualityWarning(UserWarning):
+class DataQualityWarning(WhippleKickWarning):
     """A tyre file's own warning about its data (e.g. T02's fit that misses its published factors).
 
     Issued by :func:`load`; a run's summary lists it under
@@ -378,7 +378,7 @@ class Tyre:
         The tyre file's warning about its data.
     measured : dict or None
         The ranges the fits were measured over, from the file's ``[measured]``
-        table: ``slip_deg`` (|slip|, deg), ``load_min``, ``load_max`` (N).
+        table: ``slip_deg`` (``|slip|``, deg), ``load_min``, ``load_max`` (N).
     """
 
     def __init__(self, data, pressure_kpa, coefficient_set, friction, missing_moment):

@@ -64,8 +64,8 @@ import math
 
 #: Largest patch slip [deg] of the rising branch. Beyond it the steady curve's
 #: extreme is taken at the cap: T03's 500 kPa fit (C = 1.024) has no peak
-#: below 90 deg, and a patch slip near 90 deg would slide at |v_x| tan(a'),
-#: without bound. At 80 deg that is 5.7 |v_x|; the limit of T03 at 500 kPa,
+#: below 90 deg, and a patch slip near 90 deg would slide at ``|v_x|`` tan(a'),
+#: without bound. At 80 deg that is 5.7 ``|v_x|``; the limit of T03 at 500 kPa,
 #: 635 N, is then within 0.1 % of the curve's value at 89.9 deg (docs/tyres.md).
 PATCH_SLIP_CAP_DEG = 80.0
 #: Sliding viscosity [N s/m] past the friction limit (undamped carcass): a

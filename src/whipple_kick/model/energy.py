@@ -5,16 +5,18 @@ quadratures (:data:`QUADRATURE_STATES`, zero at the start of a run except
 the carcass tyre's stored energy, which starts at c y^2/2): the work done on
 the bicycle by the kick plate, the steer torque, the rear-wheel torque, the
 tyres' zero-slip forces and their aligning moments; the dissipation of the
-contact patches' sliding, of the vertical tyre dampers and of the carcass
-tyre's lateral dampers; and the energy stored in each tyre's lateral
+contact patches' sliding, of the vertical tyre dampers (and, with a
+rider's body, the hip and arm dampers: ``damper_dissipation``) and of the
+carcass tyre's lateral dampers; and the energy stored in each tyre's lateral
 carcass compliance.
 They obey, at every instant,
 
-    d(KE + PE + tyre springs + carcass_r + carcass_f)/dt
+    d(KE + PE + springs + carcass_r + carcass_f)/dt
         = plate + steer + wheel + zero-slip + moment - sliding - dampers - carcass dampers,
 
-so :func:`balance_residual` of a trajectory stays at integration accuracy
-(the plate stop's impulse adds its work to the plate's column; see
+where ``springs`` (``spring_energy``) are the vertical tyre springs and,
+with a body, the rider's hip and arm springs, so :func:`balance_residual`
+of a trajectory stays at integration accuracy (the plate stop's impulse adds its work to the plate's column; see
 :func:`whipple_kick.model.kane.impulsive_projection`). The split of the tyre's
 power is defined in :mod:`whipple_kick.model.transient`; docs/validation.md gives
 the argument and the measured sizes.

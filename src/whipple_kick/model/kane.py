@@ -63,7 +63,7 @@ class ConstraintPartition:
 
 
 def constraint_power(M, f, u, udot):
-    """Power of the constraint forces, ``u . (M du/dt - f)`` [W].
+    """Power of the constraint forces, ``u @ (M du/dt - f)`` [W].
 
     Kane's full equations read ``M du/dt = f + A^T lambda``, so this is
     ``lambda . (A u) = -lambda . a0``: zero for fixed constraints, the work

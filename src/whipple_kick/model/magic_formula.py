@@ -97,7 +97,7 @@ N_MZ_COEFFICIENTS = 18
 FY_OFFSET_INDICES = (9, 10, 12, 13)
 MZ_OFFSET_INDICES = (12, 13, 16, 17)
 #: Coefficients of the terms odd in camber: a8 (Sh) and a11 (Sv) of F_y, c11
-#: (Sh) and c14, c15 (Sv) of M_z. Every other camber term is in |gamma|, so
+#: (Sh) and c14, c15 (Sv) of M_z. Every other camber term is in ``|gamma|``, so
 #: negating these five equals evaluating the curves at the opposite camber
 #: (:func:`camber_reversed`).
 FY_CAMBER_ODD_INDICES = (8, 11)
@@ -180,7 +180,7 @@ def camber_reversed(coefficients, kind):
     ``F(slip, camber, Fz)`` with the returned coefficients equals
     ``F(slip, -camber, Fz)`` with ``coefficients``, exactly: the terms odd in
     camber change sign (:data:`FY_CAMBER_ODD_INDICES`,
-    :data:`MZ_CAMBER_ODD_INDICES`), the even ones (in |gamma|) do not. With
+    :data:`MZ_CAMBER_ODD_INDICES`), the even ones (in ``|gamma|``) do not. With
     it the thesis authors' published code is reproduced, which feeds the
     camber to the formula with the opposite sign to this module's mapping,
     so that a leaning wheel's camber thrust pushes away from the lean.
@@ -418,7 +418,7 @@ def cornering_stiffness_model(fz_n, a, friction_scale=1):
     return -sm.diff(force, slip).subs(slip, 0)
 
 
-#: |B x| (x = slip in deg) below which :func:`lateral_secant_model` uses its
+#: ``|B x|`` (x = slip in deg) below which :func:`lateral_secant_model` uses its
 #: series: the next term is O((B x)^4), below 1e-16 there, while the direct
 #: quotient loses digits to cancellation (sin and atan of a tiny argument).
 SECANT_SERIES_LIMIT = 1e-4

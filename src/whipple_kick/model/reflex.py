@@ -24,7 +24,10 @@ P. Graves-Morris, *Pade Approximants*, 2nd ed., Cambridge University Press
     D(x) = sum_j (L+M-j)! M! / ((L+M)! j! (M-j)!)   x^j,   j = 0..M
 
 N/D agrees with exp(-x) to order x^(L+M). :func:`pade_coefficients`
-returns them with D made monic.
+returns them with D made monic. They are python-control's
+``control.pade(tau, 4, numdeg=3)`` to 1 ulp (``tests/model/test_reflex.py``);
+the exact rationals are kept here because control's recursion rounds them
+(840.0000000000001 for 840), and so that no run imports python-control.
 
 The filter's states (:data:`STATE_NAMES`) are those of the controllable
 canonical form of :func:`realisation` in scaled time t' = t/tau; in real

@@ -14,7 +14,8 @@ It needs the Python headers (``Python.h``) beside the interpreter; where they
 are missing, or the compiler fails on them, :func:`module` returns None and
 :class:`whipple_kick.model.slip.CompiledRHS` keeps its ctypes call (the same
 numbers, slower: ``scripts/bench.py rhs`` shows which path is in use), and
-one warning line on stderr says so, once per process (:func:`_fall_back`).
+a :class:`~whipple_kick.errors.PerformanceWarning` says so, once per process
+(:func:`_fall_back`; a library caller can filter it).
 """
 import functools
 import hashlib
@@ -24,10 +25,11 @@ import platform
 import subprocess
 import sys
 import sysconfig
+import warnings
 
 import numpy as np
 
-from whipple_kick.errors import CacheError
+from whipple_kick.errors import CacheError, PerformanceWarning
 
 from . import cache
 
@@ -234,7 +236,7 @@ def module(compiler):
     Parameters
     ----------
     compiler : str
-        Path of the C compiler (:func:`whipple_kick.model.slip._compiler`).
+        Path of the C compiler (:func:`whipple_kick.model.slip.compiled._compiler`).
 
     Returns
     -------
@@ -280,10 +282,14 @@ _warned = False
 
 
 def _fall_back(why):
-    """Say once per process why the extension is not used and what it costs."""
+    """Say once per process why the extension is not used and what it costs.
+
+    A :class:`~whipple_kick.errors.PerformanceWarning` (not a print), so that a
+    library caller can filter it; the command-line tools print it as one line.
+    """
     global _warned
     if not _warned:
         _warned = True
-        print(f"whipple_kick: warning: the fast call into the compiled model is not available: {why}; "
-              f"using ctypes instead (same results, each model evaluation about {CTYPES_COST:g} times "
-              "as costly)", file=sys.stderr)
+        warnings.warn(f"the fast call into the compiled model is not available: {why}; using ctypes instead "
+                      f"(same results, each model evaluation about {CTYPES_COST:g} times as costly)",
+                      PerformanceWarning, stacklevel=2)

@@ -13,7 +13,7 @@ reduced to numbers in exactly the same way. Definitions (see
   the last such peak *relative to the kick*. Not a recovery time: the
   signal may still be at half its first peak then.
 * **Settling time** (:func:`settling_time`). Time after the kick from which
-  |signal - steady| stays within 5 % of the signal's first peak; the
+  ``|signal - steady|`` stays within 5 % of the signal's first peak; the
   **recovery time** (:func:`recovery`) is when yaw, roll and steer rates
   have all settled. The one definition of recovery in whipple_kick.
 * **Logarithmic decrement** (eq. 8.2) ``delta = (1/n) ln(|U0| / |Un|)``
@@ -73,9 +73,9 @@ METRIC_UNITS = {
 #: Peak pairs of the thesis' Tables 8.6-8.8, as (first, second) peak numbers.
 PEAK_PAIRS = ((1, 3), (2, 4), (3, 5))
 
-#: Recovery: |signal - steady| stays within this fraction of the signal's first peak.
+#: Recovery: ``|signal - steady|`` stays within this fraction of the signal's first peak.
 SETTLING_FRACTION = 0.05
-#: A signal's first peak is the first extremum of |signal - steady| after the kick that reaches
+#: A signal's first peak is the first extremum of ``|signal - steady|`` after the kick that reaches
 #: this fraction of the largest (a smaller lobe before it is a ripple, not the response).
 FIRST_PEAK_FRACTION = 0.5
 #: Signals that must all have settled for the bicycle to have recovered, with their units.
@@ -409,7 +409,7 @@ class Settling:
     time : float or None
         Settling time [s from the kick], None when the signal does not settle in the record.
     first_peak : float or None
-        |signal - baseline| at its first peak (signal units), None without a peak.
+        ``|signal - baseline|`` at its first peak (signal units), None without a peak.
     reason : str or None
         Why ``time`` is None.
     """
@@ -421,7 +421,7 @@ class Settling:
 
 def settling_time(t, signal, t_kick=0.0, baseline=0.0, *, fraction=SETTLING_FRACTION,
                   first_peak_fraction=FIRST_PEAK_FRACTION, label="signal"):
-    """Time after the kick from which |signal - baseline| stays within ``fraction`` of its first peak.
+    """Time after the kick from which ``|signal - baseline|`` stays within ``fraction`` of its first peak.
 
     The first peak is the first extremum of the deviation after the kick
     (:func:`yaw_rate_peaks` with ``threshold=first_peak_fraction``) that

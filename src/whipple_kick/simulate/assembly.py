@@ -24,7 +24,7 @@ from whipple_kick.simulate import steady
 
 from .scenario import LOW_INERTIA_KEYS, THESIS_DESIGN_SPEED
 
-#: |steady yaw rate| [rad/s] below which steady running counts as straight (a yaw-angle gain needs it).
+#: ``|steady yaw rate|`` [rad/s] below which steady running counts as straight (a yaw-angle gain needs it).
 STRAIGHT_YAW_RATE = 1e-9
 
 
@@ -103,7 +103,7 @@ def assemble(scenario, kick, *, tyres=None, gains=None) -> Assembly:
         (:class:`whipple_kick.simulate.steady.NoSteadyMotion`); a yaw-angle gain with
         a steady turn.
     """
-    custom = None if gains is None else custom_gains(gains)
+    custom = None if gains is None else custom_gains(gains, scenario)
     # Tyres first: a pressure outside the measured range is the commonest mistake and cheap to find.
     if tyres is None:
         rear, front, notes = build_tyres(scenario)
@@ -121,15 +121,9 @@ def assemble(scenario, kick, *, tyres=None, gains=None) -> Assembly:
         controller = scenario.controller
     else:
         gains, poles, controller = custom, None, "custom gains"
-    params = slip.model_parameters(moore, rear, front, gains=gains, symmetric=scenario.symmetric_tyres,
-                                   kick=kick.model_kick(), tyre_transient=scenario.tyre_transient,
-                                   reverse_camber=scenario.camber_sign == "reversed",
-                                   carcass_sliding=scenario.carcass_sliding, carcass_damping=scenario.carcass_damping,
-                                   carcass_viscosity=scenario.carcass_viscosity, slip_speed=scenario.slip_speed,
-                                   body=rider_body(scenario, info),
-                                   carcass_stiffness_scale=scenario.carcass_stiffness_scale)
+    params = model_parameters(scenario, kick, moore, info, rear, front, gains)
     found, start = steady.start_state(params, scenario, advice=_steady_advice(scenario, controller))
-    stability = linear_stability(scenario, moore, gains, found, controller)
+    stability = linear_stability(scenario, no_slip_plant(moore, design, info), gains, found, controller)
     steady_yaw_rate = float(start.x[slip.X["u3"]])
     if gains.get("kq3", 0.0) and abs(steady_yaw_rate) > STRAIGHT_YAW_RATE:
         # In a steady turn the yaw angle grows without bound, and so would kq3's torque.
@@ -140,6 +134,17 @@ def assemble(scenario, kick, *, tyres=None, gains=None) -> Assembly:
 
 
 # ------------------------------------------------------------------ the parts
+
+def model_parameters(scenario, kick, moore, info, rear, front, gains):
+    """The compiled model's parameters of ``scenario`` (before the steady motion's drive torque is found)."""
+    return slip.model_parameters(moore, rear, front, gains=gains, symmetric=scenario.symmetric_tyres,
+                                 kick=kick.model_kick(), tyre_transient=scenario.tyre_transient,
+                                 reverse_camber=scenario.camber_sign == "reversed",
+                                 carcass_sliding=scenario.carcass_sliding, carcass_damping=scenario.carcass_damping,
+                                 carcass_viscosity=scenario.carcass_viscosity, slip_speed=scenario.slip_speed,
+                                 body=rider_body(scenario, info),
+                                 carcass_stiffness_scale=scenario.carcass_stiffness_scale)
+
 
 def build_bicycle(scenario):
     """Bicycle with rider for ``scenario``: (moore parameters, design parameters, info dict).
@@ -159,18 +164,22 @@ def build_bicycle(scenario):
 
 def _file_stamp(name):
     """Modification time of a parameter file given by path (so an edited file is re-read)."""
+    from whipple_kick.library import bicycleparameters
     path = pathlib.Path(str(name))
+    if path.suffix != ".toml" and bicycleparameters.is_bicycleparameters_path(name):
+        return bicycleparameters.stamp(name)
     return path.stat().st_mtime_ns if path.suffix == ".toml" and path.is_file() else None
 
 
 @functools.lru_cache(maxsize=256)
 def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia, split=False, arms_on_bar=False):
-    from whipple_kick.library import bicycles, riders
+    from whipple_kick.library import bicycleparameters, riders
     from whipple_kick.model import benchmark
 
-    bike = bicycles.load(bicycle)
+    bike = bicycleparameters.load_bicycle(bicycle)
     if split and bike.includes_rider:
         raise _lumped_rider_error(bike)
+    _refuse_rider_file(bike, rider_name)
     if bike.includes_rider:
         if fz_n is not None or rider_mass_kg is not None:
             raise InputError(f"bicycle {bike.name!r} already includes its rider; "
@@ -199,10 +208,33 @@ def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia
             bench[key] *= 0.5
         moore = benchmark.to_moore(bench)
     info = {"bicycle": bike.name, "includes_rider_preset": bike.includes_rider,
+            # What the bicycle's source lacked, from defaults (a BicycleParameters set): name -> "value unit: source".
+            "defaults": bicycleparameters.describe_defaults(bike),
             "rider_mass_kg": rider_mass, "static_load_rear_n": rear_n, "static_load_front_n": front_n,
             "total_mass_kg": sum(float(combined.benchmark[k]) for k in ("mR", "mB", "mH", "mF"))
             + (body["mt"] if body else 0.0), "body": body}
     return moore, design, info
+
+
+def _refuse_rider_file(bike, rider_name):
+    """A preset with its rider lumped in seats no Yeadon rider: a rider file given with it would be ignored."""
+    from whipple_kick.simulate.scenario import Scenario
+
+    default = Scenario.__dataclass_fields__["rider"].default
+    if bike.includes_rider and rider_name != default:
+        raise InputError(f"bicycle {bike.name!r} already includes its rider; rider {rider_name!r} would be ignored: "
+                         f"leave it at its default {default!r} or choose a bicycle-only set")
+
+
+def no_slip_plant(moore, design, info):
+    """Moore parameters of the whole bicycle with rider, for the no-slip classic model of the run's plant.
+
+    ``moore`` itself for a rider lumped into the rear frame; with a rider's body (``info["body"]``)
+    ``moore`` holds the bicycle without the upper body, whose mass the classic model would leave out, so
+    the lumped ``design`` set (the whole rider, locked at the hip) is the plant. (``low_inertia``, the one
+    change ``design`` lacks, is refused with a body.)
+    """
+    return design if info.get("body") else moore
 
 
 def _lumped_rider_error(bike):
@@ -214,8 +246,8 @@ def _lumped_rider_error(bike):
 def _rear_load_range(bicycle, _stamp, rider_name):
     # The rear loads a rider can give the bicycle (a probe rider seated, ~10 ms) do not depend on the load:
     # a sweep over loads finds them once per process.
-    from whipple_kick.library import bicycles, riders
-    return riders.rear_load_range(bicycles.load(bicycle), rider_name)
+    from whipple_kick.library import bicycleparameters, riders
+    return riders.rear_load_range(bicycleparameters.load_bicycle(bicycle), rider_name)
 
 
 @functools.lru_cache(maxsize=256)
@@ -304,13 +336,8 @@ def lqr_on_simulated_model(scenario, moore, design, info, rear, front):
 
     speed = float(scenario.lqr_design_speed)
     body = rider_body(scenario, info)
-    felt = (["kq4", "kq7", "ku4", "ku7"] + (["kq11", "ku11"] if scenario.rider_body == "leaning" else [])
-            + (["kq3"] if scenario.lqr_heading else []))
-    K = np.r_[_lqr(tuple(sorted(design.items())), speed)[0], np.zeros(len(felt) - 4)]
-    if scenario.lqr_heading:   # start from the Whipple model's heading design (its yaw gain holds the heading)
-        whipple = dict(zip(control.HEADING_GAIN_ORDER, control.heading_lqr_gains(design, speed)[0], strict=True))
-        K = np.array([whipple.get(name, 0.0) for name in felt])
-    scaled = ("ka", "ca", "rq4", "rq7", "ru4", "ru7")
+    felt, K = simulated_design_start(scenario, design)
+    scaled = SCALED_BODY_GAINS
     models = {}
 
     def model(share):
@@ -345,6 +372,24 @@ def lqr_on_simulated_model(scenario, moore, design, info, rear, front):
     gains = dict.fromkeys(slip.GAIN_NAMES, 0.0)
     gains.update({name: float(scenario.gain_scale * k) for name, k in zip(felt, K, strict=True)})
     return gains, poles
+
+
+#: The body's gains (arms, reflex) the design on the simulated model brings in by continuation.
+SCALED_BODY_GAINS = ("ka", "ca", "rq4", "rq7", "ru4", "ru7")
+
+
+def simulated_design_start(scenario, design):
+    """The gains the design on the simulated model feeds back (``felt``) and its starting gains (Whipple design)."""
+    from . import control
+
+    speed = float(scenario.lqr_design_speed)
+    felt = (["kq4", "kq7", "ku4", "ku7"] + (["kq11", "ku11"] if scenario.rider_body == "leaning" else [])
+            + (["kq3"] if scenario.lqr_heading else []))
+    K = np.r_[_lqr(tuple(sorted(design.items())), speed)[0], np.zeros(len(felt) - 4)]
+    if scenario.lqr_heading:   # start from the Whipple model's heading design (its yaw gain holds the heading)
+        whipple = dict(zip(control.HEADING_GAIN_ORDER, control.heading_lqr_gains(design, speed)[0], strict=True))
+        K = np.array([whipple.get(name, 0.0) for name in felt])
+    return felt, K
 
 
 def _linear_design_model(scenario, moore, rear, front, body, felt, share, scaled):
@@ -397,13 +442,13 @@ def thesis_load(scenario):
     rider is labelled with (``balanceassist_635N``: 635 N), else 635 N for a
     bicycle whose rider is seated for the default load.
     """
-    from whipple_kick.library import bicycles
+    from whipple_kick.library import bicycleparameters
 
     if scenario.thesis_load_n is not None:
         return scenario.thesis_load_n
     if scenario.fz_n is not None:
         return scenario.fz_n
-    bike = bicycles.load(scenario.bicycle)
+    bike = bicycleparameters.load_bicycle(scenario.bicycle)
     if bike.includes_rider and bike.thesis_rear_load_n is not None:
         return bike.thesis_rear_load_n
     if scenario.rider_mass_kg is None and not bike.includes_rider:
@@ -417,11 +462,11 @@ def thesis_gains_warning(scenario):
 
     The run's load: the one a preset with rider is labelled with, or ``fz_n``.
     """
-    from whipple_kick.library import bicycles
+    from whipple_kick.library import bicycleparameters
 
     if scenario.controller != "thesis":
         return None
-    bike = bicycles.load(scenario.bicycle)
+    bike = bicycleparameters.load_bicycle(scenario.bicycle)
     own, what = ((bike.thesis_rear_load_n, f"bicycle {bike.name!r} is labelled") if bike.includes_rider
                  else (scenario.fz_n, "the rider is seated for"))
     gains = thesis_load(scenario)
@@ -458,17 +503,18 @@ def preflight(scenario):
     conflicts (a preset with its rider lumped in cannot lean or hold the bar), the Table 8.4 row of ``controller="thesis"``. Raises
     :class:`InputError`; returns ``scenario``.
     """
-    from whipple_kick.library import bicycles
+    from whipple_kick.library import bicycleparameters
     from whipple_kick.simulate import control
 
     scenario.validate()
     build_tyres(scenario)
-    bike = bicycles.load(scenario.bicycle)
+    bike = bicycleparameters.load_bicycle(scenario.bicycle)
     if bike.includes_rider and (scenario.fz_n is not None or scenario.rider_mass_kg is not None):
         raise InputError(f"bicycle {bike.name!r} already includes its rider; "
                          "do not give a rear-tyre load fz or a rider mass with it")
     if bike.includes_rider and (scenario.rider_body != "rigid" or scenario.arms == "on"):
         raise _lumped_rider_error(bike)
+    _refuse_rider_file(bike, scenario.rider)
     if scenario.controller == "thesis":
         control.thesis_gains(thesis_load(scenario))
     return scenario
@@ -537,11 +583,27 @@ def linear_stability(scenario, moore, gains, found, controller_type):
     if not stable:
         message = (f"{who_rides(scenario, controller_type)} is linearly unstable at {scenario.speed:g} m/s: "
                    f"slowest closed-loop pole {_pole_text(slowest)} 1/s ({model}; no-slip model "
-                   f"{_pole_text(classic[0])} 1/s)")
+                   f"{_pole_text(classic[0])} 1/s)" + _stabilising_advice(scenario, controller_type))
     pairs = lambda poles: None if poles is None else [[float(p.real), float(p.imag)] for p in poles]
     return {"stable": stable, "message": message, "slowest_pole_1_s": pairs([slowest])[0], "model": model,
             "poles_slip_model_1_s": pairs(slip_poles), "poles_no_slip_model_1_s": pairs(classic),
             "criterion": f"unstable when a closed-loop pole has real part > {UNSTABLE_REAL_PART:g} 1/s"}
+
+
+def _stabilising_advice(scenario, controller_type):
+    """What may make an unstable rider stable, as the end of :func:`linear_stability`'s message ("" if nothing)."""
+    if controller_type != "lqr":
+        return ""
+    changes = []
+    if scenario.lqr_model == "whipple" and (scenario.rider_body != "rigid" or scenario.arms == "on"):
+        body = " and ".join(part for part, used in (("a leaning upper body", scenario.rider_body != "rigid"),
+                                                    ("arms on the bar", scenario.arms == "on")) if used)
+        changes.append(f"the rider is designed on the Whipple model without {body}: design it on the model "
+                       "simulated (--lqr-model simulated, lqr_model='simulated')")
+    if scenario.design_speed is not None and scenario.design_speed != scenario.speed:
+        changes.append(f"it is designed at {scenario.design_speed:g} m/s: leave the design speed unset (the run's "
+                       "speed)")
+    return "; " + "; or ".join(changes) if changes else ""
 
 
 def _pole_text(pole):
@@ -549,16 +611,38 @@ def _pole_text(pole):
     return text + (f" +- {abs(pole.imag):.3f}j" if abs(pole.imag) > 1e-9 else "")
 
 
-def custom_gains(gains):
-    """Check user-given steer-torque gains (by name) and fill the missing ones with 0."""
+#: Scenario fields that choose or shape the rider's voluntary gains: user-given gains replace them all.
+CONTROLLER_FIELDS = ("controller", "design_speed", "gain_scale", "thesis_load_n", "lqr_model", "lqr_heading")
+
+
+def custom_gains(gains, scenario=None):
+    """Check user-given steer-torque gains (by name) and fill the missing ones with 0.
+
+    Every gain given is used (none is dropped): the upper body's lean gains
+    ``kq11``/``ku11`` need ``scenario.rider_body="leaning"`` (a rigid rider has
+    no lean to feed back). With ``scenario``, its fields that the given gains
+    replace (:data:`CONTROLLER_FIELDS`) must be at their defaults.
+    """
+    from dataclasses import fields
+
     from whipple_kick.model import symbols
     from whipple_kick.simulate import control
 
     unknown = sorted(set(gains) - set(slip.GAIN_NAMES))
     if unknown:
         raise InputError(f"unknown steer-torque gain(s) {unknown}; known: {list(slip.GAIN_NAMES)}")
-    # The four of the thesis' law always; the yaw gains only when given.
-    names = control.GAIN_ORDER + tuple(n for n in ("kq3", "ku3") if n in gains)
+    if scenario is not None:
+        defaults = {f.name: f.default for f in fields(scenario)}
+        for name in CONTROLLER_FIELDS:
+            if getattr(scenario, name) != defaults[name]:
+                raise InputError(f"{name} = {getattr(scenario, name)!r} is replaced by the given gains (it would be "
+                                 f"ignored): leave it at its default {defaults[name]!r} with gains=")
+        lean = [n for n in ("kq11", "ku11") if gains.get(n, 0.0) != 0.0]
+        if lean and scenario.rider_body != "leaning":
+            raise InputError(f"gain(s) {lean} feed back the upper body's lean, which only rider_body 'leaning' "
+                             f"has (here {scenario.rider_body!r}); allowed: 0 or a leaning rider")
+    # The four of the thesis' law always; the others (yaw, the upper body's lean) when given.
+    names = control.GAIN_ORDER + tuple(n for n in slip.GAIN_NAMES if n in gains and n not in control.GAIN_ORDER)
     return {name: check_range(f"gain {name}", gains.get(name, 0.0), None, None, symbols.info(name).unit)
             for name in names}
 

@@ -9,7 +9,7 @@ the settle before the kick on its own (display only, with the heading fixed
 at the kick), the kick and the rest of the run across the kick's
 breakpoints, the constant-acceleration profile's instant plate stop as a
 velocity jump (:func:`whipple_kick.model.slip.velocity_jump`), a kick table as one
-parameter set per table interval. A fall (|roll| or |steer| beyond its
+parameter set per table interval. A fall (``|roll|`` or ``|steer|`` beyond its
 limit, :func:`end_limits`) ends it as an event. The result is one
 :class:`Solution`, handed to :mod:`whipple_kick.simulate.results`.
 """
@@ -118,7 +118,7 @@ def sample_times(scenario):
 
 
 def end_limits(scenario):
-    """The limits that end a run as lost (``lsoda.integrate`` keywords): |roll| and |steer| [rad]."""
+    """The limits that end a run as lost (``lsoda.integrate`` keywords): ``|roll|`` and ``|steer|`` [rad]."""
     return {"fall_angle": math.radians(scenario.fall_angle_deg),
             "steer_limit": None if scenario.steer_limit_deg is None else math.radians(scenario.steer_limit_deg)}
 

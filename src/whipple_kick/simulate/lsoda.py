@@ -5,7 +5,7 @@ jumps at the start and end of the kick. Asking an adaptive integrator to
 step over such a jump costs accuracy and steps; instead each smooth piece
 is integrated on its own and the state is carried across the breakpoint,
 through a jump map where the caller gives one (the plate stop's impulse).
-A fall (|roll| beyond a limit) ends the run as an event, not an error.
+A fall (``|roll|`` beyond a limit) ends the run as an event, not an error.
 LSODA's stiff steps use the compiled model's Jacobian (forward differences
 in C over the dynamic states, one foreign call; the energy quadratures feed
 nothing back). LSODA calls the compiled model through
@@ -254,7 +254,7 @@ class _PastTheLimit(Exception):
 
 
 def _guarded(rhs, roll_index, fall_angle, steer_index, steer_limit):
-    """``f(t, x)`` that raises :class:`_PastTheLimit` once |roll| or |steer| passes its limit.
+    """``f(t, x)`` that raises :class:`_PastTheLimit` once ``|roll|`` or ``|steer|`` passes its limit.
 
     Odeint has no events, and integrating a fallen bicycle onwards is wasted
     work, so the fast path stops as soon as a limit is passed.
@@ -270,7 +270,7 @@ def _guarded(rhs, roll_index, fall_angle, steer_index, steer_limit):
 
 
 def _within_limits(states, roll_index, fall_angle, steer_index, steer_limit):
-    """Whether every row of ``states`` has |roll| and |steer| inside their limits."""
+    """Whether every row of ``states`` has ``|roll|`` and ``|steer|`` inside their limits."""
     return bool(np.all(np.abs(states[:, roll_index]) < fall_angle) and np.all(np.abs(states[:, steer_index]) < steer_limit))
 
 
@@ -330,9 +330,9 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
     output_rate : float
         Sample rate of the output [Hz] (when ``samples`` is not given).
     fall_angle : float
-        |roll| limit [rad] ending the run.
+        ``|roll|`` limit [rad] ending the run.
     steer_limit : float, optional
-        |steer| limit [rad] ending the run too (None: no limit). Past 90 deg
+        ``|steer|`` limit [rad] ending the run too (None: no limit). Past 90 deg
         the front wheel rolls backwards, which the tyre model does not
         describe, and no rider recovers from it.
     chunk : float, optional

@@ -101,9 +101,10 @@ def sha256(path) -> str:
     Example
     -------
     >>> import tempfile
-    >>> path = pathlib.Path(tempfile.mkdtemp()) / "empty.csv"
-    >>> _ = path.write_bytes(b"")
-    >>> sha256(path)[:16]
+    >>> with tempfile.TemporaryDirectory() as folder:   # removed afterwards
+    ...     path = pathlib.Path(folder) / "empty.csv"
+    ...     _ = path.write_bytes(b"")
+    ...     sha256(path)[:16]
     'e3b0c44298fc1c14'
     """
     digest = hashlib.sha256()
@@ -111,6 +112,49 @@ def sha256(path) -> str:
         for block in iter(lambda: fh.read(1 << 20), b""):
             digest.update(block)
     return digest.hexdigest()
+
+
+#: The package's folders whose Python makes a run's result (the equations, the parameter sets and their readers,
+#: one run from scenario to summary); a sweep's records are those summaries, flattened (simulate/results.py).
+RESULT_CODE = ("model", "library", "simulate")
+
+
+def _read_source(path) -> bytes:
+    """The bytes of one file :func:`code_hash` covers (a seam for tests that change the code)."""
+    return pathlib.Path(path).read_bytes()
+
+
+def result_sources() -> list:
+    """The files :func:`code_hash` covers: the ``*.py`` of :data:`RESULT_CODE` and the shipped parameter files."""
+    from whipple_kick.library import parameters
+
+    files = [p for folder in RESULT_CODE for p in (PACKAGE_DIR.parent / folder).rglob("*.py")]
+    files += [p for kind in ("bicycles", "riders", "tyres", "experiments")
+              for p in parameters.shipped(kind).rglob("*.toml")]
+    return sorted(files)
+
+
+@functools.cache
+def code_hash() -> str:
+    """SHA-256 (20 hex digits) of the code and data that make a run's result: :func:`result_sources`.
+
+    Two processes with the same hash compute the same result from the same
+    scenario (with the same dependencies and compiled model: the sweep
+    folder also records ``model_hash``). Read once per process (about 60
+    files, about 50 ms): a process runs the code it imported.
+
+    Example
+    -------
+    >>> len(code_hash()), code_hash() == code_hash()
+    (20, True)
+    """
+    digest = hashlib.sha256()
+    top = PACKAGE_DIR.parent.parent
+    for path in result_sources():
+        name = path.relative_to(top) if path.is_relative_to(top) else path.name
+        digest.update(f"{name}\n".encode())
+        digest.update(hashlib.sha256(_read_source(path)).digest())
+    return digest.hexdigest()[:20]
 
 
 def input_files(scenario, custom_tyres=False) -> dict:

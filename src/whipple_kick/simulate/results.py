@@ -166,7 +166,11 @@ class Result:
             scenario = Scenario(**summary["scenario"])
         except (ValueError, KeyError, TypeError) as exc:
             raise InputError(f"{str(path / SUMMARY_FILE)!r} is not a run summary: {exc}") from None
-        return cls(scenario=scenario, trajectory=read_trajectory(path / TRAJECTORY_FILE), summary=summary)
+        except OSError as exc:   # no permission: the input cannot be read (not an output failure)
+            raise InputError(f"{str(path / SUMMARY_FILE)!r} cannot be read: {exc.strerror or exc}") from None
+        trajectory = read_trajectory(path / TRAJECTORY_FILE)
+        check_trajectory(trajectory, summary, scenario, path / TRAJECTORY_FILE)
+        return cls(scenario=scenario, trajectory=trajectory, summary=summary)
 
 
 #: The files of a run folder (:meth:`Result.save`).
@@ -264,6 +268,51 @@ def with_units(frame):
     return frame.rename(columns={c: f"{c} [{UNITS[c]}]" for c in frame.columns})
 
 
+def check_trajectory(frame, summary, scenario, path):
+    """Refuse a trajectory table that is not the whole run its summary describes (one-line InputError).
+
+    The run's samples are known from the scenario and the summary: every
+    multiple of 1/``output_rate`` from ``-settle`` to ``end_time_s``
+    (:func:`whipple_kick.simulate.integration.sample_times`; a fall or a failure
+    ends the run early and adds its own last sample). A table cut short (an
+    interrupted copy, a full disk), one with a row missing, a row of text or
+    an empty cell (a row cut in the middle) is refused, naming what is wrong.
+    Times are compared to 1e-9 s: trajectory.csv keeps 13 significant digits.
+    """
+    from .integration import sample_times
+
+    where = f"{str(path)!r}"
+    if "time" not in frame:
+        raise InputError(f"{where} has no time column ('time [s]'): not a trajectory of simulate")
+    if not all(str(t).startswith(("float", "int")) for t in frame.dtypes):
+        bad = next(c for c, t in frame.dtypes.items() if not str(t).startswith(("float", "int")))
+        raise InputError(f"{where}: column {bad!r} holds a value that is not a number (a damaged file)")
+    values = frame.to_numpy(dtype=float)
+    if values.size and not np.isfinite(values).all():
+        row = int(np.flatnonzero(~np.isfinite(values).all(axis=1))[0])
+        raise InputError(f"{where}: row {row + 2} has an empty or non-finite cell (a damaged or truncated file)")
+    time = frame["time"].to_numpy(dtype=float)
+    tol = 1e-9
+    try:
+        end = float(summary["end_time_s"])
+    except (KeyError, TypeError, ValueError):
+        raise InputError(f"{str(path.parent / SUMMARY_FILE)!r} has no end_time_s: not a run summary") from None
+    expected = sample_times(scenario)
+    expected = expected[expected <= end + tol]
+    if not time.size or abs(time[-1] - end) > tol or abs(time[0] - expected[0]) > tol:
+        last = f"{time[-1]:g} s" if time.size else "no rows"
+        raise InputError(f"{where} is truncated or not this run's: it ends at {last} with {time.size} rows, but "
+                         f"{SUMMARY_FILE} says the run went from {expected[0]:g} to {end:g} s "
+                         f"({expected.size} samples at {scenario.output_rate:g} Hz or more)")
+    if np.any(np.diff(time) < 0.0):
+        raise InputError(f"{where}: the time column decreases (a damaged file)")
+    found = np.searchsorted(time, expected - tol)
+    missing = (found >= time.size) | (np.abs(time[np.minimum(found, time.size - 1)] - expected) > tol)
+    if missing.any():
+        raise InputError(f"{where} misses {int(missing.sum())} of the run's {expected.size} samples (the first at "
+                         f"time {expected[missing][0]:g} s): a damaged file")
+
+
 def read_trajectory(path):
     """trajectory.csv as a DataFrame with the plain column names of :attr:`Result.trajectory` (units dropped).
 
@@ -281,16 +330,21 @@ def response_metrics(df, baseline, x0, scenario, traj):
 
     fall_roll = math.radians(scenario.fall_angle_deg)
     ended = None
-    if traj.fell:
+    if traj.fell and traj.fall_time < 0.0:
+        # A rider unstable enough to fall while riding steadily (linear_stability says so): no kick response.
+        ended = f"fell {-traj.fall_time:.3f} s before the kick start: there is no response to the kick"
+    elif traj.fell:
         ended = f"fell {traj.fall_time:.3f} s after the kick start"
     elif traj.failed:
         ended = "the integration failed before the end of the run"
+    if traj.fell and traj.fall_time < 0.0:
+        return no_response_metrics(ended), {"time_s": None, "reason": ended, "signals": {}}
     try:
         metrics = analysis.kick_metrics(df, t_kick=0.0, baseline=baseline, include_spectra=False,
                                         fall_roll=fall_roll)
         rec = analysis.recovery(df, 0.0, rate_baselines(x0), ended=ended)
     except InputError as exc:   # a failure so early that too little of the response exists
-        metrics = {"unavailable": {"all": f"no response to analyse: {exc}"}}
+        metrics = no_response_metrics(f"no response to analyse: {exc}")
         rec = {"time_s": None, "reason": ended or str(exc), "signals": {}}
     # The fall is the integrator's exact event (summary fell, fall_time_s): kick_metrics' own estimate of it,
     # from |roll| up to the limit, is left out of the summary (DUPLICATE_METRICS).
@@ -299,6 +353,21 @@ def response_metrics(df, baseline, x0, scenario, traj):
         # The last peak above 8 % before a fall or a failure is not the end of the response.
         metrics["last_peak_time"], unavailable["last_peak_time"] = None, ended
     return metrics, rec
+
+
+def no_response_metrics(reason):
+    """The metrics of a run without a response to analyse (say a fall before the kick): every one unavailable.
+
+    The same keys as :func:`whipple_kick.simulate.analysis.kick_metrics` gives (no peaks, each
+    peak metric None), so tables of runs keep their columns; ``unavailable`` names ``reason`` for each.
+    """
+    from . import analysis
+
+    keys = ["peak_times", "peak_values", "last_peak_time",
+            *(f"{name}_{a}_{b}" for a, b in analysis.PEAK_PAIRS for name in ("log_decrement", "damping_ratio",
+                                                                              "period")), "period"]
+    return {"n_peaks": 0, "peak_times": [], "peak_values": [], "peak_stop_reason": reason,
+            **dict.fromkeys(keys[2:]), "unavailable": dict.fromkeys(keys, reason)}
 
 
 #: The recovery's signals and the states they are: column -> state.
@@ -412,7 +481,9 @@ def _energy_summary(df, jumps, scenario):
     residual = np.abs(df[BALANCE_COLUMN].to_numpy())
     return {
         "convention": ("works done ON the bicycle and dissipations, cumulative from the kick start (J); "
-                       "stored = kinetic + potential + tyre springs + carcasses; balance residual = "
+                       "stored = kinetic + potential + springs (vertical tyre springs, and with a rider's body the hip "
+                       "and arm springs) + carcasses; dampers = vertical tyre dampers and, with a body, the hip "
+                       "and arm dampers; balance residual = "
                        "change of stored - (works - dissipations)"),
         **totals,
         "stored_change_after_kick_j": float(stored[-1] - stored[after][0]) if after.any() else 0.0,
@@ -519,7 +590,7 @@ def _carcass_section(scenario, assembly, start_outputs):
 def extrapolation(frame, rear, front):
     """Where a run leaves the ranges its tyre fits were measured over (after the kick start).
 
-    Per wheel: the measured |slip| and load range (the tyre file's
+    Per wheel: the measured ``|slip|`` and load range (the tyre file's
     ``[measured]`` table, None when it has none) and the time [s] the patch
     slip (the slip the steady curve is evaluated at), the kinematic slip and
     the normal load spend outside them, with their extremes.
@@ -555,7 +626,10 @@ def extrapolation(frame, rear, front):
         load = after(f"fz_{wheel}")
         entry = {"max_abs_patch_slip_deg": float(patch.max(initial=0.0)),
                  "max_abs_kinematic_slip_deg": float(kinematic.max(initial=0.0)),
-                 "max_load_n": float(load.max(initial=0.0)), "min_load_n": float(load.min(initial=0.0))}
+                 # The true extremes over the run after the kick (None when it has no such sample): an
+                 # ``initial`` of 0 would make every minimum of a positive load 0.
+                 "max_load_n": float(load.max()) if load.size else None,
+                 "min_load_n": float(load.min()) if load.size else None}
         if measured is None:
             entry["measured"] = None
         else:
@@ -575,7 +649,7 @@ def extrapolation_line(summary):
     parts = []
     for wheel, e in (summary["tyres"].get("extrapolation") or {}).items():
         m = e.get("measured")
-        if not m:
+        if not m or e["max_load_n"] is None:   # no tyre data, or no sample after the kick start
             continue
         parts.append(f"{wheel}: patch slip beyond +-{m['slip_deg']:g} deg for {e['patch_slip_beyond_s']:.2f} s "
                      f"(max {e['max_abs_patch_slip_deg']:.0f} deg; kinematic slip max "

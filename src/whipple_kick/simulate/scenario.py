@@ -140,9 +140,9 @@ class Scenario:
     output_rate : float
         Samples per second of the trajectory [Hz].
     fall_angle_deg : float
-        |roll| [deg] that counts as a fall and ends the run.
+        ``|roll|`` [deg] that counts as a fall and ends the run.
     steer_limit_deg : float or None
-        |steer| [deg] that also ends the run as lost (``fall_reason``
+        ``|steer|`` [deg] that also ends the run as lost (``fall_reason``
         "steer"): past 90 deg the front wheel rolls backwards, which the tyre
         model (forward rolling, pneumatic trail behind the contact) does not
         describe, and no rider recovers from a fork turned over. Without
@@ -259,6 +259,8 @@ class Scenario:
         relative to its contact (rolling, pitching, steering); the
         trajectory's ``rolling_speed_*`` columns are the speed in use.
 
+    Notes
+    -----
     The fields fall in four groups (:data:`FIELD_GROUPS`; :attr:`physics`,
     :attr:`run`, :attr:`numerics`, :attr:`compatibility` give each as a
     dict): the **physics** of the bicycle, rider, tyres, control and kick;
@@ -486,6 +488,13 @@ class Scenario:
         if self.controller == "off" and self.gain_scale != 1.0:
             raise InputError(f"gain scale = {self.gain_scale:g} conflicts with controller off "
                              "(there are no gains to scale)")
+        self._refuse_unused()
+        if self.low_inertia and (self.rider_body != "rigid" or self.arms != "off"):
+            # Halving the rear frame's zB and inertias with the upper body split off it would lower the whole
+            # mass centre far less than for the rigid rider (0.943 -> 0.773 m, not 0.500 m): not Figure 8.9's variant.
+            raise InputError(f"low_inertia halves the rear frame with the whole rider lumped into it (thesis Figure "
+                             f"8.9); it conflicts with rider_body {self.rider_body!r} / arms {self.arms!r}: allowed "
+                             "with rider_body 'rigid' and arms 'off'")
         if self.fz_n is not None and self.rider_mass_kg is not None:
             raise InputError("give the rear-tyre load fz (N) or the rider mass (kg), not both")
         if self.fz_n is not None:
@@ -496,6 +505,35 @@ class Scenario:
                 check_range(name, p, 0.0, None, "kPa", low_open=True)
         inputs.kick_of(self)
         return self
+
+    def unused_fields(self) -> dict:
+        """Fields given (other than their defaults) that no mechanism of this scenario reads: field -> why.
+
+        From :data:`MECHANISM_FIELDS`; :meth:`validate` refuses each of them
+        (a field accepted and then ignored would let a sweep over it return
+        identical rows). A field equal to its default is never "given".
+
+        Example
+        -------
+        >>> Scenario(arm_stiffness=5.0).unused_fields()
+        {'arm_stiffness': "the arms on the bar (arms 'on')"}
+        """
+        defaults = {f.name: f.default for f in fields(self)}
+        unused = {}
+        for mechanism, condition, active, names in MECHANISM_FIELDS:
+            for name in names:
+                if name not in unused and getattr(self, name) != defaults[name] and not active(self):
+                    unused[name] = f"{mechanism} ({condition})"
+        if self.pressure_front_kpa is not None and self.pressure_rear_kpa is not None \
+                and self.pressure_kpa != defaults["pressure_kpa"]:
+            unused["pressure_kpa"] = "a tyre without its own pressure (pressure_front_kpa and pressure_rear_kpa are both given)"
+        return unused
+
+    def _refuse_unused(self):
+        for name, why in self.unused_fields().items():
+            default = {f.name: f.default for f in fields(self)}[name]
+            raise InputError(f"{name} = {getattr(self, name)!r} is read only by {why}, which this scenario does not "
+                             f"use: leave it at its default {default!r} (it would be ignored)")
 
     def to_dict(self) -> dict:
         """Fields as a plain dict (JSON-ready)."""
@@ -512,9 +550,10 @@ class Scenario:
         Example
         -------
         >>> import pathlib, tempfile
-        >>> path = pathlib.Path(tempfile.mkdtemp()) / "scenario.toml"
-        >>> Scenario(pressure_kpa=300.0, design_speed=3.0).to_file(path)
-        >>> Scenario.from_file(path) == Scenario(pressure_kpa=300.0, design_speed=3.0)
+        >>> with tempfile.TemporaryDirectory() as folder:   # removed afterwards
+        ...     path = pathlib.Path(folder) / "scenario.toml"
+        ...     Scenario(pressure_kpa=300.0, design_speed=3.0).to_file(path)
+        ...     Scenario.from_file(path) == Scenario(pressure_kpa=300.0, design_speed=3.0)
         True
         """
         import json
@@ -566,6 +605,8 @@ class Scenario:
             raise InputError(f"{label} does not exist") from None
         except IsADirectoryError:
             raise InputError(f"{label} is a folder, not a file") from None
+        except OSError as exc:   # no permission, an I/O error: the input cannot be read
+            raise InputError(f"{label} cannot be read: {exc.strerror or exc}") from None
         except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
             raise InputError(f"{label} is not valid TOML: {exc}") from None
         types = {f.name: f.type for f in fields(cls)}
@@ -611,6 +652,35 @@ def _is_path(name, value):
     text = str(value)
     return name == "kick_table" or text.endswith(".toml") or "/" in text or "\\" in text
 
+
+_REFLEX_GAINS = ("reflex_roll", "reflex_roll_rate", "reflex_steer", "reflex_steer_rate")
+
+#: Which mechanism reads which fields: (mechanism, when it is in use (words), when it is in use (test),
+#: the fields nothing else reads). :meth:`Scenario.validate` refuses a field given other than its default
+#: while its mechanism is off (:meth:`Scenario.unused_fields`): refused rather than warned, because a
+#: warning is lost among a sweep's cases and the run's scenario.toml would still record a value that
+#: did nothing. tests/simulate/test_unused_fields.py walks every field through every mechanism switch.
+MECHANISM_FIELDS = (
+    ("the carcass tyre", "tyre_transient 'carcass'", lambda s: s.tyre_transient == "carcass",
+     ("carcass_sliding", "carcass_damping", "carcass_viscosity", "carcass_stiffness_scale")),
+    ("the leaning upper body", "rider_body 'leaning'", lambda s: s.rider_body == "leaning",
+     ("hip_stiffness", "hip_damping")),
+    ("the arms on the bar", "arms 'on'", lambda s: s.arms == "on", ("arm_stiffness", "arm_damping")),
+    # "off" is no rider torque at all: neither the voluntary law nor the reflex steers.
+    ("the rider's steer control", "controller 'lqr' or 'thesis'; controller 'off' applies no rider torque",
+     lambda s: s.controller != "off", ("gain_scale", "reflex_delay") + _REFLEX_GAINS),
+    ("the reflex", "a reflex gain other than 0", lambda s: any(getattr(s, g) != 0.0 for g in _REFLEX_GAINS),
+     ("reflex_delay",)),
+    ("the LQR rider", "controller 'lqr'", lambda s: s.controller == "lqr", ("design_speed", "lqr_model")),
+    ("the LQR rider designed on the model simulated", "controller 'lqr', lqr_model 'simulated'",
+     lambda s: s.controller == "lqr" and s.lqr_model == "simulated", ("lqr_heading",)),
+    ("the thesis' Table 8.4 rider", "controller 'thesis'", lambda s: s.controller == "thesis", ("thesis_load_n",)),
+    # The integration applies the plate stop's speed change only where the plate stops instantly.
+    ("the instant plate stop", "kick_profile 'constant' and piecewise", lambda s: s.kick_profile == "constant"
+     and s.piecewise, ("plate_stop",)),
+    ("the steady start", "start 'steady'", lambda s: s.start == "steady", ("kick_heading",)),
+    ("the upright start", "start 'upright'", lambda s: s.start == "upright", ("start_pitch",)),
+)
 
 #: Every field of :class:`Scenario` in exactly one group (a test checks it).
 FIELD_GROUPS = {

@@ -16,8 +16,9 @@ fall). docs/simulate.md lists every decision.
 """
 from collections.abc import Mapping
 import time
+import warnings
 
-from whipple_kick.errors import SimulationError
+from whipple_kick.errors import SimulationError, UnstableRiderWarning
 from whipple_kick.library import inputs
 from whipple_kick.simulate import assembly, integration, results
 
@@ -39,10 +40,13 @@ def run(scenario: Scenario, *, tyres: tuple | None = None, gains: Mapping | None
         e.g. :func:`whipple_kick.library.tyres.linear_tyre` or a :class:`~whipple_kick.library.tyres.Tyre`
         loaded with other options. The summary names them.
     gains : mapping, optional
-        Steer-torque gains by name (``kq4 kq7 ku4 ku7``, and the yaw gains
-        ``kq3 ku3``; N m/rad, N m s/rad; missing ones are 0) instead of the
-        scenario's controller; the law is still ``T7 = -K x``.
-        ``scenario.gain_scale`` does not apply to them. A yaw-angle gain
+        Steer-torque gains by name (``kq4 kq7 ku4 ku7``, the yaw gains
+        ``kq3 ku3`` and, for a leaning rider, the upper body's lean gains
+        ``kq11 ku11``; N m/rad, N m s/rad; missing ones are 0) instead of the
+        scenario's controller; the law is still ``T7 = -K x``. The
+        scenario's controller fields (``controller``, ``design_speed``,
+        ``gain_scale``, ``thesis_load_n``, ``lqr_model``, ``lqr_heading``)
+        must stay at their defaults: the gains replace them. A yaw-angle gain
         (e.g. from :func:`whipple_kick.simulate.control.heading_lqr_gains`) needs a
         straight steady motion, so tyres without zero-slip offsets.
 
@@ -61,6 +65,12 @@ def run(scenario: Scenario, *, tyres: tuple | None = None, gains: Mapping | None
         stalled beyond :data:`whipple_kick.simulate.lsoda.DEFAULT_BUDGET`. Its
         ``partial`` holds the result up to the failure.
 
+    Warns
+    -----
+    UnstableRiderWarning
+        Before the integration, when the rider in use is linearly unstable at
+        the run's speed (``summary["linear_stability"]`` holds the same line).
+
     Example
     -------
     >>> import whipple_kick as wk
@@ -71,6 +81,9 @@ def run(scenario: Scenario, *, tyres: tuple | None = None, gains: Mapping | None
     started = time.perf_counter()
     kick = inputs.kick_of(scenario.validate())
     model = assembly.assemble(scenario, kick, tyres=tyres, gains=gains)
+    if not model.stability["stable"]:
+        # Said before the long part, the integration; a valid run all the same (the bicycle may well fall).
+        warnings.warn(model.stability["message"], UnstableRiderWarning, stacklevel=2)
     solution = integration.integrate_run(model, scenario, kick)
     frame = results.trajectory_frame(solution, scenario.tyre_transient)
     summary = results.summarise(scenario, kick, model, solution, frame, custom_tyres=tyres is not None)

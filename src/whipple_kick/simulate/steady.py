@@ -453,7 +453,7 @@ def upright_state(params, speed, tol=1e-13, pitch_without_compression=False):
     steady values (zero slip and camber: the fits' zero-slip offsets).
     With measured tyres this is NOT a steady motion: the offsets push the
     bicycle off it from the first instant (``unknowns["largest_rate"]`` says
-    how hard: the largest |acceleration| of the lateral speeds u2, u3, u4, u7
+    how hard: the largest ``|acceleration|`` of the lateral speeds u2, u3, u4, u7
     in SI units).
 
     Parameters

@@ -144,7 +144,7 @@ def deviations(ours, theirs, window=(0.0, 1.0)):
     Returns
     -------
     dict
-        Signal name (:data:`SIGNALS`) -> max |ours - theirs| / max |theirs| [-].
+        Signal name (:data:`SIGNALS`) -> max ``|ours - theirs|`` / max ``|theirs|`` [-].
     """
     t_ref = theirs["time"].to_numpy()
     keep = (t_ref >= window[0] - 1e-12) & (t_ref <= window[1] + 1e-12)

@@ -44,14 +44,11 @@ _CRITERION_TEXT = {"last_peak": "last-peak time (last yaw-rate peak above 8 % of
 #: and M_z terms one group at a time, all at once, and eight random draws of every coefficient in
 #: [0.99, 1.01]) or rtol goes from 1e-10 to 1e-8 or 1e-12 (``scripts/recommender_spread.py``,
 #: docs/sweeps.md). Settling: 0.215 s (a random draw at 400 kPa, 570 N); last peak: 0.001 s
-#: (random draws and all coefficients x1.01, at 300 and 500 kPa, 701 N); rtol moves neither by
-#: 1 ms. A margin between the best and the second-best pressure below the spread is "no clear
-#: optimum". Measured on the default carcass tyre transient (model slip_bbc9664c82a4da8b5788; on
-#: the earlier contact-patch default they were 0.218 and 0.005 s, on the thesis' force lag 0.570
-#: and 0.011 s); re-measure when the model changes. This is the spread of one set of modelling
-#: choices under 1 % tyre changes only: how probable each pressure is to be best over the inputs
-#: nothing pins down is the uncertainty study's (``recommend-pressure --uncertain``,
-#: :mod:`whipple_kick.studies.uncertainty`), which uses no fixed spread.
+#: (one sample; several draws); rtol moves neither by 1 ms. A margin between the best and
+#: the second-best pressure below the spread is "no clear optimum". Measured on the default
+#: carcass tyre transient (model slip_b574081a; on the contact-patch form they were 0.218 and
+#: 0.005 s, on the thesis' force lag 0.570 and 0.011 s); scripts/doc_numbers.py checks them against
+#: a rerun (group ``spread``).
 CRITERION_SPREAD_S = {"settling": 0.215, "last_peak": 0.001}
 
 
@@ -87,13 +84,17 @@ class Recommendation:
     verdict : str
         ``"clear"`` (margin >= spread, or the only pressure that recovered),
         ``"no clear optimum"`` (margin below the spread), ``"nothing to
-        choose"`` (one pressure) or ``"none recovered"``.
+        choose"`` (one pressure), ``"none recovered"``, or ``"incomplete"``
+        when a case failed (it has no result, so it may have been the best:
+        ``best_pressure_kpa`` is then the best of the others, never "clear").
     table : pandas.DataFrame
         One row per pressure: ``pressure_kpa``, ``measured``,
         ``recovery.time_s`` [s], ``last_peak_time_s`` [s], the yaw, roll and
         steer rates' settling times [s], ``n_peaks``, ``damping_ratio_1_3``,
         ``period_s``, ``peaks.max_abs_roll_absolute_rad``, ``fell``, ``status``,
         ``error``, ``rank``.
+    failed : int
+        Cases (pressures) of this load that failed: no result, ranked after every fall.
     """
 
     fz_n: float
@@ -105,6 +106,7 @@ class Recommendation:
     spread_s: float
     verdict: str
     table: "object"
+    failed: int = 0
 
 
 def tyre_pressures(tyre="T03", coefficient_set="table7_9"):
@@ -152,15 +154,22 @@ def pressure_grid(tyre="T03", pressures=None, fine=False, step_kpa=10.0, coeffic
 
 def _did_not_recover(table):
     """Rows that fell or failed (never ranked ahead of a run that did not)."""
-    fell = table["fell"].map(lambda v: v is True or _num(v) == 1.0)
-    return (fell | (table["status"] != "ok")).to_numpy()
+    return _outcome_class(table) > 0
+
+
+def _outcome_class(table):
+    """0 a run that did not fall, 1 a fall (a result: the pressure lost the bicycle), 2 a failed case (no result)."""
+    fell = table["fell"].map(lambda v: v is True or _num(v) == 1.0).to_numpy()
+    failed = (table["status"] != "ok").to_numpy()
+    return np.where(failed, 2, np.where(fell, 1, 0))
 
 
 def _rank(table, criterion):
-    """Row order: runs that neither fell nor failed first, then by the criterion's columns (missing last)."""
+    """Row order: runs that neither fell nor failed first, by the criterion's columns (missing last), then the
+    falls, then the failed cases (which have no result to rank: never ranked like a fall)."""
     keys = [np.where(np.isfinite(v), v, np.inf)
             for v in (table[col].map(_num).to_numpy(dtype=float) for col in CRITERIA[criterion])]
-    return np.lexsort(keys[::-1] + [_did_not_recover(table)])
+    return np.lexsort(keys[::-1] + [_outcome_class(table)])
 
 
 def _ranked_values(rows, criterion):
@@ -176,13 +185,15 @@ def _verdict(rows, criterion):
     if len(rows) == 1:
         return None, None, "nothing to choose"
     pressures, values = _ranked_values(rows, criterion)
-    if not pressures.size:
+    margin = float(values[1] - values[0]) if pressures.size > 1 else None
+    best = float(pressures[0]) if pressures.size else None
+    if (rows["status"] != "ok").any():
+        return best, margin, "incomplete"   # a failed case has no result: it may have been the best
+    if best is None:
         return None, None, "none recovered"
-    if pressures.size == 1:
-        return float(pressures[0]), None, "clear"   # the only pressure that recovered
-    margin = float(values[1] - values[0])
-    return float(pressures[0]), margin, ("clear" if margin >= CRITERION_SPREAD_S[criterion]
-                                         else "no clear optimum")
+    if margin is None:
+        return best, None, "clear"   # the only pressure that recovered
+    return best, margin, "clear" if margin >= CRITERION_SPREAD_S[criterion] else "no clear optimum"
 
 
 #: Columns of :attr:`Recommendation.table`.
@@ -228,7 +239,8 @@ def recommend_pressures(loads, tyre="T03", pressures=None, fine=False, step_kpa=
         best, margin, verdict = _verdict(rows, criterion)
         best_measured = _verdict(rows[rows["measured"]].reset_index(drop=True), criterion)[0]
         out.append(Recommendation(fz, tyre, best, best_measured, criterion, margin,
-                                  CRITERION_SPREAD_S[criterion], verdict, rows))
+                                  CRITERION_SPREAD_S[criterion], verdict, rows,
+                                  failed=int((rows["status"] != "ok").sum())))
     return out
 
 
@@ -330,6 +342,14 @@ def format_recommendation(rec):
                      + (f" ({rec.tyre} was measured at one pressure)" if rec.table["measured"].all() else ""))
     elif rec.verdict == "none recovered":
         lines.append(head + "none (no pressure recovered within the run)")
+    elif rec.verdict == "incomplete":
+        failed = ", ".join(f"{p:g}" for p in rec.table.loc[rec.table["status"] != "ok", "pressure_kpa"])
+        text = (f"none: {rec.failed} of {len(rec.table)} cases failed ({failed} kPa; no result, so any of them may "
+                "be the best)")
+        if rec.best_pressure_kpa is not None:
+            best = rec.table[rec.table["pressure_kpa"] == rec.best_pressure_kpa].iloc[0]
+            text += f"; the best of the others is {rec.best_pressure_kpa:g} kPa ({_num(best[column]):.3f} s)"
+        lines.append(head + text + "; see the failed cases' errors above")
     else:
         best = rec.table[rec.table["pressure_kpa"] == rec.best_pressure_kpa].iloc[0]
         text = f"{rec.best_pressure_kpa:g} kPa ({_num(best[column]):.3f} s)"
@@ -413,7 +433,9 @@ def recommend_variants(loads, variants, **options):
         # two such answers is not read as more than it is.
         text = dependence({label: rec.best_pressure_kpa for label, rec in recs_by_label.items()}, what)
         unsure = [label for label, rec in recs_by_label.items() if rec.verdict == "no clear optimum"]
-        return text + (f" (no clear optimum for {', '.join(unsure)})" if unsure else "")
+        failed = [f"{label} ({rec.failed} failed)" for label, rec in recs_by_label.items() if rec.failed]
+        return (text + (f" (no clear optimum for {', '.join(unsure)})" if unsure else "")
+                + (f" (incomplete: cases failed for {', '.join(failed)})" if failed else ""))
 
     verdicts = []
     for k, rec in enumerate(recs[next(iter(recs))]):

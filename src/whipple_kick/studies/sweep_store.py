@@ -40,8 +40,8 @@ TABLE_FILE = "table.csv"
 TRAJECTORY_DIR = "trajectories"
 #: Held (flock) by the process running a sweep on the folder; holds its pid.
 LOCK_FILE = "sweep.lock"
-#: Version of the folder layout written into the manifest.
-FOLDER_FORMAT = 1
+#: Version of the folder layout written into the manifest (2: the code hash and the provenance of every session).
+FOLDER_FORMAT = 2
 
 # Leading table columns, before the scenario fields.
 _ID_COLUMNS = ("case_id", "status", "error")
@@ -204,13 +204,11 @@ class Folder:
     def _open(self, case_list, base, extend, trajectory):
         (self.path / TRAJECTORY_DIR).mkdir(exist_ok=True)
         self.model = slip.model_hash()
+        self.code = provenance.code_hash()
         old = read_manifest(self.path)
         ids = [cid for _, _, cid in case_list]
         if old is not None:
-            if old.get("model_hash") != self.model:
-                raise InputError(
-                    f"sweep folder {str(self.path)!r} holds results of model {old.get('model_hash')}, "
-                    f"but the model now is {self.model}; use a new folder for the new model")
+            _check_same_code(self.path, old, self.model, self.code)
             old_ids = [c["case_id"] for c in old.get("cases", [])]
             if old_ids != ids:
                 if not extend:
@@ -223,11 +221,16 @@ class Folder:
                 old_cases = [(c["overrides"], Scenario(**c["scenario"]), c["case_id"])
                              for c in old["cases"] if c["case_id"] not in by_id]
                 self.case_list = old_cases + case_list
+        session = provenance.record(provenance.input_files(base))
         self.manifest = {
             "format": FOLDER_FORMAT,
             "created": (old or {}).get("created", _now()),
             "model_hash": self.model,
-            "provenance": provenance.record(provenance.input_files(base)),
+            "code_hash": self.code,
+            # Where the folder's first cases came from; every later session (a resume, an extension) is added
+            # to "sessions", never written over it (the code hash above is the same for all of them).
+            "provenance": (old or {}).get("provenance", session),
+            "sessions": [*(old or {}).get("sessions", []), session],
             "base_scenario": scenario_dict(base),
             "trajectory": None if trajectory is None else {
                 **trajectory, "columns": trajectory["columns"] if trajectory["columns"] == "all"
@@ -265,6 +268,26 @@ class Folder:
         fileio.write_csv(rows, self.path / TABLE_FILE, significant_digits=12)
         end = time.monotonic()
         self._next_table = end + max(interval, 20.0 * (end - start))
+
+
+def _check_same_code(path, old, model, code):
+    """Refuse to resume a folder whose results other code made (one line saying what to do).
+
+    A resumed sweep's table would otherwise mix the results of two versions
+    of the code (say two recovery rules) without a word.
+    """
+    where = f"sweep folder {str(path)!r}"
+    if old.get("format") != FOLDER_FORMAT or "code_hash" not in old:
+        raise InputError(f"{where} was made by an earlier version of whipple_kick (folder format "
+                         f"{old.get('format')}, no code hash): its results cannot be told to be this code's; "
+                         "use a new folder")
+    if old["model_hash"] != model:
+        raise InputError(f"{where} holds results of model {old['model_hash']}, but the model now is {model}; "
+                         "use a new folder for the new model")
+    if old["code_hash"] != code:
+        raise InputError(f"{where} holds results of other code (code hash {old['code_hash']}, now {code}: the "
+                         "Python or parameter files that make results changed since it was started); use a new "
+                         "folder for this code, or finish the sweep with the code that started it")
 
 
 def _terminate_last_line(path):

@@ -5,8 +5,10 @@
 through :func:`whipple_kick.studies.sweep_engine.sweep`, reduces each run's yaw rate
 to the thesis' metrics exactly as the recordings were reduced
 (:func:`recorded_metrics`), and compares them with Tables 8.6-8.9
-(:func:`compare`). :func:`write` puts ``validation.csv``, the model's
-trajectories, ``validation.png`` and ``summary.json`` into a folder; the
+(:func:`compare`). :func:`write` puts ``validation.csv``, the model's runs
+(run folders that :meth:`whipple_kick.simulate.results.Result.load` and
+``compare`` read), ``validation.png`` and ``summary.json`` (with the
+provenance) into a folder; the
 ``validate`` command does all of it.
 
 The choices (docs/experiments.md says why):
@@ -46,12 +48,13 @@ The choices (docs/experiments.md says why):
 """
 from dataclasses import dataclass
 import math
+import pathlib
 
 import numpy as np
 
 from whipple_kick.errors import InputError
 from whipple_kick.library import experiments
-from whipple_kick.simulate import analysis
+from whipple_kick.simulate import analysis, provenance
 from whipple_kick.simulate.scenario import Scenario
 
 #: Kick directions run (the thesis does not give one).
@@ -81,7 +84,7 @@ TIME_ORIGINS = ("first_peak", "kick")
 CSV_COLUMNS = ("case", "fz_n", "pressure_kpa", "direction", "source", "last_peak_time_s", "n_peaks", "period_s",
                "log_dec_13", "log_dec_24", "log_dec_35", "dominant_frequency_hz", "slow_swing_ratio",
                "last_peak_from_kick_s", "recovery_time_s", "status", "error")
-#: Metrics compared in the summary (mean |model - measured|), with their units.
+#: Metrics compared in the summary (mean ``|model - measured|``), with their units.
 COMPARED = {"last_peak_time_s": "s", "n_peaks": "-", "period_s": "s", "log_dec_13": "-", "log_dec_24": "-",
             "log_dec_35": "-", "dominant_frequency_hz": "Hz"}
 #: Rules for the best pressure: the thesis' (shortest last-peak time, Table 8.9) and the recommender's
@@ -286,6 +289,11 @@ def validate(base=None, experiment=None, directions=DIRECTIONS, workers=None, pr
         "dominant_frequency_window_s": [exp.conditions[DOMINANT_WINDOW_KEY],
                                         exp.conditions[DOMINANT_WINDOW_KEY] + exp.processing["record_length"]],
         "slow_swing_window_s": list(SLOW_SWING_WINDOW)}
+    # Which code, on which machine, from which files (the measured cases' file too), as every run's summary.
+    files = provenance.input_files(base)
+    if exp.path is not None and pathlib.Path(exp.path).is_file():
+        files["experiment"] = {"path": str(pathlib.Path(exp.path).resolve()), "sha256": provenance.sha256(exp.path)}
+    summary["provenance"] = {**provenance.record(files), "code_hash": provenance.code_hash()}
     return Validation(frame, runs, summary)
 
 
@@ -315,7 +323,7 @@ def best_by_rule(table, rule, direction):
 
 
 def compare(table, experiment, directions=DIRECTIONS):
-    """Model against measurement: mean |error| per metric, agreement with Table 8.9, best pressures.
+    """Model against measurement: mean ``|error|`` per metric, agreement with Table 8.9, best pressures.
 
     Returns
     -------
@@ -372,7 +380,7 @@ def compare(table, experiment, directions=DIRECTIONS):
 
 
 def write(result, out, plot=True):
-    """Write validation.csv, cases/<case>_<direction>/trajectory.csv, summary.json and validation.png into ``out``.
+    """Write validation.csv, the run folders cases/<case>_<direction>/, summary.json and validation.png into ``out``.
 
     Returns
     -------
@@ -380,7 +388,6 @@ def write(result, out, plot=True):
         The files written (relative to ``out``).
     """
     import json
-    import pathlib
 
     from whipple_kick import fileio
     from whipple_kick.simulate import results
@@ -389,12 +396,12 @@ def write(result, out, plot=True):
     fileio.write_csv(result.table, out / "validation.csv", significant_digits=6)
     files = ["validation.csv"]
     for name, run in result.runs.items():
-        folder = out / "cases" / name
-        folder.mkdir(parents=True, exist_ok=True)
-        fileio.write_csv(results.with_units(run["trajectory"]), folder / "trajectory.csv",
-                         significant_digits=results.TRAJECTORY_CSV_DIGITS)
+        # A run folder as simulate writes it (trajectory.csv, summary.json, scenario.toml): Result.load and
+        # compare read it, simulate --scenario reruns it.
+        summary = run["summary"]
+        results.Result(Scenario(**summary["scenario"]), run["trajectory"], summary).save(out / "cases" / name)
     if result.runs:
-        files.append(f"cases/ ({len(result.runs)} trajectories)")
+        files.append(f"cases/ ({len(result.runs)} run folders)")
     fileio.write_atomic(out / "summary.json",
                         json.dumps(results.clean(result.summary), indent=2, allow_nan=False) + "\n")
     files.append("summary.json")

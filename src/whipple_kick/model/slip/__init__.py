@@ -28,7 +28,6 @@ from .call import (  # noqa: F401 -- the package's names, as before the split
     parameter_vector,
 )
 from .compiled import (  # noqa: F401 -- the package's names, as before the split
-    _compiler,
     layout,
     library,
     library_path,
@@ -39,7 +38,6 @@ from .jumps import (  # noqa: F401 -- the package's names, as before the split
     velocity_jump,
 )
 from .layout import (  # noqa: F401 -- the package's names, as before the split
-    _SOURCES,  # the cache key's modules (tests check each generator is in its own key)
     COORDINATES,
     DEPENDENT,
     DYNAMIC_STATES,

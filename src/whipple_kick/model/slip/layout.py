@@ -52,7 +52,8 @@ OUTPUTS = {
     "hip_torque": ("N m", "torque of the hip spring-damper on the upper body about the lean axis"),
     "kinetic_energy": ("J", "kinetic energy of the bicycle and rider"),
     "potential_energy": ("J", "gravitational potential energy"),
-    "spring_energy": ("J", "energy stored in the vertical tyre springs"),
+    "spring_energy": ("J", "energy stored in the vertical tyre springs and, with a rider's body, in the hip "
+                          "and arm springs"),
     "holonomic": ("m", "front contact height above the ground (the holonomic constraint's residual)"),
     "sliding_power": ("W", "power of the tyres' lateral forces on the contacts' sliding, F vsy"),
     "fy_r": ("N", "lateral force the rear tyre applies to the bicycle"),

@@ -69,7 +69,6 @@ from .linear import (  # noqa: F401 -- the package's names, as before the split
     state_labels,
 )
 from .modes import (  # noqa: F401 -- the package's names, as before the split
-    _wheelbase,
     groups_of,
     match_cost,
     mode_content,
@@ -80,7 +79,6 @@ from .modes import (  # noqa: F401 -- the package's names, as before the split
 from .pressure_load import (  # noqa: F401 -- the package's names, as before the split
     THESIS_LOADS_N,
     THESIS_PRESSURES_KPA,
-    _at,
     case_row,
     pressure_load_figure,
     pressure_load_table,
@@ -100,10 +98,6 @@ from .response import (  # noqa: F401 -- the package's names, as before the spli
     free_response,
     modal_coordinate,
     perturbed_state,
-)
-from .summary import (  # noqa: F401 -- the package's names, as before the split
-    _root,
-    _weave_speed,
 )
 from .sweep import (  # noqa: F401 -- the package's names, as before the split
     Stability,

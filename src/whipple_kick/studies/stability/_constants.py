@@ -33,7 +33,7 @@ MODE_DESCRIPTIONS = {
 #: front tyre's relaxation (at walking speed), not wobble: bicycle wobble is reported at
 #: 4-10 Hz (thesis Section 2.2.1; Meijaard et al. 2007 call the fast steer mode caster).
 WOBBLE_MIN_FREQUENCY_HZ = 2.0
-#: |steer torque| [N m] below which a steady motion of one loop is also the other loop's.
+#: ``|steer torque|`` [N m] below which a steady motion of one loop is also the other loop's.
 ZERO_TORQUE_N_M = 1e-12
 #: Fewest consecutive sweep speeds a mode name must hold along a track (shorter runs take a
 #: neighbour's name): no flicker where a content hovers near a rule's threshold.

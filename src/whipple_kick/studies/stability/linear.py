@@ -231,9 +231,8 @@ def _setup(scenario, tyres=None):
         rear, front, notes = assembly.build_tyres(scenario)
     else:
         (rear, front), notes = tyres, [f"tyres given: {tyres[0]!r} (rear), {tyres[1]!r} (front)"]
-    classic_moore = moore   # the no-slip reference's rider is the rigid one (design is that rider already)
-    if scenario.rider_body != "rigid" or scenario.arms == "on":
-        classic_moore = assembly.build_bicycle(scenario.with_changes(rider_body="rigid", arms="off"))[0]
+    # The no-slip reference's rider is the rigid one: the whole rider lumped, as in the run's verdict.
+    classic_moore = assembly.no_slip_plant(moore, design, info)
     return _Setup(scenario, moore, design, info, (rear, front), notes, scenario.controller, classic_moore)
 
 

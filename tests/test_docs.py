@@ -1,0 +1,97 @@
+"""The documentation site's sources (docs/): navigation and the gallery's figure scraper.
+
+The site itself is built by .ci/run (``python -m sphinx -W``); these checks say sooner, and
+in the tests' words, what would break that build.
+"""
+import pathlib
+import re
+import sys
+
+import pytest
+
+DOCS = pathlib.Path(__file__).resolve().parents[1] / "docs"
+
+
+def _toctree_entries():
+    text = (DOCS / "index.rst").read_text(encoding="utf-8")
+    entries = set()
+    for block in re.findall(r"\.\. toctree::\n((?:[ \t]+.*\n|\n)+)", text):
+        entries |= {line.strip() for line in block.splitlines() if line.strip() and not line.strip().startswith(":")}
+    return entries
+
+
+def test_every_markdown_page_is_in_the_site_navigation():
+    """A page in docs/ that no toctree lists is a warning, so an error, in the -W build: list it in index.rst."""
+    pages = {p.stem for p in DOCS.glob("*.md")}
+    missing = sorted(pages - _toctree_entries())
+    assert pages and not missing, f"docs/index.rst lists no toctree entry for {missing}"
+
+
+def test_every_toctree_entry_is_a_page():
+    entries = _toctree_entries()
+    generated = {"auto_examples/index"}   # sphinx-gallery writes it at build time
+    absent = sorted(e for e in entries - generated
+                    if not (DOCS / f"{e}.md").exists() and not (DOCS / f"{e}.rst").exists())
+    assert not absent
+
+
+def test_gallery_scraper_shows_each_bare_figure_once_and_leaves_pyplot_figures():
+    """whipple_kick's plots are bare Figures (no pyplot), which sphinx-gallery's own scraper cannot see."""
+    pytest.importorskip("sphinx_gallery")   # the docs extra
+    import matplotlib
+    matplotlib.use("Agg")
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    import matplotlib.pyplot as plt
+
+    sys.path.insert(0, str(DOCS))
+    try:
+        import gallery_figures
+    finally:
+        sys.path.remove(str(DOCS))
+
+    bare = Figure()
+    FigureCanvasAgg(bare)
+    bare.add_subplot().plot([0, 1])
+    managed = plt.figure()
+    written = []
+
+    def paths():
+        while True:
+            written.append(str(DOCS.parent / "build" / f"never_{len(written)}.png"))
+            yield written[-1]
+
+    def scrape(example_globals):
+        saved = []
+        block_vars = {"src_file": "example.py", "example_globals": example_globals, "image_path_iterator": paths()}
+        original = Figure.savefig
+        Figure.savefig = lambda fig, path, **kw: saved.append((fig, path))   # nothing written to disk
+        try:
+            rst = gallery_figures.scrape(None, block_vars, {"src_dir": str(DOCS)})
+        finally:
+            Figure.savefig = original
+        return saved, rst
+
+    saved, rst = scrape({"fig": bare, "other": managed, "x": 1})
+    assert [fig for fig, _ in saved] == [bare] and "never_0.png" in rst
+    plt.close(managed)   # closed by pyplot (no manager now): still not taken for a bare figure
+    saved, rst = scrape({"fig": bare, "other": managed})
+    assert saved == [] and rst == ""
+
+
+def test_attributes_sharing_a_description_get_one_entry_each():
+    """``fz_n, rider_mass_kg : float or None`` under Attributes: Sphinx would read ``fz_n,`` as a type."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("docs_conf", DOCS / "conf.py")
+    conf = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(conf)
+    sys.path.remove(str(DOCS))   # conf.py puts docs/ on the path for the gallery's scraper
+    lines = [":ivar bicycle: Bicycle set.", ":vartype bicycle: str",
+             ":ivar fz_n, rider_mass_kg: Rear load [N] or", "    the rider's mass [kg].",
+             ":vartype fz_n, rider_mass_kg: float or None", "Notes"]
+    assert conf._split_shared_fields(lines) == [
+        ":ivar bicycle: Bicycle set.", ":vartype bicycle: str",
+        ":ivar fz_n: Rear load [N] or", "    the rider's mass [kg].",
+        ":ivar rider_mass_kg: Rear load [N] or", "    the rider's mass [kg].",
+        ":vartype fz_n: float or None", ":vartype rider_mass_kg: float or None", "Notes"]
