@@ -185,8 +185,8 @@ def _with_input(tmp_path, block):
     ('[inputs.p]\nfield = "pressure_kpa"\ndistribution = "uniform"\nunit = "kPa"\nlow = 300\nhigh = 500\n'
      'reason = "x"\n', r"inputs\.p: the study sets pressure_kpa itself"),
     ('[inputs.hip]\nfield = "hip_stiffness"\ndistribution = "uniform"\nunit = "N m/rad"\nlow = 128\nhigh = 1000\n'
-     'reason = "x"\n', r"inputs\.hip: hip_stiffness acts only with rider_body leaning, which no sample has "
-                       r"\(rider_body is rigid\): it would be ignored"),
+     'reason = "x"\n', r"inputs\.hip: hip_stiffness is read only by the leaning upper body \(rider_body "
+                       r"'leaning'\), which no sample uses: it would be ignored"),
 ])
 def test_inputs_naming_nothing_or_ignored_are_refused(tmp_path, block, message):
     with pytest.raises(InputError, match=message) as info:
@@ -203,7 +203,7 @@ def test_the_shipped_file_passes_the_checks():
     spec = uncertain.load()
     uncertainty.check_inputs(spec, Scenario().with_changes(**spec.fixed))
     # Without the carcass transient the carcass inputs would be ignored: refused.
-    with pytest.raises(InputError, match=r"carcass_stiffness_scale acts only with tyre_transient carcass"):
+    with pytest.raises(InputError, match=r"carcass_stiffness_scale is read only by the carcass tyre"):
         uncertainty.check_inputs(dataclasses.replace(spec, fixed={**spec.fixed, "tyre_transient": "force_lag"}),
                                  Scenario())
 

@@ -54,7 +54,7 @@ import numpy as np
 
 from whipple_kick.errors import InputError, check_range
 from whipple_kick.library import uncertain
-from whipple_kick.simulate.scenario import Scenario
+from whipple_kick.simulate.scenario import MECHANISM_FIELDS, Scenario
 
 from .recommend import _num, pressure_grid
 from .sweep_engine import check_some_ok, make_cases, sweep
@@ -71,28 +71,11 @@ CONFIDENCE = 0.95
 #: A measured best pressure is "admitted" by the model's uncertainty when the upper end of the
 #: interval of its probability is at least this (one chance in twenty).
 ADMIT_PROBABILITY = 0.05
+#: Combinations of the choices' options :func:`check_inputs` looks at (beyond, a mechanism reached only
+#: by a later combination would be refused).
+_MAX_COMBINATIONS = 4096
 #: Scenario fields a study sets itself: an uncertain input may not set them.
 _STUDY_FIELDS = ("fz_n", "pressure_kpa", "pressure_front_kpa", "pressure_rear_kpa", "rider_mass_kg")
-#: Fields that act only with a mechanism: (the field deciding it, its values that use the field).
-_USED_ONLY_WITH = {
-    "hip_stiffness": ("rider_body", {"leaning"}),
-    "hip_damping": ("rider_body", {"leaning"}),
-    "carcass_stiffness_scale": ("tyre_transient", {"carcass"}),
-    "carcass_damping": ("tyre_transient", {"carcass"}),
-    "carcass_sliding": ("tyre_transient", {"carcass"}),
-    "carcass_viscosity": ("tyre_transient", {"carcass"}),
-    "gain_scale": ("controller", {"lqr", "thesis"}),
-    "design_speed": ("controller", {"lqr"}),
-    "lqr_model": ("controller", {"lqr"}),
-    "thesis_load_n": ("controller", {"thesis"}),
-    "arm_stiffness": ("arms", {"on"}),
-    "arm_damping": ("arms", {"on"}),
-    "kick_accel": ("kick_profile", {"constant", "smooth"}),
-    "kick_duration": ("kick_profile", {"constant", "smooth"}),
-    "start_pitch": ("start", {"upright"}),
-}
-
-
 @dataclasses.dataclass
 class UncertaintyStudy:
     """Result of :func:`run_study`.
@@ -176,24 +159,28 @@ def check_inputs(spec, base):
             if field in _STUDY_FIELDS:
                 raise InputError(f"{spec.path}: inputs.{inp.name}: the study sets {field} itself "
                                  f"(pressures and loads are its grid)")
+    candidates = _candidates(spec, base)
     for inp in spec.inputs:
         for field in inp.fields:
-            if field not in _USED_ONLY_WITH:
-                continue
-            decider, using = _USED_ONLY_WITH[field]
-            possible = _possible(spec, base, decider)
-            if not possible & using:
-                raise InputError(f"{spec.path}: inputs.{inp.name}: {field} acts only with {decider} "
-                                 f"{' or '.join(sorted(using))}, which no sample has "
-                                 f"({decider} is {' or '.join(map(str, sorted(possible)))}): it would be ignored")
+            mechanisms = [(m, cond, active) for m, cond, active, names in MECHANISM_FIELDS if field in names]
+            if mechanisms and not any(all(active(sc) for _, _, active in mechanisms) for sc in candidates):
+                what = " and ".join(f"{m} ({cond})" for m, cond, _ in mechanisms)
+                raise InputError(f"{spec.path}: inputs.{inp.name}: {field} is read only by {what}, which no sample "
+                                 "uses: it would be ignored")
 
 
-def _possible(spec, base, field):
-    """The values ``field`` takes over the samples: a choice's values, or the fixed/base value."""
-    for inp in spec.inputs:
-        if field in inp.fields:
-            return inp.possible(field) if inp.distribution == "choice" else {"(sampled)"}
-    return {spec.fixed.get(field, getattr(base, field))}
+def _candidates(spec, base):
+    """One scenario per combination of the choices' options (continuous inputs at their medians): what the
+    samples can switch on. At most :data:`_MAX_COMBINATIONS`."""
+    choices = [i for i in spec.inputs if i.distribution == "choice"]
+    medians = {i.field: float(i.ppf([0.5])[0]) for i in spec.inputs if i.distribution != "choice"}
+    out = []
+    for combo in itertools.islice(itertools.product(*(i.options for i in choices)), _MAX_COMBINATIONS):
+        values = {**spec.fixed, **medians}
+        for option in combo:
+            values.update(option.values)
+        out.append(base.with_changes(**values))
+    return out
 
 
 def sample(spec, samples, seed):
@@ -215,18 +202,16 @@ def sample(spec, samples, seed):
 
 
 def row_values(spec, unit_row, base):
-    """The scenario fields of one sample row, less those the row's own mechanism does not use.
+    """The scenario fields of one sample row, less those the row's own mechanisms do not read.
 
     A conditional input (the hip stiffness with the leaning body) is sampled in every row, as the
-    Sobol design needs, but set only in the rows whose mechanism uses it: elsewhere it keeps the base
-    value, so no run is given a field it ignores (and a row's runs do not differ by an unused field).
+    Sobol design needs, but set only in the rows whose mechanism reads it
+    (:meth:`~whipple_kick.simulate.scenario.Scenario.unused_fields`): elsewhere it keeps the base
+    value, so no run is given a field it ignores (which the scenario refuses).
     """
     values = spec.values(unit_row)
-    for field in list(values):
-        if field in _USED_ONLY_WITH:
-            decider, using = _USED_ONLY_WITH[field]
-            if values.get(decider, getattr(base, decider)) not in using:
-                del values[field]
+    for field in base.with_changes(**values).unused_fields():
+        values.pop(field, None)
     return values
 
 
