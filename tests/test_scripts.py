@@ -79,3 +79,22 @@ def test_the_docs_numbers_match_a_rerun():
     import doc_numbers
 
     assert doc_numbers.main([]) == 0
+
+
+@pytest.mark.slow
+def test_uncertainty_study_reports_its_cost(tmp_path, capsys):
+    """scripts/uncertainty_study.py on a two-input file at N = 2 (8 rows x 3 pressures x 3 loads, 3 s runs):
+    it prints the study and the cost lines docs/uncertainty.md quotes."""
+    import uncertainty_study
+
+    path = tmp_path / "tiny.toml"
+    path.write_text('format = "whipple_kick uncertainty, version 1"\nname = "tiny"\ndescription = "test"\n'
+                    '[fixed]\nduration = { value = 3.0, reason = "short" }\n'
+                    '[inputs.speed]\nfield = "speed"\ndistribution = "uniform"\nunit = "m/s"\nlow = 1.92\n'
+                    'high = 2.0\nreason = "thesis Section 8.3"\n'
+                    '[inputs.accel]\nfield = "kick_accel"\ndistribution = "uniform"\nunit = "m/s^2"\nlow = 30\n'
+                    'high = 40\nreason = "thesis Section 8.3"\n')
+    uncertainty_study.main(["--file", str(path), "--samples", "2", "--out", str(tmp_path / "out")])
+    out = capsys.readouterr().out
+    assert "cost: 72 runs (8 rows x 3 pressures x 3 loads; 72 distinct cases" in out
+    assert "per run in its worker: wall mean" in out and "N = 500: 2000 rows, 18000 runs" in out

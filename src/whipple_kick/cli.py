@@ -879,7 +879,7 @@ def _recommend(argv):
                    help="settling (default): time from which yaw, roll and steer rates all stay within 5 %% "
                         "of their first peaks; last-peak: the thesis' rule, time of the last yaw-rate peak "
                         "above 8 %% of the largest")
-    p.add_argument("--duration", type=_number("s"), default=6.0, metavar="S",
+    p.add_argument("--duration", type=_number("s"), metavar="S",
                    help="simulated time after the kick in s (default 6)")
     p.add_argument("--workers", type=int, metavar="N",
                    help="worker processes (default: one per CPU core)")
@@ -895,11 +895,25 @@ def _recommend(argv):
     p.add_argument("--tyre-transient", choices=(*TYRE_TRANSIENTS, "all"), default=Scenario.tyre_transient,
                    help=f"tyre transient form (default {Scenario.tyre_transient}); all: run each form and say "
                         "whether the best pressure depends on it")
+    from whipple_kick.library import uncertain
+    p.add_argument("--uncertain", nargs="?", const=uncertain.DEFAULT, metavar="FILE",
+                   help="the uncertainty study: run every pressure on inputs sampled from FILE (default: the "
+                        f"shipped {uncertain.DEFAULT}) and say how probable each pressure is to be best and "
+                        "what that hinges on (docs/uncertainty.md)")
+    p.add_argument("--samples", type=int, metavar="N",
+                   help="with --uncertain: SALib's base sample count N (N (D + 2) rows for D inputs, each run at "
+                        "every pressure and load; default 64)")
+    p.add_argument("--seed", type=int, metavar="S", help="with --uncertain: the seed (default 0)")
     bar = p.add_mutually_exclusive_group()
     bar.add_argument("--progress", action="store_true", default=None,
                      help="show the progress bar (default: only when stderr is a terminal)")
     bar.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
     args = p.parse_args(argv)
+    if args.uncertain is not None:
+        return _recommend_uncertain(args)
+    if args.samples is not None or args.seed is not None:
+        raise InputError("--samples and --seed belong to the uncertainty study: add --uncertain [FILE]")
+    args.duration = 6.0 if args.duration is None else args.duration
     directions = DIRECTIONS if args.kick_direction == "both" else (args.kick_direction,)
     forms = TYRE_TRANSIENTS if args.tyre_transient == "all" else (args.tyre_transient,)
     variants = {(d, f): Scenario(duration=args.duration, kick_direction=d, tyre_transient=f).validate()
@@ -944,6 +958,57 @@ def _recommend(argv):
 
 #: The figure ``recommend-pressure --out`` writes into its sweep folder.
 SWEEP_FIGURE = "recommendation.png"
+#: The figures ``recommend-pressure --uncertain --out DIR`` writes into DIR.
+UNCERTAINTY_FIGURES = ("p_best.png", "recovery_settling.png", "recovery_last_peak.png", "sobol_settling.png",
+                       "sobol_last_peak.png")
+
+
+def _recommend_uncertain(args):
+    """``recommend-pressure --uncertain``: the uncertainty study (whipple_kick.studies.uncertainty)."""
+    import pathlib
+
+    from whipple_kick.figures import uncertainty as figures
+    from whipple_kick.simulate.scenario import Scenario
+    from whipple_kick.studies import recommend, uncertainty
+    given = [flag for flag, value in (("--fine", args.fine), ("--extend", args.extend),
+                                      ("--duration", args.duration is not None),
+                                      ("--kick-direction", args.kick_direction != "right"),
+                                      ("--tyre-transient", args.tyre_transient != Scenario.tyre_transient))
+             if value]
+    if given:
+        raise InputError(f"{', '.join(given)} cannot go with --uncertain: the uncertainty file samples or fixes "
+                         "the kick, the tyre transient and the run's duration")
+    criterion = recommend.criterion_key(args.criterion)
+    samples = 64 if args.samples is None else args.samples
+    seed = 0 if args.seed is None else args.seed
+    pressures = args.pressures if args.pressures is not None else recommend.tyre_pressures(args.tyre)
+    _check_loads(Scenario().bicycle, args.fz)
+    out = None if args.out is None else pathlib.Path(args.out)
+    study = uncertainty.run_study(args.uncertain, samples=samples, seed=seed, loads=args.fz, pressures=pressures,
+                                  base=Scenario(tyre=args.tyre), workers=args.workers,
+                                  folder=None if out is None else out / "runs",
+                                  progress=sys.stderr.isatty() if args.progress is None else args.progress)
+    study.verdict = uncertainty.verdict_lines(study, criterion)
+    print(uncertainty.format_study(study))
+    if out is not None:
+        study.write(out)
+        study_pair = _verdict_pair(study, criterion)
+        figures.p_best_figure(study.p_best, out / UNCERTAINTY_FIGURES[0],
+                              title=f"P(best), N = {samples} ({len(study.inputs)} rows), 95 % intervals")
+        for name, crit in zip(UNCERTAINTY_FIGURES[1:3], uncertainty.CRITERIA, strict=True):
+            figures.distribution_figure(study.outcomes, crit, out / name)
+        for name, crit in zip(UNCERTAINTY_FIGURES[3:], uncertainty.CRITERIA, strict=True):
+            figures.sobol_figure(study.sobol, crit, study_pair, out / name)
+        print(f"\nwrote the tables (CSV), verdict.txt and {', '.join(UNCERTAINTY_FIGURES)} into {out} "
+              f"(the runs in {out / 'runs'}: run again to resume)")
+    return 0
+
+
+def _verdict_pair(study, criterion):
+    """The (lower, higher) pressures of the two most probable best at the first load, for the Sobol figure."""
+    pb = study.p_best[(study.p_best["criterion"] == criterion) & study.p_best["pressure_kpa"].notna()]
+    first = pb[pb["fz_n"] == pb["fz_n"].iloc[0]].sort_values("p", ascending=False)
+    return tuple(sorted(first["pressure_kpa"].iloc[:2]))
 
 
 def recommend_main(argv=None):

@@ -48,7 +48,9 @@ _CRITERION_TEXT = {"last_peak": "last-peak time (last yaw-rate peak above 8 % of
 #: the second-best pressure below the spread is "no clear optimum". Measured on the default
 #: carcass tyre transient (model slip_b574081a; on the contact-patch form they were 0.218 and
 #: 0.005 s, on the thesis' force lag 0.570 and 0.011 s); scripts/doc_numbers.py checks them against
-#: a rerun (group ``spread``).
+#: a rerun (group ``spread``). The probability of each pressure being best over the inputs nothing
+#: pins down is the uncertainty study's (``recommend-pressure --uncertain``,
+#: :mod:`whipple_kick.studies.uncertainty`), which uses no fixed spread.
 CRITERION_SPREAD_S = {"settling": 0.215, "last_peak": 0.001}
 
 

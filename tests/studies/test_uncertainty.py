@@ -1,0 +1,290 @@
+"""The uncertainty study: known answers of its statistics, pairing, seeds, executors, refusals, the CLI."""
+import dataclasses
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import whipple_kick as wk
+from whipple_kick.errors import InputError
+from whipple_kick.library import uncertain
+from whipple_kick.simulate.scenario import Scenario
+from whipple_kick.studies import uncertainty
+
+# Short runs: the machinery, not the physics, is under test (as tests/conftest.py's SWEEP_BASE).
+BASE = Scenario(settle=0.1, output_rate=200.0)
+TINY = """format = "whipple_kick uncertainty, version 1"
+name = "tiny"
+description = "two inputs, for tests"
+[fixed]
+duration = { value = 3.0, reason = "short: the machinery is under test" }
+[inputs.speed]
+field = "speed"
+distribution = "uniform"
+unit = "m/s"
+low = 1.92
+high = 2.0
+reason = "thesis Section 8.3"
+[inputs.kick_direction]
+field = "kick_direction"
+distribution = "choice"
+reason = "not given"
+[[inputs.kick_direction.options]]
+label = "right"
+probability = 0.5
+value = "right"
+[[inputs.kick_direction.options]]
+label = "left"
+probability = 0.5
+value = "left"
+"""
+
+
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory):
+    path = tmp_path_factory.mktemp("unc") / "tiny.toml"
+    path.write_text(TINY)
+    return path
+
+
+@pytest.fixture(scope="module")
+def tiny_study(tiny, tmp_path_factory):
+    """N = 2 (8 rows) at 300 and 500 kPa, 635 N, in a sweep folder, on the process pool."""
+    folder = tmp_path_factory.mktemp("unc") / "runs"
+    return uncertainty.run_study(tiny, samples=2, seed=3, loads=[635.0], pressures=[300.0, 500.0], base=BASE,
+                                 workers=2, folder=folder), folder
+
+
+def _stable(study):
+    return study.outcomes.drop(columns=["run.wall_s", "run.cpu_s", "numerics.integration_wall_s"])
+
+
+# ----------------------------------------------------------------- known answers
+
+def _spec(names, low, high):
+    inputs = tuple(uncertain.UncertainInput(n, "uniform", "test", n, "1", low, high) for n in names)
+    return uncertain.UncertainSet("t", "", "", inputs, {})
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_ishigami_sobol_indices_match_the_analytic_values_within_their_intervals(seed):
+    """Ishigami (a = 7, b = 0.1, inputs uniform on [-pi, pi]) through the study's own path: its sampler
+    (SALib's design mapped by the inputs' inverse CDFs) and its analysis. Analytic values: Ishigami and
+    Homma (1990), e.g. Saltelli et al. (2008) Global Sensitivity Analysis, Section 4.8. N = 1024: the
+    95 % intervals are 0.03-0.09 wide; each index must lie within its own interval."""
+    a, b = 7.0, 0.1
+    spec = _spec(["x1", "x2", "x3"], -math.pi, math.pi)
+    var = a ** 2 / 8 + b * math.pi ** 4 / 5 + b ** 2 * math.pi ** 8 / 18 + 0.5
+    v1 = 0.5 * (1 + b * math.pi ** 4 / 5) ** 2
+    v13 = b ** 2 * math.pi ** 8 * (1 / 18 - 1 / 50)
+    s1 = [v1 / var, a ** 2 / 8 / var, 0.0]
+    st = [(v1 + v13) / var, a ** 2 / 8 / var, v13 / var]
+    unit, blocks = uncertainty.sample(spec, 1024, seed)
+    assert unit.shape == (1024 * 5, 3) and blocks[:5] == ["A", "AB1", "AB2", "AB3", "B"]
+    x = np.column_stack([inp.ppf(unit[:, k]) for k, inp in enumerate(spec.inputs)])
+    y = np.sin(x[:, 0]) + a * np.sin(x[:, 1]) ** 2 + b * x[:, 2] ** 4 * np.sin(x[:, 0])
+    for k, (name, S1, S1c, ST, STc) in enumerate(uncertainty.sobol_indices(spec, y, seed)):
+        assert name == f"x{k + 1}"
+        assert abs(S1 - s1[k]) <= S1c and abs(ST - st[k]) <= STc, (name, S1, S1c, ST, STc)
+        assert S1c < 0.1 and STc < 0.1   # intervals narrow enough to mean something
+    # The intervals are seeded, seed 0 included (SALib alone leaves seed 0 unseeded).
+    assert uncertainty.sobol_indices(spec, y, seed) == uncertainty.sobol_indices(spec, y, seed)
+
+
+def test_p_best_of_a_synthetic_ranking_lands_in_its_interval():
+    """Rows whose winner is drawn with known probabilities (0.2, 0.5, 0.2, and 0.1 none recovered):
+    each probability lies within its 95 % Wilson interval; ties split the credit; a pressure never best
+    in 16 rows keeps an upper bound (Wilson: z^2 / (n + z^2) = 0.194), not a zero-width interval."""
+    rng = np.random.default_rng(7)
+    truth = np.array([0.2, 0.5, 0.2, 0.1])
+    winner = rng.choice(4, size=2000, p=truth)
+    times = np.full((2000, 3), 2.0)
+    times[np.arange(2000), np.minimum(winner, 2)] = 1.0
+    times[winner == 3] = np.inf   # no pressure recovered
+    p, low, high = uncertainty.p_best_interval(uncertainty._best_share(times))
+    assert np.all((low <= truth) & (truth <= high)), (p, low, high)
+    assert np.all(high - low < 0.06)
+    p, low, high = uncertainty.p_best_interval(np.zeros((16, 1)))
+    assert p[0] == 0.0 and low[0] == 0.0 and high[0] == pytest.approx(1.959964 ** 2 / (16 + 1.959964 ** 2), rel=1e-6)
+    share = uncertainty._best_share(np.array([[1.0, 1.0, 3.0], [np.inf, 2.0, np.inf]]))
+    assert share.tolist() == [[0.5, 0.5, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0]]
+
+
+# ----------------------------------------------------------------- pairing and seeds
+
+def test_every_pressure_and_load_gets_the_same_inputs_of_a_row():
+    spec = uncertain.load()
+    unit, _ = uncertainty.sample(spec, 2, 0)
+    cases, keys = uncertainty.study_cases(spec, unit, [570.0, 701.0], [300.0, 400.0, 500.0],
+                                          BASE.with_changes(**spec.fixed))
+    assert len(cases) == len(unit) * 2 * 3
+    scenarios = [c[1] for c in wk.sweep_engine.make_cases(cases=cases, base=BASE)]
+    by_row = {}
+    for (row, fz, p), sc in zip(keys, scenarios, strict=True):
+        assert (sc.fz_n, sc.pressure_kpa) == (fz, p)
+        by_row.setdefault(row, set()).add(sc.with_changes(fz_n=None, pressure_kpa=0.0))
+    assert len(by_row) == len(unit) and all(len(s) == 1 for s in by_row.values())
+    assert len({next(iter(s)) for s in by_row.values()}) > 1   # rows differ from each other
+    # The hip stiffness is set only in the rows with the leaning body (elsewhere the run ignores it).
+    for case in cases:
+        assert ("hip_stiffness" in case) == (case["rider_body"] == "leaning")
+    assert any(c["rider_body"] == "leaning" for c in cases) and any(c["rider_body"] == "rigid" for c in cases)
+
+
+def test_the_same_seed_gives_the_same_samples():
+    spec = uncertain.load()
+    a, _ = uncertainty.sample(spec, 4, 11)
+    b, _ = uncertainty.sample(spec, 4, 11)
+    c, _ = uncertainty.sample(spec, 4, 12)
+    assert np.array_equal(a, b) and not np.array_equal(a, c)
+
+
+def test_tiny_study_counts_every_run(tiny_study):
+    study, _ = tiny_study
+    assert len(study.inputs) == 8 and len(study.outcomes) == 16
+    pb = study.p_best[study.p_best["criterion"] == "settling"]
+    assert math.isclose(pb["p"].sum(), 1.0) and (pb["rows"] == 4).all()   # A and B rows, none left out
+    assert (study.rates["runs"] == 8).all()
+    assert not study.outcomes.drop(columns=["error"]).isna().all().any()
+    assert study.verdict and study.verdict[0].startswith("635 N: ")
+
+
+def test_the_same_seed_gives_the_same_tables_and_the_folder_resumes(tiny, tiny_study):
+    study, folder = tiny_study
+    again = uncertainty.run_study(tiny, samples=2, seed=3, loads=[635.0], pressures=[300.0, 500.0], base=BASE,
+                                  workers=2, folder=folder)   # every case is in the folder: nothing reruns
+    pd.testing.assert_frame_equal(_stable(again), _stable(study))
+    pd.testing.assert_frame_equal(again.outcomes, study.outcomes)   # wall times too: read back, not rerun
+    pd.testing.assert_frame_equal(again.p_best, study.p_best)
+
+
+def test_dask_gives_the_same_tables_as_the_pool(tiny, tiny_study):
+    distributed = pytest.importorskip("distributed")
+    study, _ = tiny_study
+    with distributed.LocalCluster(processes=True, n_workers=2, threads_per_worker=1,
+                                  dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+        dask = uncertainty.run_study(tiny, samples=2, seed=3, loads=[635.0], pressures=[300.0, 500.0], base=BASE,
+                                     executor=client.get_executor())
+    pd.testing.assert_frame_equal(_stable(dask), _stable(study))
+    for name in ("p_best", "distributions", "differences", "rates", "sobol"):
+        pd.testing.assert_frame_equal(getattr(dask, name), getattr(study, name))
+
+
+# ----------------------------------------------------------------- refusals
+
+def _with_input(tmp_path, block):
+    path = tmp_path / "u.toml"
+    path.write_text(TINY + block)
+    return path
+
+
+@pytest.mark.parametrize("block, message", [
+    ('[inputs.grip]\nfield = "grip"\ndistribution = "uniform"\nunit = "1"\nlow = 0.9\nhigh = 1.1\nreason = "x"\n',
+     r"inputs\.grip: 'grip' is no scenario field"),
+    ('[inputs.p]\nfield = "pressure_kpa"\ndistribution = "uniform"\nunit = "kPa"\nlow = 300\nhigh = 500\n'
+     'reason = "x"\n', r"inputs\.p: the study sets pressure_kpa itself"),
+    ('[inputs.hip]\nfield = "hip_stiffness"\ndistribution = "uniform"\nunit = "N m/rad"\nlow = 128\nhigh = 1000\n'
+     'reason = "x"\n', r"inputs\.hip: hip_stiffness is read only by the leaning upper body \(rider_body "
+                       r"'leaning'\), which no sample uses: it would be ignored"),
+])
+def test_inputs_naming_nothing_or_ignored_are_refused(tmp_path, block, message):
+    with pytest.raises(InputError, match=message) as info:
+        uncertainty.run_study(_with_input(tmp_path, block), samples=2, base=BASE)
+    assert "\n" not in str(info.value)
+
+
+def test_pressures_outside_the_tyres_range_are_refused(tiny):
+    with pytest.raises(InputError, match=r"pressure of tyre T03 = 600(\.0)? kPa is outside the allowed range \[300, 500\] kPa"):
+        uncertainty.run_study(tiny, samples=2, pressures=[300.0, 600.0], base=BASE)
+
+
+def test_the_shipped_file_passes_the_checks():
+    spec = uncertain.load()
+    uncertainty.check_inputs(spec, Scenario().with_changes(**spec.fixed))
+    # Without the carcass transient the carcass inputs would be ignored: refused.
+    with pytest.raises(InputError, match=r"carcass_stiffness_scale is read only by the carcass tyre"):
+        uncertainty.check_inputs(dataclasses.replace(spec, fixed={**spec.fixed, "tyre_transient": "force_lag"}),
+                                 Scenario())
+
+
+# ----------------------------------------------------------------- the CLI
+
+def test_cli_bad_file_and_misplaced_options_exit_2(tmp_path, capsys):
+    from conftest import run_console
+    bad = tmp_path / "bad.toml"
+    bad.write_text(TINY.replace("low = 1.92\nhigh = 2.0", "low = 2.0\nhigh = 1.92"))
+    code, out, err = run_console(wk.cli.recommend_main, ["--fz", "635", "--uncertain", str(bad)], capsys)
+    assert code == 2 and err.count("\n") == 1 and "bounds inverted" in err and "Traceback" not in err
+    code, _, err = run_console(wk.cli.recommend_main, ["--fz", "635", "--samples", "8"], capsys)
+    assert code == 2 and "--samples and --seed belong to the uncertainty study" in err
+    code, _, err = run_console(wk.cli.recommend_main, ["--fz", "635", "--uncertain", "--fine"], capsys)
+    assert code == 2 and "--fine cannot go with --uncertain" in err
+
+
+def test_cli_writes_tables_and_figures(tiny, tmp_path, capsys):
+    from conftest import run_console
+    out = tmp_path / "study"
+    code, text, err = run_console(wk.cli.recommend_main, [
+        "--fz", "635", "--pressures", "300", "500", "--uncertain", str(tiny), "--samples", "2", "--seed", "3",
+        "--out", str(out), "--no-progress"], capsys)
+    assert code == 0, err
+    assert "P(best) by settling" in text and "635 N: " in text
+    for name in ("p_best.csv", "outcomes.csv", "sobol.csv", "verdict.txt", *wk.cli.UNCERTAINTY_FIGURES):
+        assert (out / name).stat().st_size > 0, name
+
+
+def test_falls_and_failures_are_counted_never_dropped(tiny):
+    """The rules on a made-up sweep table (2 pressures, N = 2: 8 rows, 4 of them A/B rows): a fall ranks
+    after a recovery, a row where nothing recovered is the 'none' share, a failed run leaves its row out
+    of P(best) with a note, and the Sobol analysis counts every lost run as censored at the duration."""
+    spec = uncertain.load(tiny)
+    unit, blocks = uncertainty.sample(spec, 2, 0)
+    cases, keys = uncertainty.study_cases(spec, unit, [635.0], [300.0, 500.0], BASE)
+    ids = [f"c{k}" for k in range(len(keys))]
+    rows = []
+    for k, (r, _, p) in enumerate(keys):
+        row = {"case_id": ids[k], "status": "ok", "error": None, "fell": False, "recovery.time_s": 2.0 + r / 10,
+               "last_peak_time_s": 1.0, "run.wall_s": 0.1, "run.cpu_s": 0.1, "numerics.integration_wall_s": 0.05}
+        if p == 300.0:
+            row["recovery.time_s"] -= 0.5          # 300 kPa faster ...
+        if r == 0 and p == 300.0:                  # ... except row 0 (A): 300 kPa fell
+            row.update(fell=True)
+        if r == 3:                                 # row 3 (B of base point 0): neither recovered
+            row["recovery.time_s"] = math.nan      # row 3: neither recovered
+        if r == 4 and p == 500.0:                  # row 4 (A of base point 1): 500 kPa failed
+            row.update(status="failed", error="SimulationError: test", **{"recovery.time_s": math.nan})
+        rows.append(row)
+    study = uncertainty.analyse(spec, 2, 0, unit, blocks, keys, ids, pd.DataFrame(rows), 3.0)
+    assert blocks[:4] == ["A", "AB1", "AB2", "B"]
+    pb = study.p_best[study.p_best["criterion"] == "settling"]
+    p = dict(zip(pb["pressure_kpa"].fillna(-1.0), pb["p"], strict=True))   # -1: the 'none' share
+    # A/B rows 0, 3, 4, 7; row 4 failed (left out): row 0 -> 500 (300 fell), row 3 -> none, row 7 -> 300.
+    assert (pb["rows"] == 3).all() and (pb["rows_failed"] == 1).all()
+    assert np.allclose([p[300.0], p[500.0], p[-1.0]], [1 / 3, 1 / 3, 1 / 3])
+    rates = study.rates.set_index("pressure_kpa")
+    assert rates.loc[300.0, "fell"] == 1 and rates.loc[500.0, "failed"] == 1
+    assert rates.loc[300.0, "not_recovered_settling"] == 1 and rates.loc[500.0, "not_recovered_settling"] == 1
+    assert any("1 of 4 rows left out of P(best)" in n for n in study.notes)
+    assert any("4 of 16 runs censored at 3 s" in n for n in study.notes)
+
+
+def test_every_shipped_input_changes_the_run():
+    """Each input of the shipped file does physics: moving it alone (unit sample 0.1 -> 0.9, the other
+    inputs at 0.5, the rider at the leaning body so the hip stiffness acts) changes the yaw-rate history.
+    1 s runs at 200 Hz: the change is in the dynamics, visible from the kick on."""
+    spec = uncertain.load()
+    base = Scenario(fz_n=635.0, pressure_kpa=400.0).with_changes(**spec.fixed).with_changes(
+        duration=1.0, output_rate=200.0, settle=0.1)
+    rider = spec.names.index("rider")
+    middle = [0.5] * len(spec.inputs)
+    middle[rider] = 0.9   # leaning body
+    histories = {}
+    for k, name in enumerate(spec.names):
+        for u in (0.1, 0.9):
+            row = list(middle)
+            row[k] = u
+            sc = base.with_changes(**uncertainty.row_values(spec, row, base))
+            histories[name, u] = wk.run(sc).trajectory["yaw_rate"].to_numpy()
+        low, high = histories[name, 0.1], histories[name, 0.9]
+        assert low.shape != high.shape or np.max(np.abs(low - high)) > 1e-6, name
