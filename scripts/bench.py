@@ -221,8 +221,7 @@ stages = {}
 import numpy, scipy.integrate, pandas, matplotlib
 stages["import numpy, scipy, pandas, matplotlib"] = time.perf_counter() - t0
 t = time.perf_counter()
-from whipple_kick import assembly, cli, plotting, simulation, slip, steady
-from whipple_kick.simulate.scenario import Scenario
+from whipple_kick import Scenario, assembly, cli, plotting, simulation, slip, steady
 stages["import whipple_kick (cli, simulation, plotting)"] = time.perf_counter() - t
 t = time.perf_counter()
 slip.library()
@@ -319,7 +318,7 @@ print(slip.library()._name)
 """
 _RUN = r"""
 import json, statistics, sys
-from whipple_kick.simulate.simulation import Scenario, run
+from whipple_kick import Scenario, run   # the package top: the same in a checkout from before the wings
 changes = json.loads(sys.argv[1])
 run(Scenario(duration=0.2, **changes))
 runs = [run(Scenario(**changes)).summary["numerics"] for _ in range(3)]
