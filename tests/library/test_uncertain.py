@@ -86,3 +86,38 @@ def test_a_missing_file_is_one_line():
 
 def test_facade():
     assert wk.uncertain is uncertain
+
+
+# ------------------------------------------------ a measured bicycle's +/- as inputs (issue 34)
+
+BICYCLE = ('[bicycle]\nmeasured = "balanceassist_v1"\nparameters = ["c", "lam", "seating.lst"]\n'
+           'reason = "the bicycle file\'s own standard deviations"\n')
+
+
+def test_a_bicycle_table_samples_the_measured_parameters_from_their_standard_deviations(tmp_path):
+    """Each named parameter becomes a normal input with the file's value as mean and its +/- as sd (times
+    sd_scale), truncated to 3 sd: the numbers are those of BicycleParameters' own reading of the file."""
+    from whipple_kick.library import bicycleparameters, bicycles
+    known = bicycleparameters.parameter_uncertainties(bicycles.load("balanceassist_v1"))
+    spec = uncertain.load(write(tmp_path, SPEED + BICYCLE))
+    assert spec.measured_bicycle == "balanceassist_v1"
+    assert spec.names == ("speed", "bicycle.c", "bicycle.lam", "bicycle.seating.lst")
+    for inp in spec.inputs[1:]:
+        mean, sd = known[inp.name.removeprefix("bicycle.")]
+        assert inp.distribution == "normal" and (inp.mean, inp.sd) == (mean, sd)
+        assert (inp.low, inp.high) == (mean - 3 * sd, mean + 3 * sd)
+        assert inp.ppf([0.5])[0] == pytest.approx(mean, abs=1e-12 * abs(mean))
+    doubled = uncertain.load(write(tmp_path, SPEED + BICYCLE + "sd_scale = 2.0\n"))
+    assert [i.sd for i in doubled.inputs[1:]] == [2 * i.sd for i in spec.inputs[1:]]
+
+
+@pytest.mark.parametrize("body, message", [
+    (BICYCLE.replace('"lam"', '"g"'), "'g' has no standard deviation in 'balanceassist_v1'"),
+    (BICYCLE.replace('reason = "the bicycle file\'s own standard deviations"\n', ""), "must have measured and reason"),
+    (BICYCLE + "sd_scale = 0\n", "bicycle.sd_scale: value 0 must be > 0"),
+    ('[fixed]\nbicycle = { value = "benchmark", reason = "x" }\n' + BICYCLE, "fixed.bicycle would contradict it"),
+])
+def test_a_bad_bicycle_table_is_one_line(tmp_path, body, message):
+    with pytest.raises(InputError, match=message.replace("(", r"\(").replace(")", r"\)")) as info:
+        uncertain.load(write(tmp_path, SPEED + body))
+    assert "\n" not in str(info.value)

@@ -288,3 +288,61 @@ def test_every_shipped_input_changes_the_run():
             histories[name, u] = wk.run(sc).trajectory["yaw_rate"].to_numpy()
         low, high = histories[name, 0.1], histories[name, 0.9]
         assert low.shape != high.shape or np.max(np.abs(low - high)) > 1e-6, name
+
+
+# ------------------------------------------------ a measured bicycle's +/- as inputs (issue 34)
+
+BIKE_FILE = ('format = "whipple_kick uncertainty, version 1"\nname = "bike"\ndescription = "test"\n'
+             '[inputs.speed]\nfield = "speed"\ndistribution = "uniform"\nunit = "m/s"\nlow = 2.9\nhigh = 3.1\n'
+             'reason = "test"\n'
+             '[bicycle]\nmeasured = "balanceassist_v1"\nparameters = ["c", "lam", "mB", "seating.lst"]\n'
+             'reason = "the bicycle file\'s own standard deviations"\n')
+
+
+def test_each_row_runs_on_its_sampled_bicycle_and_every_pressure_on_the_same_one(tmp_path):
+    """A row's bicycle is the measured one with the row's sampled values (exactly: written with repr) and every
+    other parameter as measured; all pressures and loads of a row share it (pairing), and a row that repeats
+    another's values shares its folder."""
+    from whipple_kick.library import bicycleparameters, bicycles
+    path = tmp_path / "bike.toml"
+    path.write_text(BIKE_FILE)
+    spec = uncertain.load(path)
+    measured = bicycles.load("balanceassist_v1")
+    unit, _ = uncertainty.sample(spec, 2, 0)
+    uncertainty.check_inputs(spec, BASE)
+    cases, keys = uncertainty.study_cases(spec, unit, [570.0, 635.0], [300.0, 500.0], BASE)
+    by_row = {}
+    for case, (row, _, _) in zip(cases, keys, strict=True):
+        by_row.setdefault(row, set()).add(case["bicycle"])
+    assert all(len(paths) == 1 for paths in by_row.values())
+    for row, (folder,) in list(by_row.items())[:3]:
+        values = spec.values(unit[row])
+        with pytest.warns(wk.errors.DefaultValueWarning):   # the tyres come from the run's tyre file
+            bike = bicycleparameters.load(folder)
+        for name in ("c", "lam", "mB"):
+            assert bike.benchmark[name] == values[f"bicycle.{name}"]
+        assert bike.geometry["lst"] == values["bicycle.seating.lst"]
+        assert bike.benchmark["w"] == measured.benchmark["w"] and bike.benchmark["IBxx"] == measured.benchmark["IBxx"]
+    assert uncertainty.sampled_bicycle("balanceassist_v1", {"bicycle.c": 0.05}) == \
+        uncertainty.sampled_bicycle("balanceassist_v1", {"bicycle.c": 0.05})
+
+
+def test_a_bicycle_input_without_its_table_is_refused(tmp_path):
+    path = tmp_path / "u.toml"
+    path.write_text(TINY + '[inputs.trail]\nfield = "bicycle.c"\ndistribution = "uniform"\nunit = "m"\n'
+                           'low = 0.03\nhigh = 0.05\nreason = "test"\n')
+    with pytest.raises(InputError, match=r"sampled from a \[bicycle\] table"):
+        uncertainty.check_inputs(uncertain.load(path), BASE)
+
+
+@pytest.mark.filterwarnings("ignore::whipple_kick.errors.DefaultValueWarning")
+def test_a_study_on_sampled_bicycles_runs_and_names_their_parameters(tmp_path):
+    """Two pressures x one load x 12 rows of 2 s runs: the study runs on the sampled folders and its input table
+    and Sobol analysis name the bicycle's parameters."""
+    path = tmp_path / "bike.toml"
+    path.write_text(BIKE_FILE.replace('"mB", "seating.lst"', '"mB"'))
+    study = uncertainty.run_study(path, samples=2, seed=0, loads=(635.0,), pressures=(300.0, 500.0),
+                                  base=BASE.with_changes(duration=2.0), workers=1)
+    assert {"bicycle.c", "bicycle.lam", "bicycle.mB"} <= set(study.inputs.columns)
+    assert len(set(study.inputs["bicycle.c"])) > 1
+    assert (study.outcomes["status"] == "ok").all() and len(study.outcomes) == 24

@@ -139,13 +139,15 @@ class UncertainInput:
 
 @dataclasses.dataclass(frozen=True)
 class UncertainSet:
-    """The inputs of an uncertainty file, in file order, and the fields it holds fixed."""
+    """The inputs of an uncertainty file, in file order, the fields it holds fixed, and the measured bicycle
+    whose parameters its ``bicycle.*`` inputs sample (None: no ``[bicycle]`` table)."""
 
     name: str
     description: str
     path: str
     inputs: tuple
     fixed: dict
+    measured_bicycle: str | None = None
 
     @property
     def names(self) -> tuple:
@@ -199,7 +201,7 @@ def load(name_or_path=DEFAULT) -> UncertainSet:
         if not path.exists():
             raise InputError(f"uncertainty file {text_name!r} does not exist (shipped: {', '.join(shipped)})")
     data = parameters.load_toml(path)
-    allowed = {"format", "name", "description", "fixed", "inputs"}
+    allowed = {"format", "name", "description", "fixed", "inputs", "bicycle"}
     unknown = sorted(set(data) - allowed)
     if unknown:
         fail(path, "top level", f"unknown key(s) {', '.join(unknown)}; allowed: {', '.join(sorted(allowed))}")
@@ -215,10 +217,18 @@ def load(name_or_path=DEFAULT) -> UncertainSet:
             fail(path, f"fixed.{field}", "must be { value = ..., reason = \"...\" }")
         text(path, f"fixed.{field}.reason", entry.get("reason"))
         fixed[field] = entry["value"]
-    entries = table(path, "inputs", data.get("inputs"))
-    if not entries:
-        fail(path, "inputs", "declares no uncertain input")
+    # [inputs] may be left out only where a [bicycle] table declares the inputs.
+    entries = table(path, "inputs", data.get("inputs")) if "inputs" in data or "bicycle" not in data else {}
     inputs = tuple(_read_input(path, key, entry) for key, entry in entries.items())
+    measured = None
+    if "bicycle" in data:
+        if "bicycle" in fixed:
+            fail(path, "bicycle", "the measured bicycle's parameters are sampled: fixed.bicycle would contradict it")
+        bicycle = table(path, "bicycle", data["bicycle"])
+        inputs += bicycle_inputs(path, bicycle)
+        measured = bicycle["measured"]
+    if not inputs:
+        fail(path, "inputs", "declares no uncertain input")
     owner = {}
     for inp in inputs:
         for field in inp.fields:
@@ -227,7 +237,59 @@ def load(name_or_path=DEFAULT) -> UncertainSet:
             if field in fixed:
                 fail(path, f"inputs.{inp.name}", f"sets {field!r}, which [fixed] holds fixed")
             owner[field] = inp.name
-    return UncertainSet(name, description, str(path), inputs, fixed)
+    return UncertainSet(name, description, str(path), inputs, fixed, measured)
+
+
+#: A field name ``bicycle.<parameter>``: a measured bicycle's parameter (BicycleParameters' names, and
+#: ``seating.<length>``), sampled from its standard deviation (:func:`bicycle_inputs`).
+BICYCLE_PREFIX = "bicycle."
+#: A measured parameter is sampled from its normal distribution truncated to this many standard deviations
+#: either side (a mass or an inertia several deviations below its nominal would be unphysical).
+BICYCLE_TRUNCATION_SD = 3.0
+
+
+def bicycle_inputs(path, entry) -> tuple:
+    """The inputs of a ``[bicycle]`` table: a measured bicycle's parameters from their ``+/-``.
+
+    ``[bicycle]`` holds ``measured`` (a shipped bicycle, or a BicycleParameters
+    folder or Benchmark.txt), ``reason``, and optionally ``parameters`` (the
+    names to sample; default every parameter with a standard deviation) and
+    ``sd_scale`` (a factor on every deviation, default 1). Each parameter is a
+    normal input ``bicycle.<name>`` with the file's value as mean and its
+    standard deviation times ``sd_scale`` as sd, truncated to
+    :data:`BICYCLE_TRUNCATION_SD` deviations.
+    """
+    from . import bicycleparameters
+
+    allowed = {"measured", "reason", "parameters", "sd_scale"}
+    extra = sorted(set(entry) - allowed)
+    if extra or "measured" not in entry or "reason" not in entry:
+        fail(path, "bicycle", "must have measured and reason, optionally parameters and sd_scale"
+                              + (f" (unknown: {', '.join(extra)})" if extra else ""))
+    measured = text(path, "bicycle.measured", entry["measured"])
+    reason = text(path, "bicycle.reason", entry["reason"])
+    scale = number(path, "bicycle.sd_scale", entry.get("sd_scale", 1.0))
+    if not scale > 0:
+        fail(path, "bicycle.sd_scale", f"value {scale:g} must be > 0")
+    bike = bicycleparameters.load_bicycle(measured)
+    # Benchmark names and seating lengths: what a BicycleParameters folder written per sample row can carry.
+    known = {k: v for k, v in bicycleparameters.parameter_uncertainties(bike).items()
+             if k in bike.benchmark or k.startswith("seating.")}
+    names = entry.get("parameters", sorted(known))
+    if not isinstance(names, list) or not names:
+        fail(path, "bicycle.parameters", "must be a non-empty array of parameter names")
+    out = []
+    for name in names:
+        if name not in known:
+            fail(path, "bicycle.parameters", f"{name!r} has no standard deviation in {measured!r}; "
+                                             f"those that have: {', '.join(sorted(known))}")
+        nominal, std = known[name]
+        sd = std * scale
+        out.append(UncertainInput(
+            f"{BICYCLE_PREFIX}{name}", "normal", f"{reason} ({measured}: {nominal:g} +/- {std:g})",
+            f"{BICYCLE_PREFIX}{name}", "SI", nominal - BICYCLE_TRUNCATION_SD * sd,
+            nominal + BICYCLE_TRUNCATION_SD * sd, nominal, sd))
+    return tuple(out)
 
 
 def _read_input(path, name, entry) -> UncertainInput:

@@ -146,12 +146,16 @@ def check_inputs(spec, base):
         One line naming the input and the field.
     """
     fields = {f.name for f in dataclasses.fields(Scenario)}
+    for inp in spec.inputs:
+        if inp.field and inp.field.startswith(uncertain.BICYCLE_PREFIX) and spec.measured_bicycle is None:
+            raise InputError(f"{spec.path}: inputs.{inp.name}: a measured bicycle's parameters are sampled from a "
+                             "[bicycle] table (measured = ..., parameters = [...]), not named as inputs")
     for field in spec.fixed:
         if field not in fields:
             raise InputError(f"{spec.path}: fixed.{field}: {field!r} is no scenario field")
         if field in _STUDY_FIELDS:
             raise InputError(f"{spec.path}: fixed.{field}: the study sets {field} itself")
-    for inp in spec.inputs:
+    for inp in _scenario_inputs(spec):
         for field in inp.fields:
             if field not in fields:
                 raise InputError(f"{spec.path}: inputs.{inp.name}: {field!r} is no scenario field "
@@ -160,7 +164,7 @@ def check_inputs(spec, base):
                 raise InputError(f"{spec.path}: inputs.{inp.name}: the study sets {field} itself "
                                  f"(pressures and loads are its grid)")
     candidates = _candidates(spec, base)
-    for inp in spec.inputs:
+    for inp in _scenario_inputs(spec):
         for field in inp.fields:
             mechanisms = [(m, cond, active) for m, cond, active, names in MECHANISM_FIELDS if field in names]
             if mechanisms and not any(all(active(sc) for _, _, active in mechanisms) for sc in candidates):
@@ -173,7 +177,7 @@ def _candidates(spec, base):
     """One scenario per combination of the choices' options (continuous inputs at their medians): what the
     samples can switch on. At most :data:`_MAX_COMBINATIONS`."""
     choices = [i for i in spec.inputs if i.distribution == "choice"]
-    medians = {i.field: float(i.ppf([0.5])[0]) for i in spec.inputs if i.distribution != "choice"}
+    medians = {i.field: float(i.ppf([0.5])[0]) for i in _scenario_inputs(spec) if i.distribution != "choice"}
     out = []
     for combo in itertools.islice(itertools.product(*(i.options for i in choices)), _MAX_COMBINATIONS):
         values = {**spec.fixed, **medians}
@@ -201,6 +205,65 @@ def sample(spec, samples, seed):
     return unit, blocks
 
 
+def _scenario_inputs(spec):
+    """The inputs that set scenario fields (not a measured bicycle's parameters)."""
+    return [i for i in spec.inputs if not (i.field or "").startswith(uncertain.BICYCLE_PREFIX)]
+
+
+def sampled_bicycle(measured, values):
+    """The measured bicycle with some parameters changed, written once as a BicycleParameters folder.
+
+    Parameters
+    ----------
+    measured : str
+        The bicycle the ``[bicycle]`` table names (shipped name or BicycleParameters path).
+    values : dict
+        ``{"bicycle.<name>": value}``: benchmark names, or ``bicycle.seating.<length>``.
+
+    Returns
+    -------
+    str
+        The folder (in the per-user cache, named by a hash of the bicycle's content and the values, so a row
+        that repeats another shares it), which a scenario's ``bicycle`` names.
+    """
+    import hashlib
+    import json
+    import os
+    import pathlib
+    import shutil
+
+    from whipple_kick.library import bicycleparameters, bicycles
+    from whipple_kick.model import cache
+
+    bike = bicycleparameters.load_bicycle(measured)
+    changes = {k[len(uncertain.BICYCLE_PREFIX):]: float(v) for k, v in values.items()}
+    benchmark, geometry = dict(bike.benchmark), dict(bike.geometry or {})
+    for name, value in changes.items():
+        if name.startswith("seating."):
+            geometry[name[len("seating."):]] = value
+        elif name in benchmark:
+            benchmark[name] = value
+        else:
+            raise InputError(f"bicycle parameter {name!r} of {measured!r} cannot be sampled "
+                             "(only benchmark names and seating lengths)")
+    key = hashlib.sha256(json.dumps([sorted(bike.benchmark.items()), sorted(geometry.items()),
+                                     sorted(changes.items()), bike.includes_rider], sort_keys=True).encode())
+    folder = cache.cache_dir() / "sampled_bicycles" / key.hexdigest()[:20]
+    target = folder / "bicycles" / "Sampled"
+    if not target.is_dir():
+        sampled = bicycles.Bicycle(
+            name="Sampled", benchmark=benchmark, parameterisation="benchmark", includes_rider=bike.includes_rider,
+            source=f"{bike.source}; sampled by the uncertainty study", description=bike.description,
+            uncertainties=dict(bike.uncertainties), geometry=geometry or None, defaults=dict(bike.defaults))
+        staging = folder.with_name(f"{folder.name}.tmp-{os.getpid()}")
+        bicycleparameters.write_folder(sampled, staging, name="Sampled")
+        try:
+            os.replace(staging, folder)   # atomic: another process sees the whole folder or none
+        except OSError:   # another process wrote it first
+            shutil.rmtree(staging, ignore_errors=True)
+    return str(pathlib.Path(target))
+
+
 def row_values(spec, unit_row, base):
     """The scenario fields of one sample row, less those the row's own mechanisms do not read.
 
@@ -210,6 +273,9 @@ def row_values(spec, unit_row, base):
     value, so no run is given a field it ignores (which the scenario refuses).
     """
     values = spec.values(unit_row)
+    sampled = {k: values.pop(k) for k in list(values) if k.startswith(uncertain.BICYCLE_PREFIX)}
+    if sampled:
+        values["bicycle"] = sampled_bicycle(spec.measured_bicycle, sampled)
     for field in base.with_changes(**values).unused_fields():
         values.pop(field, None)
     return values
