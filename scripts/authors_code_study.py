@@ -13,7 +13,7 @@ two more runs held out from the mode's tuning in its subfolders, authors_code.ST
   the first yaw-rate peak; the fall time.
 * ``held_out``: every stored run against the mode, each signal's largest difference over 0-1 s
   as a fraction of the run's peak, with the mode's slip speed and start pitch and with this
-  model's (the mode before issue 24); first yaw-rate peaks and falls.
+  model's (the mode before the slip speed and start pitch became switches); first yaw-rate peaks and falls.
 * ``switches``: each of the mode's assumptions switched back to this model's alone (from the
   mode), and each switched on alone in the authors' preset with this model's assumptions
   (``Scenario.thesis(500)``): outcome, first yaw-rate peak, largest difference from the stored
@@ -83,7 +83,7 @@ def agreement():
     print(f"rear slide after the plate stop: {jump['rear_slide_m_s']:+.4f} m/s")
 
 
-#: The mode with this model's slip speed and start pitch (the mode before issue 24).
+#: The mode with this model's slip speed and start pitch (the mode before the slip speed and start pitch became switches).
 OURS_SLIP_AND_PITCH = {"slip_speed": "wheel_centre", "start_pitch": "compressed"}
 
 

@@ -1,4 +1,4 @@
-"""The uncertainty study of thesis Chapter 8 (issue 30), and what a run of it costs.
+"""The uncertainty study of thesis Chapter 8, and what a run of it costs.
 
 Runs :func:`whipple_kick.studies.uncertainty.run_study` on the shipped
 ``kickplate_2025`` uncertainty file: 3 pressures (300/400/500 kPa) x 3 rear

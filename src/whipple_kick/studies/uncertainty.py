@@ -1,6 +1,6 @@
 """How sure is the answer: which pressure recovers fastest, with its probability, and what it hinges on.
 
-The uncertainty study (issue 30) runs the kick at every pressure for every
+The uncertainty study runs the kick at every pressure for every
 rear load on inputs sampled from an uncertainty file
 (:mod:`whipple_kick.library.uncertain`), and reports:
 
