@@ -57,7 +57,14 @@ CHANGELOG = OUT / "CHANGELOG.md"
 COLUMNS = ("time", "yaw_rate", "roll_rate", "steer_rate", "roll", "steer", "yaw", "y_rear",
            "fy_rear", "fy_front", "mz_rear", "mz_front", "fz_rear", "fz_front", "slip_rear", "slip_front",
            "slip_patch_rear", "slip_patch_front", "carcass_deflection_rear", "carcass_deflection_front",
-           "steer_torque", "plate_work", "sliding_dissipation")
+           "steer_torque", "plate_work", "sliding_dissipation",
+           # the rider's body, where the run has it (the leaning body, the arms, the reflex)
+           "upper_body_lean", "upper_body_lean_rate", "hip_torque", "arm_steer_torque", "reflex_steer_torque")
+#: Columns of the leaning upper body's part: stored only where the scenario has that part.
+LEANING_COLUMNS = ("upper_body_lean", "upper_body_lean_rate", "hip_torque")
+#: The cases of the rider's body (no pinned contact-patch copies: they came after that form's time).
+BODY_CASES = ("leaning_400kPa_635N", "arms_400kPa_635N", "leaning_arms_400kPa_635N", "reflex_400kPa_635N",
+              "lqr_simulated_400kPa_635N")
 RATE_HZ = 200.0
 #: Kick table of the tabulated case (minimum-jerk 150 mm in 150 ms, rows every 10 ms), in :data:`OUT`.
 KICK_TABLE = "kick_table_smooth_10ms.csv"
@@ -91,6 +98,18 @@ def cases():
     out["T04_400kPa_635N"] = dataclasses.replace(one, tyre="T04")
     out["lqr_350kPa_635N"] = dataclasses.replace(one, pressure_kpa=350.0)
     out["speed5_400kPa_635N"] = dataclasses.replace(one, speed=5.0)   # LQR designed at 3 m/s (default)
+    # The rider's body (each generated before the body became declared parts, so the parts must reproduce
+    # the locked-hip model's runs): the leaning upper body, the arms on the bar with the rigid rider (the
+    # upper body merged into the rear frame), both, a delayed reflex, and the LQR designed on the model.
+    out["leaning_400kPa_635N"] = dataclasses.replace(one, rider_body="leaning")
+    # (The Whipple LQR does not hold the rider with arms or a delayed reflex: those are designed on the model.)
+    designed = dataclasses.replace(one, lqr_model="simulated")
+    out["arms_400kPa_635N"] = dataclasses.replace(designed, arms="on", arm_stiffness=10.0, arm_damping=1.0)
+    out["leaning_arms_400kPa_635N"] = dataclasses.replace(designed, rider_body="leaning", arms="on",
+                                                          arm_stiffness=10.0, arm_damping=1.0)
+    out["reflex_400kPa_635N"] = dataclasses.replace(designed, reflex_delay=0.1, reflex_roll=5.0,
+                                                    reflex_steer_rate=0.5)
+    out["lqr_simulated_400kPa_635N"] = dataclasses.replace(one, lqr_model="simulated")
     return out
 
 
@@ -112,7 +131,8 @@ def write_case(name, scenario, path):
     from whipple_kick.simulate import simulation
     result = simulation.run(runnable(scenario, path.parent))
     df = result.trajectory
-    arrays = {c: df[c].to_numpy(dtype=np.float32) for c in COLUMNS if c in df.columns}
+    stored = [c for c in COLUMNS if c in df.columns and (scenario.rider_body == "leaning" or c not in LEANING_COLUMNS)]
+    arrays = {c: df[c].to_numpy(dtype=np.float32) for c in stored}
     np.savez_compressed(path, **arrays, name=np.array(name),
                         scenario_json=np.array(json.dumps(scenario.to_dict(), sort_keys=True)),
                         model_hash=np.array(wk.slip.model_hash()),
