@@ -261,8 +261,9 @@ def test_ignorable_columns_of_the_jacobian_are_exactly_zero(runs):
             assert np.array_equal(rhs(t, moved), base), name
         jac = rhs.jacobian_function(np.ones(len(slip.STATE_NAMES)))(t, x)
         assert not np.any(jac[:, [slip.X[n] for n in slip.IGNORABLE]])
-    # The default rider (hip locked, no delay) skips the hip's and the reflex filter's columns too.
-    assert len(slip.DYNAMIC_STATES) + 1 - 4 - 2 - 4 == slip.JACOBIAN_EVALUATIONS == 18
+    # The default rider's model has no trunk and no delay filter: 21 dynamic states, 18 evaluations per Jacobian.
+    assert rhs.layout is slip.layout.BASE and rhs.layout.key == "rigid"
+    assert len(slip.DYNAMIC_STATES) + 1 - 4 == slip.JACOBIAN_EVALUATIONS == 18
 
 
 def test_blended_pressure_rhs_is_unchanged_at_every_sample():
@@ -273,12 +274,20 @@ def test_blended_pressure_rhs_is_unchanged_at_every_sample():
     bit for bit)."""
     import pathlib
     ref = np.load(pathlib.Path(__file__).resolve().parents[1] / "data" / "blend" / "rhs_350kPa_635N.npz")
-    for names, now in (("output_names", slip.OUTPUT_NAMES), ("state_names", slip.STATE_NAMES),
-                       ("parameter_names", slip.PARAMETER_NAMES)):
-        assert list(ref[names]) == list(now), f"the model's layout changed since {names} were stored"
-    rhs = slip.CompiledRHS(dict(zip(slip.PARAMETER_NAMES, ref["p"], strict=True)))
+    # Stored with the locked-hip model (its hip and delay filter's states frozen at 0): the rigid rider's model
+    # has neither, so its states, outputs and parameters are read by name, and what it lacks must have been
+    # frozen (locked hip, no upper-body mass, no delay, zero rates of the dropped states).
+    p_old = dict(zip(ref["parameter_names"], ref["p"], strict=True))
+    assert p_old["hip_locked"] == 1.0 and p_old["mt"] == 0.0 and p_old["reflex_delay"] == 0.0
+    state = [list(ref["state_names"]).index(n) for n in slip.STATE_NAMES]
+    dropped = [i for i, n in enumerate(ref["state_names"]) if n not in slip.X]
+    assert sorted(ref["state_names"][dropped]) == sorted(("q11", "u11", *slip.REFLEX_STATES))
+    assert not np.any(ref["x"][:, dropped]) and not np.any(ref["dx"][:, dropped])
+    output = [list(ref["output_names"]).index(n) for n in slip.OUTPUT_NAMES]
+    rhs = slip.CompiledRHS({n: p_old[n] for n in slip.PARAMETER_NAMES})
     assert rhs.p[slip.P["wr"]] == 0.5 and rhs.p[slip.P["wf"]] == 0.5   # the blend: 300 and 400 kPa, 1:1
-    pairs = [rhs.outputs(t, x) for t, x in zip(ref["t"], ref["x"], strict=True)]
-    for got, want in ((np.array([d for d, _ in pairs]), ref["dx"]), (np.array([o for _, o in pairs]), ref["out"])):
+    pairs = [rhs.outputs(t, x) for t, x in zip(ref["t"], ref["x"][:, state], strict=True)]
+    for got, want in ((np.array([d for d, _ in pairs]), ref["dx"][:, state]),
+                      (np.array([o for _, o in pairs]), ref["out"][:, output])):
         scale = np.maximum(np.abs(want).max(axis=0), 1e-300)
         assert np.max(np.abs(got - want) / scale) <= 1e-11

@@ -59,7 +59,7 @@ def test_metadata_beside_the_library_describes_its_layouts():
     """Plain data written at build time: every state, parameter and output by position, with unit and description."""
     path = slip.library_path().with_suffix(".json")
     data = json.loads(path.read_text())
-    assert data["layout"] == slip.layout()
+    assert data["layout"] == slip.metadata_layout()
     assert [s["name"] for s in data["states"]] == list(slip.STATE_NAMES)
     assert [p["name"] for p in data["parameters"]] == list(slip.PARAMETER_NAMES)
     assert [o["name"] for o in data["outputs"]] == list(slip.OUTPUT_NAMES)
@@ -98,12 +98,12 @@ def test_library_without_matching_metadata_is_built_again(tmp_path, monkeypatch,
     monkeypatch.setenv("WHIPPLE_KICK_CACHE", str(folder))
     builds = []
 
-    def build_library(path, key, compiler, flags):   # stands in for the 20-30 s build: the good entry
+    def build_library(path, key, compiler, flags, part_names=(), delayed_reflex=False):   # stands in for the build
         builds.append(key)
         path.write_bytes(good.read_bytes())
         (folder / f"slip_{key}.json").write_text(good.with_suffix(".json").read_text())
 
     monkeypatch.setattr(slip_build, "build_library", build_library)
     lib_loaded = slip.library.__wrapped__()
-    assert len(builds) == 1 and json.loads(meta.read_text())["layout"] == slip.layout()
+    assert len(builds) == 1 and json.loads(meta.read_text())["layout"] == slip.metadata_layout()
     assert lib_loaded.wk_slip_rhs is not None

@@ -488,7 +488,7 @@ def leaning_rider(obj):
     body : dict
         :func:`whipple_kick.library.riders.seat_with_body`'s body (hinge horizontal, ``hip_tilt = -lam``; the
         hinge point taken above the rear wheel centre, any point of the line will do), with ``kh = k9``,
-        ``ch = c9`` and ``hip_locked`` 0: pass it to ``slip.model_parameters(..., body=body)``.
+        ``ch = c9``: pass it to ``slip.model_parameters(..., body=body)`` (the model with the trunk part).
     """
     params = {k: _nominal(v)[0] for k, v in obj.parameters.items()}
     missing = [n for n in (*_benchmark.MOORE_NAMES, *LEAN_NAMES) if n not in params]
@@ -501,7 +501,7 @@ def leaning_rider(obj):
     lam = bike.benchmark["lam"]
     c_x, c_z = _benchmark._pitch_matrix(lam)
     hinge = np.array([0.0, params["d4"]])              # (x, z) from the rear wheel centre, benchmark axes
-    body = {"hip_locked": 0.0, "hip_tilt": -lam, "lh1": float(hinge @ c_x), "lh3": float(hinge @ c_z),
+    body = {"hip_tilt": -lam, "lh1": float(hinge @ c_x), "lh3": float(hinge @ c_z),
             "mt": params["mg"], "lt1": params["l5"], "lt3": params["l6"], "it11": params["ig11"],
             "it22": params["ig22"], "it33": params["ig33"], "it31": params["ig31"],
             "kh": params["k9"], "ch": params["c9"]}

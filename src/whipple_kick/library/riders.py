@@ -689,7 +689,7 @@ def seat_with_body(bike, rider, arms_on_bar=True):
     body : dict
         The upper body's parameters by name (:data:`whipple_kick.model.slip.parameters.BODY_NAMES`: ``hip_tilt``,
         ``lh1``, ``lh3``, ``mt``, ``lt1``, ``lt3``, ``it11``, ``it22``, ``it33``, ``it31``), in Moore's
-        rear frame C from the rear wheel centre, with ``hip_locked`` 0.
+        rear frame C from the rear wheel centre (the trunk part's, :data:`whipple_kick.model.parts.TRUNK`).
     """
     seated = place(bike, rider)
     human = rider.human(seated.configuration)
@@ -710,7 +710,7 @@ def seat_with_body(bike, rider, arms_on_bar=True):
     c_x, c_z = _benchmark._pitch_matrix(lam)
     hip = (seat_pt - np.array([0.0, 0.0, -bike.benchmark["rR"]]))[[0, 2]]
     arm = com_t - seat_pt
-    body = {"hip_locked": 0.0, "hip_tilt": -lam, "lh1": float(hip @ c_x), "lh3": float(hip @ c_z),
+    body = {"hip_tilt": -lam, "lh1": float(hip @ c_x), "lh3": float(hip @ c_z),
             "mt": m_t, "lt1": float(arm[0]), "lt3": float(arm[2]),
             "it11": float(i_t[0, 0]), "it22": float(i_t[1, 1]), "it33": float(i_t[2, 2]), "it31": float(i_t[0, 2])}
     where = "forearms and hands in the front frame, " if arms_on_bar else ""

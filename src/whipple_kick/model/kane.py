@@ -36,12 +36,8 @@ class ConstraintPartition:
         u[self.dep] = -np.linalg.solve(A[:, self.dep], A[:, self.ind] @ u_ind + a0)
         return u
 
-    def accelerations(self, M, f, A, b, locked=()):
-        """Kane's reduced equations; return du/dt for all speeds.
-
-        ``locked``: positions among the independent speeds held constant (their
-        reduced equations replaced by d/dt = 0, a joint locked at zero speed).
-        """
+    def accelerations(self, M, f, A, b):
+        """Kane's reduced equations; return du/dt for all speeds."""
         A_dep = A[:, self.dep]
         sol = np.linalg.solve(A_dep, np.column_stack([A[:, self.ind], b]))
         C = -sol[:, :-1]
@@ -53,11 +49,6 @@ class ConstraintPartition:
         t0 = np.zeros(n, dtype=d.dtype)
         t0[self.dep] = d
         Mr, r = T.T @ M @ T, T.T @ (f - M @ t0)
-        for j in locked:
-            Mr[j, :] = 0.0
-            Mr[:, j] = 0.0
-            Mr[j, j] = 1.0
-            r[j] = 0.0
         ud_ind = np.linalg.solve(Mr, r)
         return T @ ud_ind + t0
 

@@ -77,8 +77,6 @@ def _entries():
         ("q8", "front wheel rotation angle relative to the front frame (about E.y)", "rad", q),
         ("q9", "rear tyre vertical compression", "m", q),
         ("q10", "front tyre vertical compression", "m", q),
-        ("q11", "rider's upper-body lean relative to the rear frame, about the hip axis H.x (positive = lean "
-                "right; held at 0 while hip_locked is 1)", "rad", q),
         # --- generalised speeds: u_i = d q_i / dt --------------------------
         ("u1", "rate of q1: rear contact velocity along N.x", "m/s", u),
         ("u2", "rate of q2: rear contact velocity along N.y", "m/s", u),
@@ -90,7 +88,6 @@ def _entries():
         ("u8", "rate of q8: front wheel spin rate relative to the front frame", "rad/s", u),
         ("u9", "rate of q9: rear tyre compression rate", "m/s", u),
         ("u10", "rate of q10: front tyre compression rate", "m/s", u),
-        ("u11", "rate of q11: upper-body lean rate relative to the rear frame", "rad/s", u),
         # --- inputs --------------------------------------------------------
         ("T4", "roll torque on the rear frame about A.x (from the ground)", "N m", i),
         ("T6", "rear wheel drive torque, between rear frame and rear wheel (about C.y)", "N m", i),
@@ -129,7 +126,8 @@ def _entries():
         ("W_zero_slip", "cumulative work of the tyres' zero-slip lateral forces F0 on the patch sliding velocity", "J", s),
         ("W_moment", "cumulative work of the aligning moments (M_z times the wheel's rate about the ground normal)", "J", s),
         ("D_slide", "cumulative sliding dissipation of the contact patches, -(F - F0) V'", "J", s),
-        ("D_damper", "cumulative dissipation of the vertical tyre dampers and of the rider's hip and arm dampers",
+        ("D_damper", "cumulative dissipation of the vertical tyre dampers, the rider's arm dampers and the parts' dampers "
+                     "(the leaning upper body's hip)",
          "J", s),
         ("E_carcass_r", "rear tyre carcass energy: integral of the power into the lateral carcass compliance", "J", s),
         ("E_carcass_f", "front tyre carcass energy: integral of the power into the lateral carcass compliance", "J", s),
@@ -195,27 +193,10 @@ def _entries():
         ("carcass_viscosity", "sliding viscosity of an undamped carcass tyre's patch past its friction limit "
                               "(regularises the Coulomb plateau)", "N s/m", c),
         # --- rider with a body: a leaning upper body, arms on the bar, reflexes --
-        ("hip_locked", "1: the upper body is rigidly part of the rear frame (rigid rider, q11 held at 0); "
-                       "0: it leans on the hip spring-damper", "-", c),
-        ("hip_tilt", "angle about C.y from the rear frame's C.x axis to the hip (lean) axis H.x: minus the steer "
-                     "axis tilt puts H.x horizontal in the nominal configuration", "rad", c),
-        ("lh1", "hip (lean-axis) point from the rear wheel centre along C.x", "m", c),
-        ("lh3", "hip (lean-axis) point from the rear wheel centre along C.z", "m", c),
-        ("mt", "mass of the rider's upper body G (0: the whole rider is lumped into the rear frame)", "kg", c),
-        ("lt1", "upper-body mass centre from the hip point along G.x", "m", c),
-        ("lt3", "upper-body mass centre from the hip point along G.z (negative: above the hip)", "m", c),
-        ("it11", "upper-body moment of inertia about its mass centre, G.x axis", "kg m^2", c),
-        ("it22", "upper-body moment of inertia about its mass centre, G.y axis", "kg m^2", c),
-        ("it33", "upper-body moment of inertia about its mass centre, G.z axis", "kg m^2", c),
-        ("it31", "upper-body product of inertia about its mass centre, G.z-G.x entry", "kg m^2", c),
-        ("kh", "hip lean stiffness: torque on the upper body about H.x per radian of q11", "N m/rad", c),
-        ("ch", "hip lean damping: torque on the upper body about H.x per rad/s of u11", "N m s/rad", c),
         ("ka", "arm stiffness about the steer axis: torque on the bar per radian of the bar's rotation relative "
-               "to the upper body", "N m/rad", c),
-        ("ca", "arm damping about the steer axis, per rad/s of the bar's rotation relative to the upper body",
+               "to the frame the hands hold (the upper body, or the rear frame without one)", "N m/rad", c),
+        ("ca", "arm damping about the steer axis, per rad/s of the bar's rotation relative to the hands' frame",
          "N m s/rad", c),
-        ("kq11", "steer-torque feedback gain on upper-body lean q11", "N m/rad", c),
-        ("ku11", "steer-torque feedback gain on upper-body lean rate u11", "N m s/rad", c),
         ("rq4", "reflex steer-torque gain on roll angle q4 (delayed by reflex_delay)", "N m/rad", c),
         ("rq7", "reflex steer-torque gain on steer angle q7 (delayed by reflex_delay)", "N m/rad", c),
         ("ru4", "reflex steer-torque gain on roll rate u4 (delayed by reflex_delay)", "N m s/rad", c),
@@ -238,8 +219,21 @@ def _entries():
     return {name: SymbolInfo(name, desc, unit, kind) for name, desc, unit, kind in rows}
 
 
-#: Every registered symbol by name.
+#: Every registered symbol by name (the model's parts add theirs: :func:`register`).
 REGISTRY = _entries()
+
+
+def register(rows):
+    """Register the symbols of a model part: rows of ``(name, description, unit, kind)``.
+
+    A name registered again with the same description, unit and kind is
+    accepted (a part module imported twice); with anything else it is refused.
+    """
+    for name, description, unit, kind in rows:
+        entry = SymbolInfo(name, description, unit, kind)
+        if REGISTRY.get(name, entry) != entry:
+            raise ValueError(f"symbol {name!r} is already registered as {REGISTRY[name]}")
+        REGISTRY[name] = entry
 
 #: Moore's parameters of the classic Carvallo-Whipple model, by name.
 CLASSIC_CONSTANTS = (
@@ -257,8 +251,7 @@ SLIP_CONSTANTS = CLASSIC_CONSTANTS + (
     "kick_t0", "kick_T", "kick_D", "kick_profile", "kick_c0", "kick_c1", "kick_c2", "kick_c3",
     "kq3", "kq4", "kq7", "ku3", "ku4", "ku7", "T6c", "tyre_transient", "vsx_r",
     "slip_speed_point", "ccr", "ccf", "dcr", "dcf", "carcass_sliding", "carcass_viscosity",
-    "carcass_stiffness_scale", "hip_locked", "hip_tilt", "lh1", "lh3", "mt", "lt1", "lt3", "it11", "it22", "it33", "it31",
-    "kh", "ch", "ka", "ca", "kq11", "ku11", "rq4", "rq7", "ru4", "ru7", "reflex_delay",
+    "carcass_stiffness_scale", "ka", "ca", "rq4", "rq7", "ru4", "ru7", "reflex_delay",
 ) + tuple(f"{kind}{wheel}{k}_{i}" for wheel in "rf" for k in (1, 2)
           for kind, n in (("a", 14), ("c", 18)) for i in range(n))
 

@@ -19,7 +19,7 @@ import pathlib
 import numpy as np
 
 from whipple_kick.errors import InputError, check_range
-from whipple_kick.model import slip
+from whipple_kick.model import parts, slip
 from whipple_kick.simulate import control, steady
 
 from .scenario import LOW_INERTIA_KEYS, THESIS_DESIGN_SPEED
@@ -159,7 +159,7 @@ def build_bicycle(scenario):
     """
     key = (scenario.bicycle, _file_stamp(scenario.bicycle), scenario.fz_n, scenario.rider_mass_kg,
            scenario.rider, scenario.low_inertia, scenario.rider_body != "rigid" or scenario.arms == "on",
-           scenario.arms == "on")
+           scenario.arms == "on", scenario.rider_body == "leaning")
     return copy.deepcopy(_bicycle_setup(*key))
 
 
@@ -173,7 +173,8 @@ def _file_stamp(name):
 
 
 @functools.lru_cache(maxsize=256)
-def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia, split=False, arms_on_bar=False):
+def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia, split=False, arms_on_bar=False,
+                   leaning=False):
     from whipple_kick.library import bicycleparameters, riders
     from whipple_kick.model import benchmark
 
@@ -203,6 +204,10 @@ def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia
         rider = riders.yeadon_rider(rider_name, mass_kg=rider_mass)
         combined, body = riders.seat_with_body(bike, rider, arms_on_bar=arms_on_bar)
     moore = dict(combined.moore)
+    if body and not leaning:
+        # The rigid rider with the arms on the bar: the upper body is part of the rear frame (the model
+        # without the trunk part), the forearms turn with the bar.
+        moore = parts.merge_into_rear_frame(moore, body)
     if low_inertia:
         bench = dict(combined.benchmark)
         for key in LOW_INERTIA_KEYS:
@@ -254,17 +259,16 @@ def _rear_load_range(bicycle, _stamp, rider_name):
 def rider_body(scenario, info):
     """The rider's body parameters by name (:data:`whipple_kick.model.slip.parameters.BODY_NAMES`) for ``scenario``.
 
-    The rigid rider without arms is :data:`~whipple_kick.model.slip.parameters.RIGID_BODY`; otherwise the upper
-    body of :func:`build_bicycle` (locked at the hip for the rigid rider with arms on the bar), the hip's and
-    arms' spring-dampers and the reflex.
+    The rigid rider without arms is :data:`~whipple_kick.model.slip.parameters.RIGID_BODY` (the model without
+    parts); the leaning rider adds the upper body of :func:`build_bicycle` and the hip's spring-damper (the
+    trunk part); the arms' spring-damper and the reflex act in both. (The rigid rider with arms on the bar has
+    its upper body in :func:`build_bicycle`'s rear frame.)
     """
     body = dict(slip.parameters.RIGID_BODY)
-    if info.get("body"):
-        body.update(info["body"])
-        body["hip_locked"] = 0.0 if scenario.rider_body == "leaning" else 1.0
-    body.update(kh=scenario.hip_stiffness if scenario.rider_body == "leaning" else 0.0,
-                ch=scenario.hip_damping if scenario.rider_body == "leaning" else 0.0,
-                ka=scenario.arm_stiffness if scenario.arms == "on" else 0.0,
+    if info.get("body") and scenario.rider_body == "leaning":   # the model with the trunk part
+        body.update({n: info["body"][n] for n in slip.parameters.TRUNK_BODY if n in info["body"]})
+        body.update(kh=scenario.hip_stiffness, ch=scenario.hip_damping)
+    body.update(ka=scenario.arm_stiffness if scenario.arms == "on" else 0.0,
                 ca=scenario.arm_damping if scenario.arms == "on" else 0.0,
                 rq4=scenario.reflex_roll, ru4=scenario.reflex_roll_rate, rq7=scenario.reflex_steer,
                 ru7=scenario.reflex_steer_rate, reflex_delay=scenario.reflex_delay)

@@ -500,7 +500,7 @@ def _linear_design_model(spec, moore, rear, front, body, felt, share, scaled):
     up = steady.upright_state(params, spec.speed)
     rhs = slip.CompiledRHS(up.params)
     A, b = slip.heading_linearisation(rhs, up.x)
-    names = list(slip.LINEAR_STATES) + list(slip.linear.body_states(rhs.p))
+    names = list(slip.LINEAR_STATES) + list(slip.linear.body_states(rhs))
     keep = [i for i, n in enumerate(names) if n != "v_fwd"]   # constant speed
     A, b = A[np.ix_(keep, keep)], b[keep]
     names = [names[i] for i in keep]

@@ -55,6 +55,11 @@ class Solution:
     jumps: list = field(default_factory=list)
     wall_s: float = 0.0
 
+    @property
+    def model(self):
+        """The :class:`~whipple_kick.model.slip.layout.Layout` of the compiled model that produced the samples."""
+        return (self.rhs[0] if isinstance(self.rhs, (list, tuple)) else self.rhs).layout
+
     def outputs(self, via_rhs=False) -> np.ndarray:
         """The compiled model's named outputs (:data:`whipple_kick.model.slip.OUTPUT_NAMES`) at every sample.
 
@@ -66,7 +71,7 @@ class Solution:
             return self.rhs.outputs_at(traj.t, traj.x, via_rhs)
         # Each piece's compiled model evaluates the samples it produced.
         owner = np.asarray(self.owner)
-        outs = np.empty((traj.t.size, len(slip.OUTPUT_NAMES)))
+        outs = np.empty((traj.t.size, len(self.model.OUTPUT_NAMES)))
         for k in np.unique(owner):
             rows = owner == k
             outs[rows] = self.rhs[k].outputs_at(traj.t[rows], traj.x[rows], via_rhs)

@@ -41,7 +41,7 @@ class StateHistory:
     """
 
     t: np.ndarray            # times [s], shape (n,)
-    x: np.ndarray            # states, shape (n, len(slip.STATE_NAMES))
+    x: np.ndarray            # states, shape (n, the model's state count)
     fell: bool               # the roll limit (or the steer limit) was reached
     fall_time: float | None  # time of the fall event [s]
     nfev: int                # right-hand-side evaluations by LSODA (those inside Jacobians not counted)
@@ -93,15 +93,16 @@ DEFAULT_CHUNK = 0.5
 QUADRATURE_ATOL = 1e6
 
 
-def default_atol(rtol, transient=DEFAULT_TRANSIENT):
+def default_atol(rtol, transient=DEFAULT_TRANSIENT, n_states=len(slip.STATE_NAMES)):
     """Absolute tolerances per state, scaled to each state's typical size.
 
     Angles and displacements (~1e-2..1) and speeds (~1) get ``rtol`` x 1e-2
     of their scale, the compressions x 1e-4; the tyre slots are angles too
     except in the ``force_lag`` form, whose force states (~100 N) get
-    ``rtol``; the energy quadratures :data:`QUADRATURE_ATOL`.
+    ``rtol``; the energy quadratures :data:`QUADRATURE_ATOL`. ``n_states``:
+    the model's state count (the parts' states, angles and rates, follow the base model's).
     """
-    atol = np.full(len(slip.STATE_NAMES), rtol * 1e-2)
+    atol = np.full(n_states, rtol * 1e-2)
     for name in ("q9", "q10", "u9", "u10"):
         atol[slip.X[name]] = rtol * 1e-4   # compressions are millimetres
     if transient == "force_lag":
@@ -370,7 +371,7 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
     """
     transient = getattr(rhs, "transient", DEFAULT_TRANSIENT)
     plain = getattr(rhs, "fast", rhs)   # the compiled model's one-foreign-call f(t, x)
-    atol = default_atol(rtol, transient) if atol is None else np.asarray(atol, dtype=float)
+    atol = default_atol(rtol, transient, len(x0)) if atol is None else np.asarray(atol, dtype=float)
     jac = rhs.jacobian_function(atol / rtol) if hasattr(rhs, "jacobian_function") else None
     jumps = dict(jumps or {})
     budget = DEFAULT_BUDGET if budget is None else budget

@@ -16,7 +16,7 @@ import math
 import numpy as np
 
 from whipple_kick.errors import InputError, SimulationError
-from whipple_kick.model import energy, slip
+from whipple_kick.model import energy, parts, slip
 from whipple_kick.simulate import lsoda, provenance
 
 #: Significant digits of trajectory.csv's floats: a relative round-off of at most 5e-13, far below the
@@ -32,14 +32,16 @@ COORDINATE_COLUMNS = {
     "q1": ("x_rear", "m"), "q2": ("y_rear", "m"), "q3": ("yaw", "rad"), "q4": ("roll", "rad"),
     "q5": ("frame_pitch", "rad"), "q6": ("rear_wheel_angle", "rad"), "q7": ("steer", "rad"),
     "q8": ("front_wheel_angle", "rad"), "q9": ("compression_rear", "m"),
-    "q10": ("compression_front", "m"), "q11": ("upper_body_lean", "rad"),
+    "q10": ("compression_front", "m"),
 }
 SPEED_COLUMNS = {
     "u1": ("velocity_x_fixed", "m/s"), "u2": ("velocity_y_fixed", "m/s"), "u3": ("yaw_rate", "rad/s"),
     "u4": ("roll_rate", "rad/s"), "u5": ("frame_pitch_rate", "rad/s"), "u6": ("rear_wheel_rate", "rad/s"), "u7": ("steer_rate", "rad/s"),
     "u8": ("front_wheel_rate", "rad/s"), "u9": ("compression_rate_rear", "m/s"),
-    "u10": ("compression_rate_front", "m/s"), "u11": ("upper_body_lean_rate", "rad/s"),
+    "u10": ("compression_rate_front", "m/s"),
 }
+#: The declared parts' states (:mod:`whipple_kick.model.parts`): state -> (column, unit), in a run that has them.
+PART_COLUMNS = {state: column for part in parts.REGISTRY.values() for state, column in part.columns.items()}
 #: The rear contact's velocity along the heading (yaw q3) [m/s]: forward and lateral (the drift).
 HEADING_COLUMNS = {"forward_speed": "m/s", "lateral_speed": "m/s"}
 #: The force and moment each tyre applies to the bicycle (in every transient form): output -> column.
@@ -55,7 +57,6 @@ OUTPUT_COLUMNS = {
     "sigma_r": "relaxation_length_rear", "sigma_f": "relaxation_length_front",
     "fy_limit_r": "fy_limit_rear", "fy_limit_f": "fy_limit_front",
     "T_reflex": "reflex_steer_torque", "reflex_input": "reflex_undelayed_torque", "arm_torque": "arm_steer_torque",
-    "hip_torque": "hip_torque",
 }
 #: Contact-patch states (transient forms contact_patch and slip_lag; the carcass has the camber ones
 #: and its patch slip as the output ``patch_slip_*``): state -> column.
@@ -71,6 +72,8 @@ BALANCE_COLUMN = "energy_balance_residual"
 UNITS = {"time": "s", **dict(COORDINATE_COLUMNS.values()), **dict(SPEED_COLUMNS.values()), **HEADING_COLUMNS,
          **dict.fromkeys(PATCH_STATE_COLUMNS.values(), "rad"), **dict.fromkeys(CARCASS_STATE_COLUMNS.values(), "m"),
          **{c: slip.OUTPUTS[o][0] for o, c in {**APPLIED_COLUMNS, **OUTPUT_COLUMNS}.items()},
+         **dict(PART_COLUMNS.values()),
+         **{o: unit for part in parts.REGISTRY.values() for o, (unit, _) in part.outputs.items()},
          **dict(energy.COLUMNS.values()), BALANCE_COLUMN: "J"}
 #: Columns whose largest absolute values after the kick the summary lists (``max_abs_<column>_absolute_<unit>``).
 PEAK_COLUMNS = ("yaw_rate", "roll_rate", "steer_rate", "roll", "steer", "slip_rear", "fy_rear", "fy_front",
@@ -237,7 +240,7 @@ def trajectory_frame(solution, tyre_transient="carcass"):
 
     traj = solution.states
     outs = solution.outputs()
-    layout = frame_layout(tyre_transient)
+    layout = frame_layout(tyre_transient, solution.model)
     # One float64 block, column by column (Fortran order: each column contiguous), instead of a dict of
     # columns that pandas copies into a block: a sweep builds ~1e4 of these tables.
     values = np.empty((traj.t.size, len(layout)), order="F")
@@ -264,16 +267,20 @@ def trajectory_frame(solution, tyre_transient="carcass"):
 
 
 @functools.cache
-def frame_layout(tyre_transient="carcass"):
+def frame_layout(tyre_transient="carcass", model=slip.layout.BASE):
     """The columns of :func:`trajectory_frame` before the balance residual: ``(name, source, index)``.
 
     ``source`` is ``"state"`` (``index`` into the state vector), ``"output"``
-    (into :data:`whipple_kick.model.slip.OUTPUT_NAMES`) or ``"derived"`` (time, and the
-    heading speeds from yaw and the fixed-axes velocity).
+    (into the model's ``OUTPUT_NAMES``) or ``"derived"`` (time, and the
+    heading speeds from yaw and the fixed-axes velocity). ``model``: the
+    run's :class:`~whipple_kick.model.slip.layout.Layout`; its parts' states
+    follow the bicycle's coordinates and speeds, their outputs the others.
     """
     layout = [("time", "derived", None)]
     layout += [(name, "state", slip.X[q]) for q, (name, _) in COORDINATE_COLUMNS.items()]
+    layout += [(model.COLUMNS[q][0], "state", model.X[q]) for p in model.parts for q in p.coordinates]
     layout += [(name, "output", slip.OUT[u]) for u, (name, _) in SPEED_COLUMNS.items()]   # u5 u6 u8 too
+    layout += [(model.COLUMNS[u][0], "state", model.X[u]) for p in model.parts for u in p.speeds]
     layout += [(name, "derived", None) for name in HEADING_COLUMNS]
     layout += [(name, "output", slip.OUT[o]) for o, name in APPLIED_COLUMNS.items()]
     if tyre_transient != "force_lag":
@@ -283,6 +290,7 @@ def frame_layout(tyre_transient="carcass"):
     if tyre_transient == "carcass":
         layout += [(name, "state", slip.X[state]) for state, name in CARCASS_STATE_COLUMNS.items()]
     layout += [(name, "output", slip.OUT[o]) for o, name in OUTPUT_COLUMNS.items()]
+    layout += [(o, "output", model.OUT[o]) for o in model.PART_OUTPUTS]
     layout += [(name, "state", slip.X[state]) for state, (name, _) in energy.COLUMNS.items()]
     return tuple(layout)
 
@@ -730,7 +738,8 @@ def _steady_section(scenario, assembly, baseline, start_outputs):
         "yaw_rate_baseline_rad_s": baseline,
         "lateral_drift_m_s": float(x0[slip.X["u2"]]),
         "compression_rear_m": float(x0[slip.X["q9"]]), "compression_front_m": float(x0[slip.X["q10"]]),
-        "upper_body_lean_rad": float(x0[slip.X["q11"]]),   # the leaning rider's steady lean at the hip (0 rigid)
+        # the leaning rider's steady lean at the hip (0 without the trunk part, and from an upright start)
+        "upper_body_lean_rad": float(start.unknowns.get("q11", 0.0)),
         # An upright start's front contact below the ground (+; start_pitch "uncompressed": the authors' code).
         "front_contact_below_ground_m": start.unknowns.get("front_contact_offset_m"),
         **_rear_wheel_torque(start, start_outputs),
@@ -757,7 +766,7 @@ def _numerics_section(scenario, solution, frame):
                    "per_simulated_second": lsoda.DEFAULT_BUDGET.per_second},
         "integration_wall_s": solution.wall_s,
         "max_abs_holonomic_m": float(np.max(np.abs(frame["holonomic_residual"]))),
-        "model_hash": slip.model_hash(),
+        "model_hash": slip.model_hash(solution.model),
     }
 
 

@@ -230,7 +230,7 @@ def lateral_poles(params, x):
     Sorted by decreasing real part.
     """
     rhs = slip.CompiledRHS(params)
-    body = slip.linear.body_states(rhs.p)
+    body = slip.linear.body_states(rhs)
     if body:
         # A leaning body or a delayed reflex: the compiled Jacobian's linearisation, which carries their states
         # (the finite differences of linear_state_space perturb the bicycle's states only).
@@ -307,7 +307,7 @@ class SteadyState:
     """Result of :func:`steady_state`."""
 
     def __init__(self, x, params, residual, unknowns):
-        self.x = x                  # full state vector (slip.STATE_NAMES)
+        self.x = x                  # full state vector (its model's layout: slip.STATE_NAMES and the parts' states)
         self.params = params        # parameters with the holding drive torque T6c
         self.residual = residual    # max |residual| of the steady equations
         self.unknowns = unknowns    # dict of the solved quantities
@@ -352,23 +352,23 @@ def steady_state(params, speed, tol=1e-13, guess=None):
     rhs = slip.CompiledRHS(params)
     rr = params["rr"]
     weight = params["g"] * (params["mc"] + params["md"] + params["me"] + params["mf"] + params.get("mt", 0.0))
-    x = np.zeros(len(slip.STATE_NAMES))
+    L = rhs.layout
+    x = np.zeros(len(L.STATE_NAMES))
     x[slip.X["u1"]] = speed
-    names = ("q4", "q7", "q5", "q9", "q10", "u2", "u3", "T6c")
-    z0 = np.array([0.0, 0.0, steer_axis_tilt(params),
-                   0.5 * weight / params["kzr"], 0.5 * weight / params["kzf"], 0.0, 0.0, 0.0])
-    lean = not params.get("hip_locked", 1.0)   # a leaning upper body has its own steady lean
-    if lean:
-        names = names[:-1] + ("q11", "T6c")
-        z0 = np.insert(z0, -1, 0.0)
+    # The parts' coordinates (a leaning upper body's lean) have their own steady values, their speeds are 0.
+    part_coordinates = tuple(n for p in L.parts for n in p.coordinates)
+    names = ("q4", "q7", "q5", "q9", "q10", "u2", "u3") + part_coordinates + ("T6c",)
+    z0 = np.array([0.0, 0.0, steer_axis_tilt(params), 0.5 * weight / params["kzr"], 0.5 * weight / params["kzf"],
+                   0.0, 0.0] + [0.0] * len(part_coordinates) + [0.0])
     if guess is not None:
         z0 = np.array([float(guess.get(name, value)) for name, value in zip(names, z0, strict=True)])
-    scale = np.array([1.0, 1.0, 1.0, 1e-3, 1e-3, 1.0, 1.0] + [1.0] * lean + [1.0])
+    scale = np.array([1.0, 1.0, 1.0, 1e-3, 1e-3, 1.0, 1.0] + [1.0] * len(part_coordinates) + [1.0])
+    part_speeds = [L.X[n] for p in L.parts for n in p.speeds]
 
     def state(z):
         xs = x.copy()
         for name, value in zip(names[:-1], z[:-1], strict=True):
-            xs[slip.X[name]] = value
+            xs[L.X[name]] = value
         rhs.p[slip.P["T6c"]] = z[-1]
         return _steady_tyre_states(rhs, xs)
 
@@ -381,7 +381,7 @@ def steady_state(params, speed, tol=1e-13, guess=None):
             out[slip.OUT["holonomic"]] * 1e2,
             (dx[slip.X["u1"]] + u3 * u2) * rr, dx[slip.X["u2"]] - u3 * u1, dx[slip.X["u3"]],
             dx[slip.X["u4"]], dx[slip.X["u7"]], dx[slip.X["u9"]] * 1e-2, dx[slip.X["u10"]] * 1e-2,
-            *([dx[slip.X["u11"]]] if lean else []),
+            *dx[part_speeds],
         ])
 
     sol = root(residual, z0 / scale, method="hybr", options={"xtol": tol})
@@ -410,9 +410,10 @@ def _steady_tyre_states(rhs, x):
     form = rhs.transient
     x = np.array(x, dtype=float)
     _, out = rhs.outputs(0.0, x)
-    # The reflex filter in equilibrium with its (steady) input: its output is that input.
-    x[[slip.X[n] for n in slip.REFLEX_STATES]] = reflex.steady_state(out[slip.OUT["reflex_input"]],
-                                                                      rhs.p[slip.P["reflex_delay"]])
+    # The reflex filter (a delayed reflex's model) in equilibrium with its (steady) input: its output is that input.
+    if rhs.layout.REFLEX_STATES:
+        x[[rhs.layout.X[n] for n in rhs.layout.REFLEX_STATES]] = reflex.steady_state(
+            out[slip.OUT["reflex_input"]], rhs.p[slip.P["reflex_delay"]])
     if form == "carcass":
         stiffness = (carcass_stiffness(rhs, out[slip.OUT["fz_r"]], out[slip.OUT["fz_f"]])
                      * rhs.p[slip.P["carcass_stiffness_scale"]])
@@ -492,7 +493,7 @@ def upright_state(params, speed, tol=1e-13, pitch_without_compression=False):
     out_params["T6c"] = 0.0
     rhs = slip.CompiledRHS(out_params)
     weight = params["g"] * (params["mc"] + params["md"] + params["me"] + params["mf"] + params.get("mt", 0.0))
-    x = np.zeros(len(slip.STATE_NAMES))
+    x = np.zeros(len(rhs.layout.STATE_NAMES))
     x[slip.X["u1"]] = speed
     names = ("q5", "q9", "q10")
     if pitch_without_compression:

@@ -10,11 +10,13 @@ the ``tyre_transient`` parameter), the steer controller, Kane's equations
 and the rates of the energy quadratures (:mod:`whipple_kick.model.energy`); the
 named outputs (:data:`OUTPUTS`) only when asked for.
 
-State vector layout (by name, see :data:`STATE_NAMES`): q1..q11, the
-independent speeds u1 u2 u3 u4 u7 u9 u10 u11, four tyre states in fixed slots
+State vector layout of the base model (the rigid rider; by name, see :data:`STATE_NAMES`): q1..q10, the
+independent speeds u1 u2 u3 u4 u7 u9 u10, four tyre states in fixed slots
 (:func:`tyre_state_names`: the contact patch's slip and camber angles, or
 the thesis' relaxed forces fyr fyf mzr mzf, which :data:`X` also names),
-the reflex delay filter's four states, and the quadratures of :data:`whipple_kick.model.energy.QUADRATURE_STATES`.
+the reflex delay filter's four states, and the quadratures of :data:`whipple_kick.model.energy.QUADRATURE_STATES`;
+a model with declared parts (:mod:`whipple_kick.model.parts`: the leaning upper body) appends their
+coordinates and speeds (:class:`Layout`, :func:`for_parameters`).
 
 The package, one module per concern: :mod:`.layout` (names and indices),
 :mod:`.compiled` (the compiler, the cache entry, loading), :mod:`.call`
@@ -28,9 +30,9 @@ from .call import (  # noqa: F401 -- the package's names, as before the split
     parameter_vector,
 )
 from .compiled import (  # noqa: F401 -- the package's names, as before the split
-    layout,
     library,
     library_path,
+    metadata_layout,
     model_hash,
 )
 from .jumps import (  # noqa: F401 -- the package's names, as before the split
@@ -41,7 +43,6 @@ from .layout import (  # noqa: F401 -- the package's names, as before the split
     COORDINATES,
     DEPENDENT,
     DYNAMIC_STATES,
-    HIP_STATES,
     IGNORABLE,
     INDEPENDENT,
     JACOBIAN_EVALUATIONS,
@@ -55,8 +56,11 @@ from .layout import (  # noqa: F401 -- the package's names, as before the split
     SPEEDS,
     STATE_NAMES,
     TYRE_STATES,
+    Layout,
     P,
     X,
+    for_parameters,
+    for_parts,
     tyre_state_names,
 )
 from .linear import (  # noqa: F401 -- the package's names, as before the split

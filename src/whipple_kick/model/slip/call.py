@@ -8,25 +8,35 @@ from whipple_kick.errors import InputError
 from whipple_kick.model import transient
 import whipple_kick.model.slip.compiled as compiled  # noqa: PLR0402 -- the module, not the package that imports this one; tests patch its names
 
-from .layout import DEPENDENT, JACOBIAN_EVALUATIONS, OUTPUT_NAMES, PARAMETER_NAMES, SPEEDS, STATE_NAMES, P
+from . import layout as layouts
+from .layout import P
 
 
-def parameter_vector(params):
+def parameter_vector(params, L=None):
     """Parameter array for the compiled model, looked up by name.
+
+    Parameters
+    ----------
+    params : mapping
+        Every parameter of the model by name.
+    L : Layout, optional
+        The model's layout; default the one ``params`` chooses
+        (:func:`whipple_kick.model.slip.layout.for_parameters`: the parts whose parameters it holds).
 
     Raises
     ------
     InputError
         If a name is missing or unknown.
     """
-    missing = [n for n in PARAMETER_NAMES if n not in params]
+    L = layouts.for_parameters(params) if L is None else L
+    missing = [n for n in L.PARAMETER_NAMES if n not in params]
     if missing:
         raise InputError(f"slip-model parameters are missing: {', '.join(missing[:8])}"
                          + (" ..." if len(missing) > 8 else ""))
-    unknown = [n for n in params if n not in P]
+    unknown = [n for n in params if n not in L.P]
     if unknown:
         raise InputError(f"unknown slip-model parameters: {', '.join(sorted(unknown)[:8])}")
-    return np.array([float(params[n]) for n in PARAMETER_NAMES])
+    return np.array([float(params[n]) for n in L.PARAMETER_NAMES])
 
 
 class CompiledRHS:
@@ -35,7 +45,10 @@ class CompiledRHS:
     Parameters
     ----------
     params : mapping
-        Every name in :data:`PARAMETER_NAMES`.
+        Every parameter of the model by name: the base model's
+        (:data:`whipple_kick.model.slip.layout.PARAMETER_NAMES`) and those of the
+        declared parts it has; the parts whose parameters it holds choose the
+        model (``layout``, :func:`whipple_kick.model.slip.layout.for_parameters`).
 
     Example
     -------
@@ -44,12 +57,13 @@ class CompiledRHS:
     """
 
     def __init__(self, params):
-        self.lib = compiled.library()
-        self.p = np.ascontiguousarray(parameter_vector(params))
+        self.layout = layouts.for_parameters(params)
+        self.lib = compiled.library(self.layout)
+        self.p = np.ascontiguousarray(parameter_vector(params, self.layout))
         self._p_ptr = self.p.ctypes.data
-        self._dx = np.empty(len(STATE_NAMES))
+        self._dx = np.empty(len(self.layout.STATE_NAMES))
         self._dx_ptr = self._dx.ctypes.data
-        self._out = np.empty(len(OUTPUT_NAMES))
+        self._out = np.empty(len(self.layout.OUTPUT_NAMES))
         self._out_ptr = self._out.ctypes.data
         self.fast = self.guarded()   # f(t, x): one foreign call (what the integrators call)
 
@@ -73,7 +87,7 @@ class CompiledRHS:
         native = compiled._native_call()
         if native is not None:
             address = ctypes.cast(self.lib.wk_slip_rhs, ctypes.c_void_p).value
-            return native.Rhs(address, self.p, len(STATE_NAMES), _raise_status, exception, index, limit, index2,
+            return native.Rhs(address, self.p, len(self.layout.STATE_NAMES), _raise_status, exception, index, limit, index2,
                               limit2)
         fn, p_ptr, dx_ptr, dx = self.lib.wk_slip_rhs, self._p_ptr, self._dx_ptr, self._dx
         if exception is None:
@@ -101,11 +115,11 @@ class CompiledRHS:
         -------
         callable
             ``jac(t, x)``; its ``evaluations`` attribute is the number of
-            right-hand-side evaluations one call makes (:data:`JACOBIAN_EVALUATIONS`:
+            right-hand-side evaluations one call makes (the layout's ``JACOBIAN_EVALUATIONS``:
             dynamic states + 1, less the :data:`IGNORABLE` columns).
         """
         scale = np.ascontiguousarray(scale, dtype=float)
-        n = len(STATE_NAMES)
+        n = len(self.layout.STATE_NAMES)
         fn, p_ptr, s_ptr = self.lib.wk_slip_jacobian, self._p_ptr, scale.ctypes.data
 
         def jac(t, x):
@@ -116,20 +130,20 @@ class CompiledRHS:
                 _raise_status(status, t)
             return J
         jac.scale = scale   # keeps the array alive with the closure
-        jac.evaluations = JACOBIAN_EVALUATIONS   # right-hand-side evaluations per call (the budget counts them)
+        jac.evaluations = self.layout.JACOBIAN_EVALUATIONS   # right-hand-side evaluations per call (the budget counts them)
         return jac
 
     def impulse_terms(self, t, x):
-        """Mass matrix M (10, 10), constraint matrix A (3, 10) and offset a0 (3,) at ``(t, x)``."""
+        """Mass matrix M (n, n), constraint matrix A (3, n) and offset a0 (3,) at ``(t, x)``, n speeds."""
         x = np.ascontiguousarray(x, dtype=float)
-        n, m = len(SPEEDS), len(DEPENDENT)
+        n, m = len(self.layout.SPEEDS), len(self.layout.DEPENDENT)
         M, A, a0 = np.empty((n, n)), np.empty((m, n)), np.empty(m)
         self.lib.wk_slip_impulse_terms(t, x.ctypes.data, self._p_ptr, M.ctypes.data, A.ctypes.data,
                                        a0.ctypes.data)
         return M, A, a0
 
     def outputs_at(self, t, X, via_rhs=False):
-        """Named outputs (:data:`OUTPUT_NAMES`) at many samples, in one C call.
+        """Named outputs (the layout's ``OUTPUT_NAMES``) at many samples, in one C call.
 
         The outputs need no accelerations, so the C function evaluates the
         right-hand side's statements without Kane's mass matrix, forcing and
@@ -140,7 +154,7 @@ class CompiledRHS:
         ----------
         t : array_like, shape (n,)
             Times [s].
-        X : array_like, shape (n, len(STATE_NAMES))
+        X : array_like, shape (n, len(layout.STATE_NAMES))
             States.
         via_rhs : bool
             Evaluate the whole right-hand side at each sample instead (the
@@ -149,13 +163,14 @@ class CompiledRHS:
 
         Returns
         -------
-        ndarray, shape (n, len(OUTPUT_NAMES))
+        ndarray, shape (n, len(layout.OUTPUT_NAMES))
         """
         t = np.ascontiguousarray(t, dtype=float)
         X = np.ascontiguousarray(X, dtype=float)
-        if X.shape != (t.size, len(STATE_NAMES)):
-            raise ValueError(f"states must have shape ({t.size}, {len(STATE_NAMES)}), got {X.shape}")
-        out = np.empty((t.size, len(OUTPUT_NAMES)))
+        ns = len(self.layout.STATE_NAMES)
+        if X.shape != (t.size, ns):
+            raise ValueError(f"states must have shape ({t.size}, {ns}), got {X.shape}")
+        out = np.empty((t.size, len(self.layout.OUTPUT_NAMES)))
         fn = self.lib.wk_slip_outputs if via_rhs else self.lib.wk_slip_outputs_only
         status = fn(t.size, t.ctypes.data, X.ctypes.data, self._p_ptr, out.ctypes.data)
         if status:
@@ -163,7 +178,7 @@ class CompiledRHS:
         return out
 
     def outputs(self, t, x):
-        """Derivatives and named outputs (:data:`OUTPUT_NAMES`) at one state."""
+        """Derivatives and named outputs (the layout's ``OUTPUT_NAMES``) at one state."""
         x = np.ascontiguousarray(x, dtype=float)
         status = self.lib.wk_slip_rhs(t, x.ctypes.data, self._p_ptr, self._dx_ptr, self._out_ptr)
         if status:
@@ -174,6 +189,7 @@ class CompiledRHS:
 _STATUS = {
     1: "singular constraint or mass matrix in the slip model",
     2: "non-finite derivative in the slip model",
+    3: "a reflex delay was set on a compiled model without the delay filter (make a new CompiledRHS)",
 }
 
 

@@ -1,4 +1,8 @@
-"""The compiled library: the C compiler, the cache entry (built on a miss), loading it once per process."""
+"""The compiled libraries: the C compiler, the cache entries (built on a miss), loading each once per process.
+
+One library per model: the base model (the rigid rider) and each combination of declared parts a run
+asks for (:class:`whipple_kick.model.slip.layout.Layout`), each built on its first use.
+"""
 import ctypes
 import functools
 import json
@@ -8,7 +12,8 @@ import shutil
 from whipple_kick.errors import InputError
 from whipple_kick.model import cache, rhs_call
 
-from .layout import _SOURCES, DYNAMIC_STATES, OUTPUT_NAMES, PARAMETER_NAMES, STATE_NAMES
+from . import layout as layouts
+from .layout import _SOURCES
 
 
 def _compiler():
@@ -34,58 +39,60 @@ def _native_call():
     return rhs_call.module(_compiler())
 
 
-def layout():
-    """The layouts the running code expects of the compiled library (as its metadata records them)."""
-    return {"states": list(STATE_NAMES), "parameters": list(PARAMETER_NAMES), "outputs": list(OUTPUT_NAMES),
-            "dynamic_states": len(DYNAMIC_STATES)}
+def metadata_layout(L=layouts.BASE):
+    """The layouts the running code expects of the compiled library of ``L`` (as its metadata records them)."""
+    return {"states": list(L.STATE_NAMES), "parameters": list(L.PARAMETER_NAMES), "outputs": list(L.OUTPUT_NAMES),
+            "dynamic_states": len(L.DYNAMIC_STATES)}
 
 
-def _metadata_matches(path):
-    """Whether the metadata file at ``path`` exists, is private and records the running code's layouts."""
+def _metadata_matches(path, L):
+    """Whether the metadata file at ``path`` exists, is private and records ``L``'s layouts."""
     try:
         cache.check_private_file(path)
-        return json.loads(path.read_text()).get("layout") == layout()
+        return json.loads(path.read_text()).get("layout") == metadata_layout(L)
     except (OSError, ValueError, AttributeError):
         return False
 
 
-def library_path():
-    """Path of the compiled slip model in the cache, built first on a cache miss.
+def library_path(L=layouts.BASE):
+    """Path of the compiled slip model of the layout ``L`` in the cache, built first on a cache miss.
 
-    The cache entry is ``slip_<key>.so`` with its C source and plain-data
-    metadata (``slip_<key>.json``) beside it, the key hashing the package
-    sources it is generated from, the SymPy version, the compiler and its
-    flags. A miss runs :func:`whipple_kick.model.symbolic.slip_build.build_library` (SymPy,
+    The cache entry is ``slip_<model>_<key>.so`` with its C source and plain-data
+    metadata (``.json``) beside it, ``<model>`` naming its parts (``rigid``
+    for the base model) and the key hashing the package sources it is
+    generated from, the parts' declarations and build code, the SymPy
+    version, the compiler and its flags. A miss runs
+    :func:`whipple_kick.model.symbolic.slip_build.build_library` (SymPy,
     20-30 s, one line on stderr). An entry whose metadata is missing or
     records other layouts (states, parameters, outputs) is built again.
     """
     cc = _compiler()
-    key = cache.source_hash(_SOURCES, extra=f"{os.path.basename(cc)} {' '.join(_CFLAGS)}")
+    key = L.key + "_" + cache.source_hash(_SOURCES, extra=f"{os.path.basename(cc)} {' '.join(_CFLAGS)} "
+                                                          f"{L.fingerprint()}")
     name = f"slip_{key}.so"
-
     def build(tmp):
         from whipple_kick.model.symbolic import slip_build  # SymPy and the derivation: only on a cache miss
-        slip_build.build_library(tmp, key, cc, _CFLAGS)
+        slip_build.build_library(tmp, key, cc, _CFLAGS, L.part_names, L.delayed_reflex)
 
     lib_path = cache.build_once(name, build)
-    if not _metadata_matches(lib_path.with_suffix(".json")):
+    if not _metadata_matches(lib_path.with_suffix(".json"), L):
         with cache.locked(lib_path):
             lib_path.unlink(missing_ok=True)
         lib_path = cache.build_once(name, build)
-        if not _metadata_matches(lib_path.with_suffix(".json")):
+        if not _metadata_matches(lib_path.with_suffix(".json"), L):
             raise RuntimeError(f"the compiled slip model {lib_path} has no matching metadata; remove the cache folder")
     return lib_path
 
 
-def model_hash():
-    """Name of the compiled slip model in use (``slip_<key>``, its cache entry): what a sweep folder records."""
-    return os.path.splitext(os.path.basename(library()._name))[0]
+def model_hash(L=layouts.BASE):
+    """Name of the compiled slip model of ``L`` (``slip_<model>_<key>``, its cache entry): what a sweep folder records."""
+    return os.path.splitext(os.path.basename(library(L)._name))[0]
 
 
 @functools.cache
-def library():
-    """The compiled slip model (ctypes library of :func:`library_path`), loaded once per process."""
-    lib = ctypes.CDLL(str(library_path()))
+def library(L=layouts.BASE):
+    """The compiled slip model of the layout ``L`` (ctypes library of :func:`library_path`), loaded once per process."""
+    lib = ctypes.CDLL(str(library_path(L)))
     pointer = ctypes.c_void_p
     lib.wk_slip_rhs.restype = ctypes.c_int
     lib.wk_slip_rhs.argtypes = [ctypes.c_double, pointer, pointer, pointer, pointer]
@@ -101,6 +108,6 @@ def library():
     lib.wk_slip_cornering_stiffness.argtypes = [ctypes.c_double, ctypes.c_double, pointer, pointer]
     sizes = (ctypes.c_int * 4)()
     lib.wk_slip_sizes(sizes)
-    if tuple(sizes) != (len(STATE_NAMES), len(PARAMETER_NAMES), len(OUTPUT_NAMES), len(DYNAMIC_STATES)):
+    if tuple(sizes) != (len(L.STATE_NAMES), len(L.PARAMETER_NAMES), len(L.OUTPUT_NAMES), len(L.DYNAMIC_STATES)):
         raise RuntimeError(f"compiled slip model has sizes {tuple(sizes)}; rebuild the cache")
     return lib

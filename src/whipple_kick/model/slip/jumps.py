@@ -4,7 +4,7 @@ import numpy as np
 
 from whipple_kick.model import kane
 
-from .layout import _PARTITION, INDEPENDENT, OUT, SPEEDS, P, X
+from .layout import OUT, P, X
 
 
 def kept_speeds_slide(rhs, t, x):
@@ -33,10 +33,11 @@ def kept_speeds_slide(rhs, t, x):
     float
     """
     x = np.asarray(x, dtype=float)
-    ind = [X[n] for n in INDEPENDENT]
+    L = rhs.layout
+    ind = [L.X[n] for n in L.INDEPENDENT]
     _, A, a0_plus = rhs.impulse_terms(t, x)
     _, _, a0_minus = rhs.impulse_terms(np.nextafter(t, -np.inf), x)
-    u = _PARTITION.dependent_speeds(A, a0_minus, x[ind])
+    u = L.PARTITION.dependent_speeds(A, a0_minus, x[ind])
     residual = A @ u + a0_plus
     # The rear row (vsx_r enters it as -vsx_r) is the only one the plate appears in.
     return float(rhs.p[P["vsx_r"]] + residual[0])
@@ -72,21 +73,15 @@ def velocity_jump(rhs, t, x, impulse=True):
     before = np.nextafter(t, -np.inf)
     M, A, a0_plus = rhs.impulse_terms(t, x)
     _, _, a0_minus = rhs.impulse_terms(before, x)
-    ind = [X[n] for n in INDEPENDENT]
+    L = rhs.layout
+    ind = [L.X[n] for n in L.INDEPENDENT]
     ke_before = rhs.outputs(before, x)[1][OUT["kinetic_energy"]]
     work, impulse_value = None, None
     if impulse:
-        u_minus = _PARTITION.dependent_speeds(A, a0_minus, x[ind])
-        rows = len(a0_plus)
-        if rhs.p[P["hip_locked"]] != 0.0:
-            # The locked hip is one more constraint (u11 = 0) the impulse must respect.
-            lock = np.zeros((1, A.shape[1]))
-            lock[0, SPEEDS.index("u11")] = 1.0
-            A, a0_plus, a0_minus = np.vstack([A, lock]), np.append(a0_plus, 0.0), np.append(a0_minus, 0.0)
+        u_minus = L.PARTITION.dependent_speeds(A, a0_minus, x[ind])
         u_plus, impulse_value = kane.impulsive_projection(M, A, u_minus, a0_plus)
-        x[ind] = u_plus[_PARTITION.ind]
+        x[ind] = u_plus[L.PARTITION.ind]
         work = float(-0.5 * impulse_value @ (a0_plus + a0_minus))
-        impulse_value = impulse_value[:rows]
         x[X["W_plate"]] += work
     ke_after = rhs.outputs(t, x)[1][OUT["kinetic_energy"]]
     return x, {"time_s": float(t), "kinetic_energy_change_j": float(ke_after - ke_before),

@@ -1,11 +1,20 @@
-"""The slip model's layout: states, speeds, outputs and parameters by name, and their indices."""
+"""The slip model's layouts: states, speeds, outputs and parameters by name, and their indices.
 
+The module's names (:data:`STATE_NAMES`, :data:`X`, :data:`OUT`, :data:`P`, ...) are the layout of the
+base model: the bicycle with the rigid rider, its arms and its reflex. A model with declared parts
+(:mod:`whipple_kick.model.parts`) has a :class:`Layout` that appends each part's coordinates and speeds to
+the state after the base model's (quadratures included), its speeds and outputs to the outputs, and its
+parameters to the parameters: every base name keeps its index in every model, so code that reads the
+bicycle's states by :data:`X` reads them from any model's state.
+"""
+import functools
 
-from whipple_kick.model import energy, kane, reflex, transient
+from whipple_kick.errors import InputError
+from whipple_kick.model import energy, kane, parts, reflex, transient
 from whipple_kick.model import symbols as S
 
-COORDINATES = tuple(f"q{i}" for i in range(1, 12))
-SPEEDS = tuple(f"u{i}" for i in range(1, 12))
+COORDINATES = tuple(f"q{i}" for i in range(1, 11))
+SPEEDS = tuple(f"u{i}" for i in range(1, 11))
 DEPENDENT = ("u5", "u6", "u8")
 INDEPENDENT = tuple(n for n in SPEEDS if n not in DEPENDENT)
 #: Tyre-state slot names of the thesis' form (kept as aliases in :data:`X`).
@@ -13,20 +22,17 @@ TYRE_STATES = transient.STATES["force_lag"]
 #: Tyre-state slot names of the default form.
 PATCH_STATES = transient.STATES["contact_patch"]
 QUADRATURE_STATES = energy.QUADRATURE_STATES
-#: The reflex delay filter's states (:mod:`whipple_kick.model.reflex`).
+#: The reflex delay filter's states (:mod:`whipple_kick.model.reflex`): in a model whose reflex is delayed
+#: only (:attr:`Layout.REFLEX_STATES`); without a delay the reflex acts undelayed and has no states.
 REFLEX_STATES = reflex.STATE_NAMES
-#: States integrated for the dynamics; the quadratures follow them.
-DYNAMIC_STATES = COORDINATES + INDEPENDENT + PATCH_STATES + REFLEX_STATES
-#: States that stay at 0 and drive nothing while the rider's hip is locked (the rigid rider).
-HIP_STATES = ("q11", "u11")
+#: States integrated for the dynamics of the base model; the quadratures follow them.
+DYNAMIC_STATES = COORDINATES + INDEPENDENT + PATCH_STATES
 #: Coordinates nothing depends on (Moore's ignorable coordinates: the rear contact's position, the plate
 #: being prescribed in time; the axisymmetric wheels' angles): their Jacobian columns are exactly zero
 #: (a test), so the compiled Jacobian does not evaluate them.
 IGNORABLE = ("q1", "q2", "q6", "q8")
-#: Right-hand-side evaluations one compiled Jacobian costs (the budget counts them).
-#: (The hip's and the reflex filter's columns are skipped too while the hip is locked and the delay is 0,
-#: as in the default rider: the count is for that rider.)
-JACOBIAN_EVALUATIONS = len(DYNAMIC_STATES) + 1 - len(IGNORABLE) - len(HIP_STATES) - len(REFLEX_STATES)
+#: Right-hand-side evaluations one compiled Jacobian of the base model costs (the budget counts them).
+JACOBIAN_EVALUATIONS = len(DYNAMIC_STATES) + 1 - len(IGNORABLE)
 STATE_NAMES = DYNAMIC_STATES + QUADRATURE_STATES
 #: Named outputs the C function writes when asked, after all ten speeds: name -> (unit, what it is).
 OUTPUTS = {
@@ -49,11 +55,10 @@ OUTPUTS = {
     "T_reflex": ("N m", "rider's delayed reflex steer torque (part of T7)"),
     "reflex_input": ("N m", "rider's reflex steer torque before the delay"),
     "arm_torque": ("N m", "passive torque of the rider's arms on the bar about the steer axis"),
-    "hip_torque": ("N m", "torque of the hip spring-damper on the upper body about the lean axis"),
     "kinetic_energy": ("J", "kinetic energy of the bicycle and rider"),
     "potential_energy": ("J", "gravitational potential energy"),
-    "spring_energy": ("J", "energy stored in the vertical tyre springs and, with a rider's body, in the hip "
-                          "and arm springs"),
+    "spring_energy": ("J", "energy stored in the vertical tyre springs, the arms' spring and the parts' springs (the "
+                          "leaning upper body's hip)"),
     "holonomic": ("m", "front contact height above the ground (the holonomic constraint's residual)"),
     "sliding_power": ("W", "power of the tyres' lateral forces on the contacts' sliding, F vsy"),
     "fy_r": ("N", "lateral force the rear tyre applies to the bicycle"),
@@ -81,7 +86,7 @@ OUT = {n: i for i, n in enumerate(OUTPUT_NAMES)}
 P = {n: i for i, n in enumerate(PARAMETER_NAMES)}
 
 #: Package modules the compiled library is generated from (its cache key hashes them).
-_SOURCES = ("symbols", "symbolic/derivation", "symbolic/codegen", "magic_formula", "transient", "carcass", "energy",
+_SOURCES = ("symbols", "parts", "symbolic/derivation", "symbolic/codegen", "magic_formula", "transient", "carcass", "energy",
             "reflex",
             "slip/__init__", "slip/layout", "slip/compiled", "slip/call", "slip/parameters", "slip/jumps",
             "slip/linear", "symbolic/slip_build")
@@ -92,3 +97,108 @@ def tyre_state_names(name=transient.DEFAULT_TRANSIENT):
     """Names of the four tyre-state slots under the transient form ``name``."""
     transient.check(name)
     return transient.STATES[name]
+
+
+#: The state each gain of the rider's voluntary law on the bicycle multiplies (``T7 = -sum(gain * state)``);
+#: a part's gains on its own states follow (:attr:`Layout.GAIN_STATES`).
+GAIN_STATES = {"kq3": "q3", "kq4": "q4", "kq7": "q7", "ku3": "u3", "ku4": "u4", "ku7": "u7"}
+
+
+class Layout:
+    """The layouts of the model made of the base model, the declared parts ``part_names`` and, with
+    ``delayed_reflex``, the reflex's delay filter.
+
+    Attributes have the names of the module's base-layout constants
+    (``STATE_NAMES``, ``X``, ``OUT``, ``P``, ``SPEEDS``, ``INDEPENDENT``, ...)
+    and extend them: the delay filter's states (``REFLEX_STATES``, empty
+    without the delay) and the parts' coordinates and then their speeds
+    follow the base states, the parts' speeds and outputs follow the base
+    outputs, the parts' parameters follow the base parameters. ``PART_STATES``
+    are the parts' states, ``COLUMNS`` their trajectory columns (state ->
+    (column, unit)), ``GAIN_STATES`` every gain's state, ``key`` names the
+    model (``"rigid"`` for the base model, ``"+delay"`` for the filter).
+    """
+
+    def __init__(self, part_names=(), delayed_reflex=False):
+        self.parts = parts.named(part_names)
+        self.delayed_reflex = bool(delayed_reflex)
+        self.key = ("+".join(p.name for p in self.parts) or "rigid") + ("+delay" if delayed_reflex else "")
+        coords = tuple(n for p in self.parts for n in p.coordinates)
+        speeds = tuple(n for p in self.parts for n in p.speeds)
+        self.PART_STATES = coords + speeds
+        self.REFLEX_STATES = REFLEX_STATES if delayed_reflex else ()
+        self.COORDINATES = COORDINATES + coords
+        self.SPEEDS = SPEEDS + speeds
+        self.DEPENDENT = DEPENDENT
+        self.INDEPENDENT = INDEPENDENT + speeds
+        self.DYNAMIC_STATES = DYNAMIC_STATES + self.REFLEX_STATES + self.PART_STATES
+        self.STATE_NAMES = STATE_NAMES + self.REFLEX_STATES + self.PART_STATES
+        self.OUTPUTS = dict(OUTPUTS)
+        for p in self.parts:
+            self.OUTPUTS.update(p.outputs)
+        self.PART_OUTPUTS = tuple(n for p in self.parts for n in p.outputs)
+        self.OUTPUT_NAMES = OUTPUT_NAMES + speeds + self.PART_OUTPUTS
+        self.PARAMETER_NAMES = PARAMETER_NAMES + tuple(n for p in self.parts for n in p.parameters)
+        self.X = dict(X)
+        self.X.update({n: len(STATE_NAMES) + i for i, n in enumerate(self.REFLEX_STATES + self.PART_STATES)})
+        self.OUT = {n: i for i, n in enumerate(self.OUTPUT_NAMES)}
+        self.P = {n: i for i, n in enumerate(self.PARAMETER_NAMES)}
+        self.GAIN_STATES = dict(GAIN_STATES)
+        self.COLUMNS = {}
+        for p in self.parts:
+            self.GAIN_STATES.update(p.gains)
+            self.COLUMNS.update(p.columns)
+        self.GAIN_NAMES = tuple(self.GAIN_STATES)
+        self.JACOBIAN_EVALUATIONS = JACOBIAN_EVALUATIONS + len(self.REFLEX_STATES) + len(self.PART_STATES)
+        self.PARTITION = kane.ConstraintPartition(self.SPEEDS, DEPENDENT)
+
+    def __repr__(self):
+        return f"Layout({self.key!r})"
+
+    @property
+    def part_names(self):
+        """Names of the model's parts."""
+        return tuple(p.name for p in self.parts)
+
+    def fingerprint(self):
+        """The parts' declarations and build code, hashed (part of the generated code's cache key)."""
+        return " ".join([f"{p.name}:{p.fingerprint()}" for p in self.parts] + ["delay"] * self.delayed_reflex)
+
+
+def for_parts(part_names=(), delayed_reflex=False):
+    """The (shared) :class:`Layout` of the base model with the parts ``part_names`` (in declaration order) and,
+    with ``delayed_reflex``, the reflex's delay filter: one object per model in a process."""
+    return _layout(tuple(p.name for p in parts.named(part_names)), bool(delayed_reflex))
+
+
+@functools.cache
+def _layout(part_names, delayed_reflex):
+    return Layout(part_names, delayed_reflex)
+
+
+BASE = for_parts(())
+
+
+def parts_of(params):
+    """Names of the parts whose parameters ``params`` (a mapping by name) holds: a model is chosen by them.
+
+    Raises
+    ------
+    InputError
+        Some, but not all, of a part's parameters are given.
+    """
+    names = []
+    for part in parts.REGISTRY.values():
+        given = [n for n in part.parameters if n in params]
+        if given and len(given) < len(part.parameters):
+            missing = [n for n in part.parameters if n not in params]
+            raise InputError(f"the {part.name} part's parameters are incomplete: missing {', '.join(missing[:8])}")
+        if given:
+            names.append(part.name)
+    return tuple(names)
+
+
+def for_parameters(params):
+    """The :class:`Layout` of the model whose parameters are ``params``: the parts of :func:`parts_of`,
+    and the reflex's delay filter where ``reflex_delay`` is not 0."""
+    return for_parts(parts_of(params), params.get("reflex_delay", 0.0) != 0.0)

@@ -6,13 +6,11 @@ import numpy as np
 from whipple_kick.errors import InputError
 from whipple_kick.model import transient
 
+from . import layout as layouts
 from .call import CompiledRHS
 from .layout import (
-    DYNAMIC_STATES,
-    HIP_STATES,
     OUT,
     PATCH_STATES,
-    REFLEX_STATES,
     SPEEDS,
     STATE_NAMES,
     TYRE_STATES,
@@ -20,7 +18,6 @@ from .layout import (
     X,
     tyre_state_names,
 )
-from .parameters import GAIN_STATES
 
 # ---------------------------------------------------------------- linearisation
 
@@ -40,15 +37,20 @@ def linear_states(name=transient.DEFAULT_TRANSIENT):
     return LINEAR_STATES[:-len(PATCH_STATES)] + tyre_state_names(name)
 
 
-def body_states(p):
-    """The rider body's states a linearisation with parameter vector ``p`` includes, after :data:`LINEAR_STATES`.
+def body_states(model):
+    """The rider body's states a linearisation of ``model`` includes, after :data:`LINEAR_STATES`.
 
-    The upper body's lean and its rate when the hip is free; the reflex filter's
-    states when the delay is not 0. (A locked hip's and a zero delay's states
-    drive nothing and stay put: they would only add zero eigenvalues.)
+    The model's parts' states (the leaning upper body's lean and its rate);
+    the reflex filter's states when the delay is not 0 (a zero delay's states
+    drive nothing and stay put: they would only add zero eigenvalues).
+
+    Parameters
+    ----------
+    model : CompiledRHS or mapping
+        The compiled model, or its parameters by name.
     """
-    return ((HIP_STATES if p[P["hip_locked"]] == 0.0 else ())
-            + (REFLEX_STATES if p[P["reflex_delay"]] != 0.0 else ()))
+    L = model.layout if isinstance(model, CompiledRHS) else layouts.for_parameters(model)
+    return L.PART_STATES + L.REFLEX_STATES
 
 
 def solve_pitch(rhs, x, tol=1e-14, max_iter=30):
@@ -143,7 +145,7 @@ HOLONOMIC_ROW = 2
 
 
 @functools.cache
-def _difference_scales(form):
+def _difference_scales(form, n_states=len(STATE_NAMES)):
     """Typical size of each state for the C Jacobian's steps ``1.5e-8 max(|x_j|, scale_j)``.
 
     Angles [rad] and speeds [m/s, rad/s] 1, compressions 1e-3 m, the
@@ -155,7 +157,7 @@ def _difference_scales(form):
     scales, 100 to 1e4 times smaller, serve LSODA's Newton iteration but
     leave 1e-5 round-off here.) Read-only.
     """
-    scale = np.ones(len(STATE_NAMES))
+    scale = np.ones(n_states)
     for name in ("q9", "q10"):
         scale[X[name]] = 1e-3
     if form == "force_lag":
@@ -225,10 +227,10 @@ def heading_linearisation(rhs, x, t=0.0):
     x0[X["u1"]], x0[X["u2"]] = z[_I_FWD], z[_I_LAT]
     if abs(rhs.outputs(t, x0)[1][OUT["holonomic"]]) > 1e-13:   # a steady state is on it already
         x0 = solve_pitch(rhs, x0)
-    nd = len(DYNAMIC_STATES)
-    J = rhs.jacobian_function(_difference_scales(rhs.transient))(t, x0)[:nd, :nd]
+    L = rhs.layout
+    J = rhs.jacobian_function(_difference_scales(rhs.transient, len(L.STATE_NAMES)))(t, x0)
     h_q = rhs.impulse_terms(t, x0)[1][HOLONOMIC_ROW]
-    slots = np.concatenate([_HEADING_SLOTS, [X[n] for n in body_states(rhs.p)]]).astype(int)
+    slots = np.concatenate([_HEADING_SLOTS, [L.X[n] for n in body_states(rhs)]]).astype(int)
     # A = S J E: the picked columns of J, plus the pitch column times dq5/dz.
     A = J[np.ix_(slots, slots)]
     pitch_column = J[slots, X["q5"]]
@@ -279,7 +281,7 @@ def linear_state_space(params, x, step=1e-7):
     j = LINEAR_STATES.index("u7")
     B = (A_cl[:, j] - linearize(CompiledRHS(bumped), x, step)[:, j]).reshape(-1, 1)
     K = np.zeros((1, len(LINEAR_STATES)))
-    for gain, state in GAIN_STATES.items():
+    for gain, state in layouts.GAIN_STATES.items():
         if state in LINEAR_STATES:   # the bicycle's states (q3 is not one: kq3 is refused above)
             K[0, LINEAR_STATES.index(state)] = params[gain]
     return A_cl + B @ K, B, K

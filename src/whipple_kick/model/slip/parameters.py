@@ -3,8 +3,10 @@
 import numpy as np
 
 from whipple_kick.errors import InputError
-from whipple_kick.model import carcass, magic_formula, transient
+from whipple_kick.model import carcass, magic_formula, parts, transient
 from whipple_kick.model import symbols as S
+
+from . import layout as layouts
 
 # ------------------------------------------------------- parameters and steady state
 
@@ -12,16 +14,19 @@ from whipple_kick.model import symbols as S
 #: (Sh and Sv terms not multiplied by camber). "Symmetric tyres" zero them.
 FY_OFFSET_INDICES = magic_formula.FY_OFFSET_INDICES
 MZ_OFFSET_INDICES = magic_formula.MZ_OFFSET_INDICES
-GAIN_NAMES = ("kq3", "kq4", "kq7", "ku3", "ku4", "ku7", "kq11", "ku11")
-#: The state each gain of the rider's voluntary law multiplies (``T7 = -sum(gain * state)``).
-GAIN_STATES = {"kq3": "q3", "kq4": "q4", "kq7": "q7", "ku3": "u3", "ku4": "u4", "ku7": "u7", "kq11": "q11",
-               "ku11": "u11"}
-#: The rider's body by parameter name, with the rigid rider's values: the hip locked, the
-#: upper body's mass in the rear frame (mt 0), no arm impedance, no reflex.
-RIGID_BODY = {"hip_locked": 1.0, "hip_tilt": 0.0, "lh1": 0.0, "lh3": 0.0, "mt": 0.0, "lt1": 0.0, "lt3": 0.0,
-              "it11": 0.0, "it22": 0.0, "it33": 0.0, "it31": 0.0, "kh": 0.0, "ch": 0.0, "ka": 0.0, "ca": 0.0,
-              "rq4": 0.0, "rq7": 0.0, "ru4": 0.0, "ru7": 0.0, "reflex_delay": 0.0}
-BODY_NAMES = tuple(RIGID_BODY)
+#: The state each gain of the rider's voluntary law multiplies (``T7 = -sum(gain * state)``), every
+#: declared part's gains included (a model without the part refuses its gains).
+GAIN_STATES = dict(layouts.GAIN_STATES)
+for _part in parts.REGISTRY.values():
+    GAIN_STATES.update(_part.gains)
+GAIN_NAMES = tuple(GAIN_STATES)
+#: The rider's body in the base model by parameter name, with the rigid rider's values: no arm
+#: impedance, no reflex.
+RIGID_BODY = {"ka": 0.0, "ca": 0.0, "rq4": 0.0, "rq7": 0.0, "ru4": 0.0, "ru7": 0.0, "reflex_delay": 0.0}
+#: The parameters of the trunk part (:data:`whipple_kick.model.parts.TRUNK`) that are not gains: the leaning
+#: upper body's placement and inertia and the hip's spring-damper.
+TRUNK_BODY = tuple(n for n in parts.TRUNK.parameters if n not in parts.TRUNK.gains)
+BODY_NAMES = tuple(RIGID_BODY) + TRUNK_BODY
 
 
 def tyre_parameters(tyre, wheel, symmetric=False, lateral=True, reverse_camber=False):
@@ -121,22 +126,35 @@ def model_parameters(moore, rear_tyre, front_tyre, gains=None, kick=None,
     carcass_stiffness_scale : float
         Factor on the carcass stiffnesses the steady state sets (default 1).
     body : mapping, optional
-        The rider's body by parameter name (:data:`BODY_NAMES`: the upper
-        body's placement and inertia, hip and arm spring-dampers, reflex gains
-        and delay; :func:`whipple_kick.library.riders.body_parameters` makes them).
-        Default: the rigid rider (hip locked, no upper body of its own, no
-        arms, no reflex), which is the model without a body exactly.
+        The rider's body by parameter name (:data:`BODY_NAMES`): the arms'
+        spring-damper and the reflex (:data:`RIGID_BODY`, missing ones 0) and,
+        for the trunk part, all of :data:`TRUNK_BODY` (the leaning upper body's
+        placement and inertia and the hip's spring-damper:
+        :func:`whipple_kick.library.riders.seat_with_body` makes them); with
+        them the model has the trunk part (its gains ``kq11 ku11`` then apply).
+        Default: the rigid rider, the model without parts.
     """
     if slip_speed not in SLIP_SPEEDS:
         raise InputError(f"slip speed {slip_speed!r} is unknown; choose one of {', '.join(SLIP_SPEEDS)}")
     params = {n: float(moore[n]) for n in S.CLASSIC_CONSTANTS}
     params.update(tyre_parameters(rear_tyre, "r", symmetric, lateral, reverse_camber))
     params.update(tyre_parameters(front_tyre, "f", symmetric, lateral, reverse_camber))
-    gains = dict(gains or {})
-    unknown = set(gains) - set(GAIN_NAMES)
+    body = dict(body or {})
+    unknown = set(body) - set(BODY_NAMES)
     if unknown:
-        raise InputError(f"unknown controller gains {sorted(unknown)}; known: {', '.join(GAIN_NAMES)}")
-    params.update({n: float(gains.get(n, 0.0)) for n in GAIN_NAMES})
+        raise InputError(f"unknown rider-body parameters {sorted(unknown)}; known: {', '.join(BODY_NAMES)}")
+    trunk = [n for n in TRUNK_BODY if n in body]
+    if trunk and len(trunk) < len(TRUNK_BODY):
+        raise InputError(f"the leaning upper body needs all of {', '.join(TRUNK_BODY)}; missing "
+                         f"{', '.join(n for n in TRUNK_BODY if n not in body)}")
+    layout = layouts.for_parts(("trunk",) if trunk else ())
+    gains = dict(gains or {})
+    # A zero gain on a state the model does not have changes nothing; a nonzero one is refused.
+    unknown = {n for n in set(gains) - set(layout.GAIN_NAMES) if n not in GAIN_STATES or gains[n] != 0.0}
+    if unknown:
+        raise InputError(f"unknown controller gains {sorted(unknown)} for the {layout.key} model; known: "
+                         f"{', '.join(layout.GAIN_NAMES)}")
+    params.update({n: float(gains.get(n, 0.0)) for n in layout.GAIN_NAMES})
     kick = dict(kick or {})
     params.update({
         "kick_t0": float(kick.get("t0", 0.0)),
@@ -154,9 +172,6 @@ def model_parameters(moore, rear_tyre, front_tyre, gains=None, kick=None,
         "carcass_viscosity": float(carcass_viscosity),
         "carcass_stiffness_scale": float(carcass_stiffness_scale),
     })
-    body = dict(body or {})
-    unknown = set(body) - set(BODY_NAMES)
-    if unknown:
-        raise InputError(f"unknown rider-body parameters {sorted(unknown)}; known: {', '.join(BODY_NAMES)}")
-    params.update({n: float(body.get(n, RIGID_BODY[n])) for n in BODY_NAMES})
+    params.update({n: float(body.get(n, RIGID_BODY[n])) for n in RIGID_BODY})
+    params.update({n: float(body[n]) for n in trunk})
     return params

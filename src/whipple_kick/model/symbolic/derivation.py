@@ -64,14 +64,14 @@ def kinematics(tyre_model=False):
     tyre_model : bool
         False: knife-edge wheels, coordinates q1..q8 (classic model).
         True: toroidal tyres of crown radii ``rtr``/``rtf`` with vertical
-        compressions q9 (rear) and q10 (front) as extra coordinates, and the
-        rider's upper body G leaning on the hip by q11 (a fifth body).
+        compressions q9 (rear) and q10 (front) as extra coordinates (the
+        rider's parts add theirs: :mod:`whipple_kick.model.parts`).
 
     Returns
     -------
     Kinematics
     """
-    names_q = [f"q{i}" for i in range(1, 12 if tyre_model else 9)]
+    names_q = [f"q{i}" for i in range(1, 11 if tyre_model else 9)]
     q = S.dyns(names_q)
     u = S.dyns([n.replace("q", "u") for n in names_q])
     q1, q2, q3, q4, q5, q6, q7, q8 = q[:8]
@@ -171,27 +171,6 @@ def kinematics(tyre_model=False):
 
     frames = dict(N=N, A=A, B=B, C=C, D=D, E=E, F=F)
     points = dict(O=O, dn=dn, do=do, co=co, ce=ce, fo=fo, eo=eo, fn=fn, dn_mat=dn_mat, fn_mat=fn_mat)
-    if tyre_model:
-        # The rider's upper body G leans on the hip: a revolute joint about H.x,
-        # H fixed in the rear frame (turned about C.y by hip_tilt so H.x can be
-        # horizontal), through the hip point ho. With mt = 0 and the hip locked
-        # the rider is all in the rear frame's parameters, as in the classic model.
-        b = {n: S.sym(n) for n in ("hip_tilt", "lh1", "lh3", "mt", "lt1", "lt3", "it11", "it22", "it33", "it31")}
-        H = me.ReferenceFrame("H")
-        H.orient_axis(C, C.y, b["hip_tilt"])
-        G = me.ReferenceFrame("G")
-        G.orient_axis(H, H.x, q[10])
-        G.set_ang_vel(H, u[10] * H.x)
-        ho = do.locatenew("ho", b["lh1"] * C.x + b["lh3"] * C.z)
-        ho.v2pt_theory(do, N, C)
-        go = ho.locatenew("go", b["lt1"] * G.x + b["lt3"] * G.z)
-        go.v2pt_theory(ho, N, G)
-        inertia = me.inertia(G, b["it11"], b["it22"], b["it33"], 0, 0, b["it31"])
-        bodies.append(me.RigidBody("upper_body", go, G, b["mt"], (inertia, go)))
-        gravity.append((go, b["mt"] * p["g"] * N.z))
-        frames.update(H=H, G=G)
-        points.update(ho=ho, go=go)
-
     return Kinematics(
         q=q, u=u,
         frames=frames,
@@ -381,21 +360,28 @@ def _slip_speed(centre_vel, contact_vel, heading, contact_weight):
     return centre + contact_weight * (contact_vel.dot(heading) - centre)
 
 
-def slip_equations():
+def slip_equations(part_names=()):
     """Derive the slip model: toroidal tyres, vertical compliance, lateral tyre loads as inputs.
 
     Constraints: rolling without longitudinal slip at both wheels (the rear
     relative to the kick plate, less a constant imposed slide ``vsx_r``,
     normally 0) and the front contact on the ground.
     Dependent speeds u5 (pitch rate), u6, u8 (wheel spin rates);
-    independent u1, u2, u3, u4, u7, u9, u10, u11. The rider's upper body
-    leans on a hip spring-damper (q11) and holds the bar through the arms'
-    spring-damper about the steer axis; the compiled code locks the hip
-    (u11 held at 0) while ``hip_locked`` is 1, the rigid rider. The lateral forces and aligning
+    independent u1, u2, u3, u4, u7, u9, u10 and the parts' speeds. The
+    rider is in the rear frame and holds the bar through the arms'
+    spring-damper about the steer axis; each part of ``part_names``
+    (:mod:`whipple_kick.model.parts`, e.g. ``"trunk"``: the upper body
+    leaning on the hip, which then holds the bar) adds its coordinates,
+    bodies, joint and loads. The lateral forces and aligning
     moments the tyres apply (``Fy_r Fy_f Mz_r Mz_f``) stay symbols here:
     Kane's forcing is linear in them, and the tyre's transient form
     (:mod:`whipple_kick.model.transient`) computes them from its own states and
     the kinematic quantities in ``extra``.
+
+    Parameters
+    ----------
+    part_names : tuple of str
+        Declared parts to include (:data:`whipple_kick.model.parts.REGISTRY`).
 
     Returns
     -------
@@ -410,12 +396,18 @@ def slip_equations():
         velocity along the ground normal is u9 and u10: at the rear by the
         geometry, checked symbolically, at the front by the constraint).
     """
+    from whipple_kick.model import parts
+
     kin = kinematics(tyre_model=True)
     N, A, C, D, E, F = (kin.frames[k] for k in "NACDEF")
+    chosen = parts.named(part_names)
+    par = {n: S.sym(n) for n in S.SLIP_CONSTANTS + tuple(n for p in chosen for n in p.parameters)}
+    mech = parts.Mechanics(kin=kin, par=par, hands_frame=C)
+    for part in chosen:
+        part.build(mech)
     q, u = kin.q, kin.u
-    Q = {f"q{i + 1}": qi for i, qi in enumerate(q)}
-    U = {f"u{i + 1}": ui for i, ui in enumerate(u)}
-    par = {n: S.sym(n) for n in S.SLIP_CONSTANTS}
+    Q = {f"q{i + 1}": qi for i, qi in enumerate(q[:10])} | mech.coordinates
+    U = {f"u{i + 1}": ui for i, ui in enumerate(u[:10])} | mech.speeds
     Fy_r, Fy_f, Mz_r, Mz_f = S.syms(["Fy_r", "Fy_f", "Mz_r", "Mz_f"])
     yp, vp, ap = kick_plate_motion(sm.Symbol("t", real=True))
     vp_s, ap_s = S.syms(["vp", "ap"])   # placeholders, replaced by the profile at code generation
@@ -427,25 +419,24 @@ def slip_equations():
                   for q, u, kz, cz in (("q9", "u9", "kzr", "czr"), ("q10", "u10", "kzf", "czf")))
 
     # The rider's active steer torque: the voluntary full-state feedback T = -K x
-    # (LQR convention) plus the delayed reflex torque, which the compiled code
-    # computes from the delay filter's states (whipple_kick.model.reflex).
+    # (LQR convention), on the bicycle's states and the parts' (their declared gains),
+    # plus the delayed reflex torque, which the compiled code computes from the delay
+    # filter's states (whipple_kick.model.reflex).
     T_reflex = S.sym("T_reflex")
-    T7 = -(par["kq4"] * Q["q4"] + par["kq7"] * Q["q7"] + par["ku4"] * U["u4"]
-           + par["ku7"] * U["u7"] + par["kq3"] * Q["q3"] + par["ku3"] * U["u3"]
-           + par["kq11"] * Q["q11"] + par["ku11"] * U["u11"]) + T_reflex
+    gains = {"kq4": "q4", "kq7": "q7", "ku4": "u4", "ku7": "u7", "kq3": "q3", "ku3": "u3"}
+    for part in chosen:
+        gains.update(part.gains)
+    T7 = -sum(par[g] * (Q | U)[state] for g, state in gains.items()) + T_reflex
     # The reflex acts on what the rider feels, undelayed here; the filter delays it.
     reflex_input = -(par["rq4"] * Q["q4"] + par["rq7"] * Q["q7"] + par["ru4"] * U["u4"] + par["ru7"] * U["u7"])
     T6 = par["T6c"]
-    G, H = kin.frames["G"], kin.frames["H"]
-    # The arms and the rider's torque act between the bar E and the upper body G,
-    # about the steer axis C.z. The bar turns relative to G about C.z by
-    # q7 - (H.x . C.z) q11 (H.x . C.z is constant): the arms' spring is exact,
-    # and the torques' power is the torque times this relative rate.
-    axis_share = H.x.dot(C.z)
-    arm_angle = Q["q7"] - axis_share * Q["q11"]
-    arm_rate = U["u7"] - axis_share * U["u11"]
+    # The arms and the rider's torque act between the bar E and the frame the hands
+    # hold (the rear frame, or a part's: the leaning upper body), about the steer
+    # axis C.z. The bar turns relative to that frame by q7 less the frame's own turn
+    # about C.z (exact), and the torques' power is the torque times this relative rate.
+    arm_angle = Q["q7"] - mech.hands_angle
+    arm_rate = U["u7"] - mech.hands_rate
     T_arm = -(par["ka"] * arm_angle + par["ca"] * arm_rate)
-    T_hip = -(par["kh"] * Q["q11"] + par["ch"] * U["u11"])
 
     dn_mat, fn_mat = kin.points["dn_mat"], kin.points["fn_mat"]
     loads = list(kin.gravity_loads)
@@ -454,9 +445,10 @@ def slip_equations():
         (fn_mat, -fz_f * A.z + Fy_f * kin.front_lateral),
         (D, Mz_r * A.z + T6 * C.y),
         (F, Mz_f * A.z),
-        (C, -T6 * C.y - T_hip * H.x),
-        (G, -(T7 + T_arm) * C.z + T_hip * H.x),
+        (C, -T6 * C.y),
+        (mech.hands_frame, -(T7 + T_arm) * C.z),
         (E, (T7 + T_arm) * C.z),
+        *mech.loads,
     ]
     mass_matrix, forcing = kane_full(kin, loads)
 
@@ -476,12 +468,12 @@ def slip_equations():
     # Spring energy counts only while the tyre is compressed; the damper
     # dissipates Fz dq/dt - kz max(q, 0) dq/dt >= 0 in every branch of
     # normal_force (docs/validation.md).
-    # The rider's hip and arm springs store energy, their dampers dissipate it.
-    spring = (par["kzr"] * sm.Max(0, Q["q9"])**2 + par["kzf"] * sm.Max(0, Q["q10"])**2
-              + par["kh"] * Q["q11"]**2 + par["ka"] * arm_angle**2) / 2
+    # The arms' and the parts' springs store energy, their dampers dissipate it.
+    spring = ((par["kzr"] * sm.Max(0, Q["q9"])**2 + par["kzf"] * sm.Max(0, Q["q10"])**2
+               + par["ka"] * arm_angle**2) / 2 + sum(mech.spring_energy))
     damper = (fz_r * U["u9"] - par["kzr"] * sm.Max(0, Q["q9"]) * U["u9"]
               + fz_f * U["u10"] - par["kzf"] * sm.Max(0, Q["q10"]) * U["u10"]
-              + par["ch"] * U["u11"]**2 + par["ca"] * arm_rate**2)
+              + par["ca"] * arm_rate**2 + sum(mech.damper_dissipation))
     extra = {
         "yp": yp, "vp": vp, "ap": ap,
         # Inputs of the tyre block (model convention: slip > 0 slides to the
@@ -502,7 +494,7 @@ def slip_equations():
         "wz_r": D.ang_vel_in(N).dot(A.z), "wz_f": F.ang_vel_in(N).dot(A.z),
         "T7": T7, "spring_energy": spring, "damper_dissipation_rate": damper,
         "steer_relative_rate": arm_rate, "reflex_input": reflex_input,
-        "arm_torque": T_arm, "hip_torque": T_hip,
+        "arm_torque": T_arm, **mech.outputs,
     }
     return EquationsOfMotion(
         q=q, u=u, dependent=("u5", "u6", "u8"), inputs=(vp_s, ap_s, Fy_r, Fy_f, Mz_r, Mz_f),

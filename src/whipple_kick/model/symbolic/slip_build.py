@@ -32,28 +32,21 @@ from whipple_kick import fileio
 from whipple_kick.errors import BuildError
 from whipple_kick.model import cache, carcass, energy, kane, magic_formula, reflex, transient
 from whipple_kick.model import symbols as S
+from whipple_kick.model.slip import layout as layouts
 from whipple_kick.model.slip.layout import (
-    _PARTITION,
     _SOURCES,
-    COORDINATES,
-    DEPENDENT,
-    DYNAMIC_STATES,
-    HIP_STATES,
     IGNORABLE,
-    INDEPENDENT,
-    OUTPUT_NAMES,
-    OUTPUTS,
-    PARAMETER_NAMES,
     PATCH_STATES,
     QUADRATURE_STATES,
     REFLEX_STATES,
     SPEEDS,
-    STATE_NAMES,
     P,
     X,
 )
 from whipple_kick.model.symbolic import codegen
 
+#: Status of the C functions when a reflex delay is set in a model without the delay filter.
+STATUS_NEEDS_DELAY = 3
 #: Tyre-block inputs computed with Kane's terms (plain symbols, registered in :mod:`symbols`).
 _KINEMATICS = ("vsy_r", "vsy_f", "vx_r", "vx_f", "camber_r", "camber_f", "fz_r", "fz_f",
                "vplate_r", "wz_r", "wz_f", "T7")
@@ -196,7 +189,7 @@ def _c_limit_functions():
 # ---------------------------------------------------------------- expressions
 
 @functools.cache
-def _expressions():
+def _expressions(part_names=()):
     """Everything both printers need, as plain-symbol SymPy expressions.
 
     Returns
@@ -208,10 +201,11 @@ def _expressions():
         ``blocks`` (per transient form and curve style), ``common`` (the
         form-independent quadrature rates), ``outputs`` (named outputs by
         name, the block's copies excluded), ``mass`` (the mass matrix alone)
-        and ``symbols``.
+        and ``symbols``; of the model with the parts ``part_names``.
     """
     from whipple_kick.model.symbolic import derivation
-    eom = derivation.slip_equations()
+    L = layouts.for_parts(part_names)
+    eom = derivation.slip_equations(part_names)
     dyn = list(eom.q) + list(eom.u)
     t = sm.Symbol("t", real=True)
     vp_s, ap_s = eom.inputs[:2]
@@ -248,7 +242,7 @@ def _expressions():
     outputs.update({
         # The reflex's torques are locals of the right-hand side (and arguments of the NumPy outputs).
         "T7": k_sym["T7"], "T_reflex": S.sym("T_reflex"), "reflex_input": sm.Symbol("reflex_input", real=True),
-        "arm_torque": plain(ex["arm_torque"]), "hip_torque": plain(ex["hip_torque"]),
+        "arm_torque": plain(ex["arm_torque"]), **{name: plain(ex[name]) for name in L.PART_OUTPUTS},
         "kinetic_energy": plain(eom.kinetic_energy),
         "potential_energy": plain(eom.potential_energy), "spring_energy": plain(ex["spring_energy"]),
         "holonomic": plain(eom.holonomic),
@@ -265,7 +259,7 @@ def _expressions():
             "q": [codegen.plain_symbol(s) for s in eom.q],
             "u": [codegen.plain_symbol(s) for s in eom.u],
             "s": {name: [sm.Symbol(n, real=True) for n in transient.STATES[name]] for name in transient.TRANSIENTS},
-            "p": list(S.syms(PARAMETER_NAMES)),
+            "p": list(S.syms(L.PARAMETER_NAMES)),
             "kinematics": [k_sym[n] for n in _KINEMATICS],
             "applied": [k_sym[n] for n in _APPLIED],
             "reflex": [S.sym("T_reflex")],
@@ -279,12 +273,14 @@ def _block_list(block):
     return [block[n] for n in _APPLIED] + list(block["rates"]) + [block[n] for n in _BLOCK_EXTRAS]
 
 
-def _output_list(ex, style):
-    """Output expressions in :data:`OUTPUT_NAMES` order after the speeds, block copies as their symbols."""
+def _output_list(ex, style, L):
+    """Output expressions in ``L.OUTPUT_NAMES`` order after the base speeds, block copies as their symbols."""
     steady = ex["outputs"][f"steady_{style}"]
     out = []
-    for name in OUTPUT_NAMES[len(SPEEDS):]:
-        if name in _BLOCK_OUTPUTS:
+    for name in L.OUTPUT_NAMES[len(SPEEDS):]:
+        if name in L.SPEEDS:   # a part's speed
+            out.append(sm.Symbol(name, real=True))
+        elif name in _BLOCK_OUTPUTS:
             out.append(sm.Symbol(_BLOCK_OUTPUTS[name], real=True))
         elif name in _LIMIT_OUTPUTS:
             w = name[-1]
@@ -392,10 +388,10 @@ def _c_block(exprs, targets, indent="    ", keep=None):
     return "\n".join(lines)
 
 
-def _parameter_locals(exprs, indent="    "):
-    """``const double name = p[i];`` for the parameters ``exprs`` use."""
+def _parameter_locals(exprs, indent="    ", L=layouts.BASE):
+    """``const double name = p[i];`` for the parameters ``exprs`` use (of the layout ``L``)."""
     used = set().union(*(sm.sympify(e).free_symbols for e in exprs))
-    return [f"{indent}const double {s.name} = p[{P[s.name]}];" for s in S.syms(PARAMETER_NAMES) if s in used]
+    return [f"{indent}const double {s.name} = p[{L.P[s.name]}];" for s in S.syms(L.PARAMETER_NAMES) if s in used]
 
 
 def _c_curve_functions():
@@ -432,7 +428,7 @@ _BLOCK_QUADRATURES = (("W_zero_slip", "W0"), ("D_slide", "D_slide"), ("E_carcass
                       ("E_carcass_f", "P_carcass_f"), ("D_carcass", "D_carcass"))
 
 
-def _c_prologue(ex, dynamics):
+def _c_prologue(ex, dynamics, L):
     """C statements of one evaluation up to the tyre block: the locals every later part reads.
 
     Parameters, coordinates and tyre states as locals, the constraint matrix
@@ -444,29 +440,29 @@ def _c_prologue(ex, dynamics):
     right-hand side does, without the mass matrix.
     """
     sy = ex["symbols"]
-    n, m, k = len(SPEEDS), len(DEPENDENT), len(INDEPENDENT)
-    nt, nr = len(PATCH_STATES), len(REFLEX_STATES)
-    dep = [SPEEDS.index(x) for x in DEPENDENT]
-    ind = [SPEEDS.index(x) for x in INDEPENDENT]
+    n, m, k = len(L.SPEEDS), len(L.DEPENDENT), len(L.INDEPENDENT)
+    nt, nr = len(PATCH_STATES), len(L.REFLEX_STATES)
+    dep = [L.SPEEDS.index(x) for x in L.DEPENDENT]
+    ind = [L.SPEEDS.index(x) for x in L.INDEPENDENT]
     lines = []
     for i, s in enumerate(sy["p"]):
         lines.append(f"    const double {s.name} = p[{i}];")
-    for i, s in enumerate(sy["q"]):
-        lines.append(f"    const double {s.name} = x[{i}];")
+    for s in sy["q"]:
+        lines.append(f"    const double {s.name} = x[{L.X[s.name]}];")
     declared = set()   # forms share slot names (slip_lag's are contact_patch's, the carcass' camber too)
     for name in transient.TRANSIENTS:
         for slot, s in enumerate(sy["s"][name]):
             if s.name not in declared:
                 declared.add(s.name)
-                lines.append(f"    const double {s.name} = x[{len(COORDINATES) + k + slot}];")
+                lines.append(f"    const double {s.name} = x[{X[PATCH_STATES[slot]]}];")
     lines.append(f"    double A[{m * n}], a0[{m}];")
     stage1 = ex["stage1"]
     lines += ["    {", _c_block(list(stage1["A"]) + list(stage1["a0"]),
                                  [f"A[{i}]" for i in range(m * n)] + [f"a0[{i}]" for i in range(m)], "        "), "    }"]
     # Dependent speeds: A_dep u_dep = -(A_ind u_ind + a0).
     lines.append(f"    double u[{n}];")
-    for j, idx in enumerate(ind):
-        lines.append(f"    u[{idx}] = x[{len(COORDINATES) + j}];")
+    for name, idx in zip(L.INDEPENDENT, ind, strict=True):
+        lines.append(f"    u[{idx}] = x[{L.X[name]}];")
     lines.append(f"    double Adep[{m * m}], rhs1[{m * (k + 1)}];")
     lines.append(f"    for (int i = 0; i < {m}; i++) {{")
     lines.append("        double s = a0[i];")
@@ -483,13 +479,19 @@ def _c_prologue(ex, dynamics):
         lines.append(f"    u[{idx}] = rhs1[{jj} * {k + 1} + {k}];")
     for i, s in enumerate(sy["u"]):
         lines.append(f"    const double {s.name} = u[{i}];")
-    # The rider's reflex: its undelayed torque through the delay filter (whipple_kick.model.reflex).
-    zr = ", ".join(f"x[{X[name]}]" for name in REFLEX_STATES)
-    lines += [f"    const double zr[{nr}] = {{{zr}}};", "    double reflex_input;",
-              "    {", _c_block([ex["reflex_input"]], ["reflex_input"], "        "), "    }",
-              "    const double T_reflex = wk_reflex_output(reflex_delay, zr, reflex_input);"]
-    if dynamics:
-        lines += [f"    double dzr[{nr}];", "    wk_reflex_rates(reflex_delay, zr, reflex_input, dzr);"]
+    # The rider's reflex: its undelayed torque through the delay filter (whipple_kick.model.reflex), in the
+    # model with the filter; without it the reflex acts undelayed (what the filter gives for a zero delay).
+    lines += ["    double reflex_input;",
+              "    {", _c_block([ex["reflex_input"]], ["reflex_input"], "        "), "    }"]
+    if L.delayed_reflex:
+        zr = ", ".join(f"x[{L.X[name]}]" for name in L.REFLEX_STATES)
+        lines += [f"    const double zr[{nr}] = {{{zr}}};",
+                  "    const double T_reflex = wk_reflex_output(reflex_delay, zr, reflex_input);"]
+        if dynamics:
+            lines += [f"    double dzr[{nr}];", "    wk_reflex_rates(reflex_delay, zr, reflex_input, dzr);"]
+    else:
+        lines += [f"    if (reflex_delay != 0.0) return {STATUS_NEEDS_DELAY};   /* a delay needs the filter's model */",
+                  "    const double T_reflex = reflex_input;"]
     # Kane's terms and the tyre block's inputs in one CSE'd block.
     st2 = ex["stage2"]
     kin = [s.name for s in sy["kinematics"]]
@@ -526,29 +528,31 @@ def _c_prologue(ex, dynamics):
     return lines
 
 
-def _c_outputs(ex, indent):
-    """C statements writing the named outputs (:data:`OUTPUT_NAMES`) into ``out`` from the prologue's locals."""
+def _c_outputs(ex, indent, L):
+    """C statements writing the named outputs (``L.OUTPUT_NAMES``) into ``out`` from the prologue's locals."""
     n = len(SPEEDS)
     return [f"{indent}for (int i = 0; i < {n}; i++) out[i] = u[i];", f"{indent}{{",
-            _c_block(_output_list(ex, "called"), [f"out[{n + i}]" for i in range(len(OUTPUT_NAMES) - n)],
+            _c_block(_output_list(ex, "called", L), [f"out[{n + i}]" for i in range(len(L.OUTPUT_NAMES) - n)],
                      indent + "    "), f"{indent}}}"]
 
 
-def c_source():
+def c_source(part_names=(), delayed_reflex=False):
     """Full C source of the slip model: right-hand side, outputs (with and without the dynamics), Jacobian,
-    impulse terms."""
-    ex = _expressions()
+    impulse terms, of the model with the parts ``part_names`` (and the reflex's delay filter with
+    ``delayed_reflex``)."""
+    L = layouts.for_parts(part_names, delayed_reflex)
+    ex = _expressions(part_names)
     sy = ex["symbols"]
-    n, m, k = len(SPEEDS), len(DEPENDENT), len(INDEPENDENT)
-    ns, nd = len(STATE_NAMES), len(DYNAMIC_STATES)
-    nt, nr = len(PATCH_STATES), len(REFLEX_STATES)
-    dep = [SPEEDS.index(x) for x in DEPENDENT]
-    ind = [SPEEDS.index(x) for x in INDEPENDENT]
+    n, m, k = len(L.SPEEDS), len(L.DEPENDENT), len(L.INDEPENDENT)
+    ns, nd = len(L.STATE_NAMES), len(L.DYNAMIC_STATES)
+    nt = len(PATCH_STATES)
+    dep = [L.SPEEDS.index(x) for x in L.DEPENDENT]
+    ind = [L.SPEEDS.index(x) for x in L.INDEPENDENT]
     mf_y, mf_dy, carcass_curves = _c_carcass_curves()
     lines = [_C_HELPERS, "/* Generated by whipple_kick.model.slip; do not edit. */", *_c_curve_functions(),
              *carcass_curves, carcass.c_source(P, mf_y, mf_dy), *_c_limit_functions(), reflex.c_source()]
     lines += ["int wk_slip_rhs(double t, const double *x, const double *p, double *dx, double *out)", "{"]
-    lines += _c_prologue(ex, dynamics=True)
+    lines += _c_prologue(ex, dynamics=True, L=L)
     lines.append(f"    for (int i = 0; i < {n}; i++) f[i] += G[i * 4] * Fy_r + G[i * 4 + 1] * Fy_f"
                  " + G[i * 4 + 2] * Mz_r + G[i * 4 + 3] * Mz_f;")
     # Kane's reduced equations: T = [I; C], C = -A_dep^-1 A_ind, t0 = [0; d], d = -A_dep^-1 b.
@@ -577,20 +581,17 @@ def c_source():
     lines.append(f"        for (int l = 0; l < {n}; l++) {{ double g = f[l]; for (int c = 0; c < {n}; c++) g -= M[l * {n} + c] * t0[c]; s += T[l * {k} + i] * g; }}")
     lines.append("        r[i] = s;")
     lines.append("    }")
-    # The locked hip (the rigid rider): u11's reduced equation becomes du11/dt = 0,
-    # so the upper body moves with the rear frame (exact: its torques reach the
-    # other equations through the partial velocities it shares with the rear frame).
-    h = INDEPENDENT.index("u11")
-    lines += ["    if (hip_locked != 0.0) {",
-              f"        for (int j = 0; j < {k}; j++) {{ Mr[{h} * {k} + j] = 0.0; Mr[j * {k} + {h}] = 0.0; }}",
-              f"        Mr[{h} * {k} + {h}] = 1.0; r[{h}] = 0.0;", "    }"]
     lines.append(f"    if (lu_solve({k}, Mr, 1, r)) return 1;")
-    lines.append(f"    for (int i = 0; i < {n}; i++) dx[i] = u[i];")
-    lines.append(f"    for (int i = 0; i < {k}; i++) dx[{n} + i] = r[i];")
-    lines.append(f"    for (int i = 0; i < {nt}; i++) dx[{n + k} + i] = trate[i];")
-    lines.append(f"    for (int i = 0; i < {nr}; i++) dx[{X[REFLEX_STATES[0]]} + i] = dzr[i];")
+    # Each coordinate's rate is its speed (the layouts pair them in order); the base model's states
+    # are contiguous as in its layout, the parts' follow the quadratures.
+    nb = len(SPEEDS)
+    lines.append(f"    for (int i = 0; i < {nb}; i++) dx[i] = u[i];")
+    lines += [f"    dx[{L.X[q]}] = u[{i}];" for i, q in enumerate(L.COORDINATES) if i >= nb]
+    lines += [f"    dx[{L.X[name]}] = r[{i}];" for i, name in enumerate(L.INDEPENDENT)]
+    lines.append(f"    for (int i = 0; i < {nt}; i++) dx[{X[PATCH_STATES[0]]} + i] = trate[i];")
+    lines += [f"    dx[{L.X[name]}] = dzr[{i}];" for i, name in enumerate(L.REFLEX_STATES)]
     # Quadrature rates: the form-independent ones, then the tyre block's.
-    q0 = nd
+    q0 = X[QUADRATURE_STATES[0]]
     common = ex["common"]
     lines += ["    {", _c_block([common[nm] for nm in ("W_plate", "W_steer", "W_wheel", "W_moment", "D_damper")],
                                  [f"dx[{q0 + QUADRATURE_STATES.index(nm)}]"
@@ -606,7 +607,7 @@ def c_source():
     lines.append(f"        for (int i = 0; i < {n}; i++) {{ double s = -f[i]; for (int j = 0; j < {n}; j++) s += M[i * {n} + j] * ud[j]; pc += u[i] * s; }}")
     lines.append(f"        dx[{q0 + QUADRATURE_STATES.index('W_plate')}] += pc;")
     lines.append("    }")
-    lines += ["    if (out) {", *_c_outputs(ex, "        "), "    }"]
+    lines += ["    if (out) {", *_c_outputs(ex, "        ", L), "    }"]
     lines.append(f"    for (int i = 0; i < {ns}; i++) if (!isfinite(dx[i])) return 2;")
     lines.append("    return 0;")
     lines.append("}")
@@ -614,30 +615,27 @@ def c_source():
     lines += ["int wk_slip_outputs(int n, const double *t, const double *x, const double *p, double *out)", "{",
               f"    double dx[{ns}];",
               "    for (int i = 0; i < n; i++) {",
-              f"        int status = wk_slip_rhs(t[i], x + (long)i * {ns}, p, dx, out + (long)i * {len(OUTPUT_NAMES)});",
+              f"        int status = wk_slip_rhs(t[i], x + (long)i * {ns}, p, dx, out + (long)i * {len(L.OUTPUT_NAMES)});",
               "        if (status) return status;", "    }", "    return 0;", "}"]
     # The same outputs without the dynamics: the prologue without Kane's mass matrix, forcing and solve
     # (nothing in the outputs needs the accelerations), bit for bit the right-hand side's outputs.
     lines += ["static int wk_slip_sample(double t, const double *x, const double *p, double *out)", "{",
-              *_c_prologue(ex, dynamics=False), *_c_outputs(ex, "    "), "    return 0;", "}"]
+              *_c_prologue(ex, dynamics=False, L=L), *_c_outputs(ex, "    ", L), "    return 0;", "}"]
     lines += ["int wk_slip_outputs_only(int n, const double *t, const double *x, const double *p, double *out)", "{",
               "    for (int i = 0; i < n; i++) {",
-              f"        int status = wk_slip_sample(t[i], x + (long)i * {ns}, p, out + (long)i * {len(OUTPUT_NAMES)});",
+              f"        int status = wk_slip_sample(t[i], x + (long)i * {ns}, p, out + (long)i * {len(L.OUTPUT_NAMES)});",
               "        if (status) return status;", "    }", "    return 0;", "}"]
     # Jacobian by forward differences over the dynamic states (the
     # quadratures feed nothing back and nothing depends on the ignorable
     # coordinates: their columns are exactly zero).
-    skipped = " || ".join(f"j == {STATE_NAMES.index(name)}" for name in IGNORABLE)
-    # A locked hip's and a zero delay's states drive nothing: their columns are zero too.
-    skipped += " || (hip_locked != 0.0 && (" + " || ".join(f"j == {X[nm]}" for nm in HIP_STATES) + "))"
-    skipped += (" || (reflex_delay == 0.0 && (" + " || ".join(f"j == {X[nm]}" for nm in REFLEX_STATES) + "))")
+    quadratures = f"(j >= {X[QUADRATURE_STATES[0]]} && j <= {X[QUADRATURE_STATES[-1]]})"
+    skipped = " || ".join([quadratures] + [f"j == {X[name]}" for name in IGNORABLE])
     lines += ["int wk_slip_jacobian(double t, const double *x, const double *p, const double *scale, double *J)", "{",
               f"    double f0[{ns}], f1[{ns}], xp[{ns}];",
-              f"    const double hip_locked = p[{P['hip_locked']}], reflex_delay = p[{P['reflex_delay']}];",
               "    int status = wk_slip_rhs(t, x, p, f0, 0);", "    if (status) return status;",
               "    memcpy(xp, x, sizeof xp);",
               f"    for (int j = 0; j < {ns}; j++) {{",
-              f"        if (j >= {nd} || {skipped}) {{ for (int i = 0; i < {ns}; i++) J[i * {ns} + j] = 0.0; continue; }}",
+              f"        if ({skipped}) {{ for (int i = 0; i < {ns}; i++) J[i * {ns} + j] = 0.0; continue; }}",
               "        volatile double moved = x[j] + 1.4901161193847656e-08 * fmax(fabs(x[j]), scale[j]);",
               "        const double h = moved - x[j];",
               "        xp[j] = moved;",
@@ -647,9 +645,9 @@ def c_source():
     # Mass matrix, constraint matrix and offset (the plate stop's impulse).
     stage1, mass = ex["stage1"], list(ex["stage2"]["M"])
     lines += ["int wk_slip_impulse_terms(double t, const double *x, const double *p, double *M, double *A, double *a0)",
-              "{", *_parameter_locals(list(stage1["A"]) + list(stage1["a0"]) + mass)]
-    for i, s in enumerate(sy["q"]):
-        lines.append(f"    const double {s.name} = x[{i}];")
+              "{", *_parameter_locals(list(stage1["A"]) + list(stage1["a0"]) + mass, L=L)]
+    for s in sy["q"]:
+        lines.append(f"    const double {s.name} = x[{L.X[s.name]}];")
     lines += ["    {", _c_block(list(stage1["A"]) + list(stage1["a0"]),
                                  [f"A[{i}]" for i in range(m * n)] + [f"a0[{i}]" for i in range(m)], "        "), "    }",
               "    {", _c_block(mass, [f"M[{i}]" for i in range(n * n)], "        "), "    }",
@@ -658,16 +656,17 @@ def c_source():
     lines += ["int wk_slip_cornering_stiffness(double fzr, double fzf, const double *p, double *out)", "{",
               "    double g[4];", "    wk_fyg_r(0.0, 0.0, fzr, p, g); out[0] = -g[1];",
               "    wk_fyg_f(0.0, 0.0, fzf, p, g); out[1] = -g[1];", "    return 0;", "}"]
-    lines.append(f"int wk_slip_sizes(int *sizes) {{ sizes[0] = {ns}; sizes[1] = {len(PARAMETER_NAMES)}; "
-                 f"sizes[2] = {len(OUTPUT_NAMES)}; sizes[3] = {nd}; return 0; }}")
+    lines.append(f"int wk_slip_sizes(int *sizes) {{ sizes[0] = {ns}; sizes[1] = {len(L.PARAMETER_NAMES)}; "
+                 f"sizes[2] = {len(L.OUTPUT_NAMES)}; sizes[3] = {nd}; return 0; }}")
     return "\n".join(lines) + "\n"
 
 
 # ----------------------------------------------------------------------- NumPy
 
-def numpy_source():
-    """NumPy module source of the same expressions (oracle and baseline)."""
-    ex = _expressions()
+def numpy_source(part_names=()):
+    """NumPy module source of the same expressions (oracle and baseline), of the model with ``part_names``."""
+    L = layouts.for_parts(part_names)
+    ex = _expressions(part_names)
     sy = ex["symbols"]
     t = [sy["t"]]
     st2 = ex["stage2"]
@@ -698,38 +697,39 @@ def numpy_source():
     parts.append(codegen.numpy_function(
         "outputs", [("t", t), ("q", sy["q"]), ("u", sy["u"]), ("k", sy["kinematics"]), ("a", sy["applied"]),
                     ("e", block_symbols), ("r", sy["reflex_outputs"]), ("p", sy["p"])],
-        [sm.Matrix(_output_list(ex, "inline"))], doc="Named outputs after the speeds."))
+        [sm.Matrix(_output_list(ex, "inline", L))], doc="Named outputs after the speeds."))
     return "\n\n".join(parts)
 
 
 @functools.cache
-def numpy_module():
-    """The generated NumPy oracle module (cached like the C library)."""
-    key = cache.source_hash(_SOURCES, extra="numpy")
-    path = cache.build_once(f"slip_numpy_{key}.py", lambda tmp: tmp.write_text(numpy_source()))
-    return cache.load_module(path, f"whipple_kick_generated_slip_{key}")
+def numpy_module(part_names=()):
+    """The generated NumPy oracle module of the model with ``part_names`` (cached like the C library)."""
+    L = layouts.for_parts(part_names)
+    key = cache.source_hash(_SOURCES, extra=f"numpy {L.fingerprint()}")
+    path = cache.build_once(f"slip_numpy_{L.key}_{key}.py", lambda tmp: tmp.write_text(numpy_source(part_names)))
+    return cache.load_module(path, f"whipple_kick_generated_slip_{L.key.replace('+', '_')}_{key}")
 
 
-#: Position of u11 among the independent speeds (the locked hip's reduced equation).
-_PARTITION_IND_U11 = INDEPENDENT.index("u11")
+def numpy_rhs(t, x, p, with_outputs=False, part_names=()):
+    """Right-hand side of the model with ``part_names`` evaluated with NumPy (slow; the oracle for the C code).
 
-
-def numpy_rhs(t, x, p, with_outputs=False):
-    """Right-hand side evaluated with NumPy (slow; the oracle for the C code)."""
-    mod = numpy_module()
-    nc, nk = len(COORDINATES), len(INDEPENDENT)
-    q = x[:nc]
-    u_ind = x[nc:nc + nk]
-    s = x[nc + nk:nc + nk + len(PATCH_STATES)]
-    z = x[[X[n] for n in REFLEX_STATES]]
+    The reflex's delay filter is in the model where ``p``'s ``reflex_delay`` is not 0.
+    """
+    L = layouts.for_parts(part_names, p[P["reflex_delay"]] != 0.0)
+    if len(x) != len(L.STATE_NAMES) or len(p) != len(L.PARAMETER_NAMES):
+        raise ValueError(f"numpy_rhs: {len(x)} states and {len(p)} parameters are not the layout {L.key!r}'s")
+    mod = numpy_module(part_names)
+    q = x[[L.X[n] for n in L.COORDINATES]]
+    u_ind = x[[L.X[n] for n in L.INDEPENDENT]]
+    s = x[[X[n] for n in PATCH_STATES]]
+    z = x[[L.X[n] for n in L.REFLEX_STATES]] if L.delayed_reflex else np.zeros(len(REFLEX_STATES))
     name = transient.TRANSIENTS[int(p[P["tyre_transient"]])]
     tau = p[P["reflex_delay"]]
-    locked = [_PARTITION_IND_U11] if p[P["hip_locked"]] != 0.0 else []
     # numpy.select evaluates every branch of a Piecewise, including the
     # unloaded-tyre branch's 0/0 that C never takes; the selected values are finite.
     with np.errstate(invalid="ignore", divide="ignore"):
         A, a0 = mod.stage1([t], q, p)
-        u = _PARTITION.dependent_speeds(A, a0, u_ind)
+        u = L.PARTITION.dependent_speeds(A, a0, u_ind)
         r_in = mod.reflex_input([t], q, u, p)[0][0]
         t_reflex = reflex.output(z, r_in, tau)
         M, f0, G, b, kin = mod.stage2([t], q, u, [t_reflex], p)
@@ -738,7 +738,7 @@ def numpy_rhs(t, x, p, with_outputs=False):
                  else getattr(mod, f"tyre_{name}")([t], kin, s, p)[0])
         applied = block[:4]
         f = f0 + G @ applied
-        udot = _PARTITION.accelerations(M, f, A, b, locked=locked)
+        udot = L.PARTITION.accelerations(M, f, A, b)
         rates = np.zeros(len(QUADRATURE_STATES))
         common = mod.common([t], q, u, kin, applied, p)[0]
         for value, nm in zip(common, ("W_plate", "W_steer", "W_wheel", "W_moment", "D_damper"), strict=True):
@@ -748,12 +748,18 @@ def numpy_rhs(t, x, p, with_outputs=False):
             rates[QUADRATURE_STATES.index(nm)] = extras[local]
         if np.any(a0 != 0.0):
             rates[QUADRATURE_STATES.index("W_plate")] += kane.constraint_power(M, f, u, udot)
-        dx = np.concatenate([u, udot[_PARTITION.ind], block[4:8], reflex.rates(z, r_in, tau), rates])
+        dx = np.empty(len(L.STATE_NAMES))
+        dx[[L.X[n] for n in L.COORDINATES]] = u
+        dx[[L.X[n] for n in L.INDEPENDENT]] = udot[L.PARTITION.ind]
+        dx[[X[n] for n in PATCH_STATES]] = block[4:8]
+        if L.delayed_reflex:
+            dx[[L.X[n] for n in L.REFLEX_STATES]] = reflex.rates(z, r_in, tau)
+        dx[[X[n] for n in QUADRATURE_STATES]] = rates
         if with_outputs:
             limits = [_reference_limit(p, w, kin, applied[k], branches[w]) for k, w in enumerate("rf")]
             outputs = mod.outputs([t], q, u, kin, applied, np.concatenate([block[8:], limits]), [t_reflex, r_in],
                                   p)[0]
-            return dx, np.concatenate([u, outputs])
+            return dx, np.concatenate([u[:len(SPEEDS)], outputs])
     return dx
 
 
@@ -826,7 +832,7 @@ def _reference_limit(p, wheel, kin, force, branches):
 
 # ------------------------------------------------------------------ the build
 
-def metadata(key, compiler, flags):
+def metadata(key, compiler, flags, L=layouts.BASE):
     """Plain-data description of the compiled library, written beside it at build time.
 
     The layouts the C code was generated for (states, parameters, outputs,
@@ -839,22 +845,28 @@ def metadata(key, compiler, flags):
         info = S.REGISTRY.get(name)
         return {"name": name, "unit": info.unit, "description": info.description} if info else {"name": name}
 
-    outputs = [described(n) for n in SPEEDS]
-    outputs += [{"name": n, "unit": unit, "description": what} for n, (unit, what) in OUTPUTS.items()]
+    outputs = [described(n) if n in L.SPEEDS else {"name": n, "unit": L.OUTPUTS[n][0],
+                                                     "description": L.OUTPUTS[n][1]} for n in L.OUTPUT_NAMES]
     return {
         "model": "whipple_kick slip model",
         "key": key,
-        "layout": {"states": list(STATE_NAMES), "parameters": list(PARAMETER_NAMES),
-                   "outputs": list(OUTPUT_NAMES), "dynamic_states": len(DYNAMIC_STATES)},
-        "states": [described(n) for n in STATE_NAMES],
-        "parameters": [described(n) for n in PARAMETER_NAMES],
+        "parts": [p.name for p in L.parts],
+        "layout": layout_record(L),
+        "states": [described(n) for n in L.STATE_NAMES],
+        "parameters": [described(n) for n in L.PARAMETER_NAMES],
         "outputs": outputs,
         "generated_with": {"sympy": cache.sympy_version(), "python": sys.version.split()[0],
                            "compiler": compiler, "flags": list(flags)},
     }
 
 
-def build_library(path, key, compiler, flags):
+def layout_record(L):
+    """The layouts of ``L`` as the metadata records them (what the loader compares)."""
+    return {"states": list(L.STATE_NAMES), "parameters": list(L.PARAMETER_NAMES), "outputs": list(L.OUTPUT_NAMES),
+            "dynamic_states": len(L.DYNAMIC_STATES)}
+
+
+def build_library(path, key, compiler, flags, part_names=(), delayed_reflex=False):
     """Generate, compile and describe the slip model: the library at ``path``, source and metadata beside it.
 
     Prints one line on stderr first: the build takes 20-30 s on a fresh
@@ -866,22 +878,27 @@ def build_library(path, key, compiler, flags):
         Where to write the shared library (a temporary name in the cache;
         :func:`whipple_kick.model.cache.build_once` renames it into place).
     key : str
-        The cache key (names the source and metadata files).
+        The cache key (names the source and metadata files, with the parts).
     compiler : str
         Path of the C compiler.
     flags : sequence of str
         Compiler flags.
+    part_names : tuple of str
+        The model's declared parts (:mod:`whipple_kick.model.parts`).
+    delayed_reflex : bool
+        Whether the model has the reflex's delay filter.
 
     Raises
     ------
     BuildError
         The compiler failed (one line; its full output saved beside the source).
     """
-    print("whipple_kick: building the slip model once for this version (SymPy derivation, C code generation and "
-          "compilation; about 20-30 s)...", file=sys.stderr, flush=True)
+    what = " with " + ", ".join(part_names + ("the reflex delay",) * delayed_reflex) if part_names or delayed_reflex else ""
+    print(f"whipple_kick: building the slip model{what} once for this version (SymPy derivation, C code "
+          "generation and compilation; about 20-30 s)...", file=sys.stderr, flush=True)
     folder = cache.cache_dir()
     src_path = folder / f"slip_{key}.c"
-    fileio.write_atomic(src_path, c_source(), private=True)   # kept next to the library for inspection
+    fileio.write_atomic(src_path, c_source(part_names, delayed_reflex), private=True)   # kept next to the library for inspection
     proc = subprocess.run([compiler, *flags, "-o", str(path), str(src_path), "-lm"],
                           capture_output=True, text=True, check=False)
     if proc.returncode != 0:
@@ -890,5 +907,5 @@ def build_library(path, key, compiler, flags):
         last = (proc.stderr.strip().splitlines() or ["no output"])[-1]
         raise BuildError(f"the C compiler {compiler} failed (exit status {proc.returncode}: {last[:200]}); "
                          f"its output is in {log}; install a working gcc or set CC")
-    fileio.write_atomic(folder / f"slip_{key}.json", json.dumps(metadata(key, compiler, flags), indent=1) + "\n",
+    fileio.write_atomic(folder / f"slip_{key}.json", json.dumps(metadata(key, compiler, flags, layouts.for_parts(part_names, delayed_reflex)), indent=1) + "\n",
                         private=True)

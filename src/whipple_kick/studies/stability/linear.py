@@ -35,7 +35,7 @@ def active_states(transient=DEFAULT_TRANSIENT, body=(), constant_speed=True):
     body : tuple of str
         The body states the linearisation includes
         (:func:`whipple_kick.model.slip.linear.body_states`): the upper body's lean
-        q11, u11 when the hip is free, the reflex filter's states when the
+        the parts' states (q11, u11 of the leaning upper body), the reflex filter's states when the
         delay is not 0; none for the rigid rider.
     constant_speed : bool
         Without the forward velocity (the default model).
@@ -193,7 +193,7 @@ def linearise(params, steady_state, loop, found_by="direct", constant_speed=True
     """
     rhs = slip.CompiledRHS(steady_state.params)
     J, B = slip.heading_linearisation(rhs, steady_state.x)
-    body = tuple(slip.linear.body_states(rhs.p))
+    body = tuple(slip.linear.body_states(rhs))
     if constant_speed:
         J, B = _constant_speed(J, B, slip.LINEAR_STATES + body)
     states = active_states(rhs.transient, body, constant_speed)

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from whipple_kick.model import slip
+from whipple_kick.model import parts, slip
 from whipple_kick.simulate import results
 
 from ._constants import (
@@ -106,7 +106,8 @@ def mode_content(model, eigenvalue, vector, wheelbase):
 
 
 #: States of the rider's body (after the bicycle's in a :class:`LinearModel`).
-_BODY_STATES = frozenset(slip.HIP_STATES + slip.REFLEX_STATES)
+_BODY_STATES = frozenset(tuple(n for part in parts.REGISTRY.values() for n in part.coordinates + part.speeds)
+                         + slip.REFLEX_STATES)
 
 
 def groups_of(model):

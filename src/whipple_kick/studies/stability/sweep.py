@@ -23,7 +23,7 @@ class _Loop:
         self.setup, self.loop, self.wheelbase = setup, loop, wheelbase
         self.base = _base_params(setup)
         # The eigenvectors' content groups: the rider body's too when its states are linearised.
-        body = slip.linear.body_states(slip.parameter_vector(self.base))
+        body = slip.linear.body_states(self.base)
         self.groups = GROUPS + (BODY_GROUPS if body else ())
 
     def model(self, speed, guess=None, other=None):

@@ -1,0 +1,271 @@
+"""The rider's degrees of freedom as declared parts of the bicycle-rider system.
+
+The slip model (:func:`whipple_kick.model.symbolic.derivation.slip_equations`)
+is the bicycle with a rigid rider lumped into the rear frame, its arms'
+spring-damper about the steer axis and its reflex; each :class:`Part` adds
+to it what it declares: its symbols (with units and descriptions), its
+coordinates and speeds, its bodies, joint, springs, dampers and loads (its
+``build``), its parameters, the rider's feedback gains on its states, its
+trajectory columns and its outputs. A part is declared once, in its own
+module, and the rest follows from the declaration: the derivation, the
+generated code and its cache key, the state, parameter and output layouts
+(:class:`whipple_kick.model.slip.layout.Layout`), the trajectory's columns
+and the gain table. A model without a part has none of its terms: the rigid
+rider is the model without the trunk part, not a locked one.
+
+This follows SymBRiM's split of a rider into models and connections that
+each declare their coordinates (Stienstra, SymBRiM documentation), written
+for this model's single Kane derivation.
+
+:data:`TRUNK` is the rider's upper body leaning on the hip (Moore 2012, ch. 4,
+"Leaning rider extension"). :func:`merge_into_rear_frame` lumps an upper
+body into the rear frame, exactly, for the rigid rider whose arms hold the bar.
+"""
+from collections.abc import Callable
+from dataclasses import dataclass, field
+import hashlib
+import inspect
+
+import numpy as np
+
+from whipple_kick.model import symbols as S
+
+
+@dataclass
+class Mechanics:
+    """What the parts of one derivation add to the bicycle, as SymPy objects (the build side only).
+
+    A part's ``build`` receives this and appends to it. ``hands_frame`` is the
+    frame the rider's hands react the steer torque and the arms on (the rear
+    frame C unless a part carries the upper body), and ``hands_angle`` /
+    ``hands_rate`` its rotation [rad] and rate [rad/s] about the steer axis
+    C.z relative to the rear frame (the arms' spring stretches by the bar's
+    rotation relative to the hands).
+    """
+
+    kin: object                 # derivation.Kinematics (frames, points, q, u, bodies, gravity loads)
+    par: dict                   # parameter symbols by name (the base model's and every part's)
+    coordinates: dict = field(default_factory=dict)   # name -> dynamicsymbol, the parts' coordinates
+    speeds: dict = field(default_factory=dict)        # name -> dynamicsymbol, the parts' speeds
+    loads: list = field(default_factory=list)         # (point or frame, vector) as KanesMethod takes them
+    spring_energy: list = field(default_factory=list)        # terms [J]
+    damper_dissipation: list = field(default_factory=list)   # terms [W], each >= 0
+    outputs: dict = field(default_factory=dict)       # name -> expression (the part's declared outputs)
+    hands_frame: object = None
+    hands_angle: object = 0
+    hands_rate: object = 0
+
+    def coordinate(self, q_name, u_name):
+        """A new coordinate and its speed (``u = dq/dt``), appended to the system's: (q, u) dynamicsymbols."""
+        import sympy.physics.mechanics as me
+
+        q, u = S.dyn(q_name), S.dyn(u_name)
+        self.kin.q = (*self.kin.q, q)
+        self.kin.u = (*self.kin.u, u)
+        self.kin.qd_to_u[q.diff(me.dynamicsymbols._t)] = u
+        self.coordinates[q_name], self.speeds[u_name] = q, u
+        return q, u
+
+    def body(self, name, point, frame, mass, inertia):
+        """Add a rigid body with its weight (``inertia`` a dyadic about ``point``, its mass centre)."""
+        import sympy.physics.mechanics as me
+
+        self.kin.bodies.append(me.RigidBody(name, point, frame, mass, (inertia, point)))
+        self.kin.gravity_loads.append((point, mass * self.par["g"] * self.kin.frames["N"].z))
+
+
+@dataclass(frozen=True)
+class Part:
+    """One declared part of the bicycle-rider system.
+
+    Attributes
+    ----------
+    name : str
+        Short name (the generated model's cache key and layouts name it).
+    description : str
+        What it is, one line.
+    source : str
+        Where its mechanics and parameter meanings come from.
+    symbols : tuple
+        ``(name, description, unit, kind)`` rows it registers (:func:`whipple_kick.model.symbols.register`).
+    coordinates, speeds : tuple of str
+        Its generalised coordinates and speeds (``u = dq/dt``), appended to the system's in this order.
+    parameters : tuple of str
+        Its constants, appended to the parameter vector in this order (its gains included).
+    gains : dict
+        The rider's feedback gains on its states: gain name -> state name (``T7 = -sum(gain * state)``).
+    columns : dict
+        Trajectory column of each of its states: state -> (column name, unit).
+    outputs : dict
+        Its named outputs: name -> (unit, description); ``build`` sets each in ``Mechanics.outputs``.
+    build : callable
+        ``build(mechanics)``: adds its coordinates, bodies, joint, loads, energy terms and outputs.
+    """
+
+    name: str
+    description: str
+    source: str
+    symbols: tuple
+    coordinates: tuple
+    speeds: tuple
+    parameters: tuple
+    gains: dict
+    columns: dict
+    outputs: dict
+    build: Callable
+
+    def __post_init__(self):
+        S.register(self.symbols)
+        missing = [n for n in self.coordinates + self.speeds + self.parameters if n not in S.REGISTRY]
+        if missing:
+            raise ValueError(f"part {self.name!r}: {missing} are neither declared by it nor registered")
+        unknown = [g for g in self.gains if g not in self.parameters]
+        if unknown:
+            raise ValueError(f"part {self.name!r}: gains {unknown} are not among its parameters")
+
+    def fingerprint(self):
+        """Hash of the declaration and the source of ``build`` (part of the generated code's cache key)."""
+        text = repr((self.name, self.symbols, self.coordinates, self.speeds, self.parameters, self.gains,
+                     self.outputs)) + inspect.getsource(self.build)
+        return hashlib.sha256(text.encode()).hexdigest()[:12]
+
+
+#: Every declared part by name, in declaration order (the order parts take in a model).
+REGISTRY: dict = {}
+
+
+def declare(part):
+    """Add ``part`` to :data:`REGISTRY` (again under the same name: the later declaration) and return it."""
+    REGISTRY[part.name] = part
+    return part
+
+
+def named(names):
+    """The parts called ``names``, in :data:`REGISTRY` order (refusing unknown names)."""
+    unknown = [n for n in names if n not in REGISTRY]
+    if unknown:
+        raise KeyError(f"no declared part {unknown[0]!r}; known: {', '.join(REGISTRY) or 'none'}")
+    return tuple(p for p in REGISTRY.values() if p.name in names)
+
+
+# ------------------------------------------------------------------ the trunk
+
+_TRUNK_BODY = ("hip_tilt", "lh1", "lh3", "mt", "lt1", "lt3", "it11", "it22", "it33", "it31")
+
+
+def _build_trunk(m):
+    """The upper body G on a revolute hip joint about H.x, with its spring-damper; the hands on G."""
+    import sympy.physics.mechanics as me
+
+    kin, b = m.kin, m.par
+    N, C = kin.frames["N"], kin.frames["C"]
+    q11, u11 = m.coordinate("q11", "u11")
+    # H is fixed in the rear frame, turned about C.y by hip_tilt so that H.x can be horizontal.
+    H = me.ReferenceFrame("H")
+    H.orient_axis(C, C.y, b["hip_tilt"])
+    G = me.ReferenceFrame("G")
+    G.orient_axis(H, H.x, q11)
+    G.set_ang_vel(H, u11 * H.x)
+    do = kin.points["do"]
+    ho = do.locatenew("ho", b["lh1"] * C.x + b["lh3"] * C.z)
+    ho.v2pt_theory(do, N, C)
+    go = ho.locatenew("go", b["lt1"] * G.x + b["lt3"] * G.z)
+    go.v2pt_theory(ho, N, G)
+    m.body("upper_body", go, G, b["mt"], me.inertia(G, b["it11"], b["it22"], b["it33"], 0, 0, b["it31"]))
+    kin.frames.update(H=H, G=G)
+    kin.points.update(ho=ho, go=go)
+    hip_torque = -(b["kh"] * q11 + b["ch"] * u11)
+    m.loads += [(C, -hip_torque * H.x), (G, hip_torque * H.x)]
+    # The hands hold the bar from G: the bar turns relative to G about C.z by q7 - (H.x . C.z) q11
+    # (H.x . C.z is constant), so the arms' spring is exact.
+    axis_share = H.x.dot(C.z)
+    m.hands_frame, m.hands_angle, m.hands_rate = G, axis_share * q11, axis_share * u11
+    m.spring_energy.append(b["kh"] * q11**2 / 2)
+    m.damper_dissipation.append(b["ch"] * u11**2)
+    m.outputs["hip_torque"] = hip_torque
+
+
+TRUNK = declare(Part(
+    name="trunk",
+    description="the rider's upper body (pelvis, trunk, head, upper arms) leaning on a hip spring-damper",
+    source="Moore (2012), Human Control of a Bicycle, ch. 4 'Leaning rider extension'; segments from the "
+           "rider's own Yeadon model (whipple_kick.library.riders.seat_with_body)",
+    symbols=(
+        ("q11", "rider's upper-body lean relative to the rear frame, about the hip axis H.x (positive = lean "
+                "right)", "rad", "coordinate"),
+        ("u11", "rate of q11: upper-body lean rate relative to the rear frame", "rad/s", "speed"),
+        ("hip_tilt", "angle about C.y from the rear frame's C.x axis to the hip (lean) axis H.x: minus the steer "
+                     "axis tilt puts H.x horizontal in the nominal configuration", "rad", "constant"),
+        ("lh1", "hip (lean-axis) point from the rear wheel centre along C.x", "m", "constant"),
+        ("lh3", "hip (lean-axis) point from the rear wheel centre along C.z", "m", "constant"),
+        ("mt", "mass of the rider's upper body G", "kg", "constant"),
+        ("lt1", "upper-body mass centre from the hip point along G.x", "m", "constant"),
+        ("lt3", "upper-body mass centre from the hip point along G.z (negative: above the hip)", "m", "constant"),
+        ("it11", "upper-body moment of inertia about its mass centre, G.x axis", "kg m^2", "constant"),
+        ("it22", "upper-body moment of inertia about its mass centre, G.y axis", "kg m^2", "constant"),
+        ("it33", "upper-body moment of inertia about its mass centre, G.z axis", "kg m^2", "constant"),
+        ("it31", "upper-body product of inertia about its mass centre, G.z-G.x entry", "kg m^2", "constant"),
+        ("kh", "hip lean stiffness: torque on the upper body about H.x per radian of q11", "N m/rad", "constant"),
+        ("ch", "hip lean damping: torque on the upper body about H.x per rad/s of u11", "N m s/rad", "constant"),
+        ("kq11", "steer-torque feedback gain on upper-body lean q11", "N m/rad", "constant"),
+        ("ku11", "steer-torque feedback gain on upper-body lean rate u11", "N m s/rad", "constant"),
+    ),
+    coordinates=("q11",),
+    speeds=("u11",),
+    parameters=(*_TRUNK_BODY, "kh", "ch", "kq11", "ku11"),
+    gains={"kq11": "q11", "ku11": "u11"},
+    columns={"q11": ("upper_body_lean", "rad"), "u11": ("upper_body_lean_rate", "rad/s")},
+    outputs={"hip_torque": ("N m", "torque of the hip spring-damper on the upper body about the lean axis")},
+    build=_build_trunk,
+))
+
+
+def _hinge_rotation(hip_tilt):
+    """Rotation matrix whose columns are the hip frame H's axes in the rear frame C (H turned about C.y)."""
+    c, s = np.cos(hip_tilt), np.sin(hip_tilt)
+    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+
+
+def _parallel_axis(mass, offset):
+    """Inertia [kg m^2] a point mass at ``offset`` [m] adds about the origin."""
+    d = np.asarray(offset, dtype=float)
+    return mass * (d @ d * np.eye(3) - np.outer(d, d))
+
+
+def merge_into_rear_frame(moore, body):
+    """Moore parameters with the upper body of ``body`` (the trunk's placement and inertia) in the rear frame.
+
+    The upper body at zero lean is a rigid part of the rear frame: its mass,
+    mass centre and inertia are combined with the rear frame's (Moore's
+    ``mc l1 l2 ic11 ic22 ic33 ic31``, about the combined mass centre, in the
+    rear frame's axes), exactly as a locked hip would hold it. For the rigid
+    rider whose forearms turn with the bar (the rest of the rider is then
+    the rear frame plus this upper body).
+
+    Parameters
+    ----------
+    moore : mapping
+        Moore parameters of the bicycle whose rear frame lacks the upper body.
+    body : mapping
+        At least the trunk's placement and inertia (``hip_tilt lh1 lh3 mt lt1 lt3 it11 it22 it33 it31``).
+
+    Returns
+    -------
+    dict
+        ``moore`` with the rear frame's seven entries replaced.
+    """
+    out = dict(moore)
+    mc, mt = float(moore["mc"]), float(body["mt"])
+    R = _hinge_rotation(float(body["hip_tilt"]))   # G = H at zero lean
+    r_c = np.array([moore["l1"], 0.0, moore["l2"]], dtype=float)
+    r_g = np.array([body["lh1"], 0.0, body["lh3"]], dtype=float) + R @ np.array([body["lt1"], 0.0, body["lt3"]])
+    mass = mc + mt
+    r = (mc * r_c + mt * r_g) / mass
+    I_c = np.array([[moore["ic11"], 0.0, moore["ic31"]], [0.0, moore["ic22"], 0.0],
+                    [moore["ic31"], 0.0, moore["ic33"]]], dtype=float)
+    I_g = np.array([[body["it11"], 0.0, body["it31"]], [0.0, body["it22"], 0.0],
+                    [body["it31"], 0.0, body["it33"]]], dtype=float)
+    inertia = I_c + _parallel_axis(mc, r_c - r) + R @ I_g @ R.T + _parallel_axis(mt, r_g - r)
+    out.update(mc=mass, l1=float(r[0]), l2=float(r[2]), ic11=float(inertia[0, 0]), ic22=float(inertia[1, 1]),
+               ic33=float(inertia[2, 2]), ic31=float(inertia[0, 2]))
+    return out
