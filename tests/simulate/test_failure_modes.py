@@ -67,7 +67,7 @@ def _start_long_run(out, *extra):
 def test_failing_compiler_is_one_line_naming_compiler_and_log(tmp_path, monkeypatch):
     """A compiler that exits non-zero: BuildError, one line, full output saved beside the source."""
     monkeypatch.setenv("WHIPPLE_KICK_CACHE", str(tmp_path / "cache"))
-    monkeypatch.setattr(slip_build, "c_source", lambda: "int main(void) { return 0; }\n")
+    monkeypatch.setattr(slip_build, "c_source", lambda *model: "int main(void) { return 0; }\n")
     failing = shutil.which("false")
     with pytest.raises(BuildError) as info:
         slip_build.build_library(tmp_path / "cache" / "x.so", "k", failing, ("-O2",))
@@ -77,7 +77,7 @@ def test_failing_compiler_is_one_line_naming_compiler_and_log(tmp_path, monkeypa
 
 
 def test_failing_compiler_from_simulate_is_status_1_and_leaves_no_folder(tmp_path, capsys, monkeypatch):
-    def fail():
+    def fail(*layout):
         raise BuildError("the C compiler /bin/false failed (exit status 1: no output)")
     monkeypatch.setattr(slip.compiled, "library_path", fail)
     slip.library.cache_clear()

@@ -13,7 +13,7 @@ from scipy.linalg import solve_continuous_lyapunov
 import whipple_kick as wk
 from whipple_kick.errors import InputError
 from whipple_kick.library import inputs, riders
-from whipple_kick.model import benchmark, classic, slip
+from whipple_kick.model import benchmark, classic, parts, slip
 from whipple_kick.model.benchmark import steer_axis_tilt
 from whipple_kick.model.symbolic import slip_build
 from whipple_kick.simulate import assembly, control, lsoda, steady
@@ -49,30 +49,34 @@ def _upper_body_com(seat, body):
 
 # ----------------------------------------------------------------- 1. locked body = lumped rider
 
-def test_locked_body_is_the_lumped_rider(bike, rider, t03):
-    """The split rider with the hip locked (no hip, arm or reflex impedance, forearms with the upper body) is
-    the rider lumped into the rear frame: the same steady turn, the same rates at random states (all but the
-    hip's q11 and u11, which stay exactly 0), and the same roll and steer after a push.
+def test_upper_body_merged_into_the_rear_frame_is_the_lumped_rider(bike, rider, t03):
+    """The split rider with its upper body merged back into the rear frame
+    (:func:`whipple_kick.model.parts.merge_into_rear_frame`: what the rigid rider with arms on the bar runs,
+    the model without the trunk part) is the rider lumped into the rear frame by :func:`riders.seat`, an
+    independent computation (Yeadon's combined inertia): the same Moore parameters, the same steady turn, the
+    same rates at random states and the same roll and steer after a push.
 
-    Measured: steady unknowns and carcass stiffnesses equal to ~1e-15 relative; rates 2.8e-14 relative to
-    max(|rate|, 1) over 20 states; histories over 3 s (rtol 1e-11) 1.2e-13 rad roll, 1.3e-12 rad steer.
-    Bounds 1e-10 (rates; the brief's) and 1e-11 rad (histories).
+    Measured: Moore parameters 2e-16 relative; steady unknowns ~1e-15 relative; rates ~1e-14 relative to
+    max(|rate|, 1) over 20 states; histories over 3 s (rtol 1e-11) ~1e-13 rad. Bounds 1e-12 (parameters),
+    1e-10 (rates) and 1e-11 rad (histories).
     """
     lumped = riders.seat(bike, rider)
     split, body = riders.seat_with_body(bike, rider, arms_on_bar=False)
     assert body["mt"] > 30.0   # the upper body really carries most of the rider (measured 40.1 kg of 70)
+    merged = parts.merge_into_rear_frame(dict(split.moore), body)
+    for name in ("mc", "l1", "l2", "ic11", "ic22", "ic33", "ic31"):
+        assert merged[name] == pytest.approx(lumped.moore[name], rel=1e-12, abs=1e-12), name
     gains = control.gains_dict(control.lqr_gains(lumped, 3.0)[0])
     pa = slip.model_parameters(dict(lumped.moore), t03, t03, gains=gains)
-    pb = slip.model_parameters(dict(split.moore), t03, t03, gains=gains, body=dict(body, hip_locked=1.0))
-    assert (pb["kh"], pb["ch"], pb["ka"], pb["ca"], pb["reflex_delay"]) == (0.0,) * 5
+    pb = slip.model_parameters(merged, t03, t03, gains=gains)
+    assert slip.for_parameters(pb) is slip.layout.BASE   # no trunk part, nothing locked
     sa, sb = steady.steady_state(pa, 3.0), steady.steady_state(pb, 3.0)
     assert "q11" not in sb.unknowns
     for name, value in sa.unknowns.items():
         assert sb.unknowns[name] == pytest.approx(value, rel=1e-10, abs=1e-14), name
     assert sb.params["ccr"] == pytest.approx(sa.params["ccr"], rel=1e-12)
     ra, rb = slip.CompiledRHS(sa.params), slip.CompiledRHS(sb.params)
-    hip = [slip.X["q11"], slip.X["u11"]]
-    keep = [i for i in range(len(slip.STATE_NAMES)) if i not in hip]
+    keep = list(range(len(slip.STATE_NAMES)))
     rng = np.random.default_rng(1)
     worst = 0.0
     for _ in range(20):
@@ -87,7 +91,6 @@ def test_locked_body_is_the_lumped_rider(bike, rider, t03):
             x[slip.X[name]] *= rng.uniform(-2.0, 2.0)
         x = slip.solve_pitch(ra, x)
         da, db = ra(0.0, x), rb(0.0, x)
-        assert db[hip[0]] == 0.0 and db[hip[1]] == 0.0   # the locked hip does not move
         worst = max(worst, float(np.max(np.abs(da - db)[keep] / np.maximum(np.abs(da[keep]), 1.0))))
     assert worst < 1e-10
     histories = []
@@ -99,7 +102,6 @@ def test_locked_body_is_the_lumped_rider(bike, rider, t03):
         assert not tr.fell
         histories.append(tr)
     a, b = histories
-    assert np.abs(b.state("q11")).max() == 0.0 and np.abs(b.state("u11")).max() == 0.0
     assert np.abs(a.state("q4")).max() > 0.1   # a real response (measured 0.14 rad)
     for name in ("q4", "q7"):
         assert np.abs(a.state(name) - b.state(name)).max() < 1e-11, name
@@ -147,7 +149,9 @@ def test_a_leaning_rider_reports_the_static_loads_of_the_whole_rider():
         bike = wk.bicycles.load(sc.bicycle)
         seat = riders.place(bike, riders.yeadon_rider(sc.rider, mass_kg=info["rider_mass_kg"])).seat
         com = _upper_body_com(seat, body)
-        m, x, _ = _totals(bench, [(body["mt"], com[0], com[2])])
+        # The rigid rider with arms on the bar has its upper body in the rear frame already.
+        apart = [(body["mt"], com[0], com[2])] if sc.rider_body == "leaning" else []
+        m, x, _ = _totals(bench, apart)
         weight = m * bench["g"]
         assert info["static_load_rear_n"] == pytest.approx(weight * (bench["w"] - x) / bench["w"], abs=1e-9)
         assert info["static_load_front_n"] == pytest.approx(weight * x / bench["w"], abs=1e-9)
@@ -159,10 +163,11 @@ def test_a_leaning_rider_reports_the_static_loads_of_the_whole_rider():
 # ----------------------------------------------------------------- 3, 4. single-degree-of-freedom checks
 
 def _stage2(params, q, u):
-    """Full mass matrix (11 x 11) and forcing without tyre loads (11,) from the NumPy oracle."""
-    p = slip.parameter_vector(params)
+    """Full mass matrix (n x n, n speeds of the model) and forcing without tyre loads (n,) from the NumPy oracle."""
+    layout = slip.for_parameters(params)
+    p = slip.parameter_vector(params, layout)
     with np.errstate(invalid="ignore", divide="ignore"):
-        M, f0, *_ = slip_build.numpy_module().stage2([0.0], q, u, [0.0], p)
+        M, f0, *_ = slip_build.numpy_module(layout.part_names).stage2([0.0], q, u, [0.0], p)
     return np.asarray(M, dtype=float), np.asarray(f0, dtype=float).ravel()
 
 
@@ -170,9 +175,10 @@ def _frame_fixed_sdof(params, speed_name, h=1e-6):
     """(inertia, stiffness, damping) of one speed's row with every other coordinate and speed held at the
     upright, uncompressed configuration (q5 the steer-axis tilt, all else 0): M[i, i], -df_i/dq_i and
     -df_i/du_i by central differences."""
-    i = slip.SPEEDS.index(speed_name)
-    q, u = np.zeros(len(slip.SPEEDS)), np.zeros(len(slip.SPEEDS))
-    q[slip.SPEEDS.index("u5")] = steer_axis_tilt(params)
+    speeds = slip.for_parameters(params).SPEEDS
+    i = speeds.index(speed_name)
+    q, u = np.zeros(len(speeds)), np.zeros(len(speeds))
+    q[speeds.index("u5")] = steer_axis_tilt(params)
     M, f = _stage2(params, q, u)
     assert f[i] == 0.0   # an equilibrium of this degree of freedom
     step = np.zeros_like(q)
@@ -222,7 +228,7 @@ def test_arms_are_a_spring_damper_on_the_bar_with_the_frame_held(bike, rider, t0
     """
     split, body = riders.seat_with_body(bike, rider, arms_on_bar=True)
     ka, ca = 10.0, 1.5
-    params = slip.model_parameters(dict(split.moore), t03, t03, body=dict(body, ka=ka, ca=ca))
+    params = slip.model_parameters(dict(split.moore), t03, t03, body=dict(body, ka=ka, ca=ca, kh=0.0, ch=0.0))
     params["g"] = 0.0
     inertia, k, c = _frame_fixed_sdof(params, "u7")
     bench = split.benchmark
@@ -245,7 +251,7 @@ def test_arms_are_a_spring_damper_on_the_bar_with_the_frame_held(bike, rider, t0
     assert c / (2 * math.sqrt(k * inertia)) == pytest.approx(ca / (2 * math.sqrt(ka * i_ref)), rel=1e-9)
     # The forearms on the bar more than triple the steer inertia (measured 0.159 -> 0.554 kg m^2).
     without, body_without = riders.seat_with_body(bike, rider, arms_on_bar=False)
-    bare = slip.model_parameters(dict(without.moore), t03, t03, body=dict(body_without, ka=ka, ca=ca))
+    bare = slip.model_parameters(dict(without.moore), t03, t03, body=dict(body_without, ka=ka, ca=ca, kh=0.0, ch=0.0))
     bare["g"] = 0.0
     assert _frame_fixed_sdof(bare, "u7")[0] < inertia / 3
 
@@ -319,8 +325,9 @@ def test_hip_and_arm_springs_and_dampers_are_in_the_energy(bike, rider, t03):
     body = dict(body, kh=128.0, ch=50.0, ka=10.0, ca=1.5)
     ss = steady.steady_state(slip.model_parameters(dict(split.moore), t03, t03, body=body), 3.0)
     rhs = slip.CompiledRHS(ss.params)
+    X = rhs.layout.X
     x = ss.x.copy()
-    x[slip.X["q11"]], x[slip.X["u11"]], x[slip.X["q7"]], x[slip.X["u7"]] = 0.05, -0.3, 0.1, 0.7
+    x[X["q11"]], x[X["u11"]], x[X["q7"]], x[X["u7"]] = 0.05, -0.3, 0.1, 0.7
     x[slip.X["u9"]] = x[slip.X["u10"]] = 0.0
     x = slip.solve_pitch(rhs, x)
     dx, out = rhs.outputs(0.0, x)
@@ -331,7 +338,7 @@ def test_hip_and_arm_springs_and_dampers_are_in_the_energy(bike, rider, t03):
     springs = 0.5 * 128.0 * 0.05 ** 2 + 0.5 * 10.0 * arm_angle ** 2
     assert out[slip.OUT["spring_energy"]] - tyres == pytest.approx(springs, rel=1e-12)
     assert dx[slip.X["D_damper"]] == pytest.approx(50.0 * 0.3 ** 2 + 1.5 * arm_rate ** 2, rel=1e-12)
-    assert out[slip.OUT["hip_torque"]] == pytest.approx(-(128.0 * 0.05 + 50.0 * -0.3), rel=1e-12)
+    assert out[rhs.layout.OUT["hip_torque"]] == pytest.approx(-(128.0 * 0.05 + 50.0 * -0.3), rel=1e-12)
     assert out[slip.OUT["arm_torque"]] == pytest.approx(-(10.0 * arm_angle + 1.5 * arm_rate), rel=1e-12)
 
 
@@ -431,13 +438,15 @@ def test_steady_turn_with_a_leaning_body_and_the_measured_tyres(lqr_model):
     sc = wk.Scenario(rider_body="leaning", lqr_model=lqr_model, duration=0.3)
     model = assembly.assemble(sc, inputs.kick_of(sc.validate()))
     x = model.start.x
-    assert model.params["hip_locked"] == 0.0 and model.params["mt"] > 30.0
-    dx = slip.CompiledRHS(model.params)(0.0, x)
-    u1, u2, u3 = (x[slip.X[n]] for n in ("u1", "u2", "u3"))
-    residual = [dx[slip.X["u1"]] + u3 * u2, dx[slip.X["u2"]] - u3 * u1,
-                *(dx[slip.X[n]] for n in ("u3", "u4", "u7", "u9", "u10", "u11"))]
+    rhs = slip.CompiledRHS(model.params)
+    assert rhs.layout.part_names == ("trunk",) and model.params["mt"] > 30.0
+    dx = rhs(0.0, x)
+    X = rhs.layout.X
+    u1, u2, u3 = (x[X[n]] for n in ("u1", "u2", "u3"))
+    residual = [dx[X["u1"]] + u3 * u2, dx[X["u2"]] - u3 * u1,
+                *(dx[X[n]] for n in ("u3", "u4", "u7", "u9", "u10", "u11"))]
     assert np.abs(residual).max() < 2e-13
-    lean = x[slip.X["q11"]]
+    lean = x[X["q11"]]
     assert 1e-5 < abs(lean) < 1e-2
     assert model.start.unknowns["q11"] == lean
     result = wk.run(sc)
@@ -551,7 +560,7 @@ def test_leaning_body_is_moore_rider_lean_2012_with_stiff_tyres(bike, rider, k9,
         for kappa in (1e3, 1e5):
             tyre = wk.tyres.linear_tyre(kappa, 1.0 / kappa, 1e5 * kappa)
             params = slip.model_parameters(dict(split.moore), tyre, tyre,
-                                           body=dict(body, hip_locked=0.0, kh=k9, ch=c9))
+                                           body=dict(body, kh=k9, ch=c9))
             ss = steady.steady_state(params, speed)
             A_ours, _ = slip.linear.heading_linearisation(slip.CompiledRHS(ss.params), ss.x)
             ev = np.linalg.eigvals(A_ours)
