@@ -71,8 +71,8 @@ def common_rates(extra, u, t6):
     vplate_r, wz_r, wz_f = S.syms(["vplate_r", "wz_r", "wz_f"])
     return {
         "W_plate": fy_r * vplate_r,
-        # The rider's torque acts between the bar and the upper body: its power is
-        # the torque times the bar's rate relative to the upper body (u7 while the hip is locked).
+        # The rider's torque acts between the bar and the frame the hands hold: its power is the
+        # torque times the bar's rate relative to that frame (u7 without a part that carries the hands).
         "W_steer": t7 * sm.sympify(extra["steer_relative_rate"]),
         "W_wheel": t6 * u["u6"],
         "W_moment": mz_r * wz_r + mz_f * wz_f,
