@@ -16,6 +16,7 @@ STATES = tuple(n for n in slip.LINEAR_STATES if n != "v_fwd")
 _LABELS = {
     **{q: col for q, col in results.COORDINATE_COLUMNS.items()},
     **{u: col for u, col in results.SPEED_COLUMNS.items()},
+    **results.PART_COLUMNS,   # the declared parts' states (the leaning upper body's lean and its rate)
     **{state: (col, "rad") for state, col in results.PATCH_STATE_COLUMNS.items()},
     **{state: (col, "m") for state, col in results.CARCASS_STATE_COLUMNS.items()},
     "v_fwd": ("forward_velocity", "m/s"), "v_lat": ("lateral_velocity", "m/s"),
