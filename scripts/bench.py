@@ -16,7 +16,8 @@ Usage:
                                        # RHS call cost, the C function alone and the call from Python (both
                                        # compiled libraries in one process, interleaved rounds), and the 6 s
                                        # default run at rtol 1e-10 and 1e-12, and with tyre_transient
-                                       # "force_lag" against the other's default (interleaved fresh processes)
+                                       # "force_lag" against the other's default (interleaved fresh processes),
+                                       # and the default model's cold build (--build-repeats, default 3)
 """
 import argparse
 import os
@@ -340,10 +341,10 @@ _RUN_CASES = (
 
 def _environments(args):
     """{label: environment} of this checkout and of the one compared against."""
-    here = dict(os.environ)
+    # Each side imports its own checkout's src/ (this one's too: the installed package may be another checkout).
+    here = dict(os.environ, PYTHONPATH=str(pathlib.Path(__file__).resolve().parents[1] / "src"))
     other = dict(os.environ, PYTHONPATH=str(pathlib.Path(args.against).resolve() / "src"))
     other["WHIPPLE_KICK_CACHE"] = args.against_cache or os.path.join(tempfile.gettempdir(), "wkcache_bench_against")
-    here.pop("PYTHONPATH", None)
     return {"this": here, "against": other}
 
 
@@ -419,12 +420,26 @@ def bench_compare(args):
             this, against = (statistics.median(r[k] for r in runs[label]) for label in ("this", "against"))
             print(f"6 s run, {case}, {name}: this {this:.4g}, against {against:.4g}, ratio {this / against:.3f} "
                   f"(medians of {args.repeats} interleaved processes x 3 runs)")
+    # The cold build of the default model: a fresh process on an empty cache, each side in turn.
+    builds = {label: [] for label in envs}
+    for _ in range(max(args.build_repeats, 1)):
+        for label, env in envs.items():
+            with tempfile.TemporaryDirectory() as cache:
+                t0 = time.perf_counter()
+                subprocess.run([sys.executable, "-c", "import whipple_kick as wk; wk.slip.library()"],
+                               env=dict(env, WHIPPLE_KICK_CACHE=cache), check=True, capture_output=True,
+                               cwd=tempfile.gettempdir())
+                builds[label].append(time.perf_counter() - t0)
+    this, against = (statistics.median(builds[label]) for label in ("this", "against"))
+    print(f"cold build of the default model [s]: this {this:.2f}, against {against:.2f}, ratio {this / against:.3f} "
+          f"(medians of {len(builds['this'])} interleaved fresh processes on empty caches)")
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("what", choices=("rhs", "build", "run", "cli", "all", "compare", "transient"), nargs="+")
     parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--build-repeats", type=int, default=3, help="cold builds per side in compare (default 3)")
     parser.add_argument("--record", action="store_true",
                         help="record the build and cli medians in docs/timings.json (the README's timings)")
     parser.add_argument("--machine", help="the machine in words for the record (default: CPU model and count)")
