@@ -17,6 +17,8 @@ import sys
 
 import numpy as np
 
+from whipple_kick.model import parts
+
 from . import fileio
 from .errors import BuildError, CacheError, InputError, SimulationError, Terminated, terminate_raises
 
@@ -294,9 +296,11 @@ def _body_options(p, default):
     g.add_argument("--arms", choices=ARMS, default=default("arms"),
                    help="on: the forearms turn with the bar and the arms are a spring-damper about the steer axis; "
                         "off (default): no mechanical effect on the bar")
+    # The declared parts' fields (the leaning upper body's hip) get their flags from the declarations.
+    declared = tuple((f"--{f.name.replace('_', '-')}", f.name, f.unit, _metavar(f.unit), f"{f.label} of {part.title}")
+                     for part in parts.REGISTRY.values() for f in part.fields)
     for flag, field, unit, meta, what in (
-            ("--hip-stiffness", "hip_stiffness", "N m/rad", "N_M_PER_RAD", "hip spring of the leaning upper body"),
-            ("--hip-damping", "hip_damping", "N m s/rad", "N_M_S_PER_RAD", "hip damper of the leaning upper body"),
+            *declared,
             ("--arm-stiffness", "arm_stiffness", "N m/rad", "N_M_PER_RAD", "arms' spring about the steer axis "
                                                                             "(with --arms on)"),
             ("--arm-damping", "arm_damping", "N m s/rad", "N_M_S_PER_RAD", "arms' damper about the steer axis "
@@ -446,9 +450,14 @@ def _flags_given(argv):
 
 #: Scenario fields of the rider's-body options (and the LQR design model, the carcass stiffness scale), each
 #: set by the flag of its own name.
-_BODY_FIELDS = ("rider_body", "arms", "hip_stiffness", "hip_damping", "arm_stiffness", "arm_damping", "reflex_delay",
-                "reflex_roll", "reflex_roll_rate", "reflex_steer", "reflex_steer_rate", "carcass_stiffness_scale",
-                "lqr_model", "lqr_heading")
+_BODY_FIELDS = ("rider_body", "arms", *(f.name for f in parts.fields()), "arm_stiffness", "arm_damping",
+                "reflex_delay", "reflex_roll", "reflex_roll_rate", "reflex_steer", "reflex_steer_rate",
+                "carcass_stiffness_scale", "lqr_model", "lqr_heading")
+
+
+def _metavar(unit):
+    """A flag's metavar from its unit: "N m s/rad" -> "N_M_S_PER_RAD"."""
+    return unit.upper().replace("/", "_PER_").replace(" ", "_")
 
 
 def _model_fields(args):

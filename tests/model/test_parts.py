@@ -164,3 +164,24 @@ def test_a_part_declared_here_is_built_run_and_energy_checked(shift):
     names = [name for name, _, _ in results.frame_layout("carcass", layout)]
     assert {"mass_shift", "mass_shift_rate", "shift_force"} <= set(names)
     assert "mass_shift" not in [name for name, _, _ in results.frame_layout("carcass", slip.layout.BASE)]
+
+
+def test_a_parts_scenario_fields_come_from_its_declaration():
+    """The trunk's fields (hip stiffness and damping) are scenario fields with the declared defaults, validated
+    with the declared range and unit, refused while the part is not selected (rider_body 'rigid') and given
+    CLI flags, all from the declaration; the run's trunk parameters are the fields' values."""
+    from whipple_kick import cli
+    from whipple_kick.simulate.scenario import Scenario
+
+    fields = parts.fields()
+    assert [f.name for f in fields] == ["hip_stiffness", "hip_damping"]
+    for f in fields:
+        assert Scenario.__dataclass_fields__[f.name].default == f.default and f.source
+    with pytest.raises(wk.InputError, match=r"hip stiffness = -1.0 N m/rad is outside the allowed range"):
+        Scenario(rider_body="leaning", hip_stiffness=-1.0).validate()
+    assert "the leaning upper body (rider_body 'leaning')" in Scenario(hip_damping=10.0).unused_fields()["hip_damping"]
+    flags = {a.dest: a for a in cli._simulate_parser()._actions}
+    assert flags["hip_stiffness"].metavar == "N_M_PER_RAD" and "of the leaning upper body" in flags["hip_stiffness"].help
+    sc = Scenario(rider_body="leaning", hip_stiffness=300.0, hip_damping=7.0)
+    assert parts.selected(sc) == (parts.TRUNK,) and parts.selected(Scenario()) == ()
+    assert parts.TRUNK.field_parameters(sc) == {"kh": 300.0, "ch": 7.0}

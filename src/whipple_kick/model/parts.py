@@ -75,6 +75,37 @@ class Mechanics:
 
 
 @dataclass(frozen=True)
+class Field:
+    """A scenario field that sets one of a part's parameters (its CLI flag is ``--`` + the name, dashed).
+
+    Attributes
+    ----------
+    name : str
+        The :class:`whipple_kick.simulate.scenario.Scenario` field (which must exist, with ``default``).
+    parameter : str
+        The part's parameter it sets.
+    label : str
+        Words for messages ("hip stiffness").
+    unit : str
+    low, high : float
+        Allowed range, both ends included.
+    default : float
+        The scenario's default.
+    source : str
+        Where the default comes from.
+    """
+
+    name: str
+    parameter: str
+    label: str
+    unit: str
+    low: float
+    high: float
+    default: float
+    source: str
+
+
+@dataclass(frozen=True)
 class Part:
     """One declared part of the bicycle-rider system.
 
@@ -100,6 +131,14 @@ class Part:
         Its named outputs: name -> (unit, description); ``build`` sets each in ``Mechanics.outputs``.
     build : callable
         ``build(mechanics)``: adds its coordinates, bodies, joint, loads, energy terms and outputs.
+    selected_by : tuple
+        ``(scenario field, value)`` that puts the part into a run's model (``("rider_body", "leaning")``);
+        empty for a part used from Python only.
+    fields : tuple of Field
+        The scenario fields that set its parameters (validated, given CLI flags and refused while the part
+        is not selected, all from this declaration).
+    title : str
+        Its name in messages ("the leaning upper body").
     """
 
     name: str
@@ -113,6 +152,9 @@ class Part:
     columns: dict
     outputs: dict
     build: Callable
+    selected_by: tuple = ()
+    fields: tuple = ()
+    title: str = ""
 
     def __post_init__(self):
         S.register(self.symbols)
@@ -122,6 +164,17 @@ class Part:
         unknown = [g for g in self.gains if g not in self.parameters]
         if unknown:
             raise ValueError(f"part {self.name!r}: gains {unknown} are not among its parameters")
+        unknown = [f.parameter for f in self.fields if f.parameter not in self.parameters]
+        if unknown:
+            raise ValueError(f"part {self.name!r}: fields set {unknown}, which are not among its parameters")
+
+    def selected(self, scenario):
+        """Whether ``scenario`` puts this part into its run's model (:attr:`selected_by`)."""
+        return bool(self.selected_by) and getattr(scenario, self.selected_by[0]) == self.selected_by[1]
+
+    def field_parameters(self, scenario):
+        """The part's parameters that ``scenario``'s fields set, by name."""
+        return {f.parameter: float(getattr(scenario, f.name)) for f in self.fields}
 
     def fingerprint(self):
         """Hash of the declaration and the source of ``build`` (part of the generated code's cache key)."""
@@ -217,7 +270,26 @@ TRUNK = declare(Part(
     columns={"q11": ("upper_body_lean", "rad"), "u11": ("upper_body_lean_rate", "rad/s")},
     outputs={"hip_torque": ("N m", "torque of the hip spring-damper on the upper body about the lean axis")},
     build=_build_trunk,
+    selected_by=("rider_body", "leaning"),
+    fields=(
+        Field("hip_stiffness", "kh", "hip stiffness", "N m/rad", 0.0, 1e6, 128.0,
+              "Moore (2012, Human Control of a Bicycle, PhD thesis, UC Davis, ch. 4, 'Leaning rider extension', "
+              "from de Lorenzo and Hubbard)"),
+        Field("hip_damping", "ch", "hip damping", "N m s/rad", 0.0, 1e5, 50.0,
+              "Moore (2012, ch. 4, 'Leaning rider extension', from de Lorenzo and Hubbard)"),
+    ),
+    title="the leaning upper body",
 ))
+
+
+def selected(scenario):
+    """The declared parts ``scenario`` puts into its run's model."""
+    return tuple(p for p in REGISTRY.values() if p.selected(scenario))
+
+
+def fields():
+    """Every declared part's scenario fields, in declaration order."""
+    return tuple(f for p in REGISTRY.values() for f in p.fields)
 
 
 def _hinge_rotation(hip_tilt):

@@ -265,9 +265,9 @@ def rider_body(scenario, info):
     its upper body in :func:`build_bicycle`'s rear frame.)
     """
     body = dict(slip.parameters.RIGID_BODY)
-    if info.get("body") and scenario.rider_body == "leaning":   # the model with the trunk part
+    if info.get("body") and parts.TRUNK.selected(scenario):   # the model with the trunk part
         body.update({n: info["body"][n] for n in slip.parameters.TRUNK_BODY if n in info["body"]})
-        body.update(kh=scenario.hip_stiffness, ch=scenario.hip_damping)
+        body.update(parts.TRUNK.field_parameters(scenario))   # its hip spring-damper
     body.update(ka=scenario.arm_stiffness if scenario.arms == "on" else 0.0,
                 ca=scenario.arm_damping if scenario.arms == "on" else 0.0,
                 rq4=scenario.reflex_roll, ru4=scenario.reflex_roll_rate, rq7=scenario.reflex_steer,

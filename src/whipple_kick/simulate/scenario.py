@@ -19,7 +19,7 @@ from dataclasses import asdict, dataclass, fields, replace
 
 from whipple_kick.errors import InputError, check_range
 from whipple_kick.library import inputs
-from whipple_kick.model import carcass, transient
+from whipple_kick.model import carcass, parts, transient
 from whipple_kick.model.slip import SLIP_SPEEDS
 
 #: Rider models: the LQR designed on the linearised classic model, the thesis' Table 8.4 gains, or none.
@@ -445,8 +445,8 @@ class Scenario:
             raise InputError(f"controller {self.controller!r} is unknown; choose one of {', '.join(CONTROLLERS)}")
         check_range("carcass damping", self.carcass_damping, 0.0, 1e4, "N s/m")
         check_range("carcass stiffness scale", self.carcass_stiffness_scale, 0.05, 20.0, "(factor)")
-        check_range("hip stiffness", self.hip_stiffness, 0.0, 1e6, "N m/rad")
-        check_range("hip damping", self.hip_damping, 0.0, 1e5, "N m s/rad")
+        for f in parts.fields():   # the declared parts' fields (the leaning upper body's hip)
+            check_range(f.label, getattr(self, f.name), f.low, f.high, f.unit)
         check_range("arm stiffness", self.arm_stiffness, 0.0, 1e5, "N m/rad")
         check_range("arm damping", self.arm_damping, 0.0, 1e4, "N m s/rad")
         check_range("reflex delay", self.reflex_delay, 0.0, 0.5, "s")
@@ -663,8 +663,9 @@ _REFLEX_GAINS = ("reflex_roll", "reflex_roll_rate", "reflex_steer", "reflex_stee
 MECHANISM_FIELDS = (
     ("the carcass tyre", "tyre_transient 'carcass'", lambda s: s.tyre_transient == "carcass",
      ("carcass_sliding", "carcass_damping", "carcass_viscosity", "carcass_stiffness_scale")),
-    ("the leaning upper body", "rider_body 'leaning'", lambda s: s.rider_body == "leaning",
-     ("hip_stiffness", "hip_damping")),
+    # The declared parts' fields, used while the scenario selects the part (the leaning upper body's hip).
+    *((part.title or part.name, f"{part.selected_by[0]} {part.selected_by[1]!r}", part.selected,
+       tuple(f.name for f in part.fields)) for part in parts.REGISTRY.values() if part.fields),
     ("the arms on the bar", "arms 'on'", lambda s: s.arms == "on", ("arm_stiffness", "arm_damping")),
     # "off" is no rider torque at all: neither the voluntary law nor the reflex steers.
     ("the rider's steer control", "controller 'lqr' or 'thesis'; controller 'off' applies no rider torque",
