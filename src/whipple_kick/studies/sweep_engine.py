@@ -171,17 +171,20 @@ def _trajectory_spec(columns, dtype, rate_hz):
 def _sampled(df, spec):
     """The trajectory columns of ``spec`` at (about) its rate, the last sample always kept."""
     names = list(df.columns) if spec["columns"] == "all" else list(spec["columns"])
-    missing = [n for n in names if n not in df.columns]
+    available = set(df.columns)
+    missing = [n for n in names if n not in available]
     if missing:
         raise InputError(f"trajectory column(s) {missing} do not exist; available: {', '.join(df.columns)}")
     t = df["time"].to_numpy()
-    rows = np.arange(t.size)
+    rows = slice(None)
     if spec["rate_hz"] is not None and t.size > 1:
         # Every k-th sample of the exact solution (no filtering needed: these
         # are values of the solution, not of a noisy signal); the last sample
-        # is the end of the run or the fall.
+        # is the end of the run or the fall (added where the steps miss it: ascending, no repeat).
         step = max(1, int(round(1.0 / (spec["rate_hz"] * (t[1] - t[0])))))
-        rows = np.union1d(rows[::step], [t.size - 1])
+        rows = np.arange(0, t.size, step)
+        if rows[-1] != t.size - 1:
+            rows = np.append(rows, t.size - 1)
     return {n: df[n].to_numpy()[rows].astype(spec["dtype"]) for n in names}
 
 
