@@ -123,6 +123,7 @@ def bench_split(repeats, duration):
     from whipple_kick.studies import sweep_engine
     scenarios = _thesis_scenarios(duration)
     rows = []
+    sweep_engine._keep_freed_memory()   # as in a sweep's worker
     with sweep_engine._blas_controller().limit(limits=1):   # as in a sweep's worker
         for r in range(repeats):
             rows += [case_split(sc) for sc in _rotated(scenarios, r)]
@@ -221,6 +222,7 @@ def bench_blend(repeats, duration):
     from whipple_kick.studies import sweep_engine
     pressures = (400.0, 350.0)
     per_eval, evaluations, models = {p: [] for p in pressures}, {}, {}
+    sweep_engine._keep_freed_memory()   # as in a sweep's worker
     with sweep_engine._blas_controller().limit(limits=1):
         for r in range(repeats):
             for p in _rotated(list(pressures), r):

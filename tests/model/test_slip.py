@@ -79,6 +79,22 @@ def test_steer_torque_input_matrix_matches_the_classic_model():
     np.testing.assert_allclose(A_b[:, j], (A - B @ Kfull)[:, j] - B[:, 0], atol=1e-6 * np.abs(B).max())
 
 
+def test_linearisation_columns_are_the_whole_jacobians_bit_for_bit(rider_bike, gains, t03):
+    """``linearize(..., columns=...)`` computes each asked column as the whole Jacobian does (tolerance 0: the
+    same steps, the same evaluations), so :func:`slip.linear_state_space`'s B, from the bumped model's steer-rate
+    column alone, is the B of the two whole Jacobians it came from before (tolerance 0)."""
+    ss = steady.steady_state(slip.model_parameters(rider_bike, t03, t03, gains=gains), 3.0)
+    rhs = slip.CompiledRHS(ss.params)
+    whole = slip.linearize(rhs, ss.x)
+    picked = [slip.LINEAR_STATES.index(n) for n in ("q4", "u7", "v_lat")]
+    assert np.array_equal(slip.linearize(rhs, ss.x, columns=picked), whole[:, picked])
+    A, B, K = slip.linear_state_space(ss.params, ss.x)
+    j = slip.LINEAR_STATES.index("u7")
+    bumped = slip.linearize(slip.CompiledRHS(dict(ss.params, ku7=ss.params["ku7"] + 1.0)), ss.x)
+    B_before = (whole[:, j] - bumped[:, j]).reshape(-1, 1)
+    assert np.array_equal(B, B_before) and np.array_equal(A, whole + B_before @ K)
+
+
 def test_energy_never_increases_with_slip_and_damping(rider_bike, t03):
     par = slip.model_parameters(rider_bike, t03, t03, symmetric=True)
     ss = steady.steady_state(par, 4.5)

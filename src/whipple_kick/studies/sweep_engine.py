@@ -171,17 +171,20 @@ def _trajectory_spec(columns, dtype, rate_hz):
 def _sampled(df, spec):
     """The trajectory columns of ``spec`` at (about) its rate, the last sample always kept."""
     names = list(df.columns) if spec["columns"] == "all" else list(spec["columns"])
-    missing = [n for n in names if n not in df.columns]
+    available = set(df.columns)
+    missing = [n for n in names if n not in available]
     if missing:
         raise InputError(f"trajectory column(s) {missing} do not exist; available: {', '.join(df.columns)}")
     t = df["time"].to_numpy()
-    rows = np.arange(t.size)
+    rows = slice(None)
     if spec["rate_hz"] is not None and t.size > 1:
         # Every k-th sample of the exact solution (no filtering needed: these
         # are values of the solution, not of a noisy signal); the last sample
-        # is the end of the run or the fall.
+        # is the end of the run or the fall (added where the steps miss it: ascending, no repeat).
         step = max(1, int(round(1.0 / (spec["rate_hz"] * (t[1] - t[0])))))
-        rows = np.union1d(rows[::step], [t.size - 1])
+        rows = np.arange(0, t.size, step)
+        if rows[-1] != t.size - 1:
+            rows = np.append(rows, t.size - 1)
     return {n: df[n].to_numpy()[rows].astype(spec["dtype"]) for n in names}
 
 
@@ -424,8 +427,38 @@ def _default_pool(n):
 
 
 def _worker_start():
-    """In each pool worker: SIGTERM ends it (a worker forked during a sweep inherits the sweep's handler)."""
+    """In each pool worker: SIGTERM ends it (a worker forked during a sweep inherits the sweep's handler),
+    and its freed memory stays with it (:func:`_keep_freed_memory`)."""
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    _keep_freed_memory()
+
+
+#: glibc's mallopt parameters (malloc.h) and the values a worker sets.
+_M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD = -1, -3
+_KEEP_TRIM_BYTES, _KEEP_MMAP_BYTES = 1 << 30, 1 << 26
+
+
+def _keep_freed_memory():
+    """Let this process reuse the memory it frees instead of handing it back to the system (glibc only).
+
+    A case allocates and frees tens of MB in arrays of a few MB (the samples, the outputs, the table);
+    by default glibc maps each such array afresh and unmaps it when freed, so every case pays a page fault
+    per 4 kB touched: about 2400 faults and 10 ms of system time per 6 s case measured here (the
+    integration itself is about 100 ms). Arrays up to 64 MB now come from the heap and a freed heap is
+    kept up to 1 GB, so the next case writes into pages already mapped. Results are unchanged (only
+    where the bytes live changes). Elsewhere (no glibc) nothing is done. Returns whether it was set.
+    """
+    import ctypes
+    import ctypes.util
+    if not sys.platform.startswith("linux"):
+        return False
+    try:
+        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6")
+        mallopt = libc.mallopt
+    except (OSError, AttributeError):   # not glibc (musl has no mallopt)
+        return False
+    mallopt.argtypes, mallopt.restype = (ctypes.c_int, ctypes.c_int), ctypes.c_int
+    return bool(mallopt(_M_MMAP_THRESHOLD, _KEEP_MMAP_BYTES)) and bool(mallopt(_M_TRIM_THRESHOLD, _KEEP_TRIM_BYTES))
 
 
 def _discard_default_pool(end_workers=False):

@@ -99,7 +99,7 @@ def _heading_derivative(rhs, x_ref, z, t, resolve_pitch):
     return np.array([rates[n] if n in rates else dx[X[n]] for n in LINEAR_STATES])
 
 
-def linearize(rhs, x, step=1e-7, t=0.0):
+def linearize(rhs, x, step=1e-7, t=0.0, columns=None):
     """Jacobian of the slip model in the heading frame, about the state ``x``.
 
     Resolving the rear-contact velocity along the heading removes the yaw
@@ -118,23 +118,28 @@ def linearize(rhs, x, step=1e-7, t=0.0):
         Relative finite-difference step (tyre force states use 100 times it).
     t : float
         Time [s] at which to evaluate (the plate must be at rest then).
+    columns : sequence of int, optional
+        Only these columns (indices into :data:`LINEAR_STATES`), each
+        computed exactly as in the whole Jacobian (default all).
 
     Returns
     -------
-    ndarray, shape (15, 15)
+    ndarray, shape (15, 15), or (15, len(columns))
     """
     z0 = heading_state(x)
     x = solve_pitch(rhs, x)   # once for the reference; again only when a coordinate is perturbed
-    J = np.empty((z0.size, z0.size))
+    columns = range(z0.size) if columns is None else list(columns)
+    J = np.empty((z0.size, len(columns)))
     # Tyre force states (force_lag) are ~100 N: a step 100 times larger.
     force_scale = 1e2 if rhs.transient == "force_lag" else 1.0
-    for j, name in enumerate(LINEAR_STATES):
+    for col, j in enumerate(columns):
+        name = LINEAR_STATES[j]
         h = step * max(1.0, abs(z0[j])) * (force_scale if name in PATCH_STATES else 1.0)
         zp, zm = z0.copy(), z0.copy()
         zp[j] += h
         zm[j] -= h
         moved = name.startswith("q")
-        J[:, j] = (_heading_derivative(rhs, x, zp, t, moved) - _heading_derivative(rhs, x, zm, t, moved)) / (2 * h)
+        J[:, col] = (_heading_derivative(rhs, x, zp, t, moved) - _heading_derivative(rhs, x, zm, t, moved)) / (2 * h)
     return J
 
 
@@ -279,7 +284,8 @@ def linear_state_space(params, x, step=1e-7):
     bumped = dict(params)
     bumped["ku7"] = params["ku7"] + 1.0
     j = LINEAR_STATES.index("u7")
-    B = (A_cl[:, j] - linearize(CompiledRHS(bumped), x, step)[:, j]).reshape(-1, 1)
+    # Only the steer-rate column moves with ku7: the bumped model's other 14 columns are not computed.
+    B = (A_cl[:, j] - linearize(CompiledRHS(bumped), x, step, columns=[j])[:, 0]).reshape(-1, 1)
     K = np.zeros((1, len(LINEAR_STATES)))
     for gain, state in layouts.GAIN_STATES.items():
         if state in LINEAR_STATES:   # the bicycle's states (q3 is not one: kq3 is refused above)
