@@ -115,10 +115,8 @@ static double wk_inner_inverse(double t, double E, double umax)
         if (g > 0.0) hi = u; else lo = u;
         double dg = (1.0 - E) + E / (1.0 + u * u);
         double next = u - g / dg;
-        /* Converged (g == 0 exactly included): return before the bracket test, which would bisect away
-           from a root sitting on the bracket's end (u == lo after g == 0) and take ~50 more steps. */
-        if (fabs(next - u) <= 1e-15 * (1.0 + fabs(u))) { u = next; break; }
         if (!(next > lo && next < hi) || !isfinite(next)) next = isfinite(hi) ? 0.5 * (lo + hi) : 2.0 * u + 1.0;
+        if (fabs(next - u) <= 1e-15 * (1.0 + fabs(u))) { u = next; break; }
         u = next;
     }
     return s * u;
