@@ -109,3 +109,16 @@ def test_saved_trajectory_is_thinned_and_keeps_the_fall():
     assert abs(record["trajectory"]["roll"][-1]) == pytest.approx(np.radians(20.0))
     with pytest.raises(InputError, match="trajectory_rate"):
         wk.sweep({"pressure_kpa": [300]}, base=BASE, trajectory_rate=0)
+
+
+def test_a_sweep_over_the_rear_load_share_gives_different_rows():
+    """Each share is another rider (mass and place): the rows differ in the static loads, the rider's mass
+    and shift, and the response (a field that changed nothing would give identical rows)."""
+    table = wk.sweep({"rear_load_share": [0.63, 0.69]}, base=wk.Scenario(fz_n=635.0, duration=0.4), workers=1,
+                     progress=False)
+    assert list(table["status"]) == ["ok", "ok"]
+    front = table["bicycle.static_load_front_n"].to_numpy()
+    assert front == pytest.approx(635.0 / np.array([0.63, 0.69]) - 635.0, abs=1e-9)
+    assert table["bicycle.rider_shift_m"].iloc[1] < table["bicycle.rider_shift_m"].iloc[0]
+    assert table["bicycle.rider_mass_kg"].nunique() == 2
+    assert table["yaw_rate_peaks_from_steady_rad_s"].nunique() == 2
