@@ -206,9 +206,25 @@ def group_uncertainty():
         column = rates[f"not_recovered_{criterion}"]
         out[f"uncertainty.not_recovered.{criterion}"] = f"{column.min()}-{column.max()}"
         none = p_best[(p_best["criterion"] == criterion) & p_best["pressure_kpa"].isna()]["p"]
-        out[f"uncertainty.none.{criterion}"] = f"{100 * none.min():.0f}-{100 * none.max():.0f} %"
+        low, high = f"{100 * none.min():.0f}", f"{100 * none.max():.0f}"
+        out[f"uncertainty.none.{criterion}"] = f"{low} %" if low == high else f"{low}-{high} %"
         for name, rows in sobol[sobol["criterion"] == criterion].groupby("input", sort=False):
             out[f"uncertainty.st.{criterion}.{name}"] = f"{rows['ST'].min():.2f}-{rows['ST'].max():.2f}"
+    # By the last peak the pressures are about equally likely at every load: the range of their P(best).
+    shown = p_best[(p_best["criterion"] == "last_peak") & p_best["pressure_kpa"].notna()]["p"]
+    out["uncertainty.p_range.last_peak"] = f"{shown.min():.2f}-{shown.max():.2f}"
+    share = sobol[(sobol["criterion"] == "settling") & (sobol["input"] == "rear_load_share")]
+    top = share.loc[share["ST"].idxmax()]
+    out["uncertainty.share_st"] = (f"{top['ST']:.2f} +- {top['ST_conf']:.2f}, for {top['pressure_a_kpa']:g} vs "
+                                   f"{top['pressure_b_kpa']:g} kPa at {top['fz_n']:g} N")
+    out["uncertainty.st_conf_max"] = f"{sobol['ST_conf'].max():.1f}"
+    # The rider's shift at the top of the file's share range, at each study load (riders.for_load_share).
+    from whipple_kick.library import bicycles, riders
+    entry = uncertain.load(uncertain.DEFAULT).inputs[meta["inputs"].index("rear_load_share")]
+    bike = bicycles.load("balanceassist_v1")
+    shifts = [-riders.for_load_share(bike, entry.high, fz_n=fz).shift_m for fz in LOADS]
+    out["uncertainty.share_high"] = f"{entry.high:.2f}"
+    out["uncertainty.share_shift"] = f"{min(shifts):.2f}-{max(shifts):.2f}"
     out["uncertainty.verdict"] = "\n".join(f"* {line}" for line in
                                             (UNCERTAINTY / "verdict.txt").read_text().split("\n\n")[0].splitlines())
     for key in ("run_cpu_mean_s", "run_wall_mean_s", "integration_wall_mean_s"):

@@ -54,7 +54,7 @@ MAX_RIDER_MASS_KG = 200.0
 #: A judgement, not a measurement: a saddle's rails and setback posts move it some 0.05-0.08 m, a stem's length
 #: the bar some 0.06-0.10 m, and a rider slides about 0.05 m along the saddle; 0.15 m spans these together.
 #: Beyond it the posture kept would be a different bicycle's fit. Thesis Table 8.3's totals (rear share
-#: 0.683-0.694) need 0.10-0.11 m rearward on balanceassist_v1 (tests/library/test_riders.py).
+#: 0.683-0.694) need 0.09-0.11 m rearward on balanceassist_v1 (tests/library/test_riders.py).
 MAX_RIDER_SHIFT_M = 0.15
 
 #: Rotation taking yeadon-frame components to benchmark-frame components.
