@@ -721,7 +721,8 @@ def for_load_share(bike, share, fz_n=None, rider_mass_kg=None, rider="jason", he
     m_bike = sum(float(bench[k]) for k in ("mR", "mB", "mH", "mF"))
     rear_bike, _ = static_loads(bike)
     if fz_n is not None:
-        fz = within_rear_load_range(bike, fz_n, rear_bike, math.inf)
+        # Above the bicycle's own rear load; the upper end (the heaviest rider) is the share's check below.
+        fz = check_range("rear-tyre load fz", fz_n, rear_bike, None, "N", low_open=True)
         mass = fz / (share * g) - m_bike
         what = f"rear load fz = {fz:g} N"
     else:
