@@ -33,7 +33,7 @@ import sys
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 #: The files whose markers are checked.
 DOCS = ("README.md", "docs/sweeps.md", "docs/workflow.md", "docs/simulate.md", "docs/experiments.md",
-        "docs/validation.md")
+        "docs/validation.md", "docs/uncertainty.md")
 MARKER = re.compile(r"<!-- number: ([\w.]+) -->(.*?)<!-- /number -->", re.DOTALL)
 #: Timings measured by a script (scripts/bench.py writes it): key -> value, script, machine, date.
 TIMINGS = ROOT / "docs" / "timings.json"
@@ -157,9 +157,91 @@ def group_timing():
     return out
 
 
+#: The uncertainty study docs/uncertainty.md quotes: its small tables (scripts/uncertainty_study.py --out DIR
+#: writes them; copied here, not the runs) and study.json (N, seed, inputs, commit).
+UNCERTAINTY = ROOT / "docs" / "uncertainty_study"
+
+
+def _interval(row):
+    return f"{row['p']:.2f} [{row['low']:.2f}, {row['high']:.2f}]"
+
+
+def group_uncertainty():
+    """docs/uncertainty.md: the stored study's P(best), rates, Sobol ranges and cost (the tables in
+    :data:`UNCERTAINTY`; a rerun of the study is ``python scripts/uncertainty_study.py`` with study.json's N and
+    seed). The shipped uncertainty file's inputs must be the study's: a changed file makes the doc stale."""
+    import pandas as pd
+
+    from whipple_kick.library import uncertain
+
+    meta = json.loads((UNCERTAINTY / "study.json").read_text())
+    shipped = [i.name for i in uncertain.load(uncertain.DEFAULT).inputs]
+    if shipped != meta["inputs"]:
+        raise SystemExit(f"docs/uncertainty_study holds a study of inputs {meta['inputs']}, the shipped file has "
+                         f"{shipped}: rerun the study (docs/uncertainty.md says how) and copy its tables")
+    n, d = meta["samples"], len(meta["inputs"])
+    p_best = pd.read_csv(UNCERTAINTY / "p_best.csv")
+    measured = pd.read_csv(UNCERTAINTY / "measured.csv")
+    rates = pd.read_csv(UNCERTAINTY / "rates.csv")
+    sobol = pd.read_csv(UNCERTAINTY / "sobol.csv")
+    cost = json.loads((UNCERTAINTY / "cost.json").read_text())
+    out = {"uncertainty.samples": f"{n}", "uncertainty.inputs": f"{d}", "uncertainty.rows": f"{n * (d + 2)}",
+           "uncertainty.base_rows": f"{2 * n}", "uncertainty.runs": f"{cost['runs']}",
+           "uncertainty.seed": f"{meta['seed']}", "uncertainty.commit": meta["commit"]}
+    for (fz, criterion), rows in p_best.groupby(["fz_n", "criterion"], sort=True):
+        cells = []
+        for _, row in rows.sort_values("pressure_kpa", na_position="last").iterrows():
+            text = _interval(row) if row["pressure_kpa"] == row["pressure_kpa"] else f"{row['p']:.2f}"
+            cells.append(f"**{text}**" if row["measured_best"] else text)
+        out[f"uncertainty.p_best.{criterion}.{fz:g}"] = " / ".join(cells)
+    for criterion, rows in measured.groupby("criterion"):
+        whole = rows[rows["fz_n"].isna()].iloc[0]
+        out[f"uncertainty.measured.{criterion}"] = (f"{_interval(whole)}: "
+                                                    + ("admitted" if whole["admitted"] else "not admitted"))
+        for _, row in rows[rows["fz_n"].notna()].iterrows():
+            out[f"uncertainty.measured.{criterion}.{row['fz_n']:g}"] = _interval(row)
+    out["uncertainty.fell"] = f"{int(rates['fell'].sum())}"
+    out["uncertainty.failed"] = f"{int(rates['failed'].sum())}"
+    for criterion in ("settling", "last_peak"):
+        column = rates[f"not_recovered_{criterion}"]
+        out[f"uncertainty.not_recovered.{criterion}"] = f"{column.min()}-{column.max()}"
+        none = p_best[(p_best["criterion"] == criterion) & p_best["pressure_kpa"].isna()]["p"]
+        low, high = f"{100 * none.min():.0f}", f"{100 * none.max():.0f}"
+        out[f"uncertainty.none.{criterion}"] = f"{low} %" if low == high else f"{low}-{high} %"
+        for name, rows in sobol[sobol["criterion"] == criterion].groupby("input", sort=False):
+            out[f"uncertainty.st.{criterion}.{name}"] = f"{rows['ST'].min():.2f}-{rows['ST'].max():.2f}"
+    # By the last peak the pressures are about equally likely at every load: the range of their P(best).
+    shown = p_best[(p_best["criterion"] == "last_peak") & p_best["pressure_kpa"].notna()]["p"]
+    out["uncertainty.p_range.last_peak"] = f"{shown.min():.2f}-{shown.max():.2f}"
+    share = sobol[(sobol["criterion"] == "settling") & (sobol["input"] == "rear_load_share")]
+    top = share.loc[share["ST"].idxmax()]
+    out["uncertainty.share_st"] = (f"{top['ST']:.2f} +- {top['ST_conf']:.2f}, for {top['pressure_a_kpa']:g} vs "
+                                   f"{top['pressure_b_kpa']:g} kPa at {top['fz_n']:g} N")
+    out["uncertainty.st_conf_max"] = f"{sobol['ST_conf'].max():.1f}"
+    # The rider's shift at the top of the file's share range, at each study load (riders.for_load_share).
+    from whipple_kick.library import bicycles, riders
+    entry = uncertain.load(uncertain.DEFAULT).inputs[meta["inputs"].index("rear_load_share")]
+    bike = bicycles.load("balanceassist_v1")
+    shifts = [-riders.for_load_share(bike, entry.high, fz_n=fz).shift_m for fz in LOADS]
+    out["uncertainty.share_high"] = f"{entry.high:.2f}"
+    out["uncertainty.share_shift"] = f"{min(shifts):.2f}-{max(shifts):.2f}"
+    out["uncertainty.verdict"] = "\n".join(f"* {line}" for line in
+                                            (UNCERTAINTY / "verdict.txt").read_text().split("\n\n")[0].splitlines())
+    for key in ("run_cpu_mean_s", "run_wall_mean_s", "integration_wall_mean_s"):
+        out[f"uncertainty.cost.{key}"] = f"{cost[key]:.3f}"
+    out["uncertainty.cost.integration_share"] = f"{100 * cost['integration_share']:.0f} %"
+    out["uncertainty.cost.distinct"] = f"{cost['distinct']}"
+    out["uncertainty.cost.wall_s"] = f"{cost['wall_s']:.0f}"
+    out["uncertainty.cost.extrapolate"] = (f"{cost['extrapolate_rows']} rows, {cost['extrapolate_runs']} runs, about "
+                                           f"{cost['extrapolate_distinct']:.0f} distinct")
+    out["uncertainty.cost.extrapolate_idle_h"] = f"{cost['extrapolate_idle_h']:.1f}"
+    out["uncertainty.cost.extrapolate_contended_h"] = f"{cost['extrapolate_contended_h']:.1f}"
+    return out
+
+
 GROUPS = {"nine": group_nine, "force_lag": group_force_lag, "fine": group_fine, "spread": group_spread,
           "workflow": group_workflow, "simulate": group_simulate, "experiments": group_experiments,
-          "timing": group_timing}
+          "timing": group_timing, "uncertainty": group_uncertainty}
 
 
 def markers():

@@ -21,6 +21,7 @@ Usage::
 ``recommend-pressure --fz 570 635 701 --uncertain --samples 500 --seed 0 --out DIR``.)
 """
 import argparse
+import json
 import os
 import sys
 import tempfile
@@ -28,6 +29,7 @@ import time
 
 import numpy as np
 
+from whipple_kick import fileio
 from whipple_kick.library import uncertain
 from whipple_kick.studies import uncertainty
 
@@ -50,30 +52,53 @@ def main(argv=None):
         wall = time.perf_counter() - t0
         study.write(out)
     print(uncertainty.format_study(study))
-    n = len(study.outcomes)
-    runs = study.outcomes.drop_duplicates("case_id")   # a repeated design row is one case, run once
+    record = cost(study.outcomes, wall, args.workers, len(spec.inputs), args.extrapolate,
+                  resumed=bool(args.out) and wall < 0.05 * len(study.outcomes))
+    print_cost(record)
+    if args.out:
+        fileio.write_atomic(os.path.join(args.out, "cost.json"), json.dumps(record, indent=1) + "\n")
+
+
+def cost(outcomes, wall, workers, n_inputs, extrapolate=500, resumed=False):
+    """The study's cost from its outcomes table (``Study.outcomes`` or ``outcomes.csv``): a dict.
+
+    ``wall`` is the study's wall time [s] on ``workers`` workers (a resumed study's is not the whole study's:
+    ``resumed`` says so); per run, the wall and CPU time in its worker and its integration's wall time.
+    """
+    n = len(outcomes)
+    runs = outcomes.drop_duplicates("case_id")   # a repeated design row is one case, run once
     distinct = len(runs)
     case_wall = runs["run.wall_s"].to_numpy(dtype=float)
     case_cpu = runs["run.cpu_s"].to_numpy(dtype=float)
     integ = runs["numerics.integration_wall_s"].to_numpy(dtype=float)
     ok = np.isfinite(case_wall) & np.isfinite(integ) & np.isfinite(case_cpu)
-    per_run = wall * args.workers / distinct
-    rows = args.extrapolate * (len(spec.inputs) + 2)
+    rows = extrapolate * (n_inputs + 2)
     total = rows * len(uncertainty.PRESSURES) * len(uncertainty.LOADS)
-    print(f"\ncost: {n} runs ({len(study.inputs)} rows x {len(uncertainty.PRESSURES)} pressures x "
-          f"{len(uncertainty.LOADS)} loads; {distinct} distinct cases, each run once) in {wall:.1f} s wall on "
-          f"{args.workers} workers"
-          + (" (resumed from --out: the wall time is not the study's)" if args.out and wall < 0.05 * n else ""))
-    print(f"  per run in its worker: wall mean {case_wall[ok].mean():.3f} s, median {np.median(case_wall[ok]):.3f} s; "
-          f"CPU mean {case_cpu[ok].mean():.3f} s; its integration: wall mean {integ[ok].mean():.3f} s, median "
-          f"{np.median(integ[ok]):.3f} s ({100 * integ[ok].sum() / case_wall[ok].sum():.0f} % of the run's wall)")
-    print(f"  cost per distinct case on this machine (study wall x workers / cases): {per_run:.3f} s")
     share = distinct / n
-    print(f"  N = {args.extrapolate}: {rows} rows, {total} runs (about {total * share:.0f} distinct at this share): "
-          f"about {total * share * per_run / args.workers / 3600:.1f} h wall on {args.workers} workers at this cost; "
-          f"{total * share * case_cpu[ok].mean() / args.workers / 3600:.1f} h at the measured CPU per run on "
-          f"{args.workers} otherwise idle cores")
+    return {"runs": n, "rows": n // (len(uncertainty.PRESSURES) * len(uncertainty.LOADS)), "distinct": distinct, "wall_s": wall, "workers": workers, "resumed": resumed,
+            "run_wall_mean_s": float(case_wall[ok].mean()), "run_wall_median_s": float(np.median(case_wall[ok])),
+            "run_cpu_mean_s": float(case_cpu[ok].mean()), "integration_wall_mean_s": float(integ[ok].mean()),
+            "integration_wall_median_s": float(np.median(integ[ok])),
+            "integration_share": float(integ[ok].sum() / case_wall[ok].sum()),
+            "per_case_s": wall * workers / distinct, "extrapolate": extrapolate, "extrapolate_rows": rows,
+            "extrapolate_runs": total, "extrapolate_distinct": total * share,
+            "extrapolate_idle_h": total * share * float(case_cpu[ok].mean()) / workers / 3600,
+            "extrapolate_contended_h": total * share * wall * workers / distinct / workers / 3600}
 
+
+def print_cost(c):
+    """Print :func:`cost`'s record."""
+    print(f"\ncost: {c['runs']} runs ({c['rows']} rows x {len(uncertainty.PRESSURES)} pressures x "
+          f"{len(uncertainty.LOADS)} loads; {c['distinct']} distinct cases, each run once) in {c['wall_s']:.1f} s wall on "
+          f"{c['workers']} workers" + (" (resumed from --out: the wall time is not the study's)" if c["resumed"] else ""))
+    print(f"  per run in its worker: wall mean {c['run_wall_mean_s']:.3f} s, median {c['run_wall_median_s']:.3f} s; "
+          f"CPU mean {c['run_cpu_mean_s']:.3f} s; its integration: wall mean {c['integration_wall_mean_s']:.3f} s, "
+          f"median {c['integration_wall_median_s']:.3f} s ({100 * c['integration_share']:.0f} % of the run's wall)")
+    print(f"  cost per distinct case on this machine (study wall x workers / cases): {c['per_case_s']:.3f} s")
+    print(f"  N = {c['extrapolate']}: {c['extrapolate_rows']} rows, {c['extrapolate_runs']} runs (about "
+          f"{c['extrapolate_distinct']:.0f} distinct at this share): about {c['extrapolate_contended_h']:.1f} h wall "
+          f"on {c['workers']} workers at this cost; {c['extrapolate_idle_h']:.1f} h at the measured CPU per run on "
+          f"{c['workers']} otherwise idle cores")
 
 if __name__ == "__main__":
     main()

@@ -264,6 +264,13 @@ BAD_INPUTS = {
                                    ["hip stiffness = 0 N m/rad", "(0, 1e6] N m/rad"]),
     "leaning-on-a-preset-with-rider": (["--rider-body", "leaning", "--bicycle", "balanceassist_635N"],
                                        ["balanceassist_635N", "lumped in already", "balanceassist_v1"]),
+    # The rear load share: outside (0, 1), not reachable by a shift within 0.15 m, and on a preset whose rider's
+    # place is fixed (the share would be ignored).
+    "rear-share-above-1": (["--rear-share", "1.5"], ["rear load share = 1.5", "(0, 1)"]),
+    "rear-share-unreachable": (["--fz", "570", "--rear-share", "0.75"],
+                               ["rear load share = 0.75", "[0.5467, 0.7032]", "0.15 m", "unit 1"]),
+    "rear-share-on-a-preset": (["--rear-share", "0.68", "--bicycle", "balanceassist_635N"],
+                               ["rear load share = 0.68", "would be ignored", "balanceassist_635N"]),
 }
 
 

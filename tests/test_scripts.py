@@ -1,4 +1,5 @@
 """The study scripts' own output (scripts/ is not a package: imported by path)."""
+import json
 import pathlib
 import sys
 
@@ -55,6 +56,15 @@ def test_every_stated_number_has_a_group_and_the_timings_are_their_script_s_reco
     assert stated == {f"spread.{k}": f"{v:.3f}" for k, v in recommend.CRITERION_SPREAD_S.items()}
 
 
+def test_the_uncertainty_doc_quotes_its_stored_study():
+    """docs/uncertainty.md's numbers are those of the study stored in docs/uncertainty_study (its small tables,
+    not rerun: the study takes half an hour), and that study's inputs are the shipped file's: an edited number,
+    new tables or a changed uncertainty file without a rerun fail here."""
+    import doc_numbers
+
+    assert doc_numbers.compare(doc_numbers.group_uncertainty(), ["uncertainty"]) == []
+
+
 def test_a_stale_number_is_caught(tmp_path, monkeypatch):
     """The check names a marker whose text differs from the rerun, one no group computes, and a computed key
     that no doc carries."""
@@ -98,3 +108,5 @@ def test_uncertainty_study_reports_its_cost(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "cost: 72 runs (8 rows x 3 pressures x 3 loads; 72 distinct cases" in out
     assert "per run in its worker: wall mean" in out and "N = 500: 2000 rows, 18000 runs" in out
+    record = json.loads((tmp_path / "out" / "cost.json").read_text())   # what docs/uncertainty.md's numbers read
+    assert (record["runs"], record["rows"], record["distinct"], record["extrapolate_runs"]) == (72, 8, 72, 18000)

@@ -252,6 +252,10 @@ def _model_options(p, symmetric_flag=True, design_default="the run's --speed", c
         who.add_argument("--fz", type=_number("N"), metavar="N",
                          help="static rear-tyre load in N that the rider's mass is chosen for (default 635)")
         who.add_argument("--rider-mass", type=_number("kg"), metavar="KG", help="rider mass in kg")
+        g.add_argument("--rear-share", type=_number("(unit 1)"), metavar="FRACTION",
+                       help="share of the static weight on the rear tyre, in (0, 1): the rider is moved fore-aft "
+                            "(at most 0.15 m, posture kept) so that it holds, with --fz's load (its mass follows) "
+                            "or --rider-mass (default: the seated posture's share)")
     g.add_argument("--low-inertia", action="store_true",
                    help="halve the rear frame's inertias and mass-centre height (thesis Figure 8.9)")
     if body_options:
@@ -428,7 +432,7 @@ def _animation_options(args):
 #: Scenario fields of the options ``_model_options(case_options=True)`` adds, by option name.
 _CASE_FIELDS = {"pressure_kpa": "pressure", "pressure_front_kpa": "pressure_front",
                 "pressure_rear_kpa": "pressure_rear", "fz_n": "fz", "rider_mass_kg": "rider_mass",
-                "thesis_load_n": "thesis_load"}
+                "rear_load_share": "rear_share", "thesis_load_n": "thesis_load"}
 
 #: Scenario fields set by flags of another name (the rest by the flag of the field's own name).
 _FIELD_FLAGS = {**{field: (option,) for field, option in _CASE_FIELDS.items()},

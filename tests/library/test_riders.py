@@ -210,3 +210,83 @@ def test_a_load_sweep_seats_the_probe_rider_once(monkeypatch):
     known = riders.for_rear_load(bike, 612.75, load_range=probe(bike))
     fresh = riders.for_rear_load(bike, 612.75)
     assert known.rider_mass_kg == fresh.rider_mass_kg and dict(known.combined.moore) == dict(fresh.combined.moore)
+
+
+# ----------------------------------------------------------------- the rear load share (a shifted rider)
+
+#: Thesis Table 8.3: (rear, front) static loads [N] and the rider's mass [kg] of riders A-C.
+TABLE_8_3 = ((570.0, 265.0, 52.0), (635.0, 287.0, 61.0), (701.0, 309.0, 70.0))
+
+
+@pytest.mark.parametrize("fz, share", [(570.0, 0.63), (570.0, 0.70), (635.0, 0.60), (635.0, 0.6887), (701.0, 0.72)])
+def test_a_share_gives_its_static_loads(bike, fz, share):
+    """With fz and a share the seated-and-shifted rider puts exactly fz on the rear tyre and the share of the
+    weight: measured to 2.3e-13 N and 2.2e-16. Bound 1e-9 N (the brief's) and 1e-12. The shift moves the
+    rider's mass centre by itself (x of the rider alone = seated x + shift, to round-off 1e-12 m)."""
+    sol = wk.riders.for_load_share(bike, share, fz_n=fz)
+    rear, front = wk.riders.static_loads(sol.combined)
+    assert rear == pytest.approx(fz, abs=1e-9)
+    assert rear / (rear + front) == pytest.approx(share, abs=1e-12)
+    assert (sol.rear_n, sol.front_n) == (rear, front)
+    seated = wk.riders.place(bike, wk.riders.yeadon_rider("jason", mass_kg=sol.rider_mass_kg))
+    x_rider = sol.combined.rider["rider_xB"]
+    assert x_rider == pytest.approx(seated.com[0] + sol.shift_m, abs=1e-12)
+    # The weight is fz / share: the rider's mass follows.
+    m_bike = sum(bike.benchmark[k] for k in ("mR", "mB", "mH", "mF"))
+    assert sol.rider_mass_kg == pytest.approx(fz / share / bike.benchmark["g"] - m_bike, abs=1e-9)
+
+
+@pytest.mark.parametrize("mass, share", [(52.0, 0.69), (70.0, 0.62), (90.0, 0.66)])
+def test_a_share_with_a_rider_mass_moves_the_rider_only(bike, mass, share):
+    """With the rider's mass given the share fixes the rear load (share x weight) and the mass stays.
+    Bounds as above."""
+    sol = wk.riders.for_load_share(bike, share, rider_mass_kg=mass)
+    rear, front = wk.riders.static_loads(sol.combined)
+    assert sol.rider_mass_kg == mass
+    assert rear / (rear + front) == pytest.approx(share, abs=1e-12)
+    assert rear + front == pytest.approx(bike.benchmark["g"] * (mass + sum(
+        bike.benchmark[k] for k in ("mR", "mB", "mH", "mF"))), abs=1e-9)
+
+
+@pytest.mark.parametrize("fz", [570.0, 635.0, 701.0])
+def test_the_seated_share_is_the_seated_rider(bike, fz):
+    """The share the seated rider already gives reproduces for_rear_load's bicycle to round-off, not bit for
+    bit: the share passes through a division and the shift comes out at ~6e-17 m, not 0. Measured: every
+    Moore parameter equal to 3.6e-15 (absolute; they are O(1-100)), the mass to 1.4e-14 kg. Bound 1e-12."""
+    seated = wk.riders.for_rear_load(bike, fz)
+    rear, front = wk.riders.static_loads(seated.combined)
+    sol = wk.riders.for_load_share(bike, rear / (rear + front), fz_n=fz)
+    assert abs(sol.shift_m) < 1e-12
+    assert sol.rider_mass_kg == pytest.approx(seated.rider_mass_kg, abs=1e-12)
+    for key, value in seated.combined.moore.items():
+        if isinstance(value, float):
+            assert sol.combined.moore[key] == pytest.approx(value, rel=1e-12, abs=1e-12), key
+
+
+@pytest.mark.parametrize("fz, front, mass", TABLE_8_3)
+def test_table_8_3_totals_give_table_8_3_riders(bike, fz, front, mass):
+    """Thesis Table 8.3's loads and bicycle (33 kg) imply its riders' masses: the share fz/(fz+front) at fz
+    gives a rider of 52/61/70 kg (measured 51.98/61.02/70.05 kg: the loads are rounded to 1 N and the
+    bicycle here is 33.12 kg; bound 0.3 kg). The shift it needs, 0.09-0.11 m rearward (bound 0.06-0.12), is what the file's
+    range and MAX_RIDER_SHIFT_M are sized for: the project's seated rider sits ahead of the table's estimate."""
+    sol = wk.riders.for_load_share(bike, fz / (fz + front), fz_n=fz)
+    assert sol.rider_mass_kg == pytest.approx(mass, abs=0.3)
+    assert -0.12 < sol.shift_m < -0.06
+
+
+@pytest.mark.parametrize("call, fragments", [
+    (dict(share=0.75, fz_n=570.0), ["rear load share = 0.75 (unit 1)", "[0.5467, 0.7032]", "0.15 m",
+                                    "seated share is 0.6304"]),
+    (dict(share=0.40, fz_n=635.0), ["rear load share = 0.4 (unit 1)", "[0.5484, 0.7147]", "200 kg"]),
+    (dict(share=0.95, rider_mass_kg=70.0), ["rear load share = 0.95", "rider mass 70 kg"]),
+    (dict(share=1.0, fz_n=635.0), ["rear load share = 1.0", "(0, 1)"]),
+    (dict(share=float("nan"), fz_n=635.0), ["rear load share = nan"]),
+    (dict(share=0.68, rider_mass_kg=250.0), ["rider mass = 250.0 kg", "(0, 200]"]),
+])
+def test_an_unreachable_share_is_one_line(bike, call, fragments):
+    with pytest.raises(InputError) as info:
+        wk.riders.for_load_share(bike, **call)
+    text = str(info.value)
+    assert "\n" not in text
+    for fragment in fragments:
+        assert fragment in text, (fragment, text)

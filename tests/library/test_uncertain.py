@@ -25,7 +25,7 @@ def test_the_shipped_file_reads_with_a_reason_on_every_input():
     spec = uncertain.load()
     assert spec.name == "kickplate_2025" and list(uncertain.available()) == ["kickplate_2025"]
     assert spec.names == ("speed", "kick_accel", "kick_direction", "carcass_stiffness_scale", "carcass_damping",
-                          "friction", "rider", "gain_scale", "hip_stiffness")
+                          "friction", "rider", "gain_scale", "hip_stiffness", "rear_load_share")
     assert all(len(i.reason) > 20 for i in spec.inputs)
     rider = spec.inputs[spec.names.index("rider")]
     assert rider.fields == ("lqr_model", "rider_body")
@@ -34,6 +34,14 @@ def test_the_shipped_file_reads_with_a_reason_on_every_input():
     speed, accel = spec.inputs[0], spec.inputs[1]
     assert (speed.low, speed.high, accel.low, accel.high) == (1.92, 2.0, 30.0, 40.0)
     assert spec.fixed["kick_profile"] == "smooth" and spec.fixed["duration"] == 6.0
+    # The share: from the seated rider (0.630 at 570 N) to Table 8.3's totals (0.694 at 701 N), rounded out;
+    # every value in it is reachable at every study load (riders.for_load_share; shift <= 0.15 m, tested there).
+    share = spec.inputs[spec.names.index("rear_load_share")]
+    assert (share.field, share.low, share.high) == ("rear_load_share", 0.63, 0.70)
+    bike = wk.bicycles.load("balanceassist_v1")
+    for fz in (570.0, 635.0, 701.0):
+        for value in (share.low, share.high):
+            assert abs(wk.riders.for_load_share(bike, value, fz_n=fz).shift_m) <= 0.15
 
 
 def test_inverse_cdfs():

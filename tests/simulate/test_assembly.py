@@ -115,3 +115,55 @@ def test_item7_no_slip_poles_of_a_leaning_rider_carry_the_whole_rider():
     expected = control.closed_loop_poles(plant, sc.speed, model.gains)
     got = np.array([complex(*p) for p in model.stability["poles_no_slip_model_1_s"]])
     np.testing.assert_allclose(got, expected, rtol=1e-12, atol=1e-12)
+
+
+@pytest.mark.parametrize("changes", [{}, {"rider_body": "leaning"}, {"arms": "on"},
+                                     {"rider_body": "leaning", "arms": "on"}, {"fz_n": 570.0},
+                                     {"fz_n": None, "rider_mass_kg": 61.0}])
+def test_a_rear_load_share_holds_for_every_rider_form(changes):
+    """The share moves the rider for the rigid rider, the leaning body and the arms alike: the static loads
+    (the whole rider's) hold fz (default 635 N) and the share; the summary reports the shift. Measured to
+    4.5e-13 N and 2.2e-16; bounds 1e-9 N and 1e-12."""
+    sc = Scenario(**{"fz_n": 635.0, "rear_load_share": 0.68, **changes}).validate()
+    _, _, info = assembly.build_bicycle(sc)
+    rear, front = info["static_load_rear_n"], info["static_load_front_n"]
+    if sc.fz_n is not None:
+        assert rear == pytest.approx(sc.fz_n, abs=1e-9)
+    assert rear / (rear + front) == pytest.approx(0.68, abs=1e-12)
+    assert info["rear_load_share"] == pytest.approx(0.68, abs=1e-12)
+    assert -0.15 < info["rider_shift_m"] < -0.05   # rearward: the seated share is 0.630-0.642
+
+
+def test_the_leaning_body_moves_its_hinge_with_the_rider():
+    """The leaning body's hinge (lh1, lh3 from the rear wheel centre along Moore's C axes) is the seat point,
+    moved by the shift; the upper body's own arm (lt1, lt3) and inertia are the posture's, unchanged."""
+    seated = assembly.build_bicycle(Scenario(rider_body="leaning", rider_mass_kg=61.0).validate())[2]
+    moved = assembly.build_bicycle(Scenario(rider_body="leaning", rider_mass_kg=61.0,
+                                            rear_load_share=0.69).validate())[2]
+    shift = moved["rider_shift_m"]
+    assert seated["rider_shift_m"] == 0.0 and shift < -0.05
+    lam = wk.bicycles.load("balanceassist_v1").benchmark["lam"]
+    # Moore's C.x is (cos lam, -sin lam) in benchmark (x, z): a shift dx along x is dx cos lam along C.x and
+    # dx sin lam along C.z.
+    assert moved["body"]["lh1"] - seated["body"]["lh1"] == pytest.approx(shift * np.cos(lam), abs=1e-12)
+    assert moved["body"]["lh3"] - seated["body"]["lh3"] == pytest.approx(shift * np.sin(lam), abs=1e-12)
+    for key in ("mt", "lt1", "lt3", "it11", "it22", "it33", "it31"):
+        assert moved["body"][key] == pytest.approx(seated["body"][key], abs=1e-12), key
+
+
+def test_a_share_on_a_preset_with_its_rider_is_refused():
+    """balanceassist_635N has its rider lumped in: its place is fixed, so a share would be ignored."""
+    sc = Scenario(bicycle="balanceassist_635N", rear_load_share=0.68)
+    with pytest.raises(InputError, match=r"rear load share = 0.68 \(unit 1\) would be ignored") as info:
+        assembly.preflight(sc)
+    assert "\n" not in str(info.value)
+    with pytest.raises(InputError, match="would be ignored"):
+        assembly.build_bicycle(sc)
+
+
+def test_the_summary_reports_the_shift_and_the_front_load():
+    summary = run(Scenario(fz_n=635.0, rear_load_share=0.66, duration=0.3).validate()).summary["bicycle"]
+    assert summary["rider_shift_m"] < 0.0 and summary["rear_load_share"] == pytest.approx(0.66, abs=1e-12)
+    assert summary["static_load_front_n"] == pytest.approx(635.0 / 0.66 - 635.0, abs=1e-9)
+    plain = run(Scenario(fz_n=635.0, duration=0.3).validate()).summary["bicycle"]
+    assert plain["rider_shift_m"] == 0.0

@@ -183,7 +183,7 @@ def test_load_of_a_folder_that_is_not_a_run_is_one_line(tmp_path):
 _UNIT_SUFFIX = re.compile(r"_(s|rad|rad_s|deg|m|n|n_m|n_per_m|n_s_per_m|j|w|kg|kpa|m_s|m_s2|1_s)$")
 #: Numbers without a unit: counts, ratios and tolerances; the gains' units are in controller.gain_units, the steady
 #: powers' unit in the name of their section (steady_power_w).
-_DIMENSIONLESS = re.compile(r"^(controller\.gain_scale|controller\.gains\..*|steady_state\.steady_power_w\..*|"
+_DIMENSIONLESS = re.compile(r"^(controller\.gain_scale|bicycle\.rear_load_share|controller\.gains\..*|steady_state\.steady_power_w\..*|"
                             r"steady_state\.residual|metrics\.n_peaks|metrics\.(log_decrement|damping_ratio)_\d_\d|"
                             r"numerics\.(rtol|nfev|njev|evaluations|budget\..*))$")
 

@@ -49,19 +49,21 @@ def _upper_body_com(seat, body):
 
 # ----------------------------------------------------------------- 1. locked body = lumped rider
 
-def test_upper_body_merged_into_the_rear_frame_is_the_lumped_rider(bike, rider, t03):
+@pytest.mark.parametrize("shift_m", [0.0, -0.1], ids=["seated", "shifted-0.1m"])
+def test_upper_body_merged_into_the_rear_frame_is_the_lumped_rider(bike, rider, t03, shift_m):
     """The split rider with its upper body merged back into the rear frame
     (:func:`whipple_kick.model.parts.merge_into_rear_frame`: what the rigid rider with arms on the bar runs,
     the model without the trunk part) is the rider lumped into the rear frame by :func:`riders.seat`, an
     independent computation (Yeadon's combined inertia): the same Moore parameters, the same steady turn, the
-    same rates at random states and the same roll and steer after a push.
+    same rates at random states and the same roll and steer after a push. Also with the whole rider shifted
+    0.1 m rearward (a rear load share's shift, :func:`riders.shifted`): the hinge moves with it.
 
     Measured: Moore parameters 2e-16 relative; steady unknowns ~1e-15 relative; rates ~1e-14 relative to
     max(|rate|, 1) over 20 states; histories over 3 s (rtol 1e-11) ~1e-13 rad. Bounds 1e-12 (parameters),
     1e-10 (rates) and 1e-11 rad (histories).
     """
-    lumped = riders.seat(bike, rider)
-    split, body = riders.seat_with_body(bike, rider, arms_on_bar=False)
+    lumped = riders.seat(bike, rider, shift_m=shift_m)
+    split, body = riders.seat_with_body(bike, rider, arms_on_bar=False, shift_m=shift_m)
     assert body["mt"] > 30.0   # the upper body really carries most of the rider (measured 40.1 kg of 70)
     merged = parts.merge_into_rear_frame(dict(split.moore), body)
     for name in ("mc", "l1", "l2", "ic11", "ic22", "ic33", "ic31"):
@@ -109,17 +111,18 @@ def test_upper_body_merged_into_the_rear_frame_is_the_lumped_rider(bike, rider, 
 
 # ----------------------------------------------------------------- 2. the split conserves the rider
 
+@pytest.mark.parametrize("shift_m", [0.0, 0.05])
 @pytest.mark.parametrize("arms_on_bar", [False, True])
-def test_split_conserves_the_riders_mass_and_mass_centre(bike, rider, arms_on_bar):
+def test_split_conserves_the_riders_mass_and_mass_centre(bike, rider, arms_on_bar, shift_m):
     """Legs (rear frame) + forearms (front frame, on the bar) + upper body = the seated rider: mass and mass
     centre as :func:`riders.place` and the lumped bicycle's; the hip is at the seat point.
 
     Measured: mass 1.4e-14 kg, mass centre 1.1e-16 m (the rider alone: 0 kg, 2.2e-16 m), hip 2.8e-17 m.
     Bound 1e-12 (kg, m).
     """
-    seated = riders.place(bike, rider)
-    lumped = riders.seat(bike, rider)
-    split, body = riders.seat_with_body(bike, rider, arms_on_bar=arms_on_bar)
+    seated = riders.shifted(riders.place(bike, rider), shift_m)
+    lumped = riders.seat(bike, rider, shift_m=shift_m)
+    split, body = riders.seat_with_body(bike, rider, arms_on_bar=arms_on_bar, shift_m=shift_m)
     com = _upper_body_com(seated.seat, body)
     whole = _totals(split.benchmark, [(body["mt"], com[0], com[2])])
     np.testing.assert_allclose(whole, _totals(lumped.benchmark), rtol=0, atol=1e-12)

@@ -47,6 +47,8 @@ def test_with_changes_copies_and_leaves_the_original():
     ({"fz_n": 635.0, "rider_mass_kg": 70.0}, "give the rear-tyre load fz (N) or the rider mass (kg), not both"),
     ({"pressure_kpa": -1.0}, "pressure = -1.0 kPa is outside the allowed range (0, inf] kPa"),
     ({"kick_accel": 0.0}, "kick peak acceleration = 0.0 m/s^2 is outside"),
+    ({"rear_load_share": 1.0}, "rear load share = 1.0 (unit 1) is outside the allowed range (0, 1) (unit 1)"),
+    ({"rear_load_share": 0.0}, "rear load share = 0.0 (unit 1) is outside the allowed range (0, 1)"),
 ])
 def test_fields_out_of_range_are_one_line_input_errors(changes, fragment):
     with pytest.raises(InputError, match=re.escape(fragment)) as info:

@@ -44,7 +44,7 @@ def other_value(name, other_rider):
     """A valid value of field ``name`` other than its default (other switches' values: another choice)."""
     default = DEFAULTS[name]
     special = {"bicycle": "browser_with_rider", "rider": other_rider, "tyre": "T04", "coefficient_set": "chapter8",
-               "friction": "plate", "fz_n": 701.0, "rider_mass_kg": 80.0, "pressure_front_kpa": 350.0,
+               "friction": "plate", "fz_n": 701.0, "rider_mass_kg": 80.0, "rear_load_share": 0.66, "pressure_front_kpa": 350.0,
                "pressure_rear_kpa": 350.0, "design_speed": 4.0, "thesis_load_n": 701.0, "kick_duration": 0.2,
                "kick_accel": 10.0, "kick_table": "plate.csv", "steer_limit_deg": 80.0, "settle": 0.3,
                "reflex_delay": 0.05, "arm_stiffness": 5.0, "arm_damping": 2.0, "carcass_damping": 50.0,

@@ -147,3 +147,16 @@ def test_pool_workers_reuse_the_memory_they_free():
     if kept != "True":
         pytest.skip("not glibc: mallopt is not available")
     assert int(plain) >= 20 and int(after) * 20 <= int(plain), out.stdout
+
+
+def test_a_sweep_over_the_rear_load_share_gives_different_rows():
+    """Each share is another rider (mass and place): the rows differ in the static loads, the rider's mass
+    and shift, and the response (a field that changed nothing would give identical rows)."""
+    table = wk.sweep({"rear_load_share": [0.63, 0.69]}, base=wk.Scenario(fz_n=635.0, duration=0.4), workers=1,
+                     progress=False)
+    assert list(table["status"]) == ["ok", "ok"]
+    front = table["bicycle.static_load_front_n"].to_numpy()
+    assert front == pytest.approx(635.0 / np.array([0.63, 0.69]) - 635.0, abs=1e-9)
+    assert table["bicycle.rider_shift_m"].iloc[1] < table["bicycle.rider_shift_m"].iloc[0]
+    assert table["bicycle.rider_mass_kg"].nunique() == 2
+    assert table["yaw_rate_peaks_from_steady_rad_s"].nunique() == 2

@@ -50,6 +50,12 @@ FORMAT = "whipple_kick rider, version 1"
 
 #: Largest rider mass accepted anywhere [kg] (a rider over 200 kg is refused).
 MAX_RIDER_MASS_KG = 200.0
+#: Largest fore-aft shift of the whole seated rider [m] a rear load share may ask for (:func:`for_load_share`).
+#: A judgement, not a measurement: a saddle's rails and setback posts move it some 0.05-0.08 m, a stem's length
+#: the bar some 0.06-0.10 m, and a rider slides about 0.05 m along the saddle; 0.15 m spans these together.
+#: Beyond it the posture kept would be a different bicycle's fit. Thesis Table 8.3's totals (rear share
+#: 0.683-0.694) need 0.09-0.11 m rearward on balanceassist_v1 (tests/library/test_riders.py).
+MAX_RIDER_SHIFT_M = 0.15
 
 #: Rotation taking yeadon-frame components to benchmark-frame components.
 YEADON_TO_BIKE = np.array([[0.0, -1.0, 0.0],
@@ -508,7 +514,7 @@ def _with_rider(bike, rider, seated, bench, name, how):
     )
 
 
-def seat(bike, rider):
+def seat(bike, rider, shift_m=0.0):
     """Bicycle with the rider rigidly lumped into its rear frame.
 
     Parameters
@@ -516,6 +522,8 @@ def seat(bike, rider):
     bike : Bicycle
         Bicycle-only set with seating geometry (e.g. ``"balanceassist_v1"``).
     rider : YeadonRider
+    shift_m : float
+        Fore-aft shift of the whole seated rider [m], forward positive (:func:`shifted`).
 
     Returns
     -------
@@ -524,9 +532,28 @@ def seat(bike, rider):
         ``rider`` metadata: name, mass_kg, height_m and the rider's own
         benchmark-form entries).
     """
-    seated = place(bike, rider)
+    seated = shifted(place(bike, rider), shift_m)
     bench = lump_into_rear_frame(bike.benchmark, seated.mass, seated.com, seated.inertia)
-    return _with_rider(bike, rider, seated, bench, "", " lumped into the rear frame.")
+    return _with_rider(bike, rider, seated, bench, _shift_label(shift_m), " lumped into the rear frame.")
+
+
+def shifted(seated, shift_m):
+    """``seated`` moved ``shift_m`` [m] along the bicycle's x axis (forward positive), posture unchanged.
+
+    The whole rider moves as one: mass centre, seat point (the leaning body's hinge), the feet's and the
+    hands' points; the inertia about the mass centre is unchanged. It stands for a fit change (saddle
+    setback, stem length) that keeps the rider's posture, not a rider re-posed on a fixed saddle, bar and
+    cranks (that would change the inertia as well, and tie the share to the joint limits).
+    """
+    if shift_m == 0.0:
+        return seated
+    dx = np.array([float(shift_m), 0.0, 0.0])
+    return dataclasses.replace(seated, com=seated.com + dx, seat=seated.seat + dx,
+                               bottom_bracket=seated.bottom_bracket + dx, left_grip=seated.left_grip + dx)
+
+
+def _shift_label(shift_m):
+    return "" if shift_m == 0.0 else f", shifted {shift_m:+.4f} m"
 
 
 def static_loads(params):
@@ -643,6 +670,98 @@ def for_rear_load(bike, fz_n, rider="jason", height_m=None, load_range=None):
     return RearLoadSolution(combined=combined, rider_mass_kg=mass)
 
 
+class LoadShareSolution(NamedTuple):
+    """Result of :func:`for_load_share`: the bicycle with its rider seated and shifted, the rider's mass [kg]
+    and the shift [m, forward positive]; ``rear_n``/``front_n`` as :class:`RearLoadSolution`'s."""
+
+    combined: Bicycle
+    rider_mass_kg: float
+    shift_m: float
+
+    rear_n = RearLoadSolution.rear_n
+    front_n = RearLoadSolution.front_n
+
+
+def for_load_share(bike, share, fz_n=None, rider_mass_kg=None, rider="jason", height_m=None):
+    """Seat the rider and shift it fore-aft so that a fraction ``share`` of the static weight is on the rear tyre.
+
+    With ``fz_n`` the total weight is ``fz_n / share``, which fixes the rider's mass; with ``rider_mass_kg``
+    the rear load is ``share`` times the weight. Either way the rider's mass centre ``x_r`` (from the rear
+    contact) must give the bicycle that rear load: ``rear = rear_bike + m g (1 - x_r / w)``, solved in closed
+    form for ``x_r``; the seated rider is then moved by ``x_r - x_seated`` as a whole (:func:`shifted`).
+
+    Parameters
+    ----------
+    bike : Bicycle
+        Bicycle-only set with seating geometry.
+    share : float
+        Rear tyre's share of the static weight [1].
+    fz_n, rider_mass_kg : float, optional
+        The static rear load [N] or the rider's mass [kg]; exactly one.
+    rider : str
+    height_m : float, optional
+
+    Returns
+    -------
+    LoadShareSolution
+
+    Raises
+    ------
+    InputError
+        One line naming the share, the range this bicycle and load allow, and why: a rider mass in
+        (0, :data:`MAX_RIDER_MASS_KG`] kg, a shift within +-:data:`MAX_RIDER_SHIFT_M` m, the rider's mass
+        centre inside the wheelbase.
+    """
+    share_in = share
+    share = check_range("rear load share", share, 0.0, 1.0, "1", low_open=True, high_open=True)
+    if (fz_n is None) == (rider_mass_kg is None):
+        raise ValueError("give exactly one of fz_n and rider_mass_kg")
+    bench = bike.benchmark
+    g, w = bench["g"], bench["w"]
+    m_bike = sum(float(bench[k]) for k in ("mR", "mB", "mH", "mF"))
+    rear_bike, _ = static_loads(bike)
+    if fz_n is not None:
+        # Above the bicycle's own rear load; the upper end (the heaviest rider) is the share's check below.
+        fz = check_range("rear-tyre load fz", fz_n, rear_bike, None, "N", low_open=True)
+        mass = fz / (share * g) - m_bike
+        what = f"rear load fz = {fz:g} N"
+    else:
+        mass = check_range("rider mass", rider_mass_kg, 0.0, MAX_RIDER_MASS_KG, "kg", low_open=True)
+        fz = share * g * (m_bike + mass)
+        what = f"rider mass {mass:g} kg"
+    x_seated = place(bike, yeadon_rider(rider, mass_kg=mass if 0.0 < mass <= MAX_RIDER_MASS_KG else 70.0,
+                                        height_m=height_m)).com[0]
+    # The shifts allowed: within +-MAX_RIDER_SHIFT_M and the rider's mass centre inside the wheelbase.
+    lo_dx, hi_dx = max(-MAX_RIDER_SHIFT_M, -x_seated), min(MAX_RIDER_SHIFT_M, w - x_seated)
+
+    def share_at(dx, m):   # the rear share of a rider of mass m shifted dx (rear load over weight)
+        return (rear_bike + m * g * (1.0 - (x_seated + dx) / w)) / (g * (m_bike + m))
+
+    if fz_n is not None:
+        # At a given rear load a rider further forward must be heavier: m(dx) = (fz - rear_bike) / (g (1 - x/w)).
+        def mass_at(dx):
+            return (fz - rear_bike) / (g * (1.0 - (x_seated + dx) / w))
+        low, high = share_at(hi_dx, mass_at(hi_dx)), share_at(lo_dx, mass_at(lo_dx))
+        low = max(low, fz / (g * (m_bike + MAX_RIDER_MASS_KG)))
+        seated_share = share_at(0.0, mass_at(0.0))
+    else:
+        low, high = share_at(hi_dx, mass), share_at(lo_dx, mass)
+        seated_share = share_at(0.0, mass)
+    x_rider = w * (1.0 - (fz - rear_bike) / (g * mass)) if mass > 0.0 else math.nan
+    shift = x_rider - x_seated
+    if not (0.0 < mass <= MAX_RIDER_MASS_KG and lo_dx <= shift <= hi_dx):
+        raise InputError(f"rear load share = {share_in!r} (unit 1) is outside the allowed range "
+                         f"[{low:.4f}, {high:.4f}] for {what} on {bike.name!r}: the rider (at most "
+                         f"{MAX_RIDER_MASS_KG:g} kg) moves at most {MAX_RIDER_SHIFT_M:g} m fore or aft of the "
+                         f"seated posture, its mass centre inside the wheelbase; the seated share is "
+                         f"{seated_share:.4f}")
+    combined = seat(bike, yeadon_rider(rider, mass_kg=mass, height_m=height_m), shift_m=shift)
+    achieved = static_loads(combined)[0]
+    if abs(achieved - fz) > 1e-6:
+        raise RuntimeError(f"rear load {achieved} N misses the requested {fz} N")
+    return LoadShareSolution(combined=combined, rider_mass_kg=mass, shift_m=shift)
+
+
 #: Yeadon segments of the upper body that leans on the saddle: pelvis, thorax, chest-head and
 #: the upper arms; the forearms and hands too unless they move with the bar. The legs stay in the rear frame.
 UPPER_BODY_SEGMENTS = ("P", "T", "C", "A1", "B1")
@@ -662,7 +781,7 @@ def _segments(human, seat_pt, names):
     return float(mass), com, inertia
 
 
-def seat_with_body(bike, rider, arms_on_bar=True):
+def seat_with_body(bike, rider, arms_on_bar=True, shift_m=0.0):
     """Seat a rider whose upper body leans on the saddle and whose forearms move with the bar.
 
     The rider is seated as by :func:`place`. The legs are lumped into the
@@ -681,6 +800,9 @@ def seat_with_body(bike, rider, arms_on_bar=True):
         Bicycle-only set with seating geometry.
     rider : YeadonRider
     arms_on_bar : bool
+    shift_m : float
+        Fore-aft shift of the whole seated rider [m], forward positive (:func:`shifted`): the hinge moves
+        with the seat point, the legs and the forearms (on the bar) with the rider.
 
     Returns
     -------
@@ -691,7 +813,7 @@ def seat_with_body(bike, rider, arms_on_bar=True):
         ``lh1``, ``lh3``, ``mt``, ``lt1``, ``lt3``, ``it11``, ``it22``, ``it33``, ``it31``), in Moore's
         rear frame C from the rear wheel centre (the trunk part's, :data:`whipple_kick.model.parts.TRUNK`).
     """
-    seated = place(bike, rider)
+    seated = shifted(place(bike, rider), shift_m)
     human = rider.human(seated.configuration)
     seat_pt = seated.seat
     legs = _segments(human, seat_pt, LEG_SEGMENTS)
@@ -714,6 +836,6 @@ def seat_with_body(bike, rider, arms_on_bar=True):
             "mt": m_t, "lt1": float(arm[0]), "lt3": float(arm[2]),
             "it11": float(i_t[0, 0]), "it22": float(i_t[1, 1]), "it33": float(i_t[2, 2]), "it31": float(i_t[0, 2])}
     where = "forearms and hands in the front frame, " if arms_on_bar else ""
-    combined = _with_rider(bike, rider, seated, bench, ", body",
+    combined = _with_rider(bike, rider, seated, bench, ", body" + _shift_label(shift_m),
                            f": legs in the rear frame, {where}the rest a leaning upper body.")
     return combined, body

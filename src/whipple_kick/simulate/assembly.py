@@ -159,7 +159,7 @@ def build_bicycle(scenario):
     """
     key = (scenario.bicycle, _file_stamp(scenario.bicycle), scenario.fz_n, scenario.rider_mass_kg,
            scenario.rider, scenario.low_inertia, scenario.rider_body != "rigid" or scenario.arms == "on",
-           scenario.arms == "on", scenario.rider_body == "leaning")
+           scenario.arms == "on", scenario.rear_load_share, scenario.rider_body == "leaning")
     return copy.deepcopy(_bicycle_setup(*key))
 
 
@@ -174,7 +174,7 @@ def _file_stamp(name):
 
 @functools.lru_cache(maxsize=256)
 def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia, split=False, arms_on_bar=False,
-                   leaning=False):
+                   share=None, leaning=False):
     from whipple_kick.library import bicycleparameters, riders
     from whipple_kick.model import benchmark
 
@@ -183,10 +183,13 @@ def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia
         raise _lumped_rider_error(bike)
     _refuse_rider_file(bike, rider_name)
     if bike.includes_rider:
-        if fz_n is not None or rider_mass_kg is not None:
-            raise InputError(f"bicycle {bike.name!r} already includes its rider; "
-                             "do not give a rear-tyre load fz or a rider mass with it")
+        _refuse_load_on_preset(bike, fz_n, rider_mass_kg, share)
         combined, rider_mass = bike, None
+    elif share is not None:
+        # The rider is shifted fore-aft so that the share holds (riders.for_load_share).
+        fz = 635.0 if fz_n is None and rider_mass_kg is None else fz_n
+        solution = riders.for_load_share(bike, share, fz_n=fz, rider_mass_kg=rider_mass_kg, rider=rider_name)
+        combined, rider_mass, shift = solution.combined, solution.rider_mass_kg, solution.shift_m
     elif rider_mass_kg is not None:
         rider = riders.yeadon_rider(rider_name, mass_kg=rider_mass_kg)
         combined, rider_mass = riders.seat(bike, rider), float(rider_mass_kg)
@@ -196,13 +199,15 @@ def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia
                                                     load_range=_rear_load_range(bicycle, _stamp, rider_name))
     # The static loads and the Whipple model the LQR is designed on are the whole rider's: the split below
     # moves the upper body out of the bicycle's parameters, not out of the statics or the rider's mass.
+    if share is None:
+        shift = 0.0 if rider_mass is not None else None
     rear_n, front_n = riders.static_loads(combined)
     design = dict(combined.moore)
     body = None
     if split:
         # The same rider, split into legs (rear frame), forearms (front frame, when on the bar) and upper body.
         rider = riders.yeadon_rider(rider_name, mass_kg=rider_mass)
-        combined, body = riders.seat_with_body(bike, rider, arms_on_bar=arms_on_bar)
+        combined, body = riders.seat_with_body(bike, rider, arms_on_bar=arms_on_bar, shift_m=shift)
     moore = dict(combined.moore)
     if body and not leaning:
         # The rigid rider with the arms on the bar: the upper body is part of the rear frame (the model
@@ -217,9 +222,21 @@ def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia
             # What the bicycle's source lacked, from defaults (a BicycleParameters set): name -> "value unit: source".
             "defaults": bicycleparameters.describe_defaults(bike),
             "rider_mass_kg": rider_mass, "static_load_rear_n": rear_n, "static_load_front_n": front_n,
+            # The rider's fore-aft shift from the seated posture [m, forward positive]: 0 seated, None for a preset.
+            "rider_shift_m": shift, "rear_load_share": rear_n / (rear_n + front_n),
             "total_mass_kg": sum(float(combined.benchmark[k]) for k in ("mR", "mB", "mH", "mF"))
             + (body["mt"] if body else 0.0), "body": body}
     return moore, design, info
+
+
+def _refuse_load_on_preset(bike, fz_n, rider_mass_kg, share):
+    """A preset with its rider lumped in seats no rider: a load, mass or share given with it would be ignored."""
+    if fz_n is not None or rider_mass_kg is not None:
+        raise InputError(f"bicycle {bike.name!r} already includes its rider; "
+                         "do not give a rear-tyre load fz or a rider mass with it")
+    if share is not None:
+        raise InputError(f"rear load share = {share!r} (unit 1) would be ignored: bicycle {bike.name!r} already "
+                         "includes its rider, whose place is fixed; allowed: none (or a bicycle-only set)")
 
 
 def _refuse_rider_file(bike, rider_name):
@@ -400,9 +417,8 @@ def preflight(scenario):
     scenario.validate()
     build_tyres(scenario)
     bike = bicycleparameters.load_bicycle(scenario.bicycle)
-    if bike.includes_rider and (scenario.fz_n is not None or scenario.rider_mass_kg is not None):
-        raise InputError(f"bicycle {bike.name!r} already includes its rider; "
-                         "do not give a rear-tyre load fz or a rider mass with it")
+    if bike.includes_rider:
+        _refuse_load_on_preset(bike, scenario.fz_n, scenario.rider_mass_kg, scenario.rear_load_share)
     if bike.includes_rider and (scenario.rider_body != "rigid" or scenario.arms == "on"):
         raise _lumped_rider_error(bike)
     _refuse_rider_file(bike, scenario.rider)

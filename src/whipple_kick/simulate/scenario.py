@@ -76,6 +76,12 @@ class Scenario:
     fz_n, rider_mass_kg : float or None
         Static rear-tyre load [N] the rider's mass is chosen for, or the
         rider's mass [kg]; at most one. Default 635 N for a bicycle without rider.
+    rear_load_share : float or None
+        Fraction of the bicycle-rider's static weight on the rear tyre [1], in (0, 1). None (default): the
+        rider sits in the seated posture and the share follows. Given: with ``fz_n`` (default 635 N) the
+        weight is ``fz_n / rear_load_share``, which fixes the rider's mass; with ``rider_mass_kg`` the rear
+        load follows; either way the whole rider is moved fore-aft along the bicycle's x axis (posture
+        kept, at most 0.15 m) so that the static loads hold (:func:`whipple_kick.library.riders.for_load_share`).
     rider : str
         Yeadon rider file.
     tyre : str
@@ -277,6 +283,7 @@ class Scenario:
     bicycle: str = "balanceassist_v1"
     fz_n: float | None = None
     rider_mass_kg: float | None = None
+    rear_load_share: float | None = None
     rider: str = "jason"
     tyre: str = "T03"
     pressure_kpa: float = 400.0
@@ -499,6 +506,9 @@ class Scenario:
             raise InputError("give the rear-tyre load fz (N) or the rider mass (kg), not both")
         if self.fz_n is not None:
             check_range("rear-tyre load fz", self.fz_n, 0.0, None, "N", low_open=True)
+        if self.rear_load_share is not None:
+            check_range("rear load share", self.rear_load_share, 0.0, 1.0, "(unit 1)", low_open=True,
+                        high_open=True)
         for name, p in (("pressure", self.pressure_kpa), ("front pressure", self.pressure_front_kpa),
                         ("rear pressure", self.pressure_rear_kpa)):
             if p is not None:
@@ -685,7 +695,7 @@ MECHANISM_FIELDS = (
 
 #: Every field of :class:`Scenario` in exactly one group (a test checks it).
 FIELD_GROUPS = {
-    "physics": ("bicycle", "fz_n", "rider_mass_kg", "rider", "tyre", "pressure_kpa", "pressure_front_kpa",
+    "physics": ("bicycle", "fz_n", "rider_mass_kg", "rear_load_share", "rider", "tyre", "pressure_kpa", "pressure_front_kpa",
                 "pressure_rear_kpa", "coefficient_set", "friction", "symmetric_tyres", "speed", "controller",
                 "design_speed", "gain_scale", "thesis_load_n", "low_inertia", "kick_displacement", "kick_duration",
                 "kick_accel", "kick_profile", "kick_table", "kick_direction", "tyre_transient", "carcass_sliding",
