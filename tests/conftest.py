@@ -52,3 +52,12 @@ def run_console(main, argv, capsys):
         main(argv)
     out, err = capsys.readouterr()
     return info.value.code, out, err
+
+
+@pytest.fixture(scope="session")
+def dask_client():
+    """One Dask cluster of two worker processes for the whole session (each start took 3-4 s)."""
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(processes=True, n_workers=2, threads_per_worker=1,
+                                  dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+        yield client

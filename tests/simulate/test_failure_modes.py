@@ -482,10 +482,10 @@ def _alive(pid):
     return state != "Z"
 
 
-def _start_long_sweep(folder):
+def _start_long_sweep(folder, workers=2):
     """recommend-pressure on 201 cases (300-500 kPa every 1 kPa, 6 s each: minutes of work) into ``folder``."""
     return subprocess.Popen([_console_script("recommend-pressure"), "--fz", "635", "--pressures", "300", "500",
-                             "--fine", "--step", "1", "--workers", "2", "--out", str(folder)],
+                             "--fine", "--step", "1", "--workers", str(workers), "--out", str(folder)],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 
@@ -521,7 +521,7 @@ def test_sigterm_ends_the_sweeps_workers_and_records_interrupted(tmp_path):
 
 def test_second_sweep_on_the_same_folder_is_refused_in_one_line(tmp_path):
     folder = tmp_path / "sweep"
-    first = _start_long_sweep(folder)
+    first = _start_long_sweep(folder, workers=1)   # one: the second process starts on the other core
     try:
         _wait_until_running(first, folder)
         second = subprocess.run([_console_script("recommend-pressure"), "--fz", "635", "--pressures", "300", "500",

@@ -599,20 +599,39 @@ def kicks():
             "40 m/s^2": run(Scenario(pressure_kpa=400.0, fz_n=635.0, kick_accel=40.0))}
 
 
-def _steady_curve_peaks(tyre, camber, fz):
-    """Largest |F_y| and |M_z| of the steady curves over slip in [-90, 90] deg at each (camber, load)."""
-    slips = np.radians(np.linspace(-90.0, 90.0, 3601))[None, :]
-    peaks_f, peaks_m = np.empty(camber.size), np.empty(camber.size)
-    for start in range(0, camber.size, 500):
-        rows = slice(start, start + 500)
-        g, load = camber[rows, None], fz[rows, None]
-        peaks_f[rows] = np.max(np.abs(tyre.lateral_force(slips, g, load)), axis=1)
-        peaks_m[rows] = np.max(np.abs(tyre.aligning_moment(slips, g, load)), axis=1)
-    return peaks_f, peaks_m
+# The bound the steady curve's peak sets on |F_y| and |M_z| at each sample (the acceptance's 1.001).
+CURVE_BOUND = 1.001
+# The scan over slip in [-90, 90] deg, 0.05 deg apart, and its every 20th point (1 deg apart).
+_SLIPS = np.radians(np.linspace(-90.0, 90.0, 3601))
+_SCREEN = _SLIPS[::20]
+
+
+def _curve_ratios(curve, value, camber, fz):
+    """|value| / the largest |curve| over slip in [-90, 90] deg at each sample's (camber, load), where
+    that ratio could exceed CURVE_BOUND; elsewhere a ratio at most CURVE_BOUND.
+
+    The 1 deg scan is a subset of the 0.05 deg one, so its peak is no larger and its ratio no smaller:
+    a sample within the bound on it is within the bound on the fine scan too. Only the samples it does
+    not clear are scanned at 0.05 deg, so the bound decides exactly as the full fine scan would, at a
+    fraction of its cost (the fine scan of every sample took 45 s a run).
+    """
+    def peaks(slips, rows):
+        out = np.empty(rows.size)
+        for start in range(0, rows.size, 500):
+            chunk = rows[start:start + 500]
+            out[start:start + 500] = np.max(np.abs(curve(slips[None, :], camber[chunk, None], fz[chunk, None])),
+                                            axis=1)
+        return out
+
+    ratio = np.abs(value) / peaks(_SCREEN, np.arange(value.size))
+    again = np.flatnonzero(ratio > CURVE_BOUND)
+    ratio[again] = np.abs(value[again]) / peaks(_SLIPS, again)
+    return ratio
 
 
 def _force_bound_ratios(result):
-    """max over samples of |F|/peak and |M|/peak per wheel, and the unloaded samples' loads.
+    """max over loaded samples of |F|/peak and |M|/peak per wheel (see _curve_ratios), and the unloaded
+    samples' loads.
 
     The curves are taken at the camber each form evaluates them at: the patch's (lagged) camber in the
     contact-patch forms; in the carcass form the force's limit at the wheel's camber and the moment at
@@ -626,11 +645,11 @@ def _force_bound_ratios(result):
         fz = df[f"fz_{wheel}"].to_numpy()
         force, moment = df[f"fy_{wheel}"].to_numpy(), df[f"mz_{wheel}"].to_numpy()
         patch = df[f"camber_patch_{wheel}"].to_numpy()
-        peak_f, peak_m = _steady_curve_peaks(tyre, df[f"camber_{wheel}"].to_numpy() if carcass else patch, fz)
-        if carcass:
-            _, peak_m = _steady_curve_peaks(tyre, patch, fz)
         loaded = fz > 0.0
-        out[wheel] = (np.max(np.abs(force[loaded]) / peak_f[loaded]), np.max(np.abs(moment[loaded]) / peak_m[loaded]),
+        camber_f = (df[f"camber_{wheel}"].to_numpy() if carcass else patch)[loaded]
+        ratio_f = _curve_ratios(tyre.lateral_force, force[loaded], camber_f, fz[loaded])
+        ratio_m = _curve_ratios(tyre.aligning_moment, moment[loaded], patch[loaded], fz[loaded])
+        out[wheel] = (np.max(ratio_f), np.max(ratio_m),
                       np.abs(force[~loaded]).tolist() + np.abs(moment[~loaded]).tolist())
     return out
 
@@ -646,7 +665,7 @@ def test_tyre_loads_never_exceed_the_steady_curve(base, kicks, case):
     # of the deflection at 4e4 N/m is 4e-8 N); its moment is exactly 0. The contact-patch form: exactly 0.
     zero = 1e-7 if result.scenario.tyre_transient == "carcass" else 0.0
     for wheel, (ratio_f, ratio_m, unloaded) in _force_bound_ratios(result).items():
-        assert ratio_f <= 1.001 and ratio_m <= 1.001, (wheel, ratio_f, ratio_m)
+        assert ratio_f <= CURVE_BOUND and ratio_m <= CURVE_BOUND, (wheel, ratio_f, ratio_m)
         assert all(v <= zero for v in unloaded), wheel
     if case == "controller off":
         # The front wheel really does lift off in this fall (so the zero-load check is not empty).

@@ -67,13 +67,10 @@ def test_a_case_thinned_to_200_hz_keeps_the_summary_of_every_sample():
         {k: v for k, v in direct.items() if k not in volatile}
 
 
-def test_dask_executor_gives_the_same_table(default_run):
-    distributed = pytest.importorskip("distributed")
+def test_dask_executor_gives_the_same_table(default_run, dask_client):
     _, table = default_run
-    with distributed.LocalCluster(processes=True, n_workers=2, threads_per_worker=1,
-                                  dashboard_address=None) as cluster, distributed.Client(cluster) as client:
-        dask_table = wk.sweep(GRID, base=BASE, executor=client.get_executor(), progress=False)
-        workers = set(dask_table["run.worker"])
+    dask_table = wk.sweep(GRID, base=BASE, executor=dask_client.get_executor(), progress=False)
+    workers = set(dask_table["run.worker"])
     assert len(workers) == 2   # both Dask workers ran cases
     keep = [c for c in table.columns if c not in wk.sweep_engine.VOLATILE_COLUMNS]
     pd.testing.assert_frame_equal(dask_table[keep], table[keep])

@@ -159,13 +159,10 @@ def test_the_same_seed_gives_the_same_tables_and_the_folder_resumes(tiny, tiny_s
     pd.testing.assert_frame_equal(again.p_best, study.p_best)
 
 
-def test_dask_gives_the_same_tables_as_the_pool(tiny, tiny_study):
-    distributed = pytest.importorskip("distributed")
+def test_dask_gives_the_same_tables_as_the_pool(tiny, tiny_study, dask_client):
     study, _ = tiny_study
-    with distributed.LocalCluster(processes=True, n_workers=2, threads_per_worker=1,
-                                  dashboard_address=None) as cluster, distributed.Client(cluster) as client:
-        dask = uncertainty.run_study(tiny, samples=2, seed=3, loads=[635.0], pressures=[300.0, 500.0], base=BASE,
-                                     executor=client.get_executor())
+    dask = uncertainty.run_study(tiny, samples=2, seed=3, loads=[635.0], pressures=[300.0, 500.0], base=BASE,
+                                 executor=dask_client.get_executor())
     pd.testing.assert_frame_equal(_stable(dask), _stable(study))
     for name in ("p_best", "distributions", "differences", "rates", "sobol"):
         pd.testing.assert_frame_equal(getattr(dask, name), getattr(study, name))
