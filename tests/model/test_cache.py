@@ -64,7 +64,7 @@ def test_concurrent_builds_share_one_library(tmp_path):
     env = dict(os.environ, WHIPPLE_KICK_CACHE=str(tmp_path / "cache"))
     warm_c = compiled.library_path().with_suffix(".c")
     code = ("from whipple_kick.model.symbolic import slip_build\n"
-            f"slip_build.c_source = lambda: open({str(warm_c)!r}).read()\n"
+            f"slip_build.c_source = lambda *model: open({str(warm_c)!r}).read()\n"
             "from whipple_kick import slip, lsoda\n"
             "lib = slip.library(); print('ok')\n")
     procs = [subprocess.Popen([sys.executable, "-c", code], env=env, stdout=subprocess.PIPE,
@@ -86,7 +86,7 @@ def test_every_generator_is_part_of_its_own_cache_key():
     stale module unless someone remembered to bump a layout string)."""
     from whipple_kick.model import classic, geometry
     slip_modules = tuple(f"slip/{p.stem}" for p in (cache._PACKAGE_DIR / "slip").glob("*.py"))
-    # (the slip package's name ``layout`` is the function compiled.layout: the module is read by its full name)
+    # (the layout module read by its full name: the package also exports names from its modules)
     from whipple_kick.model.slip.layout import _SOURCES as SLIP_SOURCES
     for sources, name in ((classic._SOURCES, "classic"), (geometry._SOURCES, "geometry"),
                           (SLIP_SOURCES, "symbolic/slip_build"), *((SLIP_SOURCES, m) for m in slip_modules)):
