@@ -323,7 +323,7 @@ def closed_loop_modes(fields, max_hz=10.0):
     model = assembly.assemble(sc, inputs.kick_of(sc))
     rhs = slip.CompiledRHS(model.params)
     A, _ = slip.heading_linearisation(rhs, model.start.x)
-    names = list(slip.LINEAR_STATES) + list(slip.linear.body_states(rhs.p))
+    names = list(slip.LINEAR_STATES) + list(slip.linear.body_states(rhs))
     keep = [i for i, n in enumerate(names) if n != "v_fwd"]
     names = [names[i] for i in keep]
     values, vectors = np.linalg.eig(A[np.ix_(keep, keep)])
