@@ -7,8 +7,8 @@ import numpy as np
 from whipple_kick.errors import InputError
 from whipple_kick.model import transient
 import whipple_kick.model.slip.compiled as compiled  # noqa: PLR0402 -- the module, not the package that imports this one; tests patch its names
+import whipple_kick.model.slip.layout as layouts  # the module by its full name, not through the package
 
-from . import layout as layouts
 from .layout import P
 
 

@@ -11,8 +11,8 @@ import shutil
 
 from whipple_kick.errors import InputError
 from whipple_kick.model import cache, rhs_call
+import whipple_kick.model.slip.layout as layouts  # the module by its full name, not through the package
 
-from . import layout as layouts
 from .layout import _SOURCES
 
 

@@ -5,8 +5,8 @@ import numpy as np
 
 from whipple_kick.errors import InputError
 from whipple_kick.model import transient
+import whipple_kick.model.slip.layout as layouts  # the module by its full name, not through the package
 
-from . import layout as layouts
 from .call import CompiledRHS
 from .layout import (
     OUT,

@@ -5,8 +5,7 @@ import numpy as np
 from whipple_kick.errors import InputError
 from whipple_kick.model import carcass, magic_formula, parts, transient
 from whipple_kick.model import symbols as S
-
-from . import layout as layouts
+import whipple_kick.model.slip.layout as layouts  # the module by its full name, not through the package
 
 # ------------------------------------------------------- parameters and steady state
 

@@ -32,7 +32,7 @@ from whipple_kick import fileio
 from whipple_kick.errors import BuildError
 from whipple_kick.model import cache, carcass, energy, kane, magic_formula, reflex, transient
 from whipple_kick.model import symbols as S
-from whipple_kick.model.slip import layout as layouts
+import whipple_kick.model.slip.layout as layouts  # the module by its full name, not through the package
 from whipple_kick.model.slip.layout import (
     _SOURCES,
     IGNORABLE,
