@@ -41,8 +41,7 @@ def _native_call():
 
 def metadata_layout(L=layouts.BASE):
     """The layouts the running code expects of the compiled library of ``L`` (as its metadata records them)."""
-    return {"states": list(L.STATE_NAMES), "parameters": list(L.PARAMETER_NAMES), "outputs": list(L.OUTPUT_NAMES),
-            "dynamic_states": len(L.DYNAMIC_STATES)}
+    return L.record()
 
 
 def _metadata_matches(path, L):

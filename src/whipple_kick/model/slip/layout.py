@@ -90,7 +90,6 @@ _SOURCES = ("symbols", "parts", "symbolic/derivation", "symbolic/codegen", "magi
             "reflex",
             "slip/__init__", "slip/layout", "slip/compiled", "slip/call", "slip/parameters", "slip/jumps",
             "slip/linear", "symbolic/slip_build")
-_PARTITION = kane.ConstraintPartition(SPEEDS, DEPENDENT)
 
 
 def tyre_state_names(name=transient.DEFAULT_TRANSIENT):
@@ -159,6 +158,11 @@ class Layout:
     def part_names(self):
         """Names of the model's parts."""
         return tuple(p.name for p in self.parts)
+
+    def record(self):
+        """The layouts as a compiled library's metadata records them (what its loader compares)."""
+        return {"states": list(self.STATE_NAMES), "parameters": list(self.PARAMETER_NAMES),
+                "outputs": list(self.OUTPUT_NAMES), "dynamic_states": len(self.DYNAMIC_STATES)}
 
     def fingerprint(self):
         """The parts' declarations and build code, hashed (part of the generated code's cache key)."""

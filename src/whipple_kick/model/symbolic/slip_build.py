@@ -851,19 +851,13 @@ def metadata(key, compiler, flags, L=layouts.BASE):
         "model": "whipple_kick slip model",
         "key": key,
         "parts": [p.name for p in L.parts],
-        "layout": layout_record(L),
+        "layout": L.record(),
         "states": [described(n) for n in L.STATE_NAMES],
         "parameters": [described(n) for n in L.PARAMETER_NAMES],
         "outputs": outputs,
         "generated_with": {"sympy": cache.sympy_version(), "python": sys.version.split()[0],
                            "compiler": compiler, "flags": list(flags)},
     }
-
-
-def layout_record(L):
-    """The layouts of ``L`` as the metadata records them (what the loader compares)."""
-    return {"states": list(L.STATE_NAMES), "parameters": list(L.PARAMETER_NAMES), "outputs": list(L.OUTPUT_NAMES),
-            "dynamic_states": len(L.DYNAMIC_STATES)}
 
 
 def build_library(path, key, compiler, flags, part_names=(), delayed_reflex=False):
