@@ -5,6 +5,9 @@ layouts, the steady state, the trajectory's columns and the gain table follow fr
 test below shows it: a part declared here, in this module only (no other file touched), is built, run and
 energy-checked.
 """
+import dataclasses
+import inspect
+
 import numpy as np
 import pytest
 
@@ -171,12 +174,21 @@ def test_a_parts_scenario_fields_come_from_its_declaration():
     with the declared range and unit, refused while the part is not selected (rider_body 'rigid') and given
     CLI flags, all from the declaration; the run's trunk parameters are the fields' values."""
     from whipple_kick import cli
-    from whipple_kick.simulate.scenario import Scenario
+    from whipple_kick.simulate import scenario as scenario_module
+    from whipple_kick.simulate.scenario import FIELD_GROUPS, Scenario
 
     fields = parts.fields()
     assert [f.name for f in fields] == ["hip_stiffness", "hip_damping"]
     for f in fields:
         assert Scenario.__dataclass_fields__[f.name].default == f.default and f.source
+        assert f"    {f.name} : float\n        The {f.label} of the leaning upper body [{f.unit}]" in Scenario.__doc__
+        assert f.name in FIELD_GROUPS["physics"]
+    # Generated, not hand-kept: the fields follow the field that selects the part, in declaration order.
+    names = [f.name for f in dataclasses.fields(Scenario)]
+    at = names.index("rider_body")
+    assert names[at + 1:at + 3] == ["hip_stiffness", "hip_damping"]
+    source = inspect.getsource(scenario_module)
+    assert "hip_stiffness" not in source and "hip_damping" not in source
     with pytest.raises(wk.InputError, match=r"hip stiffness = -1.0 N m/rad is outside the allowed range"):
         Scenario(rider_body="leaning", hip_stiffness=-1.0).validate()
     assert "the leaning upper body (rider_body 'leaning')" in Scenario(hip_damping=10.0).unused_fields()["hip_damping"]
@@ -185,3 +197,5 @@ def test_a_parts_scenario_fields_come_from_its_declaration():
     sc = Scenario(rider_body="leaning", hip_stiffness=300.0, hip_damping=7.0)
     assert parts.selected(sc) == (parts.TRUNK,) and parts.selected(Scenario()) == ()
     assert parts.TRUNK.field_parameters(sc) == {"kh": 300.0, "ch": 7.0}
+    from whipple_kick.studies.stability import report
+    assert "; the leaning upper body (hip stiffness 300 N m/rad, hip damping 7 N m s/rad)" in report.describe(sc)

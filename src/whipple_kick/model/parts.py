@@ -93,6 +93,9 @@ class Field:
         The scenario's default.
     source : str
         Where the default comes from.
+    refuse_low : str
+        If given, the low end itself is refused while the part is selected, and this says why
+        ("leaves a leaning upper body with nothing to hold it up").
     """
 
     name: str
@@ -103,6 +106,7 @@ class Field:
     high: float
     default: float
     source: str
+    refuse_low: str = ""
 
 
 @dataclass(frozen=True)
@@ -274,7 +278,8 @@ TRUNK = declare(Part(
     fields=(
         Field("hip_stiffness", "kh", "hip stiffness", "N m/rad", 0.0, 1e6, 128.0,
               "Moore (2012, Human Control of a Bicycle, PhD thesis, UC Davis, ch. 4, 'Leaning rider extension', "
-              "from de Lorenzo and Hubbard)"),
+              "from de Lorenzo and Hubbard)",
+              refuse_low="leaves a leaning upper body with nothing to hold it up"),
         Field("hip_damping", "ch", "hip damping", "N m s/rad", 0.0, 1e5, 50.0,
               "Moore (2012, ch. 4, 'Leaning rider extension', from de Lorenzo and Hubbard)"),
     ),

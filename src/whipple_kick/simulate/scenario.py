@@ -16,6 +16,7 @@ Example
 ((300.0, 300.0), 4.0)
 """
 from dataclasses import asdict, dataclass, fields, replace
+import inspect
 
 from whipple_kick.errors import InputError, check_range
 from whipple_kick.library import inputs
@@ -58,8 +59,41 @@ STARTS = ("steady", "upright")
 #: front contact starts below the ground; the authors' published code).
 START_PITCHES = ("compressed", "uncompressed")
 
+#: The declared parts' scenario fields (:class:`whipple_kick.model.parts.Field`) by the field that selects
+#: their part: each part's fields follow that field in :class:`Scenario` and share its group.
+_PART_FIELDS = {}
+for _part in parts.REGISTRY.values():
+    if _part.fields:
+        _PART_FIELDS.setdefault(_part.selected_by[0], []).extend(f.name for f in _part.fields)
+
+
+def _with_part_fields(cls):
+    """Give ``cls`` the declared parts' fields, each after the field that selects its part, and document them.
+
+    A part declares its fields once, with range, unit, default and source
+    (:func:`whipple_kick.model.parts.fields`); the dataclass field, its
+    entry in the class's docstring, its range check, its CLI flag and its
+    refusal while the part is off all follow from that declaration.
+    """
+    by_name = {f.name: f for f in parts.fields()}
+    annotations, documented = {}, []
+    for name, annotation in inspect.get_annotations(cls).items():
+        annotations[name] = annotation
+        for extra in _PART_FIELDS.get(name, ()):
+            f = by_name[extra]
+            part = next(p for p in parts.REGISTRY.values() if f in p.fields)
+            annotations[extra] = float
+            setattr(cls, extra, f.default)
+            documented.append(f"    {extra} : float\n        The {f.label} of {part.title or part.name} "
+                              f"[{f.unit}], {f.low:g} to {f.high:g}; default {f.default:g}: {f.source}.\n")
+    cls.__annotations__ = annotations
+    # The entries join the docstring's Parameters section, just before its Notes.
+    cls.__doc__ = cls.__doc__.replace("\n    Notes\n    -----", "".join(documented) + "\n    Notes\n    -----", 1)
+    return cls
+
 
 @dataclass(frozen=True)
+@_with_part_fields
 class Scenario:
     """One kick-plate run; the defaults are the thesis' simulation settings.
 
@@ -201,10 +235,6 @@ class Scenario:
         spring-damper about the steer axis between the bar and the upper body
         (the rear frame with a rigid rider). "off" (default): the hands have
         no mechanical effect on the bar.
-    hip_stiffness, hip_damping : float
-        The leaning upper body's hip spring [N m/rad] and damper [N m s/rad]:
-        128 and 50, Moore (2012, *Human Control of a Bicycle*, PhD thesis, UC
-        Davis, ch. 4, "Leaning rider extension", from de Lorenzo and Hubbard).
     arm_stiffness, arm_damping : float
         The arms about the steer axis [N m/rad, N m s/rad] (default 0: no
         published value was at hand; docs/experiments.md, identification).
@@ -320,8 +350,6 @@ class Scenario:
     lqr_heading: bool = False
     rider_body: str = "rigid"
     arms: str = "off"
-    hip_stiffness: float = 128.0
-    hip_damping: float = 50.0
     arm_stiffness: float = 0.0
     arm_damping: float = 0.0
     reflex_delay: float = 0.0
@@ -452,8 +480,12 @@ class Scenario:
             raise InputError(f"controller {self.controller!r} is unknown; choose one of {', '.join(CONTROLLERS)}")
         check_range("carcass damping", self.carcass_damping, 0.0, 1e4, "N s/m")
         check_range("carcass stiffness scale", self.carcass_stiffness_scale, 0.05, 20.0, "(factor)")
-        for f in parts.fields():   # the declared parts' fields (the leaning upper body's hip)
-            check_range(f.label, getattr(self, f.name), f.low, f.high, f.unit)
+        for part in parts.REGISTRY.values():   # the declared parts' fields (the leaning upper body's hip)
+            for f in part.fields:
+                value = check_range(f.label, getattr(self, f.name), f.low, f.high, f.unit)
+                if f.refuse_low and value == f.low and part.selected(self):
+                    raise InputError(f"{f.label} = {value:g} {f.unit} {f.refuse_low}; allowed "
+                                     f"({f.low:g}, {f.high:g}] {f.unit}")
         check_range("arm stiffness", self.arm_stiffness, 0.0, 1e5, "N m/rad")
         check_range("arm damping", self.arm_damping, 0.0, 1e4, "N m s/rad")
         check_range("reflex delay", self.reflex_delay, 0.0, 0.5, "s")
@@ -465,9 +497,6 @@ class Scenario:
         if self.lqr_heading and (self.controller != "lqr" or self.lqr_model != "simulated"):
             raise InputError("lqr_heading needs the LQR rider designed on the model simulated "
                              "(controller 'lqr', lqr_model 'simulated')")
-        if self.rider_body == "leaning" and self.hip_stiffness == 0.0:
-            raise InputError("hip stiffness = 0 N m/rad leaves a leaning upper body with nothing to hold it "
-                             "up; allowed (0, 1e6] N m/rad")
         # Below 1e-3 N s/m the plateau is so stiff that LSODA stalls at the plate stop (measured 5e-4).
         check_range("carcass sliding viscosity", self.carcass_viscosity, 1e-3, 10.0, "N s/m")
         for label, value, choices in (("tyre transient", self.tyre_transient, TYRE_TRANSIENTS),
@@ -699,7 +728,7 @@ FIELD_GROUPS = {
                 "pressure_rear_kpa", "coefficient_set", "friction", "symmetric_tyres", "speed", "controller",
                 "design_speed", "gain_scale", "thesis_load_n", "low_inertia", "kick_displacement", "kick_duration",
                 "kick_accel", "kick_profile", "kick_table", "kick_direction", "tyre_transient", "carcass_sliding",
-                "carcass_damping", "carcass_stiffness_scale", "lqr_model", "lqr_heading", "rider_body", "arms", "hip_stiffness", "hip_damping",
+                "carcass_damping", "carcass_stiffness_scale", "lqr_model", "lqr_heading", "rider_body", *_PART_FIELDS["rider_body"], "arms",
                 "arm_stiffness", "arm_damping", "reflex_delay", "reflex_roll", "reflex_roll_rate", "reflex_steer",
                 "reflex_steer_rate"),
     "run": ("settle", "duration", "output_rate", "fall_angle_deg", "steer_limit_deg"),

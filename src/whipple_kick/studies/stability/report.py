@@ -4,6 +4,7 @@ import math
 import numpy as np
 
 from whipple_kick import fileio
+from whipple_kick.model import parts
 from whipple_kick.simulate import results
 
 from ._constants import LOOPS, MODES, TURN_NOTE_DEG
@@ -198,8 +199,9 @@ def describe(scenario, info=None):
         rider += " on the model simulated"
     scale = f" x{scenario.gain_scale:g}" if scenario.controller != "off" and scenario.gain_scale != 1 else ""
     body = []   # the rider's body, named only when it is not the rigid rider's
-    if scenario.rider_body == "leaning":
-        body.append(f"leaning rider (hip {scenario.hip_stiffness:g} N m/rad, {scenario.hip_damping:g} N m s/rad)")
+    for part in parts.selected(scenario):   # the declared parts in the run's model, with their fields' values
+        values = ", ".join(f"{f.label} {getattr(scenario, f.name):g} {f.unit}" for f in part.fields)
+        body.append((part.title or part.name) + (f" ({values})" if values else ""))
     if scenario.arms == "on":
         body.append(f"arms on the bar ({scenario.arm_stiffness:g} N m/rad, {scenario.arm_damping:g} N m s/rad)")
     if scenario.reflex_delay:
