@@ -33,8 +33,8 @@ def test_assemble_hands_over_a_finished_model():
 
 def test_low_inertia_halves_rear_frame_inertia_and_height():
     sc = Scenario(fz_n=635.0)
-    original, design, _ = wk.assembly.build_bicycle(sc)
-    low, design_low, _ = wk.assembly.build_bicycle(Scenario(fz_n=635.0, low_inertia=True))
+    original, design, _ = wk.assembly.build_bicycle(sc.bicycle_spec)
+    low, design_low, _ = wk.assembly.build_bicycle(Scenario(fz_n=635.0, low_inertia=True).bicycle_spec)
     b0, b1 = wk.benchmark.from_moore(original), wk.benchmark.from_moore(low)
     for key in wk.scenario.LOW_INERTIA_KEYS:
         assert b1[key] == pytest.approx(0.5 * b0[key])
@@ -46,12 +46,13 @@ def test_low_inertia_halves_rear_frame_inertia_and_height():
 
 
 def test_controller_variants_and_their_errors():
-    gains, poles = wk.assembly.controller_gains(Scenario(controller="thesis", fz_n=635.0, gain_scale=0.5), None)
+    thesis = Scenario(controller="thesis", fz_n=635.0, gain_scale=0.5)
+    gains, poles = wk.assembly.controller_gains(thesis.gains_spec, None)
     assert gains["kq4"] == pytest.approx(0.5 * -19.5679)
-    gains, poles = wk.assembly.controller_gains(Scenario(controller="off"), None)
+    gains, poles = wk.assembly.controller_gains(Scenario(controller="off").gains_spec, None)
     assert set(gains.values()) == {0.0} and poles is None
     with pytest.raises(InputError, match="570, 635 and 701 N"):
-        wk.assembly.controller_gains(Scenario(controller="thesis", fz_n=600.0), None)
+        wk.assembly.controller_gains(Scenario(controller="thesis", fz_n=600.0).gains_spec, None)
     with pytest.raises(InputError, match="conflicts with controller off"):
         Scenario(controller="off", gain_scale=0.5).validate()
     with pytest.raises(InputError, match="already includes its rider"):
@@ -105,7 +106,7 @@ def test_item7_no_slip_poles_of_a_leaning_rider_carry_the_whole_rider():
     from whipple_kick.simulate import control
 
     sc = Scenario(rider_body="leaning")
-    moore, design, info = assembly.build_bicycle(sc)
+    moore, design, info = assembly.build_bicycle(sc.bicycle_spec)
     mass = lambda m: sum(m[k] for k in ("mc", "md", "me", "mf"))
     assert mass(moore) == pytest.approx(61.6, abs=0.05)                 # the split bicycle: legs only
     plant = assembly.no_slip_plant(moore, design, info)
@@ -125,7 +126,7 @@ def test_a_rear_load_share_holds_for_every_rider_form(changes):
     (the whole rider's) hold fz (default 635 N) and the share; the summary reports the shift. Measured to
     4.5e-13 N and 2.2e-16; bounds 1e-9 N and 1e-12."""
     sc = Scenario(**{"fz_n": 635.0, "rear_load_share": 0.68, **changes}).validate()
-    _, _, info = assembly.build_bicycle(sc)
+    _, _, info = assembly.build_bicycle(sc.bicycle_spec)
     rear, front = info["static_load_rear_n"], info["static_load_front_n"]
     if sc.fz_n is not None:
         assert rear == pytest.approx(sc.fz_n, abs=1e-9)
@@ -137,9 +138,9 @@ def test_a_rear_load_share_holds_for_every_rider_form(changes):
 def test_the_leaning_body_moves_its_hinge_with_the_rider():
     """The leaning body's hinge (lh1, lh3 from the rear wheel centre along Moore's C axes) is the seat point,
     moved by the shift; the upper body's own arm (lt1, lt3) and inertia are the posture's, unchanged."""
-    seated = assembly.build_bicycle(Scenario(rider_body="leaning", rider_mass_kg=61.0).validate())[2]
+    seated = assembly.build_bicycle(Scenario(rider_body="leaning", rider_mass_kg=61.0).validate().bicycle_spec)[2]
     moved = assembly.build_bicycle(Scenario(rider_body="leaning", rider_mass_kg=61.0,
-                                            rear_load_share=0.69).validate())[2]
+                                            rear_load_share=0.69).validate().bicycle_spec)[2]
     shift = moved["rider_shift_m"]
     assert seated["rider_shift_m"] == 0.0 and shift < -0.05
     lam = wk.bicycles.load("balanceassist_v1").benchmark["lam"]
@@ -158,7 +159,7 @@ def test_a_share_on_a_preset_with_its_rider_is_refused():
         assembly.preflight(sc)
     assert "\n" not in str(info.value)
     with pytest.raises(InputError, match="would be ignored"):
-        assembly.build_bicycle(sc)
+        assembly.build_bicycle(sc.bicycle_spec)
 
 
 def test_the_summary_reports_the_shift_and_the_front_load():

@@ -77,18 +77,18 @@ def fingerprint(sc):
     """What the run of ``sc`` is made of; raises InputError where the scenario is refused."""
     assembly.preflight(sc)
     kick = inputs.kick_of(sc)
-    rear, front, _ = assembly.build_tyres(sc)
-    moore, design, info = assembly.build_bicycle(sc)
+    rear, front, _ = assembly.build_tyres(sc.tyre_spec)
+    moore, design, info = assembly.build_bicycle(sc.bicycle_spec)
+    body = assembly.rider_body(sc.body_spec, info)
     if sc.controller == "lqr" and sc.lqr_model == "simulated":
-        spec = assembly.design_spec(sc)
+        spec = sc.design_spec
         felt, K = control.simulated_design_start(spec, design)
-        A, b, C = control._linear_design_model(spec, moore, rear, front, assembly.rider_body(sc, info), felt, 1.0,
-                                               control.SCALED_BODY_GAINS)
+        A, b, C = control._linear_design_model(spec, moore, rear, front, body, felt, 1.0, control.SCALED_BODY_GAINS)
         gains = {"design": (A, b, C, K, sc.gain_scale, sc.lqr_design_speed)}
-        params = assembly.model_parameters(sc, kick, moore, info, rear, front, None)
+        params = assembly.model_parameters(sc.model_spec, kick, moore, body, rear, front, None)
     else:
-        gains, _ = assembly.controller_gains(sc, design)
-        params = assembly.model_parameters(sc, kick, moore, info, rear, front, gains)
+        gains, _ = assembly.controller_gains(sc.gains_spec, design)
+        params = assembly.model_parameters(sc.model_spec, kick, moore, body, rear, front, gains)
     return (slip.parameter_vector(params), gains, kick, integration_reads(sc),
             assembly.no_slip_plant(moore, design, info), float(sc.speed))
 
@@ -203,9 +203,10 @@ def test_item5_lean_gains_given_are_used():
     gains = assembly.custom_gains({"kq4": -10.0, "kq11": 3.0, "ku11": 0.5}, Scenario(rider_body="leaning"))
     assert gains["kq11"] == 3.0 and gains["ku11"] == 0.5 and gains["kq4"] == -10.0
     sc = Scenario(rider_body="leaning")
-    moore, _, info = assembly.build_bicycle(sc)
-    rear, front, _ = assembly.build_tyres(sc)
-    params = assembly.model_parameters(sc, inputs.kick_of(sc), moore, info, rear, front, gains)
+    moore, _, info = assembly.build_bicycle(sc.bicycle_spec)
+    rear, front, _ = assembly.build_tyres(sc.tyre_spec)
+    body = assembly.rider_body(sc.body_spec, info)
+    params = assembly.model_parameters(sc.model_spec, inputs.kick_of(sc), moore, body, rear, front, gains)
     assert params["kq11"] == 3.0 and params["ku11"] == 0.5
 
 
