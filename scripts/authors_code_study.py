@@ -150,7 +150,7 @@ def geometry():
     """Their contact positions in this model: wheel radius + 2 r_t and crown radius 2 r_t (parameters only)."""
     stored = _stored()
     sc = Scenario.authors_code()
-    rear, front, _ = wk.assembly.build_tyres(sc)
+    rear, front, _ = wk.assembly.build_tyres(sc.tyre_spec)
     bike = bicycles.load(sc.bicycle)
     r_t = {"rr": rear.crown_radius, "rf": front.crown_radius}
     text = (bicycles.BICYCLE_DIR / f"{sc.bicycle}.toml").read_text()
@@ -184,9 +184,9 @@ def geometry():
 
 
 def _parameters(scenario):
-    moore, design, _ = wk.assembly.build_bicycle(scenario)
-    rear, front, _ = wk.assembly.build_tyres(scenario)
-    gains, _ = wk.assembly.controller_gains(scenario, design)
+    moore, design, _ = wk.assembly.build_bicycle(scenario.bicycle_spec)
+    rear, front, _ = wk.assembly.build_tyres(scenario.tyre_spec)
+    gains, _ = wk.assembly.controller_gains(scenario.gains_spec, design)
     return slip.model_parameters(moore, rear, front, gains=gains, tyre_transient=scenario.tyre_transient,
                                  reverse_camber=scenario.camber_sign == "reversed", slip_speed=scenario.slip_speed)
 

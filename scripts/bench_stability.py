@@ -28,9 +28,9 @@ def _steady(symmetric, speed=4.0):
     from whipple_kick.model import slip
     from whipple_kick.simulate import simulation, steady
     sc = simulation.Scenario(symmetric_tyres=symmetric, speed=speed)
-    moore, design, _ = wk.assembly.build_bicycle(sc)
-    rear, front, _ = wk.assembly.build_tyres(sc)
-    gains, _ = wk.assembly.controller_gains(sc, design)
+    moore, design, _ = wk.assembly.build_bicycle(sc.bicycle_spec)
+    rear, front, _ = wk.assembly.build_tyres(sc.tyre_spec)
+    gains, _ = wk.assembly.controller_gains(sc.gains_spec, design)
     params = slip.model_parameters(moore, rear, front, gains=gains, symmetric=symmetric)
     return steady.find_steady_state(params, speed).steady
 

@@ -46,7 +46,8 @@ def main():
         worst = 0.0
         for fields in DESIGNS:
             seen.clear()
-            assembly._simulated_design(Scenario(lqr_model="simulated", **fields))
+            sc = Scenario(lqr_model="simulated", **fields)
+            assembly.simulated_design(sc.design_spec, sc.tyre_spec, sc.bicycle_spec, sc.body_spec)
             for message, gradient in seen:
                 worst = max(worst, gradient)
                 print(f"{fields}: relative gradient {gradient:.2e} ({message})")

@@ -105,7 +105,7 @@ def measure():
         variants[label] = {}
         for (p, fz) in base:
             scenario = Scenario(pressure_kpa=p, fz_n=fz)
-            rear, front, _ = wk.assembly.build_tyres(scenario)
+            rear, front, _ = wk.assembly.build_tyres(scenario.tyre_spec)
             pair = (PerturbedTyre(rear, fy, mz, label), PerturbedTyre(front, fy, mz, label))
             variants[label][(p, fz)] = summary(scenario, tyres=pair)
 

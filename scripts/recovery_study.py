@@ -58,10 +58,10 @@ def recovery_times(result):
 
 def linear_model(scenario, gains=None, tyre_pair=None):
     """Open-loop A, B, the rider's K on :data:`slip.LINEAR_STATES`, about the steady motion."""
-    rear, front, _ = wk.assembly.build_tyres(scenario) if tyre_pair is None else (*tyre_pair, [])
-    moore, design, _ = wk.assembly.build_bicycle(scenario)
+    rear, front, _ = wk.assembly.build_tyres(scenario.tyre_spec) if tyre_pair is None else (*tyre_pair, [])
+    moore, design, _ = wk.assembly.build_bicycle(scenario.bicycle_spec)
     if gains is None:
-        gains, _ = wk.assembly.controller_gains(scenario, design)
+        gains, _ = wk.assembly.controller_gains(scenario.gains_spec, design)
     params = slip.model_parameters(moore, rear, front, gains=gains, symmetric=scenario.symmetric_tyres)
     motion = steady.steady_state(params, scenario.speed)
     return slip.linear_state_space(motion.params, motion.x)
@@ -245,19 +245,19 @@ def one_at_a_time(duration):
 
 def lqr_gains(scenario, weight):
     """Our LQR rider with Q = weight * I, R = 1, by name."""
-    design = wk.assembly.build_bicycle(scenario)[1]
+    design = wk.assembly.build_bicycle(scenario.bicycle_spec)[1]
     return control.gains_dict(control.lqr_gains(design, scenario.lqr_design_speed, Q=weight * np.eye(4))[0])
 
 
 def heading_gains(scenario):
     """The heading-holding LQR rider (Q = I, R = 1), by name."""
-    design = wk.assembly.build_bicycle(scenario)[1]
+    design = wk.assembly.build_bicycle(scenario.bicycle_spec)[1]
     K, _ = control.heading_lqr_gains(design, scenario.lqr_design_speed)
     return dict(zip(control.HEADING_GAIN_ORDER, K, strict=True))
 
 
 def measured_pair(scenario, **switches):
-    rear, front, _ = wk.assembly.build_tyres(scenario)
+    rear, front, _ = wk.assembly.build_tyres(scenario.tyre_spec)
     return ToggledTyre(rear, **switches), ToggledTyre(front, **switches)
 
 
@@ -265,8 +265,8 @@ def tyre_properties():
     """Slowest closed-loop pole (our LQR rider, 400 kPa, 635 N) with one tyre property at a time."""
     base = Scenario(pressure_kpa=400.0, fz_n=635.0)
     symmetric = base.with_changes(symmetric_tyres=True)
-    rear, front, _ = wk.assembly.build_tyres(base)
-    moore, _, info = wk.assembly.build_bicycle(base)
+    rear, front, _ = wk.assembly.build_tyres(base.tyre_spec)
+    moore, _, info = wk.assembly.build_bicycle(base.bicycle_spec)
     loads = (info["static_load_rear_n"], info["static_load_front_n"])
     coefficient = [t.cornering_stiffness(fz) / fz for t, fz in zip((rear, front), loads, strict=True)]
 

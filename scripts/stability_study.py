@@ -103,7 +103,7 @@ class ModifiedTyre:
 
 
 def _loads(scenario):
-    _, _, info = wk.assembly.build_bicycle(scenario)
+    _, _, info = wk.assembly.build_bicycle(scenario.bicycle_spec)
     return info["static_load_rear_n"], info["static_load_front_n"]
 
 
@@ -155,7 +155,7 @@ def coefficients():
     print("|---|---|---|---|---|---|---|")
     loads = _loads(BASE)
     for p in stability.THESIS_PRESSURES_KPA:
-        rear, front, _ = wk.assembly.build_tyres(BASE.with_changes(pressure_kpa=p))
+        rear, front, _ = wk.assembly.build_tyres(BASE.with_changes(pressure_kpa=p).tyre_spec)
         for wheel, t, fz in (("rear", rear, loads[0]), ("front", front, loads[1])):
             ca, cg, trail, mg = small_slip_coefficients(t, fz)
             print(f"| {p:g} | {wheel} | {fz:.0f} | {ca:.2f} | {cg:.3f} | {trail * 1e3:.1f} | {mg:+.2f} |")
@@ -178,7 +178,7 @@ def _open_loop_row(label, pair, scenario=BASE, speeds=STUDY_SPEEDS):
 
 def properties(pressure=400.0):
     scenario = BASE.with_changes(pressure_kpa=pressure)
-    rear, front, _ = wk.assembly.build_tyres(scenario)
+    rear, front, _ = wk.assembly.build_tyres(scenario.tyre_spec)
     loads = _loads(scenario)
     unit_camber = [1.0 / small_slip_coefficients(t, fz)[1] for t, fz in ((rear, loads[0]), (front, loads[1]))]
     both = lambda **kw: (ModifiedTyre(rear, **kw), ModifiedTyre(front, **kw))
@@ -220,7 +220,7 @@ def properties(pressure=400.0):
 
 def sensitivity():
     """The relaxation length (not measured for T03), the transient form and the offsets, at 400 kPa, 635 N."""
-    rear, front, _ = wk.assembly.build_tyres(BASE)
+    rear, front, _ = wk.assembly.build_tyres(BASE.tyre_spec)
     print("Sensitivity of the default case (400 kPa, 635 N) to modelling choices nothing validated\n")
     print("| choice | weave speed [m/s] | capsize speed [m/s] | self-stable [m/s] | with rider: stable [m/s] | "
           "closed-loop weave at 3 m/s (real, f, damping) | wobble at 3 m/s (f, damping) |")
@@ -284,7 +284,7 @@ def consistency():
 
 def _named_index(model, lam, vec, mode):
     """Index of the eigenvalue (Im >= 0) named ``mode`` with the largest real part."""
-    wheelbase = stability_modes._wheelbase(wk.assembly.build_bicycle(BASE)[0])
+    wheelbase = stability_modes._wheelbase(wk.assembly.build_bicycle(BASE.bicycle_spec)[0])
     best = None
     for k in range(lam.size):
         if lam[k].imag < 0:

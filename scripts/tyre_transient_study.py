@@ -148,7 +148,7 @@ def carcass():
     for label, scenario in (("default", BASE), ("symmetric", dataclasses.replace(BASE, symmetric_tyres=True))):
         r = run(scenario)
         df = r.trajectory
-        rear, front, _ = build_tyres(scenario)
+        rear, front, _ = build_tyres(scenario.tyre_spec)
         if scenario.symmetric_tyres:
             rear, front = rear.without_offsets(), front.without_offsets()
         t = df["time"].to_numpy()
@@ -190,9 +190,9 @@ def steady():
     # What positive T6c does: integrate the steady state with T6c = 0 for 20 s (no kick).
     from whipple_kick.model import slip
     from whipple_kick.simulate import lsoda
-    moore, design, _ = wk.assembly.build_bicycle(BASE)
-    gains, _ = wk.assembly.controller_gains(BASE, design)
-    rear, front, _ = build_tyres(BASE)
+    moore, design, _ = wk.assembly.build_bicycle(BASE.bicycle_spec)
+    gains, _ = wk.assembly.controller_gains(BASE.gains_spec, design)
+    rear, front, _ = build_tyres(BASE.tyre_spec)
     ss = steady.steady_state(slip.model_parameters(moore, rear, front, gains=gains), 3.0)
     for torque in (0.0, 2 * ss.params["T6c"]):
         params = dict(ss.params, T6c=torque)
@@ -236,7 +236,7 @@ def bounds():
             scenario = dataclasses.replace(BASE, tyre_transient=name, **changes)
             r = run(scenario)
             df = r.trajectory
-            rear, front, _ = build_tyres(scenario)
+            rear, front, _ = build_tyres(scenario.tyre_spec)
             for wheel, tyre in (("rear", rear), ("front", front)):
                 fz = df[f"fz_{wheel}"].to_numpy()
                 loaded = fz > 0.0

@@ -1,4 +1,6 @@
 """Fixtures shared by several test files."""
+import dataclasses
+
 import pytest
 
 import whipple_kick as wk
@@ -61,3 +63,47 @@ def dask_client():
     with distributed.LocalCluster(processes=True, n_workers=2, threads_per_worker=1,
                                   dashboard_address=None) as cluster, distributed.Client(cluster) as client:
         yield client
+
+
+#: Every :class:`Scenario` field's default.
+SCENARIO_DEFAULTS = {f.name: f.default for f in dataclasses.fields(Scenario)}
+
+
+def other_value(name, other_rider):
+    """A valid value of :class:`Scenario` field ``name`` other than its default (switches: another choice).
+
+    ``other_rider`` is the value for ``rider`` (a Yeadon rider file other than the default).
+    """
+    default = SCENARIO_DEFAULTS[name]
+    special = {"bicycle": "browser_with_rider", "rider": other_rider, "tyre": "T04", "coefficient_set": "chapter8",
+               "friction": "plate", "fz_n": 701.0, "rider_mass_kg": 80.0, "rear_load_share": 0.66, "pressure_front_kpa": 350.0,
+               "pressure_rear_kpa": 350.0, "design_speed": 4.0, "thesis_load_n": 701.0, "kick_duration": 0.2,
+               "kick_accel": 10.0, "kick_table": "plate.csv", "steer_limit_deg": 80.0, "settle": 0.3,
+               "reflex_delay": 0.05, "arm_stiffness": 5.0, "arm_damping": 2.0, "carcass_damping": 50.0,
+               "reflex_roll": -3.0, "reflex_roll_rate": -1.0, "reflex_steer": 2.0, "reflex_steer_rate": 0.5}
+    if name in special:
+        return special[name]
+    if isinstance(default, bool):
+        return not default
+    if isinstance(default, str):
+        choices = _choices(name)
+        return next(c for c in choices if c != default)
+    return default * 0.8
+
+
+def _choices(name):
+    from whipple_kick.library import inputs
+    from whipple_kick.simulate import scenario as module
+    for label in dir(module):
+        value = getattr(module, label)
+        if label.isupper() and isinstance(value, tuple) and SCENARIO_DEFAULTS[name] in value and len(value) > 1 \
+                and all(isinstance(v, str) for v in value):
+            return value
+    if name == "kick_profile":
+        return inputs.PROFILES
+    if name == "kick_direction":
+        return inputs.DIRECTIONS
+    if name == "carcass_sliding":
+        from whipple_kick.model import carcass
+        return carcass.SLIDING_LAWS
+    raise AssertionError(f"no choices known for field {name!r}")

@@ -202,7 +202,7 @@ def test_a_load_sweep_seats_the_probe_rider_once(monkeypatch):
     assembly._rear_load_range.cache_clear()
     try:
         for fz in (611.25, 612.75):
-            assembly.build_bicycle(Scenario(fz_n=fz))
+            assembly.build_bicycle(Scenario(fz_n=fz).bicycle_spec)
         assert len(calls) == 1
     finally:
         assembly._rear_load_range.cache_clear()

@@ -343,10 +343,10 @@ def test_a_tyre_without_moment_data_is_told_by_its_flag_not_by_a_message(monkeyp
             return tyres.ZERO_MOMENT_COEFFICIENTS
         raise InputError(f"tyre {self.name}: no M_z fit")
     monkeypatch.setattr(tyres.Tyre, "_moment_coefficients", reworded)
-    rear, front, notes = assembly.build_tyres(Scenario(tyre="T04"))
+    rear, front, notes = assembly.build_tyres(Scenario(tyre="T04").tyre_spec)
     assert not rear.has_aligning_moment and notes == ["T04 has no published aligning-moment data: M_z = 0"]
     assert all((mz == tyres.ZERO_MOMENT_COEFFICIENTS).all() for _, _, mz in rear.blend)
-    rear, _, notes = assembly.build_tyres(Scenario(tyre="T03"))
+    rear, _, notes = assembly.build_tyres(Scenario(tyre="T03").tyre_spec)
     assert rear.has_aligning_moment and notes == []
 
 

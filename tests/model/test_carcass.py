@@ -61,7 +61,7 @@ def test_force_stays_within_the_friction_limit(runs, case):
     speed above it: measured 1.3e-5 (default) to 5.5e-5 (40 m/s^2); the compiled limit output agrees with
     the scan to 1e-9 relative (two searches of a flat extreme: each value within ~eps of the peak)."""
     result = runs[case]
-    rear, front, _ = wk.assembly.build_tyres(result.scenario)
+    rear, front, _ = wk.assembly.build_tyres(result.scenario.tyre_spec)
     df = result.trajectory
     for wheel, tyre in (("rear", rear), ("front", front)):
         fz = df[f"fz_{wheel}"].to_numpy()

@@ -1,12 +1,16 @@
 """Assembly: bicycle with rider, tyres, the rider's gains, the model's parameters, steady motion and stability."""
+import dataclasses
+
 import numpy as np
 import pytest
 
+from conftest import other_value
 import whipple_kick as wk
 from whipple_kick.errors import InputError
 from whipple_kick.library import inputs
-from whipple_kick.model import slip
+from whipple_kick.model import parts, slip
 from whipple_kick.simulate import assembly
+from whipple_kick.simulate import scenario as scenario_module
 from whipple_kick.simulate.scenario import Scenario
 from whipple_kick.simulate.simulation import run
 
@@ -33,8 +37,8 @@ def test_assemble_hands_over_a_finished_model():
 
 def test_low_inertia_halves_rear_frame_inertia_and_height():
     sc = Scenario(fz_n=635.0)
-    original, design, _ = wk.assembly.build_bicycle(sc)
-    low, design_low, _ = wk.assembly.build_bicycle(Scenario(fz_n=635.0, low_inertia=True))
+    original, design, _ = wk.assembly.build_bicycle(sc.bicycle_spec)
+    low, design_low, _ = wk.assembly.build_bicycle(Scenario(fz_n=635.0, low_inertia=True).bicycle_spec)
     b0, b1 = wk.benchmark.from_moore(original), wk.benchmark.from_moore(low)
     for key in wk.scenario.LOW_INERTIA_KEYS:
         assert b1[key] == pytest.approx(0.5 * b0[key])
@@ -46,12 +50,13 @@ def test_low_inertia_halves_rear_frame_inertia_and_height():
 
 
 def test_controller_variants_and_their_errors():
-    gains, poles = wk.assembly.controller_gains(Scenario(controller="thesis", fz_n=635.0, gain_scale=0.5), None)
+    thesis = Scenario(controller="thesis", fz_n=635.0, gain_scale=0.5)
+    gains, poles = wk.assembly.controller_gains(thesis.gains_spec, None)
     assert gains["kq4"] == pytest.approx(0.5 * -19.5679)
-    gains, poles = wk.assembly.controller_gains(Scenario(controller="off"), None)
+    gains, poles = wk.assembly.controller_gains(Scenario(controller="off").gains_spec, None)
     assert set(gains.values()) == {0.0} and poles is None
     with pytest.raises(InputError, match="570, 635 and 701 N"):
-        wk.assembly.controller_gains(Scenario(controller="thesis", fz_n=600.0), None)
+        wk.assembly.controller_gains(Scenario(controller="thesis", fz_n=600.0).gains_spec, None)
     with pytest.raises(InputError, match="conflicts with controller off"):
         Scenario(controller="off", gain_scale=0.5).validate()
     with pytest.raises(InputError, match="already includes its rider"):
@@ -105,7 +110,7 @@ def test_item7_no_slip_poles_of_a_leaning_rider_carry_the_whole_rider():
     from whipple_kick.simulate import control
 
     sc = Scenario(rider_body="leaning")
-    moore, design, info = assembly.build_bicycle(sc)
+    moore, design, info = assembly.build_bicycle(sc.bicycle_spec)
     mass = lambda m: sum(m[k] for k in ("mc", "md", "me", "mf"))
     assert mass(moore) == pytest.approx(61.6, abs=0.05)                 # the split bicycle: legs only
     plant = assembly.no_slip_plant(moore, design, info)
@@ -125,7 +130,7 @@ def test_a_rear_load_share_holds_for_every_rider_form(changes):
     (the whole rider's) hold fz (default 635 N) and the share; the summary reports the shift. Measured to
     4.5e-13 N and 2.2e-16; bounds 1e-9 N and 1e-12."""
     sc = Scenario(**{"fz_n": 635.0, "rear_load_share": 0.68, **changes}).validate()
-    _, _, info = assembly.build_bicycle(sc)
+    _, _, info = assembly.build_bicycle(sc.bicycle_spec)
     rear, front = info["static_load_rear_n"], info["static_load_front_n"]
     if sc.fz_n is not None:
         assert rear == pytest.approx(sc.fz_n, abs=1e-9)
@@ -137,9 +142,9 @@ def test_a_rear_load_share_holds_for_every_rider_form(changes):
 def test_the_leaning_body_moves_its_hinge_with_the_rider():
     """The leaning body's hinge (lh1, lh3 from the rear wheel centre along Moore's C axes) is the seat point,
     moved by the shift; the upper body's own arm (lt1, lt3) and inertia are the posture's, unchanged."""
-    seated = assembly.build_bicycle(Scenario(rider_body="leaning", rider_mass_kg=61.0).validate())[2]
+    seated = assembly.build_bicycle(Scenario(rider_body="leaning", rider_mass_kg=61.0).validate().bicycle_spec)[2]
     moved = assembly.build_bicycle(Scenario(rider_body="leaning", rider_mass_kg=61.0,
-                                            rear_load_share=0.69).validate())[2]
+                                            rear_load_share=0.69).validate().bicycle_spec)[2]
     shift = moved["rider_shift_m"]
     assert seated["rider_shift_m"] == 0.0 and shift < -0.05
     lam = wk.bicycles.load("balanceassist_v1").benchmark["lam"]
@@ -158,7 +163,7 @@ def test_a_share_on_a_preset_with_its_rider_is_refused():
         assembly.preflight(sc)
     assert "\n" not in str(info.value)
     with pytest.raises(InputError, match="would be ignored"):
-        assembly.build_bicycle(sc)
+        assembly.build_bicycle(sc.bicycle_spec)
 
 
 def test_the_summary_reports_the_shift_and_the_front_load():
@@ -167,3 +172,92 @@ def test_the_summary_reports_the_shift_and_the_front_load():
     assert summary["static_load_front_n"] == pytest.approx(635.0 / 0.66 - 635.0, abs=1e-9)
     plain = run(Scenario(fz_n=635.0, duration=0.3).validate()).summary["bicycle"]
     assert plain["rider_shift_m"] == 0.0
+
+
+# ------------------------------------------------------------------ each step takes the part of the scenario it reads
+
+#: Each step's view, by the Scenario property that builds it.
+SPECS = {"bicycle_spec": scenario_module.BicycleSpec, "tyre_spec": scenario_module.TyreSpec,
+         "body_spec": scenario_module.BodySpec, "gains_spec": scenario_module.GainsSpec,
+         "model_spec": scenario_module.ModelSpec, "design_spec": scenario_module.DesignSpec}
+#: The derived Scenario attributes a view copies, and the fields they come from.
+DERIVED = {"pressures": ("pressure_kpa", "pressure_front_kpa", "pressure_rear_kpa"),
+           "lqr_design_speed": ("speed", "design_speed")}
+#: The Scenario fields the design on the simulated model reads (its view's fields are not named after them).
+DESIGN_READS = ("speed", "design_speed", "rider_body", "lqr_heading", "gain_scale",
+                *scenario_module.DESIGN_MODEL_OPTIONS)
+#: Scenarios the walk starts from: the default, and others whose derived values come from other fields.
+WALK_BASES = ({}, {"rider_body": "leaning", "arms": "on"}, {"controller": "thesis", "fz_n": 701.0},
+              {"pressure_front_kpa": 350.0, "pressure_rear_kpa": 450.0}, {"design_speed": 4.0})
+
+
+def fields_read(prop):
+    """The Scenario fields the view built by property ``prop`` reads."""
+    if prop == "design_spec":
+        return set(DESIGN_READS)
+    return {name for f in dataclasses.fields(SPECS[prop]) for name in DERIVED.get(f.name, (f.name,))}
+
+
+def test_every_view_copies_scenario_attributes_with_their_defaults():
+    """A view's field is a Scenario field of the same type, or a derived attribute; the default scenario's
+    view holds the Scenario's defaults."""
+    scenario_fields = {f.name: f for f in dataclasses.fields(Scenario)}
+    default = Scenario()
+    for prop, spec_class in SPECS.items():
+        view = getattr(default, prop)
+        assert type(view) is spec_class and hash(view) == hash(getattr(Scenario(), prop))
+        if prop == "design_spec":
+            continue
+        for f in dataclasses.fields(spec_class):
+            if f.name in DERIVED:
+                assert isinstance(getattr(Scenario, f.name), property), (prop, f.name)
+                assert getattr(view, f.name) == getattr(default, f.name), (prop, f.name)
+                continue
+            assert f.name in scenario_fields, (prop, f.name)
+            assert f.type == scenario_fields[f.name].type, (prop, f.name)
+            assert getattr(view, f.name) == scenario_fields[f.name].default, (prop, f.name)
+    assert default.tyre_spec.pressures == (400.0, 400.0) and default.gains_spec.lqr_design_speed == 3.0
+    assert set(DESIGN_READS) <= set(scenario_fields)
+
+
+def test_the_views_are_frozen():
+    view = Scenario().bicycle_spec
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        view.fz_n = 701.0
+
+
+def test_the_body_view_holds_every_declared_parts_fields():
+    """A part declared with scenario fields (model/parts.py) reaches rider_body through its view."""
+    names = {f.name for f in dataclasses.fields(scenario_module.BodySpec)}
+    assert {f.name for f in parts.fields()} <= names
+    assert {p.selected_by[0] for p in parts.REGISTRY.values() if p.selected_by} <= names
+
+
+@pytest.mark.parametrize("prop", SPECS)
+def test_a_field_outside_a_view_does_not_change_it_and_one_inside_does(prop):
+    """Every Scenario field, set to a valid value other than its base's: the view changes exactly when the
+    field is one it reads (derived values: when the field decides them, as from the default scenario)."""
+    reads = fields_read(prop)
+    assert reads <= {f.name for f in dataclasses.fields(Scenario)}
+    for changes in WALK_BASES:
+        base = Scenario(**changes)
+        for f in dataclasses.fields(Scenario):
+            value = other_value(f.name, "other_rider.toml")
+            if value == getattr(base, f.name):
+                continue
+            changed = getattr(base.with_changes(**{f.name: value}), prop) != getattr(base, prop)
+            if f.name not in reads:
+                assert not changed, (prop, changes, f.name)
+            elif not changes:
+                assert changed, (prop, f.name)
+
+
+def test_a_bicycle_is_seated_once_for_scenarios_that_differ_outside_its_view():
+    """build_bicycle's cache is keyed on its view: another pressure, speed or kick reuses the seated rider."""
+    sc = Scenario(fz_n=652.0)
+    first = assembly.build_bicycle(sc.bicycle_spec)
+    before = assembly._bicycle_setup.cache_info()
+    again = assembly.build_bicycle(sc.with_changes(pressure_kpa=300.0, speed=4.0, kick_accel=20.0).bicycle_spec)
+    after = assembly._bicycle_setup.cache_info()
+    assert (after.hits, after.misses) == (before.hits + 1, before.misses)
+    assert again == first and again[0] is not first[0]   # equal, and the caller's own copy

@@ -143,10 +143,10 @@ def test_a_leaning_rider_reports_the_static_loads_of_the_whole_rider():
     """The summary's static loads of a split rider include the upper body's weight (they were the bicycle's,
     the legs' and the forearms' alone: 344 N instead of 635 N at the rear). Computed here by hand from the
     split bicycle plus the upper body; measured equal to ~1e-13 N. Bound 1e-9 N."""
-    rigid = assembly.build_bicycle(wk.Scenario())[2]
+    rigid = assembly.build_bicycle(wk.Scenario().bicycle_spec)[2]
     for changes in ({"rider_body": "leaning"}, {"arms": "on"}, {"rider_body": "leaning", "arms": "on"}):
         sc = wk.Scenario(**changes)
-        split, _, info = assembly.build_bicycle(sc)
+        split, _, info = assembly.build_bicycle(sc.bicycle_spec)
         bench = benchmark.from_moore(split)
         body = info["body"]
         bike = wk.bicycles.load(sc.bicycle)
@@ -519,9 +519,9 @@ def test_the_whipple_design_sees_the_whole_rider():
     """With a body, the Whipple model the LQR is designed on (``build_bicycle``'s ``design``) is the whole rider
     lumped into the rear frame, as for the rigid rider: not the bicycle with legs and forearms only, which
     would leave the upper body's mass out of the rider's gains."""
-    rigid = assembly.build_bicycle(wk.Scenario())[1]
+    rigid = assembly.build_bicycle(wk.Scenario().bicycle_spec)[1]
     for changes in ({"rider_body": "leaning"}, {"arms": "on"}, {"rider_body": "leaning", "arms": "on"}):
-        moore, design, _ = assembly.build_bicycle(wk.Scenario(**changes))
+        moore, design, _ = assembly.build_bicycle(wk.Scenario(**changes).bicycle_spec)
         assert design == rigid and moore != rigid
 
 

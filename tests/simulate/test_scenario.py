@@ -19,7 +19,7 @@ def test_defaults_are_the_thesis_settings_and_validate_returns_the_scenario():
     kick = inputs.kick_of(sc)
     assert (kick.profile, kick.displacement, kick.duration) == ("constant", 0.150, 0.150)
     assert kick.peak_acceleration == pytest.approx(2 * 0.150 / 0.150 ** 2)      # 13.3 m/s^2
-    rear, front, notes = assembly.build_tyres(sc)
+    rear, front, notes = assembly.build_tyres(sc.tyre_spec)
     assert (rear.name, rear.pressure_kpa, front.pressure_kpa, notes) == ("T03", 400.0, 400.0, [])
     assert sc.lqr_design_speed == sc.speed == 3.0
     from whipple_kick.simulate.simulation import run

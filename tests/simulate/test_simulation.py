@@ -54,7 +54,7 @@ def test_front_and_rear_pressures_may_differ():
     """Each wheel gets the tyre of its own pressure: the assembled rear tyre is the 500 kPa one, the
     front the 300 kPa one, and the run differs from both runs at one pressure."""
     mixed = Scenario(pressure_front_kpa=300.0, pressure_rear_kpa=500.0, duration=0.3)
-    rear, front, _ = wk.assembly.build_tyres(mixed)
+    rear, front, _ = wk.assembly.build_tyres(mixed.tyre_spec)
     force = lambda tyre: tyre.lateral_force(slip=0.02, camber=0.05, fz=600.0)
     assert force(rear) == force(wk.tyres.load("T03", 500.0)) != force(wk.tyres.load("T03", 300.0)) == force(front)
     r = run(mixed)
@@ -85,7 +85,7 @@ def test_heading_rider_gains_are_applied_and_reported():
     # back to the old one: measured 4e-4 rad after 8 s, against 1.18 rad
     # kept by the balance-only rider; the bound 2 % leaves room for tuning).
     scenario = Scenario(pressure_kpa=400.0, fz_n=635.0, symmetric_tyres=True, duration=8.0)
-    design = wk.assembly.build_bicycle(scenario)[1]
+    design = wk.assembly.build_bicycle(scenario.bicycle_spec)[1]
     K, _ = wk.control.heading_lqr_gains(design, 3.0)
     held = run(scenario, gains=dict(zip(wk.control.HEADING_GAIN_ORDER, K, strict=True)))
     free = run(scenario)
@@ -223,7 +223,7 @@ def test_table_8_4_rider_in_the_no_slip_limit():
     # Measured 0.83 s and 0.64 s; the yaw rate 3.69 s.
     assert signals["roll_rate"]["time_s"] < 1.2 and signals["steer_rate"]["time_s"] < 1.2
     assert signals["yaw_rate"]["time_s"] > 3.0
-    moore, design, _ = wk.assembly.build_bicycle(scenario)
+    moore, design, _ = wk.assembly.build_bicycle(scenario.bicycle_spec)
     gains = wk.control.thesis_gains(635.0)
     K = [gains[k] for k in wk.control.GAIN_ORDER]
     classic_poles = np.linalg.eigvals(wk.control.closed_loop_matrix(moore, 3.0, K))
@@ -340,7 +340,7 @@ def test_rider_designed_at_the_run_speed_by_default():
     assert Scenario(speed=2.0, design_speed=3.0).lqr_design_speed == 3.0
     sc = Scenario(speed=2.5, duration=0.5)
     s = run(sc).summary
-    moore, design, _ = wk.assembly.build_bicycle(sc)
+    moore, design, _ = wk.assembly.build_bicycle(sc.bicycle_spec)
     K, design_poles = wk.control.lqr_gains(design, 2.5)
     assert s["controller"]["design_speed_m_s"] == 2.5
     assert [s["controller"]["gains"][k] for k in wk.control.GAIN_ORDER] == pytest.approx(K, rel=1e-12)
@@ -355,7 +355,7 @@ def test_the_3_m_s_rider_is_unstable_below_2_48_m_s_and_says_so():
     2.48 m/s (measured 2.467 m/s), +1.03 1/s at 2 m/s. A run there reports the poles at the run's speed for that rider and
     says in one line that it is linearly unstable."""
     from scipy.optimize import brentq
-    moore, design, _ = wk.assembly.build_bicycle(Scenario())
+    moore, design, _ = wk.assembly.build_bicycle(Scenario().bicycle_spec)
     gains = wk.control.gains_dict(wk.control.lqr_gains(design, 3.0)[0])
 
     def slowest(v):
@@ -637,7 +637,7 @@ def _force_bound_ratios(result):
     contact-patch forms; in the carcass form the force's limit at the wheel's camber and the moment at
     the lagged one.
     """
-    rear, front, _ = wk.assembly.build_tyres(result.scenario)
+    rear, front, _ = wk.assembly.build_tyres(result.scenario.tyre_spec)
     df = result.trajectory
     carcass = result.scenario.tyre_transient == "carcass"
     out = {}
@@ -699,9 +699,9 @@ def test_steady_rear_wheel_torque_is_a_brake_fed_by_the_tyres():
     from whipple_kick.model import slip
     from whipple_kick.simulate import lsoda, steady
     sc = r.scenario
-    moore, design, _ = wk.assembly.build_bicycle(sc)
-    gains, _ = wk.assembly.controller_gains(sc, design)
-    rear, front, _ = wk.assembly.build_tyres(sc)
+    moore, design, _ = wk.assembly.build_bicycle(sc.bicycle_spec)
+    gains, _ = wk.assembly.controller_gains(sc.gains_spec, design)
+    rear, front, _ = wk.assembly.build_tyres(sc.tyre_spec)
     ss = steady.steady_state(slip.model_parameters(moore, rear, front, gains=gains), 3.0)
     tr = lsoda.integrate(slip.CompiledRHS(dict(ss.params, T6c=0.0)), ss.x, 5.0, output_rate=10)
     assert np.hypot(tr.state("u1"), tr.state("u2"))[-1] > 3.001     # measured 3.004 m/s after 5 s

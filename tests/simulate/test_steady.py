@@ -12,8 +12,8 @@ from whipple_kick.simulate.simulation import Scenario
 
 def _params(pressure=400.0, fz=635.0, design_speed=3.0, symmetric=False):
     sc = Scenario(pressure_kpa=pressure, fz_n=fz)
-    moore, design, _ = wk.assembly.build_bicycle(sc)
-    rear, front, _ = wk.assembly.build_tyres(sc)
+    moore, design, _ = wk.assembly.build_bicycle(sc.bicycle_spec)
+    rear, front, _ = wk.assembly.build_tyres(sc.tyre_spec)
     gains = control.gains_dict(control.lqr_gains(design, design_speed)[0])
     return slip.model_parameters(moore, rear, front, gains=gains, symmetric=symmetric)
 

@@ -17,6 +17,8 @@ import re
 import numpy as np
 import pytest
 
+from conftest import SCENARIO_DEFAULTS as DEFAULTS
+from conftest import other_value
 from whipple_kick import cli
 from whipple_kick.errors import InputError
 from whipple_kick.library import inputs
@@ -24,7 +26,6 @@ from whipple_kick.model import slip
 from whipple_kick.simulate import assembly, control
 from whipple_kick.simulate.scenario import FIELD_GROUPS, MECHANISM_FIELDS, Scenario
 
-DEFAULTS = {f.name: f.default for f in dataclasses.fields(Scenario)}
 RIDER_FILE = pathlib.Path(__file__).parents[2] / "parameters" / "riders" / "jason.toml"
 
 
@@ -38,42 +39,6 @@ def other_rider(tmp_path_factory):
     path = tmp_path_factory.mktemp("rider") / "other.toml"
     path.write_text(head + "[measurements]" + changed)
     return str(path)
-
-
-def other_value(name, other_rider):
-    """A valid value of field ``name`` other than its default (other switches' values: another choice)."""
-    default = DEFAULTS[name]
-    special = {"bicycle": "browser_with_rider", "rider": other_rider, "tyre": "T04", "coefficient_set": "chapter8",
-               "friction": "plate", "fz_n": 701.0, "rider_mass_kg": 80.0, "rear_load_share": 0.66, "pressure_front_kpa": 350.0,
-               "pressure_rear_kpa": 350.0, "design_speed": 4.0, "thesis_load_n": 701.0, "kick_duration": 0.2,
-               "kick_accel": 10.0, "kick_table": "plate.csv", "steer_limit_deg": 80.0, "settle": 0.3,
-               "reflex_delay": 0.05, "arm_stiffness": 5.0, "arm_damping": 2.0, "carcass_damping": 50.0,
-               "reflex_roll": -3.0, "reflex_roll_rate": -1.0, "reflex_steer": 2.0, "reflex_steer_rate": 0.5}
-    if name in special:
-        return special[name]
-    if isinstance(default, bool):
-        return not default
-    if isinstance(default, str):
-        choices = _choices(name)
-        return next(c for c in choices if c != default)
-    return default * 0.8
-
-
-def _choices(name):
-    from whipple_kick.simulate import scenario as module
-    for label in dir(module):
-        value = getattr(module, label)
-        if label.isupper() and isinstance(value, tuple) and DEFAULTS[name] in value and len(value) > 1 \
-                and all(isinstance(v, str) for v in value):
-            return value
-    if name == "kick_profile":
-        return inputs.PROFILES
-    if name == "kick_direction":
-        return inputs.DIRECTIONS
-    if name == "carcass_sliding":
-        from whipple_kick.model import carcass
-        return carcass.SLIDING_LAWS
-    raise AssertionError(f"no choices known for field {name!r}")
 
 
 #: The mechanism switches, each with the other switches at their defaults; a new switch is a new line here,
@@ -112,18 +77,18 @@ def fingerprint(sc):
     """What the run of ``sc`` is made of; raises InputError where the scenario is refused."""
     assembly.preflight(sc)
     kick = inputs.kick_of(sc)
-    rear, front, _ = assembly.build_tyres(sc)
-    moore, design, info = assembly.build_bicycle(sc)
+    rear, front, _ = assembly.build_tyres(sc.tyre_spec)
+    moore, design, info = assembly.build_bicycle(sc.bicycle_spec)
+    body = assembly.rider_body(sc.body_spec, info)
     if sc.controller == "lqr" and sc.lqr_model == "simulated":
-        spec = assembly.design_spec(sc)
+        spec = sc.design_spec
         felt, K = control.simulated_design_start(spec, design)
-        A, b, C = control._linear_design_model(spec, moore, rear, front, assembly.rider_body(sc, info), felt, 1.0,
-                                               control.SCALED_BODY_GAINS)
+        A, b, C = control._linear_design_model(spec, moore, rear, front, body, felt, 1.0, control.SCALED_BODY_GAINS)
         gains = {"design": (A, b, C, K, sc.gain_scale, sc.lqr_design_speed)}
-        params = assembly.model_parameters(sc, kick, moore, info, rear, front, None)
+        params = assembly.model_parameters(sc.model_spec, kick, moore, body, rear, front, None)
     else:
-        gains, _ = assembly.controller_gains(sc, design)
-        params = assembly.model_parameters(sc, kick, moore, info, rear, front, gains)
+        gains, _ = assembly.controller_gains(sc.gains_spec, design)
+        params = assembly.model_parameters(sc.model_spec, kick, moore, body, rear, front, gains)
     return (slip.parameter_vector(params), gains, kick, integration_reads(sc),
             assembly.no_slip_plant(moore, design, info), float(sc.speed))
 
@@ -238,9 +203,10 @@ def test_item5_lean_gains_given_are_used():
     gains = assembly.custom_gains({"kq4": -10.0, "kq11": 3.0, "ku11": 0.5}, Scenario(rider_body="leaning"))
     assert gains["kq11"] == 3.0 and gains["ku11"] == 0.5 and gains["kq4"] == -10.0
     sc = Scenario(rider_body="leaning")
-    moore, _, info = assembly.build_bicycle(sc)
-    rear, front, _ = assembly.build_tyres(sc)
-    params = assembly.model_parameters(sc, inputs.kick_of(sc), moore, info, rear, front, gains)
+    moore, _, info = assembly.build_bicycle(sc.bicycle_spec)
+    rear, front, _ = assembly.build_tyres(sc.tyre_spec)
+    body = assembly.rider_body(sc.body_spec, info)
+    params = assembly.model_parameters(sc.model_spec, inputs.kick_of(sc), moore, body, rear, front, gains)
     assert params["kq11"] == 3.0 and params["ku11"] == 0.5
 
 

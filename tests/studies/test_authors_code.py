@@ -115,8 +115,8 @@ def test_parameters_equal_the_authors_number_for_number(name):
     stored = authors_code.load_run(DATA / folder)
     assert len(stored.samples) == 1001 and list(stored.samples.columns) == ["time", *authors_code.SIGNALS]
     sc = Scenario.authors_code(**changes)
-    moore, _, _ = wk.assembly.build_bicycle(sc)
-    rear, front, _ = wk.assembly.build_tyres(sc)
+    moore, _, _ = wk.assembly.build_bicycle(sc.bicycle_spec)
+    rear, front, _ = wk.assembly.build_tyres(sc.tyre_spec)
     params = slip.model_parameters(moore, rear, front)
     for theirs, ours in authors_code.PARAMETER_NAMES.items():
         assert params[ours] == stored.parameters[theirs], (theirs, ours)
@@ -124,7 +124,7 @@ def test_parameters_equal_the_authors_number_for_number(name):
     for tyre in (rear, front):
         (weight, fy, mz), = tyre.blend    # one measured pressure: their 500 kPa set
         assert weight == 1.0 and fy.tolist() == stored.tyre["Fy_coef"] and mz.tolist() == stored.tyre["Mz_coef"]
-    assert wk.assembly.controller_gains(sc, moore)[0] == {"kq4": -19.5679, "kq7": 15.4934,
+    assert wk.assembly.controller_gains(sc.gains_spec, moore)[0] == {"kq4": -19.5679, "kq7": 15.4934,
                                                           "ku4": -6.7665, "ku7": 1.5876}
 
 
@@ -172,8 +172,8 @@ def test_slip_speed_is_the_contact_points_forward_speed(compat):
     with slip_speed "wheel_centre" the same check is off by up to 0.07 m/s (rear) and 0.17 m/s (front)."""
     df = compat.trajectory[compat.trajectory["time"] <= 1.0]   # the first second (near the fall, 1 kHz is coarse)
     sc = Scenario.authors_code()
-    moore, _, _ = wk.assembly.build_bicycle(sc)
-    rear, front, _ = wk.assembly.build_tyres(sc)
+    moore, _, _ = wk.assembly.build_bicycle(sc.bicycle_spec)
+    rear, front, _ = wk.assembly.build_tyres(sc.tyre_spec)
     params = {**dict(moore), "rtr": rear.crown_radius, "rtf": front.crown_radius}
     columns = ("x_rear", "y_rear", "yaw", "roll", "frame_pitch", "rear_wheel_angle", "steer", "front_wheel_angle",
                "compression_rear", "compression_front")
@@ -205,13 +205,14 @@ def test_the_701N_preset_takes_its_own_table_8_4_gains():
     """Issue 24: Scenario.authors_code(bicycle="balanceassist_701N") kept the 635 N gains silently. The preset's
     label now selects the row; gains of another load are possible (thesis_load_n) and warned about."""
     sc = Scenario.authors_code(bicycle="balanceassist_701N")
-    moore, _, _ = wk.assembly.build_bicycle(sc)
-    assert wk.assembly.controller_gains(sc, moore)[0] == wk.control.thesis_gains(701.0)
-    assert wk.assembly.thesis_gains_warning(sc) is None
-    assert wk.assembly.thesis_gains_warning(Scenario.authors_code()) is None
-    warning = wk.assembly.thesis_gains_warning(sc.with_changes(thesis_load_n=635.0))
+    moore, _, _ = wk.assembly.build_bicycle(sc.bicycle_spec)
+    assert wk.assembly.controller_gains(sc.gains_spec, moore)[0] == wk.control.thesis_gains(701.0)
+    assert wk.assembly.thesis_gains_warning(sc.gains_spec) is None
+    assert wk.assembly.thesis_gains_warning(Scenario.authors_code().gains_spec) is None
+    warning = wk.assembly.thesis_gains_warning(sc.with_changes(thesis_load_n=635.0).gains_spec)
     assert "those for 635 N, but bicycle 'balanceassist_701N' is labelled a rear load of 701 N" in warning
     # A bicycle without rider: the load its rider is seated for.
     seated = Scenario(controller="thesis", fz_n=701.0, thesis_load_n=570.0)
-    assert "those for 570 N, but the rider is seated for a rear load of 701 N" in wk.assembly.thesis_gains_warning(seated)
-    assert wk.assembly.thesis_gains_warning(seated.with_changes(controller="lqr")) is None
+    warning = wk.assembly.thesis_gains_warning(seated.gains_spec)
+    assert "those for 570 N, but the rider is seated for a rear load of 701 N" in warning
+    assert wk.assembly.thesis_gains_warning(seated.with_changes(controller="lqr").gains_spec) is None

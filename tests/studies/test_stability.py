@@ -54,9 +54,9 @@ def test_heading_linearisation_equals_the_central_difference_one(symmetric, spee
     is a steady turn, so the rotating-frame terms are exercised.
     """
     sc = Scenario(symmetric_tyres=symmetric, controller=controller, speed=speed)
-    moore, design, _ = wk.assembly.build_bicycle(sc)
-    rear, front, _ = wk.assembly.build_tyres(sc)
-    gains, _ = wk.assembly.controller_gains(sc, design)
+    moore, design, _ = wk.assembly.build_bicycle(sc.bicycle_spec)
+    rear, front, _ = wk.assembly.build_tyres(sc.tyre_spec)
+    gains, _ = wk.assembly.controller_gains(sc.gains_spec, design)
     params = slip.model_parameters(moore, rear, front, gains=gains, symmetric=symmetric)
     steady = wk.steady.find_steady_state(params, speed).steady
     rhs = slip.CompiledRHS(steady.params)
@@ -75,8 +75,8 @@ def test_holonomic_row_is_the_front_contact_height_gradient():
     Measured agreement 6e-11 of the row's largest entry (central differences, step 1e-6 rad or m).
     """
     sc = Scenario(speed=3.0)
-    moore, design, _ = wk.assembly.build_bicycle(sc)
-    rear, front, _ = wk.assembly.build_tyres(sc)
+    moore, design, _ = wk.assembly.build_bicycle(sc.bicycle_spec)
+    rear, front, _ = wk.assembly.build_tyres(sc.tyre_spec)
     steady = wk.steady.steady_state(slip.model_parameters(moore, rear, front), 3.0)
     rhs = slip.CompiledRHS(steady.params)
     row = rhs.impulse_terms(0.0, steady.x)[1][slip.HOLONOMIC_ROW]
@@ -192,7 +192,7 @@ def test_stiff_tyres_give_the_classic_speeds_and_modes(rigid_sweep):
     1e-8 m/s (two root-finders on two routes to the same matrices).
     """
     s = rigid_sweep.summary
-    moore, _, _ = wk.assembly.build_bicycle(DEFAULT)
+    moore, _, _ = wk.assembly.build_bicycle(DEFAULT.bicycle_spec)
     weave, capsize = classic.weave_speed(moore, (2.0, 8.0)), classic.capsize_speed(moore, (4.0, 15.0))
     assert abs(s["no-slip"]["open"]["weave_speed_m_s"] - weave) < 1e-8
     assert abs(s["no-slip"]["open"]["capsize_speed_m_s"] - capsize) < 1e-8
@@ -254,7 +254,7 @@ def test_wobble_exists_and_matches_a_free_response(pressure):
     """
     model = stability.linear_model(Scenario(symmetric_tyres=True, pressure_kpa=pressure), 3.0, "closed")
     lam, vec = np.linalg.eig(model.matrix)
-    wheelbase = modes._wheelbase(wk.assembly.build_bicycle(DEFAULT)[0])
+    wheelbase = modes._wheelbase(wk.assembly.build_bicycle(DEFAULT.bicycle_spec)[0])
     named = [(k, stability.name_mode(stability.mode_content(model, lam[k], vec[:, k], wheelbase)[0],
                                      lam[k].imag == 0, abs(lam[k].imag) / (2 * math.pi)))
              for k in range(lam.size)]
@@ -324,8 +324,8 @@ def test_state_space_has_named_states_and_the_loops_poles():
     closed = ct.feedback(sys_ol, ct.ss([], [], [], model.K), sign=-1)
     assert np.allclose(np.sort_complex(closed.poles()), ref, rtol=1e-9, atol=1e-9)
     # the rider's gains, by name, on roll, steer and their rates
-    gains, _ = wk.assembly.controller_gains(DEFAULT.with_changes(speed=4.0),
-                                           wk.assembly.build_bicycle(DEFAULT)[1])
+    gains, _ = wk.assembly.controller_gains(DEFAULT.with_changes(speed=4.0).gains_spec,
+                                           wk.assembly.build_bicycle(DEFAULT.bicycle_spec)[1])
     for g, state in (("kq4", "q4"), ("kq7", "q7"), ("ku4", "u4"), ("ku7", "u7")):
         assert model.K[0, model.states.index(state)] == gains[g]
 
@@ -538,7 +538,7 @@ def test_leaning_rider_has_a_lean_mode_near_the_hip_estimate():
     res = stability.analyse(sc, [1.0, 1.5, 2.0])
     lean = _named(res.eigenvalues, 1.0, ["lean"])
     assert len(lean) == 1 and lean["share_lean"].iloc[0] > 0.5   # the eigenvector is mostly q11
-    body = wk.assembly.rider_body(sc, wk.assembly.build_bicycle(sc)[2])
+    body = wk.assembly.rider_body(sc.body_spec, wk.assembly.build_bicycle(sc.bicycle_spec)[2])
     inertia = body["it11"] + body["mt"] * body["lt3"] ** 2          # about the hinge
     stiffness = 400.0 - body["mt"] * 9.81 * -body["lt3"]             # hip spring less gravity
     f_sdof = math.sqrt(stiffness / inertia) / (2 * math.pi)         # 1.04 Hz

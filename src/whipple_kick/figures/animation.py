@@ -280,12 +280,12 @@ def _model_parameters(result, tyres):
     from whipple_kick.simulate import assembly
 
     scenario = result.scenario
-    moore, _, _ = assembly.build_bicycle(scenario)
+    moore, _, _ = assembly.build_bicycle(scenario.bicycle_spec)
     if tyres is None:
         if str(result.summary.get("tyres", {}).get("name", "")).startswith("custom"):
             raise InputError("this run used custom tyre objects: pass the same ones as tyres=(rear, front) "
                              "so the animation knows their crown radii (m)")
-        rear, front, _ = assembly.build_tyres(scenario)
+        rear, front, _ = assembly.build_tyres(scenario.tyre_spec)
     else:
         rear, front = tyres
     return dict(moore, rtr=rear.crown_radius, rtf=front.crown_radius)

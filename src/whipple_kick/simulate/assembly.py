@@ -5,11 +5,23 @@ validated :class:`~whipple_kick.simulate.scenario.Scenario` and its kick
 (:mod:`whipple_kick.library.inputs`), :func:`assemble` seats the Yeadon rider on
 the bicycle (:func:`build_bicycle`), loads the tyres (:func:`build_tyres`),
 designs or looks up the rider's steer-torque gains (:func:`controller_gains`),
-names every parameter of the compiled model
-(:func:`whipple_kick.model.slip.model_parameters`), finds the steady motion the
+names every parameter of the compiled model (:func:`model_parameters`), finds the steady motion the
 run starts from (:func:`whipple_kick.simulate.steady.start_state`) and judges whether the rider is
 linearly stable about it (:func:`linear_stability`). The result is one
 :class:`Assembly`, handed to the integration.
+
+Each of those steps takes the part of the scenario it reads, a frozen view
+(``scenario.bicycle_spec``, ``.tyre_spec``, ``.body_spec``, ``.gains_spec``,
+``.model_spec``, ``.design_spec``: :mod:`whipple_kick.simulate.scenario`), not the
+whole scenario: what a step reads is declared there, and the per-process caches
+are keyed on it.
+
+Example
+-------
+>>> import whipple_kick as wk
+>>> sc = wk.Scenario(controller="thesis", fz_n=701.0)
+>>> wk.assembly.controller_gains(sc.gains_spec, None)[0]["kq4"]   # Table 8.4, 701 N
+-20.5164
 """
 import copy
 from dataclasses import dataclass
@@ -106,23 +118,24 @@ def assemble(scenario, kick, *, tyres=None, gains=None) -> Assembly:
     custom = None if gains is None else custom_gains(gains, scenario)
     # Tyres first: a pressure outside the measured range is the commonest mistake and cheap to find.
     if tyres is None:
-        rear, front, notes = build_tyres(scenario)
+        rear, front, notes = build_tyres(scenario.tyre_spec)
     else:
         rear, front = tyres
         notes = [f"custom tyre objects (the scenario's tyre and pressures are not used): "
                  f"rear {rear!r}, front {front!r}"]
-    moore, design, info = build_bicycle(scenario)
+    moore, design, info = build_bicycle(scenario.bicycle_spec)
+    body = rider_body(scenario.body_spec, info)
     if custom is None and scenario.controller == "lqr" and scenario.lqr_model == "simulated":
-        gains, poles = (_cached_simulated_design(scenario) if tyres is None
-                        else control.lqr_on_simulated_model(design_spec(scenario), moore, design,
-                                                            rider_body(scenario, info), rear, front))
+        gains, poles = (simulated_design(scenario.design_spec, scenario.tyre_spec, scenario.bicycle_spec,
+                                         scenario.body_spec) if tyres is None
+                        else control.lqr_on_simulated_model(scenario.design_spec, moore, design, body, rear, front))
         controller = scenario.controller
     elif custom is None:
-        gains, poles = controller_gains(scenario, design)
+        gains, poles = controller_gains(scenario.gains_spec, design)
         controller = scenario.controller
     else:
         gains, poles, controller = custom, None, "custom gains"
-    params = model_parameters(scenario, kick, moore, info, rear, front, gains)
+    params = model_parameters(scenario.model_spec, kick, moore, body, rear, front, gains)
     found, start = steady.start_state(params, scenario, advice=_steady_advice(scenario, controller))
     stability = linear_stability(scenario, no_slip_plant(moore, design, info), gains, found, controller)
     steady_yaw_rate = float(start.x[slip.X["u3"]])
@@ -136,31 +149,42 @@ def assemble(scenario, kick, *, tyres=None, gains=None) -> Assembly:
 
 # ------------------------------------------------------------------ the parts
 
-def model_parameters(scenario, kick, moore, info, rear, front, gains):
-    """The compiled model's parameters of ``scenario`` (before the steady motion's drive torque is found)."""
-    return slip.model_parameters(moore, rear, front, gains=gains, symmetric=scenario.symmetric_tyres,
-                                 kick=kick.model_kick(), tyre_transient=scenario.tyre_transient,
-                                 reverse_camber=scenario.camber_sign == "reversed",
-                                 carcass_sliding=scenario.carcass_sliding, carcass_damping=scenario.carcass_damping,
-                                 carcass_viscosity=scenario.carcass_viscosity, slip_speed=scenario.slip_speed,
-                                 body=rider_body(scenario, info),
-                                 carcass_stiffness_scale=scenario.carcass_stiffness_scale)
+def model_parameters(spec, kick, moore, body, rear, front, gains):
+    """The compiled model's parameters by name (before the steady motion's drive torque is found).
+
+    Parameters
+    ----------
+    spec : whipple_kick.simulate.scenario.ModelSpec
+        The model's options (``scenario.model_spec``).
+    kick : whipple_kick.library.inputs.Kick
+        The plate motion (its first piece enters the parameters).
+    moore : dict
+        The bicycle with rider (:func:`build_bicycle`).
+    body : dict
+        The rider's body parameters (:func:`rider_body`).
+    rear, front : whipple_kick.library.tyres.Tyre
+    gains : dict or None
+        Steer-torque gains by name.
+    """
+    return slip.model_parameters(moore, rear, front, gains=gains, symmetric=spec.symmetric_tyres,
+                                 kick=kick.model_kick(), tyre_transient=spec.tyre_transient,
+                                 reverse_camber=spec.camber_sign == "reversed",
+                                 carcass_sliding=spec.carcass_sliding, carcass_damping=spec.carcass_damping,
+                                 carcass_viscosity=spec.carcass_viscosity, slip_speed=spec.slip_speed,
+                                 body=body, carcass_stiffness_scale=spec.carcass_stiffness_scale)
 
 
-def build_bicycle(scenario):
-    """Bicycle with rider for ``scenario``: (moore parameters, design parameters, info dict).
+def build_bicycle(spec):
+    """Bicycle with rider for ``spec`` (``scenario.bicycle_spec``): (moore parameters, design parameters, info dict).
 
     The info holds the rider mass [kg] and the static loads [N] of the
     unmodified bicycle; ``moore`` has the low-inertia change applied if asked.
     ``design`` is the unmodified set the LQR is designed on: the whole rider
     lumped into the rear frame, also when ``moore`` splits it into a body. Cached per
-    process on the fields it reads (a sweep over pressures, speeds or kicks
+    process on the spec and the bicycle file's stamp (a sweep over pressures, speeds or kicks
     seats the Yeadon rider once); callers get their own copies.
     """
-    key = (scenario.bicycle, _file_stamp(scenario.bicycle), scenario.fz_n, scenario.rider_mass_kg,
-           scenario.rider, scenario.low_inertia, scenario.rider_body != "rigid" or scenario.arms == "on",
-           scenario.arms == "on", scenario.rear_load_share, scenario.rider_body == "leaning")
-    return copy.deepcopy(_bicycle_setup(*key))
+    return copy.deepcopy(_bicycle_setup(spec, _file_stamp(spec.bicycle)))
 
 
 def _file_stamp(name):
@@ -173,47 +197,47 @@ def _file_stamp(name):
 
 
 @functools.lru_cache(maxsize=256)
-def _bicycle_setup(bicycle, _stamp, fz_n, rider_mass_kg, rider_name, low_inertia, split=False, arms_on_bar=False,
-                   share=None, leaning=False):
+def _bicycle_setup(spec, _stamp):
     from whipple_kick.library import bicycleparameters, riders
     from whipple_kick.model import benchmark
 
-    bike = bicycleparameters.load_bicycle(bicycle)
-    if split and bike.includes_rider:
+    bike = bicycleparameters.load_bicycle(spec.bicycle)
+    if spec.split and bike.includes_rider:
         raise _lumped_rider_error(bike)
-    _refuse_rider_file(bike, rider_name)
+    _refuse_rider_file(bike, spec.rider)
     if bike.includes_rider:
-        _refuse_load_on_preset(bike, fz_n, rider_mass_kg, share)
+        _refuse_load_on_preset(bike, spec.fz_n, spec.rider_mass_kg, spec.rear_load_share)
         combined, rider_mass = bike, None
-    elif share is not None:
+    elif spec.rear_load_share is not None:
         # The rider is shifted fore-aft so that the share holds (riders.for_load_share).
-        fz = 635.0 if fz_n is None and rider_mass_kg is None else fz_n
-        solution = riders.for_load_share(bike, share, fz_n=fz, rider_mass_kg=rider_mass_kg, rider=rider_name)
+        fz = 635.0 if spec.fz_n is None and spec.rider_mass_kg is None else spec.fz_n
+        solution = riders.for_load_share(bike, spec.rear_load_share, fz_n=fz, rider_mass_kg=spec.rider_mass_kg,
+                                          rider=spec.rider)
         combined, rider_mass, shift = solution.combined, solution.rider_mass_kg, solution.shift_m
-    elif rider_mass_kg is not None:
-        rider = riders.yeadon_rider(rider_name, mass_kg=rider_mass_kg)
-        combined, rider_mass = riders.seat(bike, rider), float(rider_mass_kg)
+    elif spec.rider_mass_kg is not None:
+        rider = riders.yeadon_rider(spec.rider, mass_kg=spec.rider_mass_kg)
+        combined, rider_mass = riders.seat(bike, rider), float(spec.rider_mass_kg)
     else:
-        fz = 635.0 if fz_n is None else fz_n
-        combined, rider_mass = riders.for_rear_load(bike, fz, rider=rider_name,
-                                                    load_range=_rear_load_range(bicycle, _stamp, rider_name))
+        fz = 635.0 if spec.fz_n is None else spec.fz_n
+        combined, rider_mass = riders.for_rear_load(bike, fz, rider=spec.rider,
+                                                    load_range=_rear_load_range(spec.bicycle, _stamp, spec.rider))
     # The static loads and the Whipple model the LQR is designed on are the whole rider's: the split below
     # moves the upper body out of the bicycle's parameters, not out of the statics or the rider's mass.
-    if share is None:
+    if spec.rear_load_share is None:
         shift = 0.0 if rider_mass is not None else None
     rear_n, front_n = riders.static_loads(combined)
     design = dict(combined.moore)
     body = None
-    if split:
+    if spec.split:
         # The same rider, split into legs (rear frame), forearms (front frame, when on the bar) and upper body.
-        rider = riders.yeadon_rider(rider_name, mass_kg=rider_mass)
-        combined, body = riders.seat_with_body(bike, rider, arms_on_bar=arms_on_bar, shift_m=shift)
+        rider = riders.yeadon_rider(spec.rider, mass_kg=rider_mass)
+        combined, body = riders.seat_with_body(bike, rider, arms_on_bar=spec.arms_on_bar, shift_m=shift)
     moore = dict(combined.moore)
-    if body and not leaning:
+    if body and not spec.leaning:
         # The rigid rider with the arms on the bar: the upper body is part of the rear frame (the model
         # without the trunk part), the forearms turn with the bar.
         moore = parts.merge_into_rear_frame(moore, body)
-    if low_inertia:
+    if spec.low_inertia:
         bench = dict(combined.benchmark)
         for key in LOW_INERTIA_KEYS:
             bench[key] *= 0.5
@@ -273,79 +297,70 @@ def _rear_load_range(bicycle, _stamp, rider_name):
     return riders.rear_load_range(bicycleparameters.load_bicycle(bicycle), rider_name)
 
 
-def rider_body(scenario, info):
-    """The rider's body parameters by name (:data:`whipple_kick.model.slip.parameters.BODY_NAMES`) for ``scenario``.
+def rider_body(spec, info):
+    """The rider's body parameters by name (:data:`whipple_kick.model.slip.parameters.BODY_NAMES`).
 
+    ``spec`` is ``scenario.body_spec``, ``info`` :func:`build_bicycle`'s.
     The rigid rider without arms is :data:`~whipple_kick.model.slip.parameters.RIGID_BODY` (the model without
     parts); the leaning rider adds the upper body of :func:`build_bicycle` and the hip's spring-damper (the
     trunk part); the arms' spring-damper and the reflex act in both. (The rigid rider with arms on the bar has
     its upper body in :func:`build_bicycle`'s rear frame.)
     """
     body = dict(slip.parameters.RIGID_BODY)
-    if info.get("body") and parts.TRUNK.selected(scenario):   # the model with the trunk part
+    if info.get("body") and parts.TRUNK.selected(spec):   # the model with the trunk part
         body.update({n: info["body"][n] for n in slip.parameters.TRUNK_BODY if n in info["body"]})
-        body.update(parts.TRUNK.field_parameters(scenario))   # its hip spring-damper
-    body.update(ka=scenario.arm_stiffness if scenario.arms == "on" else 0.0,
-                ca=scenario.arm_damping if scenario.arms == "on" else 0.0,
-                rq4=scenario.reflex_roll, ru4=scenario.reflex_roll_rate, rq7=scenario.reflex_steer,
-                ru7=scenario.reflex_steer_rate, reflex_delay=scenario.reflex_delay)
+        body.update(parts.TRUNK.field_parameters(spec))   # its hip spring-damper
+    body.update(ka=spec.arm_stiffness if spec.arms == "on" else 0.0,
+                ca=spec.arm_damping if spec.arms == "on" else 0.0,
+                rq4=spec.reflex_roll, ru4=spec.reflex_roll_rate, rq7=spec.reflex_steer,
+                ru7=spec.reflex_steer_rate, reflex_delay=spec.reflex_delay)
     return body
 
 
-#: Fields the design on the simulated model does not read (the kick, the run's length and numerics).
-_NOT_IN_DESIGN = ("kick_displacement", "kick_duration", "kick_accel", "kick_profile", "kick_table", "kick_direction",
-                  "settle", "duration", "rtol", "output_rate", "fall_angle_deg", "steer_limit_deg", "piecewise")
+def simulated_design(design, tyres, bicycle, body):
+    """:func:`~whipple_kick.simulate.control.lqr_on_simulated_model` on the scenario's own tyres and bicycle.
 
+    ``design``, ``tyres``, ``bicycle`` and ``body`` are the scenario's ``design_spec``, ``tyre_spec``,
+    ``bicycle_spec`` and ``body_spec``: all the design reads. Once per process for each (both kick
+    directions, or any kick, of a case share one design); callers get their own copies.
 
-def _cached_simulated_design(scenario):
-    """:func:`~whipple_kick.simulate.control.lqr_on_simulated_model` of ``scenario``, once per process for the fields the design reads.
-
-    Both kick directions (or any kick) of a case share one design.
+    Returns
+    -------
+    gains : dict
+        By name.
+    poles : ndarray
+        The design's closed-loop eigenvalues.
     """
-    from dataclasses import fields
-
-    key = scenario.with_changes(**{f.name: f.default for f in fields(scenario) if f.name in _NOT_IN_DESIGN})
-    gains, poles = _simulated_design(key)
+    gains, poles = _simulated_design(design, tyres, bicycle, body)
     return dict(gains), np.array(poles)
 
 
 @functools.lru_cache(maxsize=256)
-def _simulated_design(scenario):
-    rear, front, _ = build_tyres(scenario)
-    moore, design, info = build_bicycle(scenario)
-    gains, poles = control.lqr_on_simulated_model(design_spec(scenario), moore, design, rider_body(scenario, info),
-                                                  rear, front)
+def _simulated_design(design_spec, tyre_spec, bicycle_spec, body_spec):
+    rear, front, _ = build_tyres(tyre_spec)
+    moore, design, info = build_bicycle(bicycle_spec)
+    gains, poles = control.lqr_on_simulated_model(design_spec, moore, design, rider_body(body_spec, info), rear, front)
     return tuple(gains.items()), tuple(poles)
 
 
-def design_spec(scenario):
-    """What the LQR design on the simulated model reads of ``scenario`` (:class:`~.control.DesignSpec`)."""
-    return control.DesignSpec(
-        speed=float(scenario.lqr_design_speed), leaning=scenario.rider_body == "leaning",
-        heading=bool(scenario.lqr_heading), gain_scale=float(scenario.gain_scale),
-        model_options=(("tyre_transient", scenario.tyre_transient), ("carcass_sliding", scenario.carcass_sliding),
-                       ("carcass_damping", scenario.carcass_damping),
-                       ("carcass_viscosity", scenario.carcass_viscosity), ("slip_speed", scenario.slip_speed),
-                       ("carcass_stiffness_scale", scenario.carcass_stiffness_scale)))
-
-
-def controller_gains(scenario, design):
+def controller_gains(spec, design):
     """Steer-torque gains by name, and the LQR design's closed-loop poles at its design speed (or None).
 
-    The LQR rider is designed at :attr:`Scenario.lqr_design_speed` (the run's
-    speed unless ``design_speed`` is given).
+    ``spec`` is ``scenario.gains_spec``; ``design`` the Whipple model the LQR rider is designed on
+    (:func:`build_bicycle`'s; unused by the other controllers). The LQR rider is designed at
+    :attr:`Scenario.lqr_design_speed` (the run's speed unless ``design_speed`` is given).
     """
-    if scenario.controller == "off":
+    if spec.controller == "off":
         return dict.fromkeys(control.GAIN_ORDER, 0.0), None
-    if scenario.controller == "thesis":
-        gains = control.thesis_gains(thesis_load(scenario))
-        return {k: scenario.gain_scale * v for k, v in gains.items()}, None
-    K, poles = control.whipple_lqr(design, float(scenario.lqr_design_speed))
-    return control.gains_dict(K, scenario.gain_scale), poles
+    if spec.controller == "thesis":
+        gains = control.thesis_gains(thesis_load(spec))
+        return {k: spec.gain_scale * v for k, v in gains.items()}, None
+    K, poles = control.whipple_lqr(design, float(spec.lqr_design_speed))
+    return control.gains_dict(K, spec.gain_scale), poles
 
 
-def thesis_load(scenario):
-    """Rear load [N] whose Table 8.4 row ``controller="thesis"`` uses.
+def thesis_load(spec):
+    """Rear load [N] whose Table 8.4 row ``controller="thesis"`` uses (``spec``: ``scenario.gains_spec``).
 
     ``thesis_load_n`` if given, else ``fz_n``, else the load a preset with
     rider is labelled with (``balanceassist_635N``: 635 N), else 635 N for a
@@ -353,53 +368,54 @@ def thesis_load(scenario):
     """
     from whipple_kick.library import bicycleparameters
 
-    if scenario.thesis_load_n is not None:
-        return scenario.thesis_load_n
-    if scenario.fz_n is not None:
-        return scenario.fz_n
-    bike = bicycleparameters.load_bicycle(scenario.bicycle)
+    if spec.thesis_load_n is not None:
+        return spec.thesis_load_n
+    if spec.fz_n is not None:
+        return spec.fz_n
+    bike = bicycleparameters.load_bicycle(spec.bicycle)
     if bike.includes_rider and bike.thesis_rear_load_n is not None:
         return bike.thesis_rear_load_n
-    if scenario.rider_mass_kg is None and not bike.includes_rider:
+    if spec.rider_mass_kg is None and not bike.includes_rider:
         return 635.0
     raise InputError("controller thesis uses Table 8.4 gains for a rear load of 570, 635 or 701 N: give fz (N), "
                      "or thesis_load_n (--thesis-load N) for a rider given by mass or a preset with rider")
 
 
-def thesis_gains_warning(scenario):
+def thesis_gains_warning(spec):
     """One line when ``controller="thesis"`` uses the Table 8.4 gains of another load than the run's, else None.
 
-    The run's load: the one a preset with rider is labelled with, or ``fz_n``.
+    ``spec`` is ``scenario.gains_spec``. The run's load: the one a preset with rider is labelled with, or
+    ``fz_n``.
     """
     from whipple_kick.library import bicycleparameters
 
-    if scenario.controller != "thesis":
+    if spec.controller != "thesis":
         return None
-    bike = bicycleparameters.load_bicycle(scenario.bicycle)
+    bike = bicycleparameters.load_bicycle(spec.bicycle)
     own, what = ((bike.thesis_rear_load_n, f"bicycle {bike.name!r} is labelled") if bike.includes_rider
-                 else (scenario.fz_n, "the rider is seated for"))
-    gains = thesis_load(scenario)
+                 else (spec.fz_n, "the rider is seated for"))
+    gains = thesis_load(spec)
     if own is None or abs(own - gains) < 1e-9:
         return None
     return (f"the Table 8.4 gains in use are those for {gains:g} N, but {what} a rear load of {own:g} N "
             f"(thesis_load_n = {gains:g} N; leave it unset for the gains of {own:g} N)")
 
 
-def build_tyres(scenario):
-    """(rear, front) tyres and a list of notes about them."""
+def build_tyres(spec):
+    """(rear, front) tyres and a list of notes about them, for ``spec`` (``scenario.tyre_spec``)."""
     from whipple_kick.library import tyres
 
     notes = []
-    rear_p, front_p = scenario.pressures
+    rear_p, front_p = spec.pressures
     loaded = []
     for p in (rear_p, front_p):
         # missing_moment="zero" changes nothing for a tyre with M_z data (its flag says which it is).
-        tyre = tyres.load(scenario.tyre, p, coefficient_set=scenario.coefficient_set,
-                          friction=scenario.friction, missing_moment="zero")
+        tyre = tyres.load(spec.tyre, p, coefficient_set=spec.coefficient_set,
+                          friction=spec.friction, missing_moment="zero")
         loaded.append(tyre)
         if not tyre.has_aligning_moment:
             # Tyres without published M_z data: run with M_z = 0 and say so.
-            note = f"{scenario.tyre} has no published aligning-moment data: M_z = 0"
+            note = f"{spec.tyre} has no published aligning-moment data: M_z = 0"
             if note not in notes:
                 notes.append(note)
     return loaded[0], loaded[1], notes
@@ -408,14 +424,16 @@ def build_tyres(scenario):
 def preflight(scenario):
     """Cheap checks of everything a user can get wrong, before any long work.
 
-    Field ranges, tyre name and pressure range, bicycle name and rider
-    conflicts (a preset with its rider lumped in cannot lean or hold the bar), the Table 8.4 row of ``controller="thesis"``. Raises
-    :class:`InputError`; returns ``scenario``.
+    It takes the whole scenario, as it checks the whole of it: field ranges
+    (:meth:`~whipple_kick.simulate.scenario.Scenario.validate`), tyre name and
+    pressure range, bicycle name and rider conflicts (a preset with its rider
+    lumped in cannot lean or hold the bar), the Table 8.4 row of
+    ``controller="thesis"``. Raises :class:`InputError`; returns ``scenario``.
     """
     from whipple_kick.library import bicycleparameters
 
     scenario.validate()
-    build_tyres(scenario)
+    build_tyres(scenario.tyre_spec)
     bike = bicycleparameters.load_bicycle(scenario.bicycle)
     if bike.includes_rider:
         _refuse_load_on_preset(bike, scenario.fz_n, scenario.rider_mass_kg, scenario.rear_load_share)
@@ -423,7 +441,7 @@ def preflight(scenario):
         raise _lumped_rider_error(bike)
     _refuse_rider_file(bike, scenario.rider)
     if scenario.controller == "thesis":
-        control.thesis_gains(thesis_load(scenario))
+        control.thesis_gains(thesis_load(scenario.gains_spec))
     return scenario
 
 

@@ -15,7 +15,6 @@ time. It stays the library of the control-analysis API
 ``control.StateSpace``) and the tests' oracle: ``control.lqr`` gives the
 same gains (``tests/simulate/test_control.py``).
 """
-from dataclasses import dataclass
 import functools
 import math
 import warnings
@@ -378,32 +377,6 @@ def classic_closed_loop_poles(moore, speed, gains):
     return np.asarray(_classic_poles(tuple(sorted(moore.items())), float(speed), tuple(sorted(gains.items()))))
 
 
-@dataclass(frozen=True)
-class DesignSpec:
-    """What the LQR design on the simulated model reads of a run's scenario, and nothing else.
-
-    Attributes
-    ----------
-    speed : float
-        Design speed [m/s].
-    leaning : bool
-        The rider's upper body leans (its lean and lean rate are fed back).
-    heading : bool
-        The heading is fed back too (yaw-angle gain ``kq3``).
-    gain_scale : float
-        Factor on the designed gains [-].
-    model_options : tuple of (name, value)
-        Keyword options of :func:`whipple_kick.model.slip.model_parameters`
-        (tyre transient, carcass, slip speed).
-    """
-
-    speed: float
-    leaning: bool
-    heading: bool
-    gain_scale: float
-    model_options: tuple
-
-
 def lqr_on_simulated_model(spec, moore, design, body, rear, front):
     """The LQR rider designed on the model the run simulates (``lqr_model="simulated"``).
 
@@ -420,7 +393,7 @@ def lqr_on_simulated_model(spec, moore, design, body, rear, front):
 
     Parameters
     ----------
-    spec : DesignSpec
+    spec : whipple_kick.simulate.scenario.DesignSpec
         What the design reads of the run (speed, lean, heading, gain scale, the model's options).
     moore, design : dict
         The bicycle as simulated, and with the whole rider lumped (the Whipple design's model).

@@ -716,7 +716,7 @@ def _controller_section(scenario, assembly):
         # The LQR design's own poles, at its design speed (at the run's speed, for the gains used:
         # linear_stability.poles_no_slip_model_1_s).
         "design_poles_1_s": None if poles is None else [[p.real, p.imag] for p in poles],
-        "warning": None if kind == "custom gains" else assembly_module.thesis_gains_warning(scenario),
+        "warning": None if kind == "custom gains" else assembly_module.thesis_gains_warning(scenario.gains_spec),
     }
 
 

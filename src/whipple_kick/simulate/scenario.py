@@ -307,7 +307,10 @@ class Scenario:
     (the thesis' or its authors' code's: plate stop, heading at the kick,
     camber sign, start, start pitch, slip speed), each at the project's own
     choice by default. Construction stays flat: ``Scenario(speed=4.0,
-    rtol=1e-12, camber_sign="reversed")``.
+    rtol=1e-12, camber_sign="reversed")``. Each step of the assembly
+    (:mod:`whipple_kick.simulate.assembly`) reads its own frozen view:
+    :attr:`bicycle_spec`, :attr:`tyre_spec`, :attr:`body_spec`,
+    :attr:`gains_spec`, :attr:`model_spec`, :attr:`design_spec`.
     """
 
     bicycle: str = "balanceassist_v1"
@@ -380,7 +383,7 @@ class Scenario:
         -------
         >>> import whipple_kick as wk
         >>> sc = Scenario.thesis(bicycle="balanceassist_701N")
-        >>> wk.assembly.thesis_load(sc), wk.assembly.thesis_gains_warning(sc) is None
+        >>> wk.assembly.thesis_load(sc.gains_spec), wk.assembly.thesis_gains_warning(sc.gains_spec) is None
         (701.0, True)
         """
         base = dict(bicycle="balanceassist_635N", controller="thesis",
@@ -462,6 +465,50 @@ class Scenario:
         rear = self.pressure_kpa if self.pressure_rear_kpa is None else self.pressure_rear_kpa
         front = self.pressure_kpa if self.pressure_front_kpa is None else self.pressure_front_kpa
         return rear, front
+
+    # ------------------------------------------------------------ what each step of the assembly reads
+
+    @property
+    def bicycle_spec(self) -> "BicycleSpec":
+        """What :func:`~whipple_kick.simulate.assembly.build_bicycle` reads (:class:`BicycleSpec`)."""
+        return self._view(BicycleSpec)
+
+    @property
+    def tyre_spec(self) -> "TyreSpec":
+        """What :func:`~whipple_kick.simulate.assembly.build_tyres` reads (:class:`TyreSpec`).
+
+        Example
+        -------
+        >>> Scenario(pressure_front_kpa=350.0).tyre_spec
+        TyreSpec(tyre='T03', pressures=(400.0, 350.0), coefficient_set='table7_9', friction='none')
+        """
+        return self._view(TyreSpec)
+
+    @property
+    def body_spec(self) -> "BodySpec":
+        """What :func:`~whipple_kick.simulate.assembly.rider_body` reads (:class:`BodySpec`)."""
+        return self._view(BodySpec)
+
+    @property
+    def gains_spec(self) -> "GainsSpec":
+        """What :func:`~whipple_kick.simulate.assembly.controller_gains` reads (:class:`GainsSpec`)."""
+        return self._view(GainsSpec)
+
+    @property
+    def model_spec(self) -> "ModelSpec":
+        """What :func:`~whipple_kick.simulate.assembly.model_parameters` reads (:class:`ModelSpec`)."""
+        return self._view(ModelSpec)
+
+    @property
+    def design_spec(self) -> "DesignSpec":
+        """What the LQR design on the simulated model reads (:class:`DesignSpec`)."""
+        return DesignSpec(speed=float(self.lqr_design_speed), leaning=self.rider_body == "leaning",
+                          heading=bool(self.lqr_heading), gain_scale=float(self.gain_scale),
+                          model_options=tuple((name, getattr(self, name)) for name in DESIGN_MODEL_OPTIONS))
+
+    def _view(self, spec_class):
+        # The views' fields are named after the attributes they copy.
+        return spec_class(**{f.name: getattr(self, f.name) for f in fields(spec_class)})
 
     def validate(self) -> "Scenario":
         """Check every field; raise :class:`InputError` naming value, range and unit. Returns ``self``."""
@@ -735,3 +782,211 @@ FIELD_GROUPS = {
     "numerics": ("rtol", "piecewise", "carcass_viscosity"),
     "compatibility": ("plate_stop", "kick_heading", "camber_sign", "start", "start_pitch", "slip_speed"),
 }
+
+
+# ------------------------------------------------------------------ what each step of the assembly reads
+# One frozen (hashable) view per step of :mod:`whipple_kick.simulate.assembly`, built by the matching Scenario
+# property (``scenario.bicycle_spec`` ...). A step takes its view, not the Scenario, so what it reads
+# is declared here, a cache can be keyed on it, and a field outside it cannot change the step's result
+# (tests/simulate/test_assembly.py walks every field). The views hold no defaults: the Scenario's are the only
+# ones. Their fields are named after the Scenario attributes they copy (fields, or the derived
+# ``pressures`` and ``lqr_design_speed``), except :class:`DesignSpec`'s.
+
+
+@dataclass(frozen=True)
+class BicycleSpec:
+    """What :func:`~whipple_kick.simulate.assembly.build_bicycle` reads: the bicycle and the rider seated on it.
+
+    Attributes
+    ----------
+    bicycle : str
+        Bicycle parameter set or path.
+    fz_n : float or None
+        Static rear-tyre load [N] the rider's mass is chosen for.
+    rider_mass_kg : float or None
+        The rider's mass [kg].
+    rear_load_share : float or None
+        Fraction of the static weight on the rear tyre [1].
+    rider : str
+        Yeadon rider file.
+    low_inertia : bool
+        Halve the rear frame's inertias and mass-centre height (thesis Figure 8.9).
+    rider_body : {"rigid", "leaning"}
+        The rider lumped into the rear frame, or an upper body leaning on the saddle.
+    arms : {"off", "on"}
+        Whether the forearms turn with the bar.
+    """
+
+    bicycle: str
+    fz_n: float | None
+    rider_mass_kg: float | None
+    rear_load_share: float | None
+    rider: str
+    low_inertia: bool
+    rider_body: str
+    arms: str
+
+    @property
+    def split(self) -> bool:
+        """Whether the rider is split into legs, forearms and upper body (a leaning body or arms on the bar)."""
+        return self.rider_body != "rigid" or self.arms_on_bar
+
+    @property
+    def leaning(self) -> bool:
+        """Whether the upper body leans on the hip (otherwise it is merged into the rear frame)."""
+        return self.rider_body == "leaning"
+
+    @property
+    def arms_on_bar(self) -> bool:
+        """Whether the forearms and hands turn with the bar."""
+        return self.arms == "on"
+
+
+@dataclass(frozen=True)
+class TyreSpec:
+    """What :func:`~whipple_kick.simulate.assembly.build_tyres` reads: the tyres and their pressures.
+
+    Attributes
+    ----------
+    tyre : str
+        Tyre on both wheels.
+    pressures : (float, float)
+        (rear, front) inflation pressures [kPa] (:attr:`Scenario.pressures`).
+    coefficient_set : str
+        Magic-Formula coefficient set.
+    friction : str
+        Friction mode of both tyres.
+    """
+
+    tyre: str
+    pressures: tuple
+    coefficient_set: str
+    friction: str
+
+
+@dataclass(frozen=True)
+class BodySpec:
+    """What :func:`~whipple_kick.simulate.assembly.rider_body` reads: the rider's body, arms and reflex.
+
+    Attributes
+    ----------
+    rider_body : {"rigid", "leaning"}
+        Selects the leaning upper body (the trunk part, :data:`whipple_kick.model.parts.TRUNK`).
+    arms : {"off", "on"}
+        Whether the arms' spring-damper acts about the steer axis.
+    hip_stiffness, hip_damping : float
+        The declared parts' fields (:func:`whipple_kick.model.parts.fields`): the hip's spring [N m/rad]
+        and damper [N m s/rad].
+    arm_stiffness, arm_damping : float
+        The arms about the steer axis [N m/rad, N m s/rad].
+    reflex_delay : float
+        Delay of the reflex [s].
+    reflex_roll, reflex_roll_rate, reflex_steer, reflex_steer_rate : float
+        Reflex gains on roll [N m/rad], roll rate [N m s/rad], steer [N m/rad] and steer rate [N m s/rad].
+    """
+
+    rider_body: str
+    arms: str
+    hip_stiffness: float
+    hip_damping: float
+    arm_stiffness: float
+    arm_damping: float
+    reflex_delay: float
+    reflex_roll: float
+    reflex_roll_rate: float
+    reflex_steer: float
+    reflex_steer_rate: float
+
+
+@dataclass(frozen=True)
+class GainsSpec:
+    """What :func:`~whipple_kick.simulate.assembly.controller_gains` and the thesis' gain look-up read.
+
+    Attributes
+    ----------
+    controller : {"lqr", "thesis", "off"}
+        The rider's voluntary law.
+    gain_scale : float
+        Factor on every gain [1].
+    lqr_design_speed : float
+        Speed [m/s] the LQR rider is designed at (:attr:`Scenario.lqr_design_speed`).
+    thesis_load_n : float or None
+        Rear load [N] of the Table 8.4 row ``controller="thesis"`` uses.
+    fz_n, rider_mass_kg : float or None
+        The rear load [N] or rider mass [kg] the rider is seated for (the row's default).
+    bicycle : str
+        Bicycle parameter set or path (a preset with rider is labelled with its load).
+    """
+
+    controller: str
+    gain_scale: float
+    lqr_design_speed: float
+    thesis_load_n: float | None
+    fz_n: float | None
+    rider_mass_kg: float | None
+    bicycle: str
+
+
+@dataclass(frozen=True)
+class ModelSpec:
+    """What :func:`~whipple_kick.simulate.assembly.model_parameters` reads: the compiled model's options.
+
+    Attributes
+    ----------
+    symmetric_tyres : bool
+        Zero the tyres' zero-slip offsets.
+    tyre_transient : str
+        How the tyre forces build up (:mod:`whipple_kick.model.transient`).
+    camber_sign : {"physical", "reversed"}
+        Sign of the camber the Magic Formula is fed.
+    carcass_sliding : {"peak", "curve"}
+        The carcass tyre's friction limit.
+    carcass_damping : float
+        Lateral damping of each carcass [N s/m].
+    carcass_viscosity : float
+        Sliding viscosity [N s/m] regularising the friction limit.
+    carcass_stiffness_scale : float
+        Factor on both carcass stiffnesses [1].
+    slip_speed : {"wheel_centre", "contact_point"}
+        Whose forward speed the tyres' slip angle uses.
+    """
+
+    symmetric_tyres: bool
+    tyre_transient: str
+    camber_sign: str
+    carcass_sliding: str
+    carcass_damping: float
+    carcass_viscosity: float
+    carcass_stiffness_scale: float
+    slip_speed: str
+
+
+#: The options of the compiled model the LQR design on the simulated model uses, in :class:`DesignSpec` order.
+DESIGN_MODEL_OPTIONS = ("tyre_transient", "carcass_sliding", "carcass_damping", "carcass_viscosity", "slip_speed",
+                        "carcass_stiffness_scale")
+
+
+@dataclass(frozen=True)
+class DesignSpec:
+    """What the LQR design on the simulated model reads of a run's scenario, and nothing else.
+
+    Attributes
+    ----------
+    speed : float
+        Design speed [m/s].
+    leaning : bool
+        The rider's upper body leans (its lean and lean rate are fed back).
+    heading : bool
+        The heading is fed back too (yaw-angle gain ``kq3``).
+    gain_scale : float
+        Factor on the designed gains [-].
+    model_options : tuple of (name, value)
+        Keyword options of :func:`whipple_kick.model.slip.model_parameters`
+        (tyre transient, carcass, slip speed: :data:`DESIGN_MODEL_OPTIONS`).
+    """
+
+    speed: float
+    leaning: bool
+    heading: bool
+    gain_scale: float
+    model_options: tuple

@@ -31,9 +31,9 @@ Example
 -------
 >>> from whipple_kick import Scenario, assembly, slip, steady
 >>> sc = Scenario()
->>> moore, design, _ = assembly.build_bicycle(sc)
->>> rear, front, _ = assembly.build_tyres(sc)
->>> gains, _ = assembly.controller_gains(sc, design)
+>>> moore, design, _ = assembly.build_bicycle(sc.bicycle_spec)
+>>> rear, front, _ = assembly.build_tyres(sc.tyre_spec)
+>>> gains, _ = assembly.controller_gains(sc.gains_spec, design)
 >>> found = steady.find_steady_state(slip.model_parameters(moore, rear, front, gains=gains), 3.0)
 >>> found.route
 'direct'

@@ -227,9 +227,9 @@ class _Setup:
 
 def _setup(scenario, tyres=None):
     assembly.preflight(scenario)
-    moore, design, info = assembly.build_bicycle(scenario)
+    moore, design, info = assembly.build_bicycle(scenario.bicycle_spec)
     if tyres is None:
-        rear, front, notes = assembly.build_tyres(scenario)
+        rear, front, notes = assembly.build_tyres(scenario.tyre_spec)
     else:
         (rear, front), notes = tyres, [f"tyres given: {tyres[0]!r} (rear), {tyres[1]!r} (front)"]
     # The no-slip reference's rider is the rigid one: the whole rider lumped, as in the run's verdict.
@@ -243,7 +243,7 @@ def _base_params(setup):
     return slip.model_parameters(setup.moore, *setup.tyres, symmetric=sc.symmetric_tyres,
                                  tyre_transient=sc.tyre_transient,
                                  reverse_camber=sc.camber_sign == "reversed", slip_speed=sc.slip_speed,
-                                 body=assembly.rider_body(sc, setup.info))
+                                 body=assembly.rider_body(sc.body_spec, setup.info))
 
 
 def _loop_params(setup, speed, loop, base=None):
@@ -263,12 +263,12 @@ def _rider_gains(setup, speed):
     """The rider's gains by name at ``speed`` (the LQR on the simulated model cached per design speed)."""
     sc = setup.scenario.with_changes(speed=float(speed))
     if sc.controller != "lqr" or sc.lqr_model != "simulated":
-        return assembly.controller_gains(sc, setup.design)[0]
+        return assembly.controller_gains(sc.gains_spec, setup.design)[0]
     key = float(sc.lqr_design_speed)
     if key not in setup.designs:
         try:
             setup.designs[key] = control.lqr_on_simulated_model(
-                assembly.design_spec(sc), setup.moore, setup.design, assembly.rider_body(sc, setup.info),
+                sc.design_spec, setup.moore, setup.design, assembly.rider_body(sc.body_spec, setup.info),
                 *setup.tyres)[0]
         except InputError as exc:
             setup.designs[key] = NoRiderDesign(f"no LQR rider designed on the model simulated at {key:g} m/s: "

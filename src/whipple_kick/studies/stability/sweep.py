@@ -341,7 +341,7 @@ def _classic_rows(setup, speeds, loops, raw=None, groups=GROUPS):
 def _classic_gains(setup, speed):
     """The rider's gains on the no-slip model: the scenario's controller on the rigid rider (Whipple design)."""
     from whipple_kick.simulate import control
-    gains, _ = assembly.controller_gains(setup.scenario.with_changes(speed=float(speed)), setup.design)
+    gains, _ = assembly.controller_gains(setup.scenario.with_changes(speed=float(speed)).gains_spec, setup.design)
     return np.array([gains.get(n, 0.0) for n in control.GAIN_ORDER])
 
 
