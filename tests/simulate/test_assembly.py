@@ -261,3 +261,26 @@ def test_a_bicycle_is_seated_once_for_scenarios_that_differ_outside_its_view():
     after = assembly._bicycle_setup.cache_info()
     assert (after.hits, after.misses) == (before.hits + 1, before.misses)
     assert again == first and again[0] is not first[0]   # equal, and the caller's own copy
+
+
+def test_an_edited_bicycle_file_is_designed_on_afresh(tmp_path):
+    """The design on the simulated model is cached per process on its views and the bicycle file's stamp: an
+    edited file gives a new design (the same file unedited is a cache hit)."""
+    from importlib import resources
+    import os
+    import shutil
+
+    from whipple_kick import parameter_files
+
+    path = tmp_path / "bike.toml"
+    shutil.copy(resources.files(parameter_files) / "bicycles" / "balanceassist_v1.toml", path)
+    sc = wk.Scenario(bicycle=str(path), controller="lqr", lqr_model="simulated").validate()
+    specs = (sc.design_spec, sc.tyre_spec, sc.bicycle_spec, sc.body_spec)
+    before, _ = assembly.simulated_design(*specs)
+    assert assembly.simulated_design(*specs)[0] == before
+    text = path.read_text().replace("mR   = { value = 4.085,", "mR   = { value = 8.085,")
+    path.write_text(text)
+    stat = path.stat()
+    os.utime(path, ns=(stat.st_atime_ns, stat.st_mtime_ns + 10**9))   # a new stamp even on a coarse clock
+    after, _ = assembly.simulated_design(*specs)
+    assert after != before

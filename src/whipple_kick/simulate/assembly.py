@@ -331,12 +331,13 @@ def simulated_design(design, tyres, bicycle, body):
     poles : ndarray
         The design's closed-loop eigenvalues.
     """
-    gains, poles = _simulated_design(design, tyres, bicycle, body)
+    # Keyed on the bicycle file's stamp too, as build_bicycle is: an edited file is designed on again.
+    gains, poles = _simulated_design(design, tyres, bicycle, body, _file_stamp(bicycle.bicycle))
     return dict(gains), np.array(poles)
 
 
 @functools.lru_cache(maxsize=256)
-def _simulated_design(design_spec, tyre_spec, bicycle_spec, body_spec):
+def _simulated_design(design_spec, tyre_spec, bicycle_spec, body_spec, _stamp):
     rear, front, _ = build_tyres(tyre_spec)
     moore, design, info = build_bicycle(bicycle_spec)
     gains, poles = control.lqr_on_simulated_model(design_spec, moore, design, rider_body(body_spec, info), rear, front)

@@ -70,6 +70,8 @@ for _part in parts.REGISTRY.values():
 def _with_part_fields(cls):
     """Give ``cls`` the declared parts' fields, each after the field that selects its part, and document them.
 
+    For :class:`Scenario` and for the view of the step that reads them (:class:`BodySpec`).
+
     A part declares its fields once, with range, unit, default and source
     (:func:`whipple_kick.model.parts.fields`); the dataclass field, its
     entry in the class's docstring, its range check, its CLI flag and its
@@ -83,12 +85,15 @@ def _with_part_fields(cls):
             f = by_name[extra]
             part = next(p for p in parts.REGISTRY.values() if f in p.fields)
             annotations[extra] = float
-            setattr(cls, extra, f.default)
+            if hasattr(cls, name):   # defaults where the class has them (Scenario), none in a view
+                setattr(cls, extra, f.default)
             documented.append(f"    {extra} : float\n        The {f.label} of {part.title or part.name} "
                               f"[{f.unit}], {f.low:g} to {f.high:g}; default {f.default:g}: {f.source}.\n")
     cls.__annotations__ = annotations
-    # The entries join the docstring's Parameters section, just before its Notes.
-    cls.__doc__ = cls.__doc__.replace("\n    Notes\n    -----", "".join(documented) + "\n    Notes\n    -----", 1)
+    # The entries join the docstring's list of fields: before its Notes, or at its end.
+    notes = "\n    Notes\n    -----"
+    cls.__doc__ = (cls.__doc__.replace(notes, "".join(documented) + notes, 1) if notes in cls.__doc__
+                   else cls.__doc__.rstrip() + "\n" + "".join(documented))
     return cls
 
 
@@ -865,6 +870,7 @@ class TyreSpec:
 
 
 @dataclass(frozen=True)
+@_with_part_fields
 class BodySpec:
     """What :func:`~whipple_kick.simulate.assembly.rider_body` reads: the rider's body, arms and reflex.
 
@@ -874,9 +880,6 @@ class BodySpec:
         Selects the leaning upper body (the trunk part, :data:`whipple_kick.model.parts.TRUNK`).
     arms : {"off", "on"}
         Whether the arms' spring-damper acts about the steer axis.
-    hip_stiffness, hip_damping : float
-        The declared parts' fields (:func:`whipple_kick.model.parts.fields`): the hip's spring [N m/rad]
-        and damper [N m s/rad].
     arm_stiffness, arm_damping : float
         The arms about the steer axis [N m/rad, N m s/rad].
     reflex_delay : float
@@ -887,8 +890,6 @@ class BodySpec:
 
     rider_body: str
     arms: str
-    hip_stiffness: float
-    hip_damping: float
     arm_stiffness: float
     arm_damping: float
     reflex_delay: float
