@@ -300,15 +300,12 @@ def _body_options(p, default):
     g.add_argument("--arms", choices=ARMS, default=default("arms"),
                    help="on: the forearms turn with the bar and the arms are a spring-damper about the steer axis; "
                         "off (default): no mechanical effect on the bar")
-    # The declared parts' fields (the leaning upper body's hip) get their flags from the declarations.
+    # The declared parts' fields (the leaning upper body's hip, the arms' spring-damper) get their flags from
+    # the declarations.
     declared = tuple((f"--{f.name.replace('_', '-')}", f.name, f.unit, _metavar(f.unit), f"{f.label} of {part.title}")
                      for part in parts.REGISTRY.values() for f in part.fields)
     for flag, field, unit, meta, what in (
             *declared,
-            ("--arm-stiffness", "arm_stiffness", "N m/rad", "N_M_PER_RAD", "arms' spring about the steer axis "
-                                                                            "(with --arms on)"),
-            ("--arm-damping", "arm_damping", "N m s/rad", "N_M_S_PER_RAD", "arms' damper about the steer axis "
-                                                                            "(with --arms on)"),
             ("--reflex-delay", "reflex_delay", "s", "S",
              "delay of the rider's reflex steer torque (a Pade filter; at most 0.5 s)"),
             ("--reflex-roll", "reflex_roll", "N m/rad", "N_M_PER_RAD",
@@ -454,8 +451,7 @@ def _flags_given(argv):
 
 #: Scenario fields of the rider's-body options (and the LQR design model, the carcass stiffness scale), each
 #: set by the flag of its own name.
-_BODY_FIELDS = ("rider_body", "arms", *(f.name for f in parts.fields()), "arm_stiffness", "arm_damping",
-                "reflex_delay", "reflex_roll", "reflex_roll_rate", "reflex_steer", "reflex_steer_rate",
+_BODY_FIELDS = ("rider_body", "arms", *(f.name for f in parts.fields()), "reflex_delay", "reflex_roll", "reflex_roll_rate", "reflex_steer", "reflex_steer_rate",
                 "carcass_stiffness_scale", "lqr_model", "lqr_heading")
 
 

@@ -170,25 +170,27 @@ def test_a_part_declared_here_is_built_run_and_energy_checked(shift):
 
 
 def test_a_parts_scenario_fields_come_from_its_declaration():
-    """The trunk's fields (hip stiffness and damping) are scenario fields with the declared defaults, validated
-    with the declared range and unit, refused while the part is not selected (rider_body 'rigid') and given
-    CLI flags, all from the declaration; the run's trunk parameters are the fields' values."""
+    """The parts' fields (the trunk's hip stiffness and damping, the arms' stiffness and damping) are scenario
+    fields with the declared defaults, validated with the declared range and unit, refused while the part is
+    not selected (rider_body 'rigid', arms 'off') and given CLI flags, all from the declaration; the run's
+    part parameters are the fields' values."""
     from whipple_kick import cli
     from whipple_kick.simulate import scenario as scenario_module
-    from whipple_kick.simulate.scenario import FIELD_GROUPS, Scenario
+    from whipple_kick.simulate.scenario import FIELD_GROUPS, BodySpec, Scenario
 
     fields = parts.fields()
-    assert [f.name for f in fields] == ["hip_stiffness", "hip_damping"]
-    for f in fields:
-        assert Scenario.__dataclass_fields__[f.name].default == f.default and f.source
-        assert f"    {f.name} : float\n        The {f.label} of the leaning upper body [{f.unit}]" in Scenario.__doc__
-        assert f.name in FIELD_GROUPS["physics"]
-    # Generated, not hand-kept: the fields follow the field that selects the part, in declaration order.
+    assert [f.name for f in fields] == ["hip_stiffness", "hip_damping", "arm_stiffness", "arm_damping"]
     names = [f.name for f in dataclasses.fields(Scenario)]
-    at = names.index("rider_body")
-    assert names[at + 1:at + 3] == ["hip_stiffness", "hip_damping"]
     source = inspect.getsource(scenario_module)
-    assert "hip_stiffness" not in source and "hip_damping" not in source
+    for part in (parts.TRUNK, parts.ARMS):
+        for f in part.fields:
+            assert Scenario.__dataclass_fields__[f.name].default == f.default and f.source
+            assert f"    {f.name} : float\n        The {f.label} of {part.title} [{f.unit}]" in Scenario.__doc__
+            assert f.name in FIELD_GROUPS["physics"] and f.name in BodySpec.__dataclass_fields__
+            assert f.name not in source   # generated, not hand-kept
+        # The fields follow the field that selects the part, in declaration order.
+        at = names.index(part.selected_by[0])
+        assert names[at + 1:at + 1 + len(part.fields)] == [f.name for f in part.fields]
     with pytest.raises(wk.InputError, match=r"hip stiffness = -1.0 N m/rad is outside the allowed range"):
         Scenario(rider_body="leaning", hip_stiffness=-1.0).validate()
     assert "the leaning upper body (rider_body 'leaning')" in Scenario(hip_damping=10.0).unused_fields()["hip_damping"]
@@ -197,5 +199,8 @@ def test_a_parts_scenario_fields_come_from_its_declaration():
     sc = Scenario(rider_body="leaning", hip_stiffness=300.0, hip_damping=7.0)
     assert parts.selected(sc) == (parts.TRUNK,) and parts.selected(Scenario()) == ()
     assert parts.TRUNK.field_parameters(sc) == {"kh": 300.0, "ch": 7.0}
+    arms = Scenario(arms="on", arm_stiffness=10.0, arm_damping=1.0)
+    assert parts.selected(arms) == (parts.ARMS,) and parts.ARMS.field_parameters(arms) == {"ka": 10.0, "ca": 1.0}
+    assert "the arms on the bar (arms 'on')" in Scenario(arm_damping=1.0).unused_fields()["arm_damping"]
     from whipple_kick.studies.stability import report
     assert "; the leaning upper body (hip stiffness 300 N m/rad, hip damping 7 N m s/rad)" in report.describe(sc)

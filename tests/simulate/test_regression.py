@@ -39,6 +39,7 @@ import numpy as np
 import pytest
 
 import whipple_kick as wk
+from whipple_kick.model import parts
 from whipple_kick.simulate import simulation
 
 DATA = pathlib.Path(__file__).resolve().parents[1] / "data" / "regression"
@@ -66,9 +67,18 @@ def load_reference(name, folder=DATA):
     return regenerate_regression.runnable(scenario, folder), arrays
 
 
+#: Trajectory columns of the declared parts (their states and outputs): a run whose model lacks the part
+#: has none of them.
+PART_COLUMNS = {name for part in parts.REGISTRY.values()
+                for name in (*part.outputs, *(column for column, _ in part.columns.values()))}
+
+
 def trajectory(scenario, columns, tyres=None):
+    """The run's ``columns``; a part's column the run's model lacks (the arms' torque of a rider without arms)
+    is zero, which its reference must then be throughout (a reference made when the part's terms were in
+    every model, multiplied by zero)."""
     df = simulation.run(scenario, tyres=tyres).trajectory
-    return {c: df[c].to_numpy() for c in columns}
+    return {c: df[c].to_numpy() if c in df or c not in PART_COLUMNS else np.zeros(len(df)) for c in columns}
 
 
 def deviations(fresh, ref):

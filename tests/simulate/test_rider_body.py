@@ -342,7 +342,7 @@ def test_hip_and_arm_springs_and_dampers_are_in_the_energy(bike, rider, t03):
     assert out[slip.OUT["spring_energy"]] - tyres == pytest.approx(springs, rel=1e-12)
     assert dx[slip.X["D_damper"]] == pytest.approx(50.0 * 0.3 ** 2 + 1.5 * arm_rate ** 2, rel=1e-12)
     assert out[rhs.layout.OUT["hip_torque"]] == pytest.approx(-(128.0 * 0.05 + 50.0 * -0.3), rel=1e-12)
-    assert out[slip.OUT["arm_torque"]] == pytest.approx(-(10.0 * arm_angle + 1.5 * arm_rate), rel=1e-12)
+    assert out[rhs.layout.OUT["arm_steer_torque"]] == pytest.approx(-(10.0 * arm_angle + 1.5 * arm_rate), rel=1e-12)
 
 
 # ----------------------------------------------------------------- 7. output-feedback LQR

@@ -1,8 +1,8 @@
 """The rider's degrees of freedom as declared parts of the bicycle-rider system.
 
 The slip model (:func:`whipple_kick.model.symbolic.derivation.slip_equations`)
-is the bicycle with a rigid rider lumped into the rear frame, its arms'
-spring-damper about the steer axis and its reflex; each :class:`Part` adds
+is the bicycle with a rigid rider lumped into the rear frame and its
+reflex; each :class:`Part` adds
 to it what it declares: its symbols (with units and descriptions), its
 coordinates and speeds, its bodies, joint, springs, dampers and loads (its
 ``build``), its parameters, the rider's feedback gains on its states, its
@@ -18,7 +18,10 @@ each declare their coordinates (Stienstra, SymBRiM documentation), written
 for this model's single Kane derivation.
 
 :data:`TRUNK` is the rider's upper body leaning on the hip (Moore 2012, ch. 4,
-"Leaning rider extension"). :func:`merge_into_rear_frame` lumps an upper
+"Leaning rider extension"); :data:`ARMS` the arms' spring-damper about the
+steer axis between the bar and the frame the hands hold (the upper body's
+when it leans: it is declared after the trunk, and parts are built in
+declaration order). :func:`merge_into_rear_frame` lumps an upper
 body into the rear frame, exactly, for the rigid rider whose arms hold the bar.
 """
 from collections.abc import Callable
@@ -284,6 +287,55 @@ TRUNK = declare(Part(
               "Moore (2012, ch. 4, 'Leaning rider extension', from de Lorenzo and Hubbard)"),
     ),
     title="the leaning upper body",
+))
+
+
+# ------------------------------------------------------------------ the arms
+
+def _build_arms(m):
+    """The arms' spring-damper about the steer axis, between the bar E and the frame the hands hold.
+
+    Built after the trunk (declaration order), so the hands' frame is the upper body's when it leans.
+    """
+    kin, b = m.kin, m.par
+    C, E = kin.frames["C"], kin.frames["E"]
+    # The bar turns relative to the hands' frame by q7 less that frame's own turn about C.z (exact).
+    arm_angle = S.dyn("q7") - m.hands_angle
+    arm_rate = S.dyn("u7") - m.hands_rate
+    arm_torque = -(b["ka"] * arm_angle + b["ca"] * arm_rate)
+    m.loads += [(m.hands_frame, -arm_torque * C.z), (E, arm_torque * C.z)]
+    m.spring_energy.append(b["ka"] * arm_angle**2 / 2)
+    m.damper_dissipation.append(b["ca"] * arm_rate**2)
+    m.outputs["arm_steer_torque"] = arm_torque
+
+
+ARMS = declare(Part(
+    name="arms",
+    description="the rider's arms holding the bar: a spring-damper about the steer axis between the bar and the "
+                "frame the hands hold (the forearms' mass turns with the bar)",
+    source="Moore (2012), Human Control of a Bicycle, ch. 4 (the arms as a passive steer impedance); forearms "
+           "from the rider's own Yeadon model (whipple_kick.library.riders.seat_with_body)",
+    symbols=(
+        ("ka", "arm stiffness about the steer axis: torque on the bar per radian of the bar's rotation relative "
+               "to the frame the hands hold (the upper body, or the rear frame without one)", "N m/rad", "constant"),
+        ("ca", "arm damping about the steer axis, per rad/s of the bar's rotation relative to the hands' frame",
+         "N m s/rad", "constant"),
+    ),
+    coordinates=(),
+    speeds=(),
+    parameters=("ka", "ca"),
+    gains={},
+    columns={},
+    outputs={"arm_steer_torque": ("N m", "passive torque of the rider's arms on the bar about the steer axis")},
+    build=_build_arms,
+    selected_by=("arms", "on"),
+    fields=(
+        Field("arm_stiffness", "ka", "arm stiffness", "N m/rad", 0.0, 1e5, 0.0,
+              "no published value was at hand (docs/experiments.md, the identification of the rider's body)"),
+        Field("arm_damping", "ca", "arm damping", "N m s/rad", 0.0, 1e4, 0.0,
+              "no published value was at hand (docs/experiments.md, the identification of the rider's body)"),
+    ),
+    title="the arms on the bar",
 ))
 
 

@@ -192,11 +192,7 @@ def _entries():
                                     "(ccr, ccf)", "-", c),
         ("carcass_viscosity", "sliding viscosity of an undamped carcass tyre's patch past its friction limit "
                               "(regularises the Coulomb plateau)", "N s/m", c),
-        # --- rider with a body: a leaning upper body, arms on the bar, reflexes --
-        ("ka", "arm stiffness about the steer axis: torque on the bar per radian of the bar's rotation relative "
-               "to the frame the hands hold (the upper body, or the rear frame without one)", "N m/rad", c),
-        ("ca", "arm damping about the steer axis, per rad/s of the bar's rotation relative to the hands' frame",
-         "N m s/rad", c),
+        # --- the rider's reflexes (the upper body and the arms are declared parts: model/parts.py) --
         ("rq4", "reflex steer-torque gain on roll angle q4 (delayed by reflex_delay)", "N m/rad", c),
         ("rq7", "reflex steer-torque gain on steer angle q7 (delayed by reflex_delay)", "N m/rad", c),
         ("ru4", "reflex steer-torque gain on roll rate u4 (delayed by reflex_delay)", "N m s/rad", c),
@@ -251,7 +247,7 @@ SLIP_CONSTANTS = CLASSIC_CONSTANTS + (
     "kick_t0", "kick_T", "kick_D", "kick_profile", "kick_c0", "kick_c1", "kick_c2", "kick_c3",
     "kq3", "kq4", "kq7", "ku3", "ku4", "ku7", "T6c", "tyre_transient", "vsx_r",
     "slip_speed_point", "ccr", "ccf", "dcr", "dcf", "carcass_sliding", "carcass_viscosity",
-    "carcass_stiffness_scale", "ka", "ca", "rq4", "rq7", "ru4", "ru7", "reflex_delay",
+    "carcass_stiffness_scale", "rq4", "rq7", "ru4", "ru7", "reflex_delay",
 ) + tuple(f"{kind}{wheel}{k}_{i}" for wheel in "rf" for k in (1, 2)
           for kind, n in (("a", 14), ("c", 18)) for i in range(n))
 

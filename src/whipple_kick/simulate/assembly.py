@@ -301,18 +301,18 @@ def rider_body(spec, info):
     """The rider's body parameters by name (:data:`whipple_kick.model.slip.parameters.BODY_NAMES`).
 
     ``spec`` is ``scenario.body_spec``, ``info`` :func:`build_bicycle`'s.
-    The rigid rider without arms is :data:`~whipple_kick.model.slip.parameters.RIGID_BODY` (the model without
-    parts); the leaning rider adds the upper body of :func:`build_bicycle` and the hip's spring-damper (the
-    trunk part); the arms' spring-damper and the reflex act in both. (The rigid rider with arms on the bar has
-    its upper body in :func:`build_bicycle`'s rear frame.)
+    The reflex (:data:`~whipple_kick.model.slip.parameters.RIGID_BODY`) in every model; each declared part
+    the scenario selects adds its fields' parameters: the leaning upper body (the trunk part) also its
+    placement and inertia from :func:`build_bicycle`, the arms on the bar (the arms part) their
+    spring-damper. (The rigid rider with arms on the bar has its upper body in :func:`build_bicycle`'s
+    rear frame.)
     """
     body = dict(slip.parameters.RIGID_BODY)
-    if info.get("body") and parts.TRUNK.selected(spec):   # the model with the trunk part
+    for part in parts.selected(spec):   # the model with the selected parts
+        body.update(part.field_parameters(spec))
+    if parts.TRUNK.selected(spec) and info.get("body"):
         body.update({n: info["body"][n] for n in slip.parameters.TRUNK_BODY if n in info["body"]})
-        body.update(parts.TRUNK.field_parameters(spec))   # its hip spring-damper
-    body.update(ka=spec.arm_stiffness if spec.arms == "on" else 0.0,
-                ca=spec.arm_damping if spec.arms == "on" else 0.0,
-                rq4=spec.reflex_roll, ru4=spec.reflex_roll_rate, rq7=spec.reflex_steer,
+    body.update(rq4=spec.reflex_roll, ru4=spec.reflex_roll_rate, rq7=spec.reflex_steer,
                 ru7=spec.reflex_steer_rate, reflex_delay=spec.reflex_delay)
     return body
 

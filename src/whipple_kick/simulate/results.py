@@ -56,7 +56,7 @@ OUTPUT_COLUMNS = {
     "spring_energy": "spring_energy", "sliding_power": "sliding_power", "holonomic": "holonomic_residual",
     "sigma_r": "relaxation_length_rear", "sigma_f": "relaxation_length_front",
     "fy_limit_r": "fy_limit_rear", "fy_limit_f": "fy_limit_front",
-    "T_reflex": "reflex_steer_torque", "reflex_input": "reflex_undelayed_torque", "arm_torque": "arm_steer_torque",
+    "T_reflex": "reflex_steer_torque", "reflex_input": "reflex_undelayed_torque",
 }
 #: Contact-patch states (transient forms contact_patch and slip_lag; the carcass has the camber ones
 #: and its patch slip as the output ``patch_slip_*``): state -> column.

@@ -240,9 +240,6 @@ class Scenario:
         spring-damper about the steer axis between the bar and the upper body
         (the rear frame with a rigid rider). "off" (default): the hands have
         no mechanical effect on the bar.
-    arm_stiffness, arm_damping : float
-        The arms about the steer axis [N m/rad, N m s/rad] (default 0: no
-        published value was at hand; docs/experiments.md, identification).
     reflex_delay : float
         Delay of the rider's reflex [s], a (3,4) Pade filter (:mod:`whipple_kick.model.reflex`); 0 none.
     reflex_roll, reflex_roll_rate, reflex_steer, reflex_steer_rate : float
@@ -358,8 +355,6 @@ class Scenario:
     lqr_heading: bool = False
     rider_body: str = "rigid"
     arms: str = "off"
-    arm_stiffness: float = 0.0
-    arm_damping: float = 0.0
     reflex_delay: float = 0.0
     reflex_roll: float = 0.0
     reflex_roll_rate: float = 0.0
@@ -538,8 +533,6 @@ class Scenario:
                 if f.refuse_low and value == f.low and part.selected(self):
                     raise InputError(f"{f.label} = {value:g} {f.unit} {f.refuse_low}; allowed "
                                      f"({f.low:g}, {f.high:g}] {f.unit}")
-        check_range("arm stiffness", self.arm_stiffness, 0.0, 1e5, "N m/rad")
-        check_range("arm damping", self.arm_damping, 0.0, 1e4, "N m s/rad")
         check_range("reflex delay", self.reflex_delay, 0.0, 0.5, "s")
         for label, value, unit in (("reflex roll gain", self.reflex_roll, "N m/rad"),
                                    ("reflex roll-rate gain", self.reflex_roll_rate, "N m s/rad"),
@@ -606,8 +599,8 @@ class Scenario:
 
         Example
         -------
-        >>> Scenario(arm_stiffness=5.0).unused_fields()
-        {'arm_stiffness': "the arms on the bar (arms 'on')"}
+        >>> Scenario(thesis_load_n=570.0).unused_fields()
+        {'thesis_load_n': "the thesis' Table 8.4 rider (controller 'thesis')"}
         """
         defaults = {f.name: f.default for f in fields(self)}
         unused = {}
@@ -757,7 +750,6 @@ MECHANISM_FIELDS = (
     # The declared parts' fields, used while the scenario selects the part (the leaning upper body's hip).
     *((part.title or part.name, f"{part.selected_by[0]} {part.selected_by[1]!r}", part.selected,
        tuple(f.name for f in part.fields)) for part in parts.REGISTRY.values() if part.fields),
-    ("the arms on the bar", "arms 'on'", lambda s: s.arms == "on", ("arm_stiffness", "arm_damping")),
     # "off" is no rider torque at all: neither the voluntary law nor the reflex steers.
     ("the rider's steer control", "controller 'lqr' or 'thesis'; controller 'off' applies no rider torque",
      lambda s: s.controller != "off", ("gain_scale", "reflex_delay") + _REFLEX_GAINS),
@@ -781,7 +773,7 @@ FIELD_GROUPS = {
                 "design_speed", "gain_scale", "thesis_load_n", "low_inertia", "kick_displacement", "kick_duration",
                 "kick_accel", "kick_profile", "kick_table", "kick_direction", "tyre_transient", "carcass_sliding",
                 "carcass_damping", "carcass_stiffness_scale", "lqr_model", "lqr_heading", "rider_body", *_PART_FIELDS["rider_body"], "arms",
-                "arm_stiffness", "arm_damping", "reflex_delay", "reflex_roll", "reflex_roll_rate", "reflex_steer",
+                *_PART_FIELDS["arms"], "reflex_delay", "reflex_roll", "reflex_roll_rate", "reflex_steer",
                 "reflex_steer_rate"),
     "run": ("settle", "duration", "output_rate", "fall_angle_deg", "steer_limit_deg"),
     "numerics": ("rtol", "piecewise", "carcass_viscosity"),
@@ -880,8 +872,6 @@ class BodySpec:
         Selects the leaning upper body (the trunk part, :data:`whipple_kick.model.parts.TRUNK`).
     arms : {"off", "on"}
         Whether the arms' spring-damper acts about the steer axis.
-    arm_stiffness, arm_damping : float
-        The arms about the steer axis [N m/rad, N m s/rad].
     reflex_delay : float
         Delay of the reflex [s].
     reflex_roll, reflex_roll_rate, reflex_steer, reflex_steer_rate : float
@@ -890,8 +880,6 @@ class BodySpec:
 
     rider_body: str
     arms: str
-    arm_stiffness: float
-    arm_damping: float
     reflex_delay: float
     reflex_roll: float
     reflex_roll_rate: float

@@ -54,11 +54,10 @@ OUTPUTS = {
     "T7": ("N m", "rider's active steer torque: the voluntary law plus the delayed reflex"),
     "T_reflex": ("N m", "rider's delayed reflex steer torque (part of T7)"),
     "reflex_input": ("N m", "rider's reflex steer torque before the delay"),
-    "arm_torque": ("N m", "passive torque of the rider's arms on the bar about the steer axis"),
     "kinetic_energy": ("J", "kinetic energy of the bicycle and rider"),
     "potential_energy": ("J", "gravitational potential energy"),
-    "spring_energy": ("J", "energy stored in the vertical tyre springs, the arms' spring and the parts' springs (the "
-                          "leaning upper body's hip)"),
+    "spring_energy": ("J", "energy stored in the vertical tyre springs and the parts' springs (the leaning upper "
+                          "body's hip, the arms)"),
     "holonomic": ("m", "front contact height above the ground (the holonomic constraint's residual)"),
     "sliding_power": ("W", "power of the tyres' lateral forces on the contacts' sliding, F vsy"),
     "fy_r": ("N", "lateral force the rear tyre applies to the bicycle"),

@@ -19,13 +19,21 @@ GAIN_STATES = dict(layouts.GAIN_STATES)
 for _part in parts.REGISTRY.values():
     GAIN_STATES.update(_part.gains)
 GAIN_NAMES = tuple(GAIN_STATES)
-#: The rider's body in the base model by parameter name, with the rigid rider's values: no arm
-#: impedance, no reflex.
-RIGID_BODY = {"ka": 0.0, "ca": 0.0, "rq4": 0.0, "rq7": 0.0, "ru4": 0.0, "ru7": 0.0, "reflex_delay": 0.0}
+#: The rider's reflex in the base model by parameter name, with the rigid rider's values: none. (The
+#: upper body and the arms are parts: a model without them has none of their parameters.)
+RIGID_BODY = {"rq4": 0.0, "rq7": 0.0, "ru4": 0.0, "ru7": 0.0, "reflex_delay": 0.0}
 #: The parameters of the trunk part (:data:`whipple_kick.model.parts.TRUNK`) that are not gains: the leaning
 #: upper body's placement and inertia and the hip's spring-damper.
 TRUNK_BODY = tuple(n for n in parts.TRUNK.parameters if n not in parts.TRUNK.gains)
-BODY_NAMES = tuple(RIGID_BODY) + TRUNK_BODY
+#: The arms part's parameters (:data:`whipple_kick.model.parts.ARMS`): their spring-damper.
+ARMS_BODY = parts.ARMS.parameters
+BODY_NAMES = tuple(RIGID_BODY) + TRUNK_BODY + ARMS_BODY
+
+
+def _part_body():
+    """Each declared part's parameters that are not gains, by part name (read when called: a part declared
+    later counts too)."""
+    return {p.name: tuple(n for n in p.parameters if n not in p.gains) for p in parts.REGISTRY.values()}
 
 
 def tyre_parameters(tyre, wheel, symmetric=False, lateral=True, reverse_camber=False):
@@ -125,13 +133,14 @@ def model_parameters(moore, rear_tyre, front_tyre, gains=None, kick=None,
     carcass_stiffness_scale : float
         Factor on the carcass stiffnesses the steady state sets (default 1).
     body : mapping, optional
-        The rider's body by parameter name (:data:`BODY_NAMES`): the arms'
-        spring-damper and the reflex (:data:`RIGID_BODY`, missing ones 0) and,
-        for the trunk part, all of :data:`TRUNK_BODY` (the leaning upper body's
-        placement and inertia and the hip's spring-damper:
-        :func:`whipple_kick.library.riders.seat_with_body` makes them); with
-        them the model has the trunk part (its gains ``kq11 ku11`` then apply).
-        Default: the rigid rider, the model without parts.
+        The rider's body by parameter name (:data:`BODY_NAMES`): the reflex
+        (:data:`RIGID_BODY`, missing ones 0) and each part's parameters, all
+        or none: for the trunk part :data:`TRUNK_BODY` (the leaning upper
+        body's placement and inertia and the hip's spring-damper:
+        :func:`whipple_kick.library.riders.seat_with_body` makes them; its
+        gains ``kq11 ku11`` then apply), for the arms part :data:`ARMS_BODY`
+        (their spring-damper about the steer axis). The model has the parts
+        whose parameters are given. Default: the rigid rider, the model without parts.
     """
     if slip_speed not in SLIP_SPEEDS:
         raise InputError(f"slip speed {slip_speed!r} is unknown; choose one of {', '.join(SLIP_SPEEDS)}")
@@ -139,14 +148,21 @@ def model_parameters(moore, rear_tyre, front_tyre, gains=None, kick=None,
     params.update(tyre_parameters(rear_tyre, "r", symmetric, lateral, reverse_camber))
     params.update(tyre_parameters(front_tyre, "f", symmetric, lateral, reverse_camber))
     body = dict(body or {})
-    unknown = set(body) - set(BODY_NAMES)
+    part_body = _part_body()
+    known = tuple(RIGID_BODY) + tuple(n for names in part_body.values() for n in names)
+    unknown = set(body) - set(known)
     if unknown:
-        raise InputError(f"unknown rider-body parameters {sorted(unknown)}; known: {', '.join(BODY_NAMES)}")
-    trunk = [n for n in TRUNK_BODY if n in body]
-    if trunk and len(trunk) < len(TRUNK_BODY):
-        raise InputError(f"the leaning upper body needs all of {', '.join(TRUNK_BODY)}; missing "
-                         f"{', '.join(n for n in TRUNK_BODY if n not in body)}")
-    layout = layouts.for_parts(("trunk",) if trunk else ())
+        raise InputError(f"unknown rider-body parameters {sorted(unknown)}; known: {', '.join(known)}")
+    chosen = []   # the parts whose parameters the body holds: all of them, or none
+    for name, names in part_body.items():
+        given = [n for n in names if n in body]
+        if given and len(given) < len(names):
+            part = parts.REGISTRY[name]
+            raise InputError(f"{part.title or part.name} needs all of {', '.join(names)}; missing "
+                             f"{', '.join(n for n in names if n not in body)}")
+        if given:
+            chosen.append(name)
+    layout = layouts.for_parts(tuple(chosen))
     gains = dict(gains or {})
     # A zero gain on a state the model does not have changes nothing; a nonzero one is refused.
     unknown = {n for n in set(gains) - set(layout.GAIN_NAMES) if n not in GAIN_STATES or gains[n] != 0.0}
@@ -172,5 +188,5 @@ def model_parameters(moore, rear_tyre, front_tyre, gains=None, kick=None,
         "carcass_stiffness_scale": float(carcass_stiffness_scale),
     })
     params.update({n: float(body.get(n, RIGID_BODY[n])) for n in RIGID_BODY})
-    params.update({n: float(body[n]) for n in trunk})
+    params.update({n: float(body[n]) for name in chosen for n in part_body[name]})
     return params

@@ -430,13 +430,12 @@ def slip_equations(part_names=()):
     # The reflex acts on what the rider feels, undelayed here; the filter delays it.
     reflex_input = -(par["rq4"] * Q["q4"] + par["rq7"] * Q["q7"] + par["ru4"] * U["u4"] + par["ru7"] * U["u7"])
     T6 = par["T6c"]
-    # The arms and the rider's torque act between the bar E and the frame the hands
-    # hold (the rear frame, or a part's: the leaning upper body), about the steer
-    # axis C.z. The bar turns relative to that frame by q7 less the frame's own turn
-    # about C.z (exact), and the torques' power is the torque times this relative rate.
-    arm_angle = Q["q7"] - mech.hands_angle
-    arm_rate = U["u7"] - mech.hands_rate
-    T_arm = -(par["ka"] * arm_angle + par["ca"] * arm_rate)
+    # The rider's torque acts between the bar E and the frame the hands hold (the
+    # rear frame, or a part's: the leaning upper body), about the steer axis C.z.
+    # The bar turns relative to that frame by q7 less the frame's own turn about
+    # C.z (exact), and the torque's power is the torque times this relative rate.
+    # (The arms' spring-damper, a part, acts between the same two frames.)
+    steer_relative_rate = U["u7"] - mech.hands_rate
 
     dn_mat, fn_mat = kin.points["dn_mat"], kin.points["fn_mat"]
     loads = list(kin.gravity_loads)
@@ -446,8 +445,8 @@ def slip_equations(part_names=()):
         (D, Mz_r * A.z + T6 * C.y),
         (F, Mz_f * A.z),
         (C, -T6 * C.y),
-        (mech.hands_frame, -(T7 + T_arm) * C.z),
-        (E, (T7 + T_arm) * C.z),
+        (mech.hands_frame, -T7 * C.z),
+        (E, T7 * C.z),
         *mech.loads,
     ]
     mass_matrix, forcing = kane_full(kin, loads)
@@ -468,12 +467,12 @@ def slip_equations(part_names=()):
     # Spring energy counts only while the tyre is compressed; the damper
     # dissipates Fz dq/dt - kz max(q, 0) dq/dt >= 0 in every branch of
     # normal_force (docs/validation.md).
-    # The arms' and the parts' springs store energy, their dampers dissipate it.
-    spring = ((par["kzr"] * sm.Max(0, Q["q9"])**2 + par["kzf"] * sm.Max(0, Q["q10"])**2
-               + par["ka"] * arm_angle**2) / 2 + sum(mech.spring_energy))
+    # The parts' springs (the hip's, the arms') store energy, their dampers dissipate it.
+    spring = ((par["kzr"] * sm.Max(0, Q["q9"])**2 + par["kzf"] * sm.Max(0, Q["q10"])**2) / 2
+              + sum(mech.spring_energy))
     damper = (fz_r * U["u9"] - par["kzr"] * sm.Max(0, Q["q9"]) * U["u9"]
               + fz_f * U["u10"] - par["kzf"] * sm.Max(0, Q["q10"]) * U["u10"]
-              + par["ca"] * arm_rate**2 + sum(mech.damper_dissipation))
+              + sum(mech.damper_dissipation))
     extra = {
         "yp": yp, "vp": vp, "ap": ap,
         # Inputs of the tyre block (model convention: slip > 0 slides to the
@@ -493,8 +492,8 @@ def slip_equations(part_names=()):
         "vplate_r": plate_vel.dot(kin.rear_lateral),
         "wz_r": D.ang_vel_in(N).dot(A.z), "wz_f": F.ang_vel_in(N).dot(A.z),
         "T7": T7, "spring_energy": spring, "damper_dissipation_rate": damper,
-        "steer_relative_rate": arm_rate, "reflex_input": reflex_input,
-        "arm_torque": T_arm, **mech.outputs,
+        "steer_relative_rate": steer_relative_rate, "reflex_input": reflex_input,
+        **mech.outputs,
     }
     return EquationsOfMotion(
         q=q, u=u, dependent=("u5", "u6", "u8"), inputs=(vp_s, ap_s, Fy_r, Fy_f, Mz_r, Mz_f),

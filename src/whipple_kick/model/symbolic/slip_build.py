@@ -242,7 +242,7 @@ def _expressions(part_names=()):
     outputs.update({
         # The reflex's torques are locals of the right-hand side (and arguments of the NumPy outputs).
         "T7": k_sym["T7"], "T_reflex": S.sym("T_reflex"), "reflex_input": sm.Symbol("reflex_input", real=True),
-        "arm_torque": plain(ex["arm_torque"]), **{name: plain(ex[name]) for name in L.PART_OUTPUTS},
+        **{name: plain(ex[name]) for name in L.PART_OUTPUTS},
         "kinetic_energy": plain(eom.kinetic_energy),
         "potential_energy": plain(eom.potential_energy), "spring_energy": plain(ex["spring_energy"]),
         "holonomic": plain(eom.holonomic),

@@ -202,8 +202,6 @@ def describe(scenario, info=None):
     for part in parts.selected(scenario):   # the declared parts in the run's model, with their fields' values
         values = ", ".join(f"{f.label} {getattr(scenario, f.name):g} {f.unit}" for f in part.fields)
         body.append((part.title or part.name) + (f" ({values})" if values else ""))
-    if scenario.arms == "on":
-        body.append(f"arms on the bar ({scenario.arm_stiffness:g} N m/rad, {scenario.arm_damping:g} N m s/rad)")
     if scenario.reflex_delay:
         body.append(f"reflex delayed {scenario.reflex_delay * 1e3:g} ms")
     return (f"{scenario.tyre} {p} kPa ({offsets}, {scenario.tyre_transient}), {scenario.bicycle}{load}; "
