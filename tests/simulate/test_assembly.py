@@ -92,7 +92,7 @@ def test_upright_start_without_a_steady_motion_is_judged_about_upright_running(m
 
     def none(*args, **kwargs):
         raise steady.NoSteadyMotion("no steady motion (forced by the test)")
-    monkeypatch.setattr(steady, "steady_motion", none)
+    monkeypatch.setattr(steady, "find_steady_state", none)
     r = run(Scenario(start="upright", settle=0.0, duration=0.2))
     stability, st = r.summary["linear_stability"], r.summary["steady_state"]
     assert "upright running without the tyres' zero-slip offsets" in stability["model"]

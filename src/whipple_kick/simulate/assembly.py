@@ -136,7 +136,8 @@ def assemble(scenario, kick, *, tyres=None, gains=None) -> Assembly:
     else:
         gains, poles, controller = custom, None, "custom gains"
     params = model_parameters(scenario.model_spec, kick, moore, body, rear, front, gains)
-    found, start = steady.start_state(params, scenario, advice=_steady_advice(scenario, controller))
+    found, start = steady.start_state(params, float(scenario.speed), start=scenario.start,
+                                      start_pitch=scenario.start_pitch, advice=_steady_advice(scenario, controller))
     stability = linear_stability(scenario, no_slip_plant(moore, design, info), gains, found, controller)
     steady_yaw_rate = float(start.x[slip.X["u3"]])
     if gains.get("kq3", 0.0) and abs(steady_yaw_rate) > STRAIGHT_YAW_RATE:

@@ -570,17 +570,12 @@ def advance_steady(rhs, x, tau, t=0.0):
 
 # ------------------------------------------------------------ the run's start
 
-def steady_motion(params, scenario, advice=None):
-    """The steady motion before the kick (:func:`find_steady_state` at the scenario's speed)."""
-    return find_steady_state(params, scenario.speed, advice=advice)
-
-
 #: What an upright start's stability is judged about when the tyres' offsets allow no steady motion.
 SYMMETRIC_ABOUT = "upright running without the tyres' zero-slip offsets"
 SYMMETRIC_ROUTE = f"{SYMMETRIC_ABOUT} (no steady motion with them)"
 
 
-def start_state(params, scenario, advice=None):
+def start_state(params, speed, *, start="steady", start_pitch="compressed", advice=None):
     """The steady motion the rider's stability is judged about, and the state the run starts from.
 
     With ``start="steady"`` both are the steady motion. With
@@ -593,7 +588,10 @@ def start_state(params, scenario, advice=None):
     ----------
     params : mapping
         The model's parameters (:func:`whipple_kick.model.slip.model_parameters`).
-    scenario : whipple_kick.simulate.scenario.Scenario
+    speed : float
+        Forward speed [m/s] (the scenario's ``speed``).
+    start, start_pitch : str
+        The scenario's ``start`` and ``start_pitch`` (the pitch of an upright start).
     advice : str, optional
         What a user can change if there is no steady motion (the one-line error's end).
 
@@ -604,16 +602,17 @@ def start_state(params, scenario, advice=None):
     """
     from whipple_kick.errors import SimulationError
 
-    if scenario.start == "steady":
-        found = steady_motion(params, scenario, advice)
+    if start == "steady":
+        found = find_steady_state(params, speed, advice=advice)
         return found, found.steady
     try:
-        start = upright_state(params, scenario.speed, pitch_without_compression=scenario.start_pitch == "uncompressed")
+        upright = upright_state(params, speed, pitch_without_compression=start_pitch == "uncompressed")
     except FloatingPointError as exc:
         raise SimulationError(str(exc)) from None
     try:
-        found = steady_motion(params, scenario, advice)
+        found = find_steady_state(params, speed, advice=advice)
     except NoSteadyMotion:
-        symmetric = steady_state(offset_scaled(params, 0.0), scenario.speed)
+        symmetric = steady_state(offset_scaled(params, 0.0), speed)
         found = Found(symmetric, SYMMETRIC_ROUTE, 1)
+    return found, upright
     return found, start
