@@ -3,6 +3,7 @@
 Usage:
     python scripts/bench_sweep.py split           # per-case split: integration, outputs, summary, the rest
     python scripts/bench_sweep.py nine            # 9 thesis cases, 1 vs 2 workers, interleaved repeats
+    python scripts/bench_sweep.py parallel        # the same in both kick directions (18 cases): 1 vs 2 workers
     python scripts/bench_sweep.py blend           # a blended pressure (350 kPa) against a measured one (400 kPa)
     python scripts/bench_sweep.py many --n 1000   # an n-case sweep into a temporary folder
     python scripts/bench_sweep.py all
@@ -147,17 +148,50 @@ def pool_startup(workers):
     return time.perf_counter() - t0
 
 
-def _sweep_time(workers, base, fresh=False):
-    """(wall time [s], table) of the nine-case sweep on ``workers``; ``fresh``: on a new pool."""
+def _sweep_time(workers, base, fresh=False, grid=None):
+    """(wall time [s], table) of the sweep over ``grid`` (default: the nine thesis cases) on ``workers``;
+    ``fresh``: on a new pool."""
     import whipple_kick as wk
     from whipple_kick.studies import sweep_engine
     if fresh:
         sweep_engine._discard_default_pool(end_workers=True)
     t0 = time.perf_counter()
-    table = wk.sweep(_thesis_grid(), base=base, workers=workers, progress=False)
+    table = wk.sweep(grid or _thesis_grid(), base=base, workers=workers, progress=False)
     wall = time.perf_counter() - t0
     assert (table["status"] == "ok").all(), table["error"].dropna().tolist()
     return wall, table
+
+
+def _interleaved(repeats, base, grid=None):
+    """One- and two-worker sweeps of ``grid`` and the pure-Python ceiling, interleaved: (times, tables,
+    ceilings, efficiencies), the efficiency per repeat being the speed-up over the ceiling beside it."""
+    times, tables, ceilings, efficiency = {1: [], 2: []}, {1: [], 2: []}, [], []
+    for w in (1, 2):   # warm pools of each size once (a later sweep of the same size reuses its pool)
+        _sweep_time(w, base, grid=grid)
+    for r in range(repeats):
+        done = {}
+        for what in _rotated(["1", "2", "ceiling"], r):
+            if what == "ceiling":
+                done["ceiling"] = parallel_ceiling(2)
+            else:
+                w = int(what)
+                wall, table = _sweep_time(w, base, grid=grid)
+                done[w] = wall
+                times[w].append(wall)
+                tables[w].append(table)
+        ceilings.append(done["ceiling"])
+        efficiency.append((done[1] / done[2]) / done["ceiling"])
+    return times, tables, ceilings, efficiency
+
+
+def _print_scaling(label, times, ceilings, efficiency, cap_note):
+    speedup = [a / b for a, b in zip(times[1], times[2], strict=True)]
+    print(f"{label}: speed-up 2 workers over 1, per repeat: {', '.join(f'{s:.2f}' for s in speedup)} "
+          f"(median {statistics.median(speedup):.2f}x; {cap_note})")
+    print(f"pure-Python ceiling beside them (two processes vs one): {', '.join(f'{c:.2f}' for c in ceilings)} "
+          f"(median {statistics.median(ceilings):.2f}x)")
+    print(f"parallel efficiency, speed-up / ceiling per repeat: {', '.join(f'{e:.2f}' for e in efficiency)}; "
+          f"median {statistics.median(efficiency):.2f} (target >= 0.85)")
 
 
 def bench_nine(repeats, duration):
@@ -172,22 +206,7 @@ def bench_nine(repeats, duration):
             starts[w].append(pool_startup(w))
         for w in _rotated([1, 2], r):
             first[w].append(_sweep_time(w, base, fresh=True)[0])
-    times, tables, ceilings, efficiency = {1: [], 2: []}, {1: [], 2: []}, [], []
-    for w in (1, 2):   # warm pools of each size once (a later sweep of the same size reuses its pool)
-        _sweep_time(w, base)
-    for r in range(repeats):
-        done = {}
-        for what in _rotated(["1", "2", "ceiling"], r):
-            if what == "ceiling":
-                done["ceiling"] = parallel_ceiling(2)
-            else:
-                w = int(what)
-                wall, table = _sweep_time(w, base)
-                done[w] = wall
-                times[w].append(wall)
-                tables[w].append(table)
-        ceilings.append(done["ceiling"])
-        efficiency.append((done[1] / done[2]) / done["ceiling"])
+    times, tables, ceilings, efficiency = _interleaved(repeats, base)
     for w in (1, 2):
         split = table_split(pd.concat(tables[w]))
         print(f"9 thesis cases, {w} worker(s): wall median {statistics.median(times[w]):.3f} s "
@@ -196,17 +215,28 @@ def bench_nine(repeats, duration):
               f"+ the rest {split['rest'] * 1e3:.1f} ms (CPU {split['cpu'] * 1e3:.1f} ms); "
               f"median run.wall_s / median integration {split['wall'] / split['integration']:.2f}"
               + (" (target <= 1.3)" if w == 1 else ""))
-    speedup = [a / b for a, b in zip(times[1], times[2], strict=True)]
-    print(f"speed-up 2 workers over 1, per repeat: {', '.join(f'{s:.2f}' for s in speedup)} "
-          f"(median {statistics.median(speedup):.2f}x; nine equal cases cannot beat 9/5 = 1.8x)")
-    print(f"pure-Python ceiling beside them (two processes vs one): {', '.join(f'{c:.2f}' for c in ceilings)} "
-          f"(median {statistics.median(ceilings):.2f}x)")
-    print(f"parallel efficiency, speed-up / ceiling per repeat: {', '.join(f'{e:.2f}' for e in efficiency)}; "
-          f"median {statistics.median(efficiency):.2f} (target >= 0.85)")
+    _print_scaling("9 thesis cases", times, ceilings, efficiency, "nine equal cases cannot beat 9/5 = 1.8x")
     print(f"pool start-up until every worker answered: 1 worker {statistics.median(starts[1]) * 1e3:.0f} ms, "
           f"2 workers {statistics.median(starts[2]) * 1e3:.0f} ms (medians of {repeats})")
     print(f"first sweep on a fresh pool: 1 worker {statistics.median(first[1]):.3f} s, 2 workers "
           f"{statistics.median(first[2]):.3f} s (medians of {repeats}; 2 must not exceed 1)")
+    return statistics.median(efficiency)
+
+
+def bench_parallel(repeats, duration):
+    """Print the parallel efficiency on the nine thesis cases in both kick directions (18 cases).
+
+    Eighteen cases on two workers are nine rounds each, so the granularity that caps nine cases at
+    9/5 = 1.8x (one worker runs five, the other four) does not enter; the cases are the validation's set.
+    """
+    from whipple_kick.simulate import simulation
+    base = simulation.Scenario(duration=duration)
+    grid = {**_thesis_grid(), "kick_direction": ["right", "left"]}
+    times, _, ceilings, efficiency = _interleaved(repeats, base, grid)
+    for w in (1, 2):
+        print(f"18 cases (9 thesis cases x 2 kick directions), {w} worker(s): wall median "
+              f"{statistics.median(times[w]):.3f} s (runs: {', '.join(f'{t:.3f}' for t in times[w])})")
+    _print_scaling("18 cases", times, ceilings, efficiency, "equal cases on two workers could reach 2x")
     return statistics.median(efficiency)
 
 
@@ -292,7 +322,7 @@ def bench_many(n, duration, workers, folder):
 
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    p.add_argument("what", choices=("split", "nine", "blend", "many", "all"))
+    p.add_argument("what", choices=("split", "nine", "parallel", "blend", "many", "all"))
     p.add_argument("--repeats", type=int, default=3)
     p.add_argument("--n", type=int, default=1000, help="cases of the large sweep")
     p.add_argument("--duration", type=float, default=6.0, help="simulated time after the kick [s]")
@@ -305,6 +335,8 @@ def main(argv=None):
         bench_split(args.repeats, args.duration)
     if args.what in ("nine", "all"):
         bench_nine(args.repeats, args.duration)
+    if args.what in ("parallel", "all"):
+        bench_parallel(args.repeats, args.duration)
     if args.what in ("blend", "all"):
         bench_blend(args.repeats, args.duration)
     if args.what in ("many", "all"):
