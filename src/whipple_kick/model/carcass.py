@@ -164,6 +164,22 @@ static void wk_curve_FdF(const wk_curve *c, double a_deg, double *F, double *dF)
     *F = -c->lam * y; *dF = -c->lam * dy;
 }
 
+/* The friction limit on the side of F [N] of one set whose peak lies inside the cap, as wk_curve_F gives it
+   at the end wk_curve_end finds, without finding the end: there C atan(inner) = +-pi/2 to round-off, whose
+   sine is exactly +-1, so the curve is Sv +- D. The peak is inside when the inner function at the cap has
+   passed the peak's value tan(pi/2C) (it rises with the slip for E <= 1). Returns 0 for a blend, no peak
+   (C <= 1), a turning inner function (E > 1) or a peak within 1e-9 of the cap: the search decides there. */
+static int wk_curve_peak(const wk_curve *c, double F, double *lim)
+{
+    const double B = c->f1[0], C = c->f1[1], D = c->f1[2], E = c->f1[3], Sh = c->f1[4], Sv = c->f1[5];
+    if (c->two || !(C > 1.0) || !(E <= 1.0) || !(B > 0.0)) return 0;
+    const double x = B * (F >= 0.0 ? WK_CAP_DEG - Sh : WK_CAP_DEG + Sh);   /* the cap on the force's side */
+    if (!((1.0 - E) * x + E * atan(x) > tan(M_PI / (2.0 * C)) * (1.0 + 1e-9))) return 0;
+    /* F >= 0: wk_curve_F at the lower end (sine -1); F < 0: minus it at the upper end (sine +1) */
+    *lim = F >= 0.0 ? -c->lam * ((1.0 - c->w) * (Sv - D)) : c->lam * ((1.0 - c->w) * (D + Sv));
+    return 1;
+}
+
 /* One end of the rising branch of the (blended) curve [deg]: side 0 where F is largest (lo), side 1 where
    it is smallest (hi). Each end is found on its own (the friction limit on a force's side needs one). */
 static double wk_curve_end(wk_curve *c, int side)

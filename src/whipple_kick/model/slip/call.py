@@ -177,6 +177,28 @@ class CompiledRHS:
             raise FloatingPointError(_STATUS.get(status, f"status {status}") + " while evaluating outputs")
         return out
 
+    def friction_limits(self, wheel, camber, fz, force, search=False):
+        """The friction-limit output (``fy_limit_r``/``fy_limit_f``) [N] at many points of one wheel, in one C call.
+
+        Parameters
+        ----------
+        wheel : {"r", "f"}
+        camber, fz, force : array_like, shape (n,)
+            Camber [rad], normal load [N] and the lateral force [N] whose side the limit is on.
+        search : bool
+            By the rising branch's search alone, also where one set's interior peak gives the limit
+            directly (the reference the tests compare the outputs with).
+
+        Returns
+        -------
+        ndarray, shape (n,)
+        """
+        camber, fz, force = (np.ascontiguousarray(v, dtype=float) for v in (camber, fz, force))
+        out = np.empty(camber.size)
+        self.lib.wk_slip_friction_limits(camber.size, "rf".index(wheel), camber.ctypes.data, fz.ctypes.data,
+                                         force.ctypes.data, self._p_ptr, int(search), out.ctypes.data)
+        return out
+
     def outputs(self, t, x):
         """Derivatives and named outputs (the layout's ``OUTPUT_NAMES``) at one state."""
         x = np.ascontiguousarray(x, dtype=float)
