@@ -106,6 +106,27 @@ def test_friction_limit_shortcut_is_the_search_over_cambers_loads_and_sides(pres
         assert np.count_nonzero(fast) > fast.size // 2   # most points have grip
 
 
+@pytest.mark.parametrize("fields", [{"pressure_kpa": 350.0}, {"pressure_rear_kpa": 450.0, "pressure_front_kpa": 400.0},
+                                    {"pressure_kpa": 330.0, "kick_accel": 40.0}],
+                         ids=["350kPa", "450kPa_rear", "330kPa_40m_s2"])
+def test_blend_finds_its_common_rising_branch_as_the_search_does_bit_for_bit(fields):
+    """A pressure blend's patch slip tests whether each set's root lies on the other set's rising branch by
+    one evaluation of the inner function, not by a Newton solve for each set's peak: at every sample of a
+    blended run, at the camber and at the lagged camber, the slips equal the search's exactly (tolerance 0:
+    the same decision, then the same Newton solve), and the force's equals the run's patch-slip column."""
+    scenario = Scenario(duration=2.0, **fields)
+    result = run(scenario)
+    rhs = slip.CompiledRHS(wk.assembly.assemble(scenario, inputs.kick_of(scenario.validate())).params)
+    df = result.trajectory
+    for wheel, name in (("r", "rear"), ("f", "front")):
+        args = [df[column].to_numpy() for column in (f"camber_{name}", f"camber_patch_{name}", f"fz_{name}",
+                                                     f"fy_{name}")]
+        fast, search = rhs.carcass_slips(wheel, *args), rhs.carcass_slips(wheel, *args, search=True)
+        assert np.array_equal(fast, search), wheel
+        loaded = args[2] > 0.0
+        assert np.array_equal(fast[loaded, 0], df[f"slip_patch_{name}"].to_numpy()[loaded]), wheel
+
+
 # ------------------------------------------------------------- the block at a constant slip
 
 def _frozen_block(params, slip_deg, fz_target=635.0):

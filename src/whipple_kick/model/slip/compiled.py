@@ -108,6 +108,9 @@ def library(L=layouts.BASE):
     lib.wk_slip_friction_limits.restype = ctypes.c_int
     lib.wk_slip_friction_limits.argtypes = [ctypes.c_int, ctypes.c_int, pointer, pointer, pointer, pointer,
                                             ctypes.c_int, pointer]
+    lib.wk_slip_carcass_slips.restype = ctypes.c_int
+    lib.wk_slip_carcass_slips.argtypes = [ctypes.c_int, ctypes.c_int, pointer, pointer, pointer, pointer, pointer,
+                                          ctypes.c_int, pointer]
     sizes = (ctypes.c_int * 4)()
     lib.wk_slip_sizes(sizes)
     if tuple(sizes) != (len(L.STATE_NAMES), len(L.PARAMETER_NAMES), len(L.OUTPUT_NAMES), len(L.DYNAMIC_STATES)):

@@ -671,6 +671,12 @@ def c_source(part_names=(), delayed_reflex=False):
               "    for (int i = 0; i < n; i++)",
               "        out[i] = wheel ? wk_fylim_f_by(camber[i], fz[i], F[i], p, search) "
               ": wk_fylim_r_by(camber[i], fz[i], F[i], p, search);", "    return 0;", "}"]
+    # The undamped carcass' patch slips at n points of one wheel, its blend's common branch found either way.
+    lines += ["int wk_slip_carcass_slips(int n, int wheel, const double *camber, const double *gl, const double *fz, "
+              "const double *F, const double *p, int search, double *out)", "{",
+              "    for (int i = 0; i < n; i++)",
+              "        (wheel ? wk_carcass_slips_f : wk_carcass_slips_r)(camber[i], gl[i], fz[i], F[i], p, search, "
+              "out + 2 * i);", "    return 0;", "}"]
     lines.append(f"int wk_slip_sizes(int *sizes) {{ sizes[0] = {ns}; sizes[1] = {len(L.PARAMETER_NAMES)}; "
                  f"sizes[2] = {len(L.OUTPUT_NAMES)}; sizes[3] = {nd}; return 0; }}")
     return "\n".join(lines) + "\n"
