@@ -310,9 +310,23 @@ static double wk_carcass_slip_%(w)s(wk_curve *c, double F, int curve_law, double
         /* when both lie where both sets rise, the blend's root is between them and the blend is monotone there */
         if (common) return wk_curve_solve(c, F, 0.0, fmin(a1, a2), fmax(a1, a2), (1.0 - c->w) * a1 + c->w * a2);
     }
-    double lo, hi;
-    wk_curve_branch(c, &lo, &hi);
-    double lim_pos = wk_curve_F(c, lo), lim_neg = wk_curve_F(c, hi);
+    double lo = NAN, hi = NAN, lim_pos = NAN, lim_neg = NAN;
+    int have_lo = 0, have_hi = 0;
+    if (!curve_law && !search) {
+        /* The sliding law "peak": a force past the branch end on its own side saturates there (the tests
+           below decide the same), so that end is searched first and the other one only for a force inside,
+           as the inverse's bracket (search: both ends first, the reference). A negative force counts as
+           past only strictly below its end: at the end itself the test of the positive side comes first. */
+        if (F >= 0.0) {
+            lo = wk_curve_end(c, 0); lim_pos = wk_curve_F(c, lo); have_lo = 1;
+            if (F >= lim_pos) { *sat = 1; *lim = lim_pos; return lo; }
+        } else {
+            hi = wk_curve_end(c, 1); lim_neg = wk_curve_F(c, hi); have_hi = 1;
+            if (F < lim_neg) { *sat = -1; *lim = lim_neg; return hi; }
+        }
+    }
+    if (!have_lo) { lo = wk_curve_end(c, 0); lim_pos = wk_curve_F(c, lo); }
+    if (!have_hi) { hi = wk_curve_end(c, 1); lim_neg = wk_curve_F(c, hi); }
     double a_pos = lo, a_neg = hi;
     /* "curve": past the peak the limit is the steady curve at the kinematic slip, reached on the rising
        branch where the curve gives the same force. */
@@ -389,7 +403,7 @@ static void wk_carcass_%(w)s(double vsy, double vx, double camber, double fz, do
 
 /* The undamped carcass' patch slips [deg] giving the force F at the camber and at the lagged camber gl, as
    wk_carcass_%(w)s finds them with the sliding law "peak" (search: a blend's common rising branch by the
-   sets' branch ends, the reference); what the tests compare. */
+   sets' branch ends, both branch ends before the saturation tests; the references); what the tests compare. */
 static void wk_carcass_slips_%(w)s(double camber, double gl, double fz, double F, const double *p, int search,
                                   double *out)
 {

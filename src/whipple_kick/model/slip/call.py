@@ -208,8 +208,9 @@ class CompiledRHS:
         camber, lagged_camber, fz, force : array_like, shape (n,)
             Camber and the moment's lagged camber [rad], normal load [N], carcass force [N].
         search : bool
-            Find a pressure blend's common rising branch by the sets' branch ends (the reference the tests
-            compare the shortcut with).
+            Find a pressure blend's common rising branch by the sets' branch ends, and both ends of the
+            rising branch before testing a force for saturation (the references the tests compare the
+            shortcuts with).
 
         Returns
         -------
