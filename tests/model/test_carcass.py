@@ -10,6 +10,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import whipple_kick as wk
+from whipple_kick.library import inputs
 from whipple_kick.model import carcass, slip
 from whipple_kick.model.symbolic import slip_build
 from whipple_kick.simulate import steady
@@ -71,6 +72,61 @@ def test_force_stays_within_the_friction_limit(runs, case):
         limit = np.where(force[loaded] >= 0.0, hi, -lo)
         assert np.max(np.abs(force[loaded]) / limit) <= 1.0001, wheel
         np.testing.assert_allclose(df[f"fy_limit_{wheel}"].to_numpy()[loaded], limit, rtol=1e-9)
+
+
+@pytest.mark.parametrize("case", list(RUNS))
+def test_friction_limit_of_an_interior_peak_is_the_search_bit_for_bit(runs, case):
+    """The limit output takes one set's peak value Sv +- D where the peak lies inside the cap, without the
+    branch search: at every sample of the run (the wheel's own camber, load and force side) it equals the
+    search's value exactly (tolerance 0: the sine at the peak the search finds is exactly +-1), so the
+    trajectory's ``fy_limit_*`` columns do not move by one bit."""
+    df = runs[case].trajectory
+    scenario = runs[case].scenario
+    rhs = slip.CompiledRHS(wk.assembly.assemble(scenario, inputs.kick_of(scenario.validate())).params)
+    for wheel, name in (("r", "rear"), ("f", "front")):
+        args = [df[f"{column}_{name}"].to_numpy() for column in ("camber", "fz", "fy")]
+        fast, search = rhs.friction_limits(wheel, *args), rhs.friction_limits(wheel, *args, search=True)
+        assert np.array_equal(fast, search), wheel
+        assert np.array_equal(fast, df[f"fy_limit_{name}"].to_numpy()), wheel
+
+
+@pytest.mark.parametrize("pressure", [300.0, 350.0, 400.0, 500.0])
+def test_friction_limit_shortcut_is_the_search_over_cambers_loads_and_sides(pressure):
+    """The same, away from any run: 60 cambers (+-40 deg) x 60 loads (1 N - 3 kN, past the fits' grip) x
+    both force sides, at each measured pressure and a blend (which always searches): identical values."""
+    scenario = Scenario(pressure_kpa=pressure)
+    rear, front, _ = wk.assembly.build_tyres(scenario)
+    rhs = slip.CompiledRHS(slip.model_parameters(wk.assembly.build_bicycle(scenario)[0], rear, front))
+    camber, fz, side = np.meshgrid(np.radians(np.linspace(-40.0, 40.0, 60)), np.geomspace(1.0, 3000.0, 60),
+                                   [-1.0, 1.0])
+    for wheel in "rf":
+        fast = rhs.friction_limits(wheel, camber.ravel(), fz.ravel(), side.ravel())
+        search = rhs.friction_limits(wheel, camber.ravel(), fz.ravel(), side.ravel(), search=True)
+        assert np.array_equal(fast, search), wheel
+        assert np.count_nonzero(fast) > fast.size // 2   # most points have grip
+
+
+@pytest.mark.parametrize("fields", [{"pressure_kpa": 350.0}, {"pressure_rear_kpa": 450.0, "pressure_front_kpa": 400.0},
+                                    {"pressure_kpa": 330.0, "kick_accel": 40.0}, {"kick_accel": 40.0}],
+                         ids=["350kPa", "450kPa_rear", "330kPa_40m_s2", "400kPa_40m_s2"])
+def test_patch_slip_shortcuts_are_the_search_bit_for_bit(fields):
+    """Two shortcuts of the patch slip, each against its reference at every sample of a run (three blended,
+    one measured pressure; the 40 m/s^2 kicks saturate the rear tyre), at the camber and at the lagged
+    camber: a pressure blend tests whether each set's root lies on the other set's rising branch by one
+    evaluation of the inner function, not by a Newton solve for each set's peak; a saturated force finds
+    only the branch end on its own side. The slips equal the search's exactly (tolerance 0: the same
+    decisions, then the same solves), and the force's equals the run's patch-slip column."""
+    scenario = Scenario(duration=2.0, **fields)
+    result = run(scenario)
+    rhs = slip.CompiledRHS(wk.assembly.assemble(scenario, inputs.kick_of(scenario.validate())).params)
+    df = result.trajectory
+    for wheel, name in (("r", "rear"), ("f", "front")):
+        args = [df[column].to_numpy() for column in (f"camber_{name}", f"camber_patch_{name}", f"fz_{name}",
+                                                     f"fy_{name}")]
+        fast, search = rhs.carcass_slips(wheel, *args), rhs.carcass_slips(wheel, *args, search=True)
+        assert np.array_equal(fast, search), wheel
+        loaded = args[2] > 0.0
+        assert np.array_equal(fast[loaded, 0], df[f"slip_patch_{name}"].to_numpy()[loaded]), wheel
 
 
 # ------------------------------------------------------------- the block at a constant slip

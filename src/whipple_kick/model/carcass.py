@@ -164,6 +164,22 @@ static void wk_curve_FdF(const wk_curve *c, double a_deg, double *F, double *dF)
     *F = -c->lam * y; *dF = -c->lam * dy;
 }
 
+/* The friction limit on the side of F [N] of one set whose peak lies inside the cap, as wk_curve_F gives it
+   at the end wk_curve_end finds, without finding the end: there C atan(inner) = +-pi/2 to round-off, whose
+   sine is exactly +-1, so the curve is Sv +- D. The peak is inside when the inner function at the cap has
+   passed the peak's value tan(pi/2C) (it rises with the slip for E <= 1). Returns 0 for a blend, no peak
+   (C <= 1), a turning inner function (E > 1) or a peak within 1e-9 of the cap: the search decides there. */
+static int wk_curve_peak(const wk_curve *c, double F, double *lim)
+{
+    const double B = c->f1[0], C = c->f1[1], D = c->f1[2], E = c->f1[3], Sh = c->f1[4], Sv = c->f1[5];
+    if (c->two || !(C > 1.0) || !(E <= 1.0) || !(B > 0.0)) return 0;
+    const double x = B * (F >= 0.0 ? WK_CAP_DEG - Sh : WK_CAP_DEG + Sh);   /* the cap on the force's side */
+    if (!((1.0 - E) * x + E * atan(x) > tan(M_PI / (2.0 * C)) * (1.0 + 1e-9))) return 0;
+    /* F >= 0: wk_curve_F at the lower end (sine -1); F < 0: minus it at the upper end (sine +1) */
+    *lim = F >= 0.0 ? -c->lam * ((1.0 - c->w) * (Sv - D)) : c->lam * ((1.0 - c->w) * (D + Sv));
+    return 1;
+}
+
 /* One end of the rising branch of the (blended) curve [deg]: side 0 where F is largest (lo), side 1 where
    it is smallest (hi). Each end is found on its own (the friction limit on a force's side needs one). */
 static double wk_curve_end(wk_curve *c, int side)
@@ -217,6 +233,16 @@ static double wk_curve_solve(const wk_curve *c, double target, double k, double 
     return a;
 }
 
+/* Whether the slip a [deg] lies inside the cap on the rising branch of one set with C > 1 and E <= 1, as
+   wk_set_branch's ends say, without finding them: the inner function rises with the slip there, and the
+   curve with it while |C atan(inner)| < pi/2. */
+static int wk_set_rises(const double *f, double a)
+{
+    const double B = f[0], C = f[1], E = f[3], x = B * (a + f[4]);
+    if (!(B > 0.0)) return fabs(a) < WK_CAP_DEG;   /* no peak: the branch is the whole cap */
+    return fabs(a) < WK_CAP_DEG && fabs((1.0 - E) * x + E * atan(x)) < tan(M_PI / (2.0 * C));
+}
+
 /* Closed-form patch slip [deg] of one set for the force F (d = 0), clamped to [lo, hi]. */
 static double wk_set_inverse(const double *f, double lam, double F, double lo, double hi)
 {
@@ -246,7 +272,7 @@ _C_WHEEL = r"""
    reaches it), 0 inside. Fast path: one set with C > 1 and E <= 1 (every table7_9 fit) whose closed
    form lands inside the cap needs no branch search. */
 static double wk_carcass_slip_%(w)s(wk_curve *c, double F, int curve_law, double vsy, double speed, double loaded,
-                                   int *sat, double *lim)
+                                   int *sat, double *lim, int search)
 {
     *sat = 0; *lim = 0.0;
     if (!(loaded > 0.0) || !(c->f1[2] > 0.0) || (c->two && !(c->f2[2] > 0.0))) {
@@ -266,23 +292,41 @@ static double wk_carcass_slip_%(w)s(wk_curve *c, double F, int curve_law, double
     }
     if (c->two && !curve_law && c->f1[1] > 1.0 && c->f1[3] <= 1.0 && c->f2[1] > 1.0 && c->f2[3] <= 1.0) {
         /* A pressure blend: where both sets rise, so does the blend, and its root lies between the two
-           sets' own roots; only a force beyond that common part needs the blend's own extremes. */
-        double l1, h1, l2, h2;
-        wk_set_branch(c->f1, &c->up[0], &l1, &h1);
-        wk_set_branch(c->f2, &c->up[1], &l2, &h2);
-        const double lo_in = fmax(l1, l2), hi_in = fmin(h1, h2);
-        if (lo_in < hi_in) {
-            /* Each set's own root (closed form, unclamped); when both lie where both sets rise, the
-               blend's root is between them and the blend is monotone there. */
-            const double a1 = wk_set_inverse(c->f1, c->lam, F, -INFINITY, INFINITY);
-            const double a2 = wk_set_inverse(c->f2, c->lam, F, -INFINITY, INFINITY);
-            if (a1 > lo_in && a1 < hi_in && a2 > lo_in && a2 < hi_in)
-                return wk_curve_solve(c, F, 0.0, fmin(a1, a2), fmax(a1, a2), (1.0 - c->w) * a1 + c->w * a2);
+           sets' own roots; only a force beyond that common part needs the blend's own extremes. Each
+           set's own root (closed form, unclamped) lies on its own rising branch (|asin| < pi/2); whether
+           each lies on the other's too is one evaluation of its inner function (search: by both sets'
+           branch ends, the reference, with a Newton solve for each set's peak). */
+        const double a1 = wk_set_inverse(c->f1, c->lam, F, -INFINITY, INFINITY);
+        const double a2 = wk_set_inverse(c->f2, c->lam, F, -INFINITY, INFINITY);
+        int common;
+        if (search) {
+            double l1, h1, l2, h2;
+            wk_set_branch(c->f1, &c->up[0], &l1, &h1);
+            wk_set_branch(c->f2, &c->up[1], &l2, &h2);
+            const double lo_in = fmax(l1, l2), hi_in = fmin(h1, h2);
+            common = lo_in < hi_in && a1 > lo_in && a1 < hi_in && a2 > lo_in && a2 < hi_in;
+        } else common = fabs(a1) < WK_CAP_DEG && fabs(a2) < WK_CAP_DEG && wk_set_rises(c->f2, a1)
+                        && wk_set_rises(c->f1, a2);
+        /* when both lie where both sets rise, the blend's root is between them and the blend is monotone there */
+        if (common) return wk_curve_solve(c, F, 0.0, fmin(a1, a2), fmax(a1, a2), (1.0 - c->w) * a1 + c->w * a2);
+    }
+    double lo = NAN, hi = NAN, lim_pos = NAN, lim_neg = NAN;
+    int have_lo = 0, have_hi = 0;
+    if (!curve_law && !search) {
+        /* The sliding law "peak": a force past the branch end on its own side saturates there (the tests
+           below decide the same), so that end is searched first and the other one only for a force inside,
+           as the inverse's bracket (search: both ends first, the reference). A negative force counts as
+           past only strictly below its end: at the end itself the test of the positive side comes first. */
+        if (F >= 0.0) {
+            lo = wk_curve_end(c, 0); lim_pos = wk_curve_F(c, lo); have_lo = 1;
+            if (F >= lim_pos) { *sat = 1; *lim = lim_pos; return lo; }
+        } else {
+            hi = wk_curve_end(c, 1); lim_neg = wk_curve_F(c, hi); have_hi = 1;
+            if (F < lim_neg) { *sat = -1; *lim = lim_neg; return hi; }
         }
     }
-    double lo, hi;
-    wk_curve_branch(c, &lo, &hi);
-    double lim_pos = wk_curve_F(c, lo), lim_neg = wk_curve_F(c, hi);
+    if (!have_lo) { lo = wk_curve_end(c, 0); lim_pos = wk_curve_F(c, lo); }
+    if (!have_hi) { hi = wk_curve_end(c, 1); lim_neg = wk_curve_F(c, hi); }
     double a_pos = lo, a_neg = hi;
     /* "curve": past the peak the limit is the steady curve at the kinematic slip, reached on the rising
        branch where the curve gives the same force. */
@@ -338,7 +382,7 @@ static void wk_carcass_%(w)s(double vsy, double vx, double camber, double fz, do
         o->rate = (F - cc * y) / dc;
     } else {
         F = cc * y;
-        a = wk_carcass_slip_%(w)s(&c, F, curve_law, vsy, speed, loaded, &sat, &lim);
+        a = wk_carcass_slip_%(w)s(&c, F, curve_law, vsy, speed, loaded, &sat, &lim, 0);
         /* Past the limit the patch slides faster than at the limit's own slip on the rising branch,
            by (limit - c y) / viscosity: continuous with the rising branch, stiff, and passive. */
         o->rate = speed * tan(a / WK_DEG) - vsy + (sat ? (lim - F) / p[%(visc)d] : 0.0);
@@ -350,11 +394,30 @@ static void wk_carcass_%(w)s(double vsy, double vx, double camber, double fz, do
         int sat_l;
         double lim_l;
         cl.up[0] = c.up[0]; cl.up[1] = c.up[1];   /* the peaks' inner values do not depend on the camber */
-        aM = wk_carcass_slip_%(w)s(&cl, F, 0, vsy, speed, loaded, &sat_l, &lim_l);
+        aM = wk_carcass_slip_%(w)s(&cl, F, 0, vsy, speed, loaded, &sat_l, &lim_l, 0);
     }
     o->slip_moment = aM / WK_DEG;
     o->M = wk_mz_%(w)s(aM / WK_DEG, gl, fz, p);
     o->vslide = vsy + o->rate;
+}
+
+/* The undamped carcass' patch slips [deg] giving the force F at the camber and at the lagged camber gl, as
+   wk_carcass_%(w)s finds them with the sliding law "peak" (search: a blend's common rising branch by the
+   sets' branch ends, both branch ends before the saturation tests; the references); what the tests compare. */
+static void wk_carcass_slips_%(w)s(double camber, double gl, double fz, double F, const double *p, int search,
+                                  double *out)
+{
+    const double fzs = fmax(fz, %(floor).17g), loaded = fz > 0.0 ? 1.0 : 0.0;
+    wk_curve c, cl;
+    int sat;
+    double lim;
+    c.w = cl.w = p[%(wgt)d]; c.lam = cl.lam = p[%(lam)d]; c.two = cl.two = c.w != 0.0;
+    c.up[0] = c.up[1] = NAN;
+    wk_fyfac2_%(w)s_1(camber, gl, fzs, p, c.f1, cl.f1);
+    if (c.two) wk_fyfac2_%(w)s_2(camber, gl, fzs, p, c.f2, cl.f2);
+    out[0] = wk_carcass_slip_%(w)s(&c, F, 0, 0.0, 1.0, loaded, &sat, &lim, search);
+    cl.up[0] = c.up[0]; cl.up[1] = c.up[1];
+    out[1] = wk_carcass_slip_%(w)s(&cl, F, 0, 0.0, 1.0, loaded, &sat, &lim, search);
 }
 """
 

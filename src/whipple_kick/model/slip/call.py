@@ -177,6 +177,53 @@ class CompiledRHS:
             raise FloatingPointError(_STATUS.get(status, f"status {status}") + " while evaluating outputs")
         return out
 
+    def friction_limits(self, wheel, camber, fz, force, search=False):
+        """The friction-limit output (``fy_limit_r``/``fy_limit_f``) [N] at many points of one wheel, in one C call.
+
+        Parameters
+        ----------
+        wheel : {"r", "f"}
+        camber, fz, force : array_like, shape (n,)
+            Camber [rad], normal load [N] and the lateral force [N] whose side the limit is on.
+        search : bool
+            By the rising branch's search alone, also where one set's interior peak gives the limit
+            directly (the reference the tests compare the outputs with).
+
+        Returns
+        -------
+        ndarray, shape (n,)
+        """
+        camber, fz, force = (np.ascontiguousarray(v, dtype=float) for v in (camber, fz, force))
+        out = np.empty(camber.size)
+        self.lib.wk_slip_friction_limits(camber.size, "rf".index(wheel), camber.ctypes.data, fz.ctypes.data,
+                                         force.ctypes.data, self._p_ptr, int(search), out.ctypes.data)
+        return out
+
+    def carcass_slips(self, wheel, camber, lagged_camber, fz, force, search=False):
+        """The undamped carcass' patch slips [rad] giving ``force`` at many points of one wheel, in one C call.
+
+        Parameters
+        ----------
+        wheel : {"r", "f"}
+        camber, lagged_camber, fz, force : array_like, shape (n,)
+            Camber and the moment's lagged camber [rad], normal load [N], carcass force [N].
+        search : bool
+            Find a pressure blend's common rising branch by the sets' branch ends, and both ends of the
+            rising branch before testing a force for saturation (the references the tests compare the
+            shortcuts with).
+
+        Returns
+        -------
+        ndarray, shape (n, 2)
+            The patch slip at the camber (the force's) and at the lagged camber (the moment's), sliding law "peak".
+        """
+        camber, lagged_camber, fz, force = (np.ascontiguousarray(v, dtype=float)
+                                            for v in (camber, lagged_camber, fz, force))
+        out = np.empty((camber.size, 2))
+        self.lib.wk_slip_carcass_slips(camber.size, "rf".index(wheel), camber.ctypes.data, lagged_camber.ctypes.data,
+                                       fz.ctypes.data, force.ctypes.data, self._p_ptr, int(search), out.ctypes.data)
+        return out / (180.0 / np.pi)   # as the C code converts its degrees
+
     def outputs(self, t, x):
         """Derivatives and named outputs (the layout's ``OUTPUT_NAMES``) at one state."""
         x = np.ascontiguousarray(x, dtype=float)

@@ -105,6 +105,12 @@ def library(L=layouts.BASE):
     lib.wk_slip_impulse_terms.argtypes = [ctypes.c_double, pointer, pointer, pointer, pointer, pointer]
     lib.wk_slip_cornering_stiffness.restype = ctypes.c_int
     lib.wk_slip_cornering_stiffness.argtypes = [ctypes.c_double, ctypes.c_double, pointer, pointer]
+    lib.wk_slip_friction_limits.restype = ctypes.c_int
+    lib.wk_slip_friction_limits.argtypes = [ctypes.c_int, ctypes.c_int, pointer, pointer, pointer, pointer,
+                                            ctypes.c_int, pointer]
+    lib.wk_slip_carcass_slips.restype = ctypes.c_int
+    lib.wk_slip_carcass_slips.argtypes = [ctypes.c_int, ctypes.c_int, pointer, pointer, pointer, pointer, pointer,
+                                          ctypes.c_int, pointer]
     sizes = (ctypes.c_int * 4)()
     lib.wk_slip_sizes(sizes)
     if tuple(sizes) != (len(L.STATE_NAMES), len(L.PARAMETER_NAMES), len(L.OUTPUT_NAMES), len(L.DYNAMIC_STATES)):

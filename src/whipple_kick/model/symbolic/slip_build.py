@@ -170,19 +170,28 @@ def _c_carcass_curves():
 
 
 def _c_limit_functions():
-    """Per wheel ``wk_fylim_<w>(camber, fz, F, p)``: the friction limit on the side of ``F`` [N] (an output)."""
+    """Per wheel ``wk_fylim_<w>(camber, fz, F, p)``: the friction limit on the side of ``F`` [N] (an output).
+
+    ``wk_fylim_<w>_by(..., search)``: with ``search`` by the branch search alone, the reference of the
+    shortcut one set's interior peak takes (``wk_curve_peak``; the same value bit for bit, a test checks it).
+    """
     lines = []
     for wheel in "rf":
-        lines += [f"static double wk_fylim_{wheel}(double camber, double fz, double F, const double *p)", "{",
+        lines += [f"static double wk_fylim_{wheel}_by(double camber, double fz, double F, const double *p, "
+                  "int search)", "{",
                   "    if (!(fz > 0.0)) return 0.0;",
                   "    wk_curve c;", "    c.up[0] = c.up[1] = NAN;",
                   f"    c.w = p[{P['w' + wheel]}]; c.lam = p[{P['lam' + wheel]}]; c.two = c.w != 0.0;",
                   f"    wk_fyfac_{wheel}_1(camber, fmax(fz, {carcass.FZ_SHAPE_FLOOR!r}), p, c.f1);",
                   f"    if (c.two) wk_fyfac_{wheel}_2(camber, fmax(fz, {carcass.FZ_SHAPE_FLOOR!r}), p, c.f2);",
                   "    if (!(c.f1[2] > 0.0) || (c.two && !(c.f2[2] > 0.0))) return 0.0;   /* no grip in the fit */",
+                  "    double peak;",
+                  "    if (!search && wk_curve_peak(&c, F, &peak)) return peak;",
                   "    /* only the end on the force's side (a blend searches each end on its own) */",
                   "    return F >= 0.0 ? wk_curve_F(&c, wk_curve_end(&c, 0)) : -wk_curve_F(&c, wk_curve_end(&c, 1));",
-                  "}"]
+                  "}",
+                  f"static double wk_fylim_{wheel}(double camber, double fz, double F, const double *p)",
+                  f"{{ return wk_fylim_{wheel}_by(camber, fz, F, p, 0); }}"]
     return lines
 
 
@@ -656,6 +665,18 @@ def c_source(part_names=(), delayed_reflex=False):
     lines += ["int wk_slip_cornering_stiffness(double fzr, double fzf, const double *p, double *out)", "{",
               "    double g[4];", "    wk_fyg_r(0.0, 0.0, fzr, p, g); out[0] = -g[1];",
               "    wk_fyg_f(0.0, 0.0, fzf, p, g); out[1] = -g[1];", "    return 0;", "}"]
+    # The friction-limit outputs at n points of one wheel (0 rear, 1 front), by the search alone or not.
+    lines += ["int wk_slip_friction_limits(int n, int wheel, const double *camber, const double *fz, const double *F, "
+              "const double *p, int search, double *out)", "{",
+              "    for (int i = 0; i < n; i++)",
+              "        out[i] = wheel ? wk_fylim_f_by(camber[i], fz[i], F[i], p, search) "
+              ": wk_fylim_r_by(camber[i], fz[i], F[i], p, search);", "    return 0;", "}"]
+    # The undamped carcass' patch slips at n points of one wheel, its blend's common branch found either way.
+    lines += ["int wk_slip_carcass_slips(int n, int wheel, const double *camber, const double *gl, const double *fz, "
+              "const double *F, const double *p, int search, double *out)", "{",
+              "    for (int i = 0; i < n; i++)",
+              "        (wheel ? wk_carcass_slips_f : wk_carcass_slips_r)(camber[i], gl[i], fz[i], F[i], p, search, "
+              "out + 2 * i);", "    return 0;", "}"]
     lines.append(f"int wk_slip_sizes(int *sizes) {{ sizes[0] = {ns}; sizes[1] = {len(L.PARAMETER_NAMES)}; "
                  f"sizes[2] = {len(L.OUTPUT_NAMES)}; sizes[3] = {nd}; return 0; }}")
     return "\n".join(lines) + "\n"
