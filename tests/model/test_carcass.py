@@ -95,8 +95,8 @@ def test_friction_limit_shortcut_is_the_search_over_cambers_loads_and_sides(pres
     """The same, away from any run: 60 cambers (+-40 deg) x 60 loads (1 N - 3 kN, past the fits' grip) x
     both force sides, at each measured pressure and a blend (which always searches): identical values."""
     scenario = Scenario(pressure_kpa=pressure)
-    rear, front, _ = wk.assembly.build_tyres(scenario)
-    rhs = slip.CompiledRHS(slip.model_parameters(wk.assembly.build_bicycle(scenario)[0], rear, front))
+    rear, front, _ = wk.assembly.build_tyres(scenario.tyre_spec)
+    rhs = slip.CompiledRHS(slip.model_parameters(wk.assembly.build_bicycle(scenario.bicycle_spec)[0], rear, front))
     camber, fz, side = np.meshgrid(np.radians(np.linspace(-40.0, 40.0, 60)), np.geomspace(1.0, 3000.0, 60),
                                    [-1.0, 1.0])
     for wheel in "rf":
