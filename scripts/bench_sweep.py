@@ -190,8 +190,10 @@ def _print_scaling(label, times, ceilings, efficiency, cap_note):
           f"(median {statistics.median(speedup):.2f}x; {cap_note})")
     print(f"pure-Python ceiling beside them (two processes vs one): {', '.join(f'{c:.2f}' for c in ceilings)} "
           f"(median {statistics.median(ceilings):.2f}x)")
+    quartiles = statistics.quantiles(efficiency, n=4) if len(efficiency) > 1 else efficiency * 3
     print(f"parallel efficiency, speed-up / ceiling per repeat: {', '.join(f'{e:.2f}' for e in efficiency)}; "
-          f"median {statistics.median(efficiency):.2f} (target >= 0.85)")
+          f"median {statistics.median(efficiency):.2f}, quartiles {quartiles[0]:.2f}-{quartiles[2]:.2f} "
+          f"(target >= 0.85); ratio of the medians {statistics.median(times[1]) / statistics.median(times[2]) / statistics.median(ceilings):.2f}")
 
 
 def bench_nine(repeats, duration):
