@@ -18,6 +18,9 @@ Usage:
                                        # default run at rtol 1e-10 and 1e-12, and with tyre_transient
                                        # "force_lag" against the other's default (interleaved fresh processes),
                                        # and the default model's cold build (--build-repeats, default 3)
+    python scripts/bench.py instructions --against DIR [--against-cache DIR]
+                                       # the default run's integration in instructions (valgrind callgrind),
+                                       # this checkout against the other: independent of the machine's load
 """
 import argparse
 import os
@@ -435,9 +438,46 @@ def bench_compare(args):
           f"(medians of {len(builds['this'])} interleaved fresh processes on empty caches)")
 
 
+_INTEGRATION_RUN = """
+import sys
+import whipple_kick as wk
+result = wk.run(wk.Scenario(rtol=float(sys.argv[1])))
+print("evaluations", result.summary["numerics"]["evaluations"])
+"""
+
+
+def bench_instructions(args):
+    """Instructions the default 6 s run's integration executes, this checkout against ``--against``.
+
+    Counted by valgrind's callgrind inside SciPy's LSODA (``--toggle-collect=lsoda``: the integrator, the
+    right-hand side and Jacobian calls from Python into C, nothing before or after), so the figure does not
+    depend on the machine's load the way a wall time does; each side runs once per tolerance.
+    """
+    import re
+    if shutil.which("valgrind") is None:
+        raise SystemExit("instructions needs valgrind (Debian package valgrind)")
+    counts = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        script = os.path.join(tmp, "run.py")
+        pathlib.Path(script).write_text(_INTEGRATION_RUN)
+        for rtol in ("1e-12", "1e-10"):
+            for label, env in _environments(args).items():
+                out = subprocess.run(["valgrind", "--tool=callgrind", "--toggle-collect=lsoda",
+                                      f"--callgrind-out-file={os.path.join(tmp, label + '.out')}", sys.executable,
+                                      script, rtol], env=env, capture_output=True, text=True, check=True, cwd=tmp)
+                collected = int(re.search(r"Collected : (\d+)", out.stderr).group(1))
+                evaluations = int(re.search(r"evaluations (\d+)", out.stdout).group(1))
+                counts[rtol, label] = (collected, evaluations)
+            (this, n_this), (against, n_against) = counts[rtol, "this"], counts[rtol, "against"]
+            print(f"6 s run, defaults, rtol {rtol}: integration instructions this {this:.4e}, against "
+                  f"{against:.4e}, ratio {this / against:.4f}; RHS evaluations (Jacobians' included) this "
+                  f"{n_this}, against {n_against}")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("what", choices=("rhs", "build", "run", "cli", "all", "compare", "transient"), nargs="+")
+    parser.add_argument("what", choices=("rhs", "build", "run", "cli", "all", "compare", "instructions", "transient"),
+                        nargs="+")
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--build-repeats", type=int, default=3, help="cold builds per side in compare (default 3)")
     parser.add_argument("--record", action="store_true",
@@ -448,10 +488,13 @@ def main():
     args = parser.parse_args()
     RECORD.update(on=args.record, machine=args.machine)
     np.set_printoptions(precision=4)
-    if "compare" in args.what:
+    if "compare" in args.what or "instructions" in args.what:
         if not args.against:
-            parser.error("compare needs --against DIR")
-        bench_compare(args)
+            parser.error("compare and instructions need --against DIR")
+        if "compare" in args.what:
+            bench_compare(args)
+        if "instructions" in args.what:
+            bench_instructions(args)
         return
     if "transient" in args.what:
         bench_transient(args.repeats)
