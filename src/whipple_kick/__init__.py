@@ -21,7 +21,7 @@ loaded unless it is used.
 """
 import importlib
 
-__version__ = "0.3.0"
+__version__ = "0.4.0"
 
 #: The public names and the module each lives in.
 _EXPORTS = {
