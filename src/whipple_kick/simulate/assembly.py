@@ -157,8 +157,9 @@ def model_parameters(spec, kick, moore, body, rear, front, gains):
     ----------
     spec : whipple_kick.simulate.scenario.ModelSpec
         The model's options (``scenario.model_spec``).
-    kick : whipple_kick.library.inputs.Kick
-        The plate motion (its first piece enters the parameters).
+    kick : whipple_kick.library.inputs.Kick or None
+        The plate motion (its first piece enters the parameters); None: the plate stays still (a linear
+        analysis about the steady motion).
     moore : dict
         The bicycle with rider (:func:`build_bicycle`).
     body : dict
@@ -168,7 +169,7 @@ def model_parameters(spec, kick, moore, body, rear, front, gains):
         Steer-torque gains by name.
     """
     return slip.model_parameters(moore, rear, front, gains=gains, symmetric=spec.symmetric_tyres,
-                                 kick=kick.model_kick(), tyre_transient=spec.tyre_transient,
+                                 kick=None if kick is None else kick.model_kick(), tyre_transient=spec.tyre_transient,
                                  reverse_camber=spec.camber_sign == "reversed",
                                  carcass_sliding=spec.carcass_sliding, carcass_damping=spec.carcass_damping,
                                  carcass_viscosity=spec.carcass_viscosity, slip_speed=spec.slip_speed,

@@ -238,12 +238,14 @@ def _setup(scenario, tyres=None):
 
 
 def _base_params(setup):
-    """Slip-model parameters of the scenario without steer control (with the rider's body, arms and reflex)."""
+    """Slip-model parameters of the scenario without steer control (with the rider's body, arms and reflex).
+
+    The run's own (:func:`whipple_kick.simulate.assembly.model_parameters`): every model option of the
+    scenario, the carcass tyre's damping, stiffness scale, sliding law and viscosity included.
+    """
     sc = setup.scenario
-    return slip.model_parameters(setup.moore, *setup.tyres, symmetric=sc.symmetric_tyres,
-                                 tyre_transient=sc.tyre_transient,
-                                 reverse_camber=sc.camber_sign == "reversed", slip_speed=sc.slip_speed,
-                                 body=assembly.rider_body(sc.body_spec, setup.info))
+    return assembly.model_parameters(sc.model_spec, None, setup.moore, assembly.rider_body(sc.body_spec, setup.info),
+                                     *setup.tyres, None)
 
 
 def _loop_params(setup, speed, loop, base=None):

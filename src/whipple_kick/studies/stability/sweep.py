@@ -14,6 +14,26 @@ from .modes import _wheelbase, mode_content, name_tracks, track
 from .report import describe
 from .summary import _summarise
 
+#: Scenario fields a linear analysis about the steady motion at each speed does not read: the kick, the
+#: run's length, sampling and end, the integration's numerics and the run's start. :func:`analyse` refuses
+#: them other than at their defaults (a stability sweep over one would give identical rows).
+NOT_ANALYSED = ("kick_displacement", "kick_duration", "kick_accel", "kick_profile", "kick_table", "kick_direction",
+                "settle", "duration", "output_rate", "fall_angle_deg", "steer_limit_deg", "rtol", "piecewise",
+                "plate_stop", "kick_heading", "start", "start_pitch")
+
+
+def _refuse_unread(scenario):
+    """InputError naming the first field of :data:`NOT_ANALYSED` set other than its default."""
+    from dataclasses import fields
+
+    defaults = {f.name: f.default for f in fields(scenario)}
+    for name in NOT_ANALYSED:
+        if getattr(scenario, name) != defaults[name]:
+            raise InputError(f"{name} = {getattr(scenario, name)!r} is not read by the stability analysis (the "
+                             f"linearisation about the steady motion at each speed) and would be ignored: leave it "
+                             f"at its default {defaults[name]!r}")
+
+
 # ------------------------------------------------------------------ the sweep
 
 class _Loop:
@@ -184,8 +204,10 @@ def analyse(scenario, speeds, *, loops=None, tyres=None):
     Parameters
     ----------
     scenario : whipple_kick.simulate.scenario.Scenario
-        Bicycle, rider, tyres, controller. Its kick and run fields are not
-        used, nor its speed. With the measured tyres' zero-slip offsets the
+        Bicycle, rider, tyres, controller, the model's options. Its speed is
+        not used (``speeds`` are), and its kick, run, integration and start
+        fields (:data:`NOT_ANALYSED`) are refused other than at their
+        defaults. With the measured tyres' zero-slip offsets the
         steady motions are turns (large ones where the loop has a real
         eigenvalue near zero): ``symmetric_tyres=True`` analyses straight
         running (the ``stability`` command's default).
@@ -211,6 +233,7 @@ def analyse(scenario, speeds, *, loops=None, tyres=None):
     """
     import pandas as pd
 
+    _refuse_unread(scenario)
     speeds = check_speeds(speeds)
     loops = _check_loops(scenario, loops)
     setup = _setup(scenario, tyres)
