@@ -34,7 +34,7 @@ from whipple_kick.errors import InputError, check_range
 from whipple_kick.model import parts, slip
 from whipple_kick.simulate import control, steady
 
-from .scenario import LOW_INERTIA_KEYS, THESIS_DESIGN_SPEED
+from .scenario import DEFAULTS, LOW_INERTIA_KEYS, THESIS_DESIGN_SPEED
 
 #: ``|steady yaw rate|`` [rad/s] below which steady running counts as straight (a yaw-angle gain needs it).
 STRAIGHT_YAW_RATE = 1e-9
@@ -550,19 +550,16 @@ def custom_gains(gains, scenario=None):
     no lean to feed back). With ``scenario``, its fields that the given gains
     replace (:data:`CONTROLLER_FIELDS`) must be at their defaults.
     """
-    from dataclasses import fields
-
     from whipple_kick.model import symbols
 
     unknown = sorted(set(gains) - set(slip.GAIN_NAMES))
     if unknown:
         raise InputError(f"unknown steer-torque gain(s) {unknown}; known: {list(slip.GAIN_NAMES)}")
     if scenario is not None:
-        defaults = {f.name: f.default for f in fields(scenario)}
         for name in CONTROLLER_FIELDS:
-            if getattr(scenario, name) != defaults[name]:
+            if getattr(scenario, name) != DEFAULTS[name]:
                 raise InputError(f"{name} = {getattr(scenario, name)!r} is replaced by the given gains (it would be "
-                                 f"ignored): leave it at its default {defaults[name]!r} with gains=")
+                                 f"ignored): leave it at its default {DEFAULTS[name]!r} with gains=")
         lean = [n for n in ("kq11", "ku11") if gains.get(n, 0.0) != 0.0]
         if lean and scenario.rider_body != "leaning":
             raise InputError(f"gain(s) {lean} feed back the upper body's lean, which only rider_body 'leaning' "

@@ -77,18 +77,18 @@ def _with_part_fields(cls):
     entry in the class's docstring, its range check, its CLI flag and its
     refusal while the part is off all follow from that declaration.
     """
-    by_name = {f.name: f for f in parts.fields()}
     annotations, documented = {}, []
     for name, annotation in inspect.get_annotations(cls).items():
         annotations[name] = annotation
-        for extra in _PART_FIELDS.get(name, ()):
-            f = by_name[extra]
-            part = next(p for p in parts.REGISTRY.values() if f in p.fields)
-            annotations[extra] = float
-            if hasattr(cls, name):   # defaults where the class has them (Scenario), none in a view
-                setattr(cls, extra, f.default)
-            documented.append(f"    {extra} : float\n        The {f.label} of {part.title or part.name} "
-                              f"[{f.unit}], {f.low:g} to {f.high:g}; default {f.default:g}: {f.source}.\n")
+        for part in parts.REGISTRY.values():
+            if part.selected_by[:1] != (name,):
+                continue
+            for f in part.fields:
+                annotations[f.name] = float
+                if hasattr(cls, name):   # defaults where the class has them (Scenario), none in a view
+                    setattr(cls, f.name, f.default)
+                documented.append(f"    {f.name} : float\n        The {f.label} of {part.title or part.name} "
+                                  f"[{f.unit}], {f.low:g} to {f.high:g}; default {f.default:g}: {f.source}.\n")
     cls.__annotations__ = annotations
     # The entries join the docstring's list of fields: before its Notes, or at its end.
     notes = "\n    Notes\n    -----"
@@ -602,22 +602,20 @@ class Scenario:
         >>> Scenario(thesis_load_n=570.0).unused_fields()
         {'thesis_load_n': "the thesis' Table 8.4 rider (controller 'thesis')"}
         """
-        defaults = {f.name: f.default for f in fields(self)}
         unused = {}
         for mechanism, condition, active, names in MECHANISM_FIELDS:
             for name in names:
-                if name not in unused and getattr(self, name) != defaults[name] and not active(self):
+                if name not in unused and getattr(self, name) != DEFAULTS[name] and not active(self):
                     unused[name] = f"{mechanism} ({condition})"
         if self.pressure_front_kpa is not None and self.pressure_rear_kpa is not None \
-                and self.pressure_kpa != defaults["pressure_kpa"]:
+                and self.pressure_kpa != DEFAULTS["pressure_kpa"]:
             unused["pressure_kpa"] = "a tyre without its own pressure (pressure_front_kpa and pressure_rear_kpa are both given)"
         return unused
 
     def _refuse_unused(self):
         for name, why in self.unused_fields().items():
-            default = {f.name: f.default for f in fields(self)}[name]
             raise InputError(f"{name} = {getattr(self, name)!r} is read only by {why}, which this scenario does not "
-                             f"use: leave it at its default {default!r} (it would be ignored)")
+                             f"use: leave it at its default {DEFAULTS[name]!r} (it would be ignored)")
 
     def to_dict(self) -> dict:
         """Fields as a plain dict (JSON-ready)."""
@@ -726,6 +724,9 @@ class Scenario:
         """
         return replace(self, **changes)
 
+
+#: Every field's default, by name.
+DEFAULTS = {f.name: f.default for f in fields(Scenario)}
 
 #: Fields that may hold a file path (written absolute by :meth:`Scenario.to_file`).
 _PATH_FIELDS = ("bicycle", "kick_table")

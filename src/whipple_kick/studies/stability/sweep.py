@@ -24,14 +24,13 @@ NOT_ANALYSED = ("kick_displacement", "kick_duration", "kick_accel", "kick_profil
 
 def _refuse_unread(scenario):
     """InputError naming the first field of :data:`NOT_ANALYSED` set other than its default."""
-    from dataclasses import fields
+    from whipple_kick.simulate.scenario import DEFAULTS
 
-    defaults = {f.name: f.default for f in fields(scenario)}
     for name in NOT_ANALYSED:
-        if getattr(scenario, name) != defaults[name]:
+        if getattr(scenario, name) != DEFAULTS[name]:
             raise InputError(f"{name} = {getattr(scenario, name)!r} is not read by the stability analysis (the "
                              f"linearisation about the steady motion at each speed) and would be ignored: leave it "
-                             f"at its default {defaults[name]!r}")
+                             f"at its default {DEFAULTS[name]!r}")
 
 
 # ------------------------------------------------------------------ the sweep
