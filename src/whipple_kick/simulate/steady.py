@@ -12,15 +12,26 @@ branches, at other leans. :func:`find_steady_state` tries, in order and each
 only if the previous failed:
 
 1. the direct solve (from upright running);
-2. steady turns: starts at leans of +-1 to +-30 deg, each with the yaw rate
-   of a balanced turn (g tan(lean) / v) and its kinematic steer angle; of the
-   motions found, the one with the smallest lean (the closest to upright
-   running);
-3. continuation in the tyres' offsets: symmetric tyres (exactly upright,
+2. continuation in the tyres' offsets: symmetric tyres (exactly upright,
    always solvable), then the offsets scaled up to their measured size,
-   each solve starting from the previous one;
+   each solve starting from the previous one (the motion connected to
+   upright running, where the direct solve's start was too far from it);
+3. steady turns: starts at leans of +-1 to +-30 deg, each with the yaw rate
+   of a balanced turn (g tan(lean) / v) and its kinematic steer angle; of the
+   motions found that are a start (below), the one with the smallest lean;
 4. continuation in speed from neighbouring speeds where a steady motion is
    found, with the same rider and tyres.
+
+A motion is taken as a start only if it is near-upright and inside the
+tyres' measured slip range (:func:`start_problem`): lean and steer within
+:data:`NEAR_UPRIGHT_DEG`, both tyres' slip within :data:`START_SLIP_DEG`. The turn
+search finds motions on other branches too (the same tyres and rider hold
+steady turns at 20 deg of lean, or at 85 deg of steer with the front tyre
+sliding sideways and the rear wheel driving hard); for a run (``hold=True``)
+a turn is taken only if the rider's closed loop about it is stable as well.
+The direct solve and the two continuations stay on the branch of upright
+running, whose stability is the rider's own
+(:func:`whipple_kick.simulate.assembly.linear_stability` reports it).
 
 If none succeeds, :class:`NoSteadyMotion` says why in physical terms (how far
 the offset continuation got, the lean there, the real closed-loop pole that
@@ -58,6 +69,19 @@ _MIN_STEP = 1e-3
 MAX_SOLVES = 400
 #: Slowest speed [m/s] a speed continuation may start from.
 _MIN_START_SPEED = 0.5
+#: Largest |lean| and |steer| [deg] of a start ("near-upright"): the rider is an LQR designed on the model
+#: linearised about upright straight running, whose small-angle terms err by 1 - cos(10 deg) = 1.5 % at 10 deg;
+#: and a start is meant to be the straight running of the experiment, not a turn (the turn search also finds
+#: turns at 20 deg of lean, or at 85 deg of steer with the front tyre sliding sideways).
+NEAR_UPRIGHT_DEG = 10.0
+#: Largest |slip| [deg] of either tyre in a start: the slip sweep's extent (thesis Section 7.3, |alpha| up to
+#: 6 deg; the tyre files' ``[measured] slip_deg``). A steady motion with a tyre sliding beyond it is no start.
+#: The camber was measured to +-5 deg only (Section 7.3): a start leaning 5-10 deg rests on the fits' camber
+#: extrapolation (the default rider with arms, designed on the model simulated, starts at 5.2 deg of lean).
+START_SLIP_DEG = 6.0
+#: A closed-loop pole whose real part exceeds this [1/s] makes the rider linearly unstable
+#: (slower growth, by less than 1 % over a 10 s run, is not reported).
+UNSTABLE_REAL_PART = 1e-3
 #: A guessed unknown smaller than this (in its SI unit) starts at exactly 0: MINPACK's
 #: forward-difference step is relative to each unknown (1.5e-8 |x|, or 1.5e-8 at x = 0),
 #: so a round-off lean of 1e-14 rad would get a 1e-22 rad step and a useless Jacobian.
@@ -156,8 +180,8 @@ def _continue(counter, solve_at, start, end, first_step):
     return (last if value == end else None), last, value, steps
 
 
-def find_steady_state(params, speed, *, advice=None):
-    """Steady motion at ``speed`` [m/s]: the direct solve, then steady turns, then continuation (see the module).
+def find_steady_state(params, speed, *, advice=None, hold=True):
+    """Steady motion at ``speed`` [m/s] that a run can start from (see the module for the search).
 
     Parameters
     ----------
@@ -169,6 +193,10 @@ def find_steady_state(params, speed, *, advice=None):
     advice : str, optional
         What the user can change, appended to the error (e.g. "choose another
         design speed or speed").
+    hold : bool
+        A steady turn found by the turn search must also be held by the
+        rider's closed loop (True: a run's start); False for a linear
+        analysis, which is about the motion whatever its stability.
 
     Returns
     -------
@@ -181,31 +209,81 @@ def find_steady_state(params, speed, *, advice=None):
     """
     counter = _Counter()
     direct = counter.solve(params, speed)
-    if direct is not None:
+    if direct is not None and start_problem(direct) is None:
         return Found(direct, "direct", counter.solves)
-    turns = {}
-    for lean in TURN_LEANS_DEG:
-        found = counter.solve(params, speed, turn_guess(params, speed, math.radians(lean)))
-        if found is not None:
-            turns.setdefault(round(math.degrees(found.unknowns["q4"]), 6), (lean, found))
-    if turns:
-        lean, found = turns[min(turns, key=abs)]
-        return Found(found, f"steady turn started at {lean:+g} deg of lean (of {len(turns)} found)", counter.solves)
-    # Offsets: from symmetric tyres (exactly upright) up to the measured offsets.
-    found, last, fraction, steps = _continue(
-        counter, lambda s, guess: counter.solve(offset_scaled(params, s), speed, guess), 0.0, 1.0, 0.25)
+    # Offsets: from symmetric tyres (exactly upright) up to the measured offsets, on the branch of upright running.
+    # A step whose motion has left the tyres' measured range counts as a failed step. The last failed step (the
+    # smallest step past the point reached) says why the continuation stopped: the range, or no solution (a fold).
+    left = {}
+
+    def offset_step(fraction, guess):
+        found = counter.solve(offset_scaled(params, fraction), speed, guess)
+        problem = None if found is None else start_problem(found)
+        if found is None or problem is not None:
+            left.update(fraction=fraction, problem=problem)
+            return None
+        return found
+
+    found, last, fraction, steps = _continue(counter, offset_step, 0.0, 1.0, 0.25)
     if found is not None:
         return Found(found, f"offset continuation ({steps} steps)", counter.solves)
-    # Neighbouring speeds: a steady motion there, followed to this speed.
+    turns, refused = {}, {}
+    for lean in TURN_LEANS_DEG:
+        turn = counter.solve(params, speed, turn_guess(params, speed, math.radians(lean)))
+        if turn is None:
+            continue
+        key = (round(math.degrees(turn.unknowns["q4"]), 6), round(math.degrees(turn.unknowns["q7"]), 6))
+        problem = start_problem(turn, hold=hold)
+        if problem is None:
+            turns.setdefault(key, (lean, turn))
+        else:
+            refused.setdefault(key, problem)
+    if turns:
+        lean, found = turns[min(turns, key=lambda k: math.hypot(*k))]
+        return Found(found, f"steady turn started at {lean:+g} deg of lean (of {len(turns)} found)", counter.solves)
+    # Neighbouring speeds: the upright branch there, followed to this speed.
     for step in NEIGHBOUR_STEPS:
         start = speed + step
         if start < _MIN_START_SPEED or counter.solves >= MAX_SOLVES:
             continue
         found_v, _, _, steps_v = _continue(
-            counter, lambda v, guess: counter.solve(params, v, guess), start, speed, abs(step) / 4)
+            counter, lambda v, guess: _start_or_none(counter.solve(params, v, guess)), start, speed, abs(step) / 4)
         if found_v is not None:
             return Found(found_v, f"speed continuation from {start:g} m/s ({steps_v} steps)", counter.solves)
-    raise NoSteadyMotion(diagnosis(params, speed, last, fraction, advice, counter.solves >= MAX_SOLVES))
+    raise NoSteadyMotion(diagnosis(params, speed, last, fraction, advice, counter.solves >= MAX_SOLVES,
+                                   refused=refused, direct=direct, left=left))
+
+
+def start_problem(steady, hold=False):
+    """Why ``steady`` (a :class:`SteadyState`) is no start, in a few words; None if it is one.
+
+    A start is near-upright running (lean and steer within
+    :data:`NEAR_UPRIGHT_DEG`) with both tyres inside their measured slip
+    range (:data:`START_SLIP_DEG`); with ``hold`` the rider's closed loop
+    about it must also be stable (slowest pole's real part <=
+    :data:`UNSTABLE_REAL_PART`).
+    """
+    lean, steer = (math.degrees(steady.unknowns[n]) for n in ("q4", "q7"))
+    where = f"lean {lean:+.1f} deg, steer {steer:+.1f} deg"
+    if max(abs(lean), abs(steer)) > NEAR_UPRIGHT_DEG:
+        return f"{where}: not near-upright (lean and steer within +-{NEAR_UPRIGHT_DEG:g} deg)"
+    angles = {name: math.degrees(value) for name, value in (steady.angles or {}).items()}
+    for wheel, word in (("r", "rear"), ("f", "front")):
+        slip_angle = angles.get(f"slip_{wheel}", 0.0)
+        if abs(slip_angle) > START_SLIP_DEG:
+            return (f"{where}: the {word} tyre's slip {slip_angle:+.1f} deg is outside the measured "
+                    f"+-{START_SLIP_DEG:g} deg")
+    if hold:
+        poles = _poles_or_none(steady.params, steady.x)
+        if poles is None or poles[0].real > UNSTABLE_REAL_PART:
+            pole = "" if poles is None else f" (slowest pole {poles[0].real:+.2f} 1/s)"
+            return f"{where}: the rider's closed loop about it is unstable{pole}"
+    return None
+
+
+def _start_or_none(steady):
+    """``steady`` if it is a start by :func:`start_problem` (without the closed loop's stability), else None."""
+    return steady if steady is not None and start_problem(steady) is None else None
 
 
 def turn_guess(params, speed, lean):
@@ -261,18 +339,26 @@ def _nearest_real_pole(poles):
     return float(real[np.argmin(np.abs(real))]) if real.size else None
 
 
-def diagnosis(params, speed, last, fraction, advice=None, exhausted=False):
+def diagnosis(params, speed, last, fraction, advice=None, exhausted=False, *, refused=None, direct=None,
+              left=None):
     """One line saying why no steady motion was found (see :func:`find_steady_state`).
 
     ``last`` is the last steady motion of the continuation in the tyre
     offsets and ``fraction`` how far it got; ``exhausted`` that the search
-    spent :data:`MAX_SOLVES`.
+    spent :data:`MAX_SOLVES`; ``refused`` the steady turns found that are no
+    start (:func:`start_problem`'s reason by (lean, steer) in deg); ``direct``
+    the direct solve's motion if it found one (and it was no start); ``left``
+    where the offset continuation's motion first left the tyres' measured
+    range (``fraction`` and ``problem``), if it did.
     """
-    text = f"no steady motion at {speed:g} m/s: "
+    text = f"no near-upright steady motion at {speed:g} m/s: "
     if (last is None or fraction <= 0.0) and exhausted:
         text += f"the search stopped after {MAX_SOLVES} solves"
     elif last is None or fraction <= 0.0:
         text += "not even with symmetric tyres"
+    elif left and left["problem"] is not None:
+        text += (f"continued from symmetric tyres, the steady motion leaves the starts' range past "
+                 f"{fraction:.1%} of their zero-slip offsets (at {left['fraction']:.1%}: {left['problem']})")
     else:
         lean = math.degrees(last.unknowns["q4"])
         near = _nearest_real_pole(_poles_or_none(last.params, last.x))
@@ -286,8 +372,15 @@ def diagnosis(params, speed, last, fraction, advice=None, exhausted=False):
         pole_text = f"{slowest.real:+.2f}" + (f" +- {abs(slowest.imag):.2f}j" if abs(slowest.imag) > 1e-9 else "")
         text += (f"; with symmetric tyres the rider's closed loop is "
                  f"{'unstable' if slowest.real > 0 else 'stable'} at {speed:g} m/s (slowest pole {pole_text} 1/s)")
+    if direct is not None:
+        text += f"; the direct solve found no start ({start_problem(direct)})"
     if exhausted and last is not None and fraction > 0.0:
         text += f"; the search stopped after {MAX_SOLVES} solves"
+    elif refused:
+        closest = refused[min(refused, key=lambda k: math.hypot(*k))]
+        text += (f"; the {len(refused)} steady turn{'s' if len(refused) > 1 else ''} found from "
+                 f"{min(map(abs, TURN_LEANS_DEG)):g}-{max(TURN_LEANS_DEG):g} deg of lean "
+                 f"{'are' if len(refused) > 1 else 'is'} no start (closest to upright: {closest})")
     elif TURN_LEANS_DEG and not exhausted:
         text += (f"; nor from steady turns of {min(map(abs, TURN_LEANS_DEG)):g}-{max(TURN_LEANS_DEG):g} "
                  "deg of lean")
@@ -303,14 +396,19 @@ def diagnosis(params, speed, last, fraction, advice=None, exhausted=False):
 STEADY_PARAMETERS = ("T6c", "ccr", "ccf")
 
 
+#: The wheels' angles of a steady motion (:func:`start_problem` checks the slips), as the compiled model's outputs [rad].
+WHEEL_ANGLES = ("slip_r", "slip_f", "camber_r", "camber_f")
+
+
 class SteadyState:
     """Result of :func:`steady_state`."""
 
-    def __init__(self, x, params, residual, unknowns):
+    def __init__(self, x, params, residual, unknowns, angles=None):
         self.x = x                  # full state vector (its model's layout: slip.STATE_NAMES and the parts' states)
         self.params = params        # parameters with the holding drive torque T6c
         self.residual = residual    # max |residual| of the steady equations
         self.unknowns = unknowns    # dict of the solved quantities
+        self.angles = angles        # the wheels' slip and camber [rad] (slip_r, slip_f, camber_r, camber_f), or None
 
     def __repr__(self):
         u = ", ".join(f"{k}={v:.3g}" for k, v in self.unknowns.items())
@@ -390,10 +488,12 @@ def steady_state(params, speed, tol=1e-13, guess=None):
     if not np.all(np.isfinite(z)) or res > 1e-8:
         raise FloatingPointError(f"steady state not found at {speed} m/s: {sol.message} (residual {res:.3g})")
     xs = state(z)
+    out = rhs.outputs(0.0, xs)[1]
     out_params = dict(params)
     out_params["T6c"] = float(z[-1])
     out_params["ccr"], out_params["ccf"] = float(rhs.p[slip.P["ccr"]]), float(rhs.p[slip.P["ccf"]])
-    return SteadyState(xs, out_params, res, dict(zip(names, z, strict=True)))
+    return SteadyState(xs, out_params, res, dict(zip(names, z, strict=True)),
+                       {name: float(out[slip.OUT[name]]) for name in WHEEL_ANGLES})
 
 
 def _steady_tyre_states(rhs, x):

@@ -285,14 +285,22 @@ class NoRiderDesign(InputError):
 
 
 def _steady(params, speed, guess):
-    """(SteadyState, found_by): continued from ``guess``, else the robust search (may raise NoSteadyMotion)."""
+    """(SteadyState, found_by): continued from ``guess``, else the robust search (may raise NoSteadyMotion).
+
+    Only near-upright motions inside the tyres' measured range
+    (:func:`whipple_kick.simulate.steady.start_problem`), stable or not: a
+    continued motion that has left them is searched for afresh, and a speed
+    with none is left out as having no near-upright steady motion.
+    """
     from whipple_kick.simulate import steady
     if guess is not None:
         try:
-            return steady.steady_state(params, speed, guess=guess), "continued"
+            continued = steady.steady_state(params, speed, guess=guess)
         except FloatingPointError:
-            pass
-    found = steady.find_steady_state(params, speed)
+            continued = None
+        if continued is not None and steady.start_problem(continued) is None:
+            return continued, "continued"
+    found = steady.find_steady_state(params, speed, hold=False)
     return found.steady, found.route
 
 

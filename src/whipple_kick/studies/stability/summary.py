@@ -20,18 +20,26 @@ def _root(fun, a, b):
     linearisations at the ends may disagree (a mode matched to another
     eigenvalue, a steady motion continued to another branch). Then there is
     no bracket and no root is claimed: an estimate outside [a, b] would be a
-    number without meaning.
+    number without meaning. Nor where a speed tried has no near-upright
+    steady motion (:class:`_NoLinearisation`).
     """
     from scipy.optimize import brentq
-    fa, fb = fun(a), fun(b)
-    if fa == 0.0:
-        return a, None
-    if fb == 0.0:
-        return b, None
-    if not (np.isfinite(fa) and np.isfinite(fb)) or fa * fb > 0:
-        return None, (f"the real part does not change sign between {a:g} and {b:g} m/s on fresh "
-                      f"linearisations ({fa:+.3g} and {fb:+.3g} 1/s), although the sweep's samples do")
-    return float(brentq(fun, a, b, xtol=1e-9, rtol=1e-12)), None
+    try:
+        fa, fb = fun(a), fun(b)
+        if fa == 0.0:
+            return a, None
+        if fb == 0.0:
+            return b, None
+        if not (np.isfinite(fa) and np.isfinite(fb)) or fa * fb > 0:
+            return None, (f"the real part does not change sign between {a:g} and {b:g} m/s on fresh "
+                          f"linearisations ({fa:+.3g} and {fb:+.3g} 1/s), although the sweep's samples do")
+        return float(brentq(fun, a, b, xtol=1e-9, rtol=1e-12)), None
+    except _NoLinearisation as exc:   # a speed between the samples without a near-upright steady motion
+        return None, str(exc)
+
+
+class _NoLinearisation(Exception):
+    """A speed between two sweep samples has no near-upright steady motion to linearise about (issue 40)."""
 
 
 class _Split(NamedTuple):
@@ -50,7 +58,7 @@ class _Sweep:
     """One model and loop of a sweep: eigenvalues, tracks and names per speed, with refinement."""
 
     def __init__(self, table, speeds, raw, eigen_at):
-        self.table, self.speeds, self.eigen_at = table, speeds, eigen_at
+        self.table, self.speeds, self._eigen_at = table, speeds, eigen_at
         self.lams, self.vecs, self.ids = raw
         # mode name of (speed index, track)
         self.name = {(int(r.speed_index), int(r.track)): r.mode for r in table.itertuples()}
@@ -58,6 +66,20 @@ class _Sweep:
 
     def present(self, k):
         return self.lams[k] is not None
+
+    def eigen_at(self, v, k):
+        """Eigenvalues and angle-like vectors of a fresh linearisation at ``v`` [m/s] (continued from sample k).
+
+        Raises _NoLinearisation where there is no near-upright steady motion at ``v``: the refinement then
+        gives no speed, with the reason, instead of one found on another branch.
+        """
+        from whipple_kick.errors import InputError
+        try:
+            return self._eigen_at(v, k)
+        except InputError as exc:    # NoSteadyMotion, or no rider design at that speed
+            raise _NoLinearisation(f"{str(exc).split(':', maxsplit=1)[0]} between the sweep's samples "
+                                   f"{self.speeds[max(k - 1, 0)]:g}-{self.speeds[min(k + 1, len(self.speeds) - 1)]:g} "
+                                   "m/s; refine the speed grid there") from None
 
     def values(self, k, mode):
         """Eigenvalues named ``mode`` at speed index ``k`` (with their tracks)."""
@@ -129,7 +151,10 @@ class _Sweep:
                            if complex(l) in (a, a.conjugate()))
         if (k, tracks) not in self._splits:
             moduli = [abs(a)] + [abs(self.eigenvalue(k + 1, t) or 0.0) for t in tracks]
-            self._splits[k, tracks] = self._locate_split(k, 2 * max(moduli) + 1.0)
+            try:
+                self._splits[k, tracks] = self._locate_split(k, 2 * max(moduli) + 1.0)
+            except _NoLinearisation as exc:
+                self._splits[k, tracks] = None, str(exc)
         return self._splits[k, tracks]
 
     def _locate_split(self, k, radius):
