@@ -624,7 +624,8 @@ def test_rider_body_flags_reach_the_run_and_a_scenario_file(tmp_path, capsys):
         "leaning", "simulated", 40.0, 0.05, 0.2)
     status, _, err = _simulate(["--scenario", str(out / "scenario.toml"), "--reflex-delay", "0.05",
                                 "--out", str(tmp_path / "refused")], capsys)
-    assert status == 2 and "reflex_delay = 0.05 is read only by the reflex" in err
+    # Named as it was given: the flag, with its unit (issue 40 item 11).
+    assert status == 2 and "--reflex-delay 0.05 s is read only by the reflex (a reflex gain other than 0)" in err
 
 
 def test_stability_takes_the_rider_body_flags(tmp_path, capsys):

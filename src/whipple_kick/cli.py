@@ -485,6 +485,57 @@ def _model_fields(args):
     return fields
 
 
+def _flag(field):
+    """The flag that sets a Scenario field (:data:`_FIELD_FLAGS`; the rest by the flag of the field's own name)."""
+    return "--" + _FIELD_FLAGS.get(field, (field,))[0].replace("_", "-")
+
+
+def _flag_value(field, value):
+    """``field = value`` as flags give it: ``--hip-stiffness 500 N m/rad``, ``--plate-stop resolve``, ``--lqr-heading``."""
+    from whipple_kick.simulate.scenario import UNITS
+    if isinstance(value, bool):
+        return _flag(field) if value else f"no {_flag(field)}"
+    unit = UNITS.get(field)
+    if unit is None or not isinstance(value, (int, float)):
+        return f"{_flag(field)} {value}"
+    return f"{_flag(field)} {value:g}" + (" (unit 1)" if unit == "1" else f" {unit}")
+
+
+def _in_flags(words):
+    """A mechanism's condition (:data:`whipple_kick.simulate.scenario.MECHANISM_FIELDS`) in flags: "rider_body
+    'leaning'" -> "--rider-body leaning", "pressure_front_kpa" -> "--pressure-front"."""
+    import re
+
+    from whipple_kick.simulate.scenario import DEFAULTS
+
+    def quoted(match):
+        if match[1] not in DEFAULTS:
+            return match[0]
+        return f"{_flag(match[1])} {match[2]}" + match[3].replace("'", "")
+
+    words = re.sub(r"\b([a-z][a-z0-9_]*) '([^']*)'((?: or '[^']*')*)", quoted, words)
+    return re.sub(r"(?<![-\w])([a-z0-9]+_[a-z0-9_]+)\b",
+                  lambda m: _flag(m[1]) if m[1] in DEFAULTS else m[0], words)
+
+
+def _preflight(scenario):
+    """:func:`whipple_kick.simulate.assembly.preflight`, a field its mechanism does not read refused by its flag.
+
+    The scenario's own refusal (:class:`~whipple_kick.simulate.scenario.UnusedFieldError`) names the Python
+    field; a user of the command line gave a flag.
+    """
+    from whipple_kick.simulate import assembly
+    from whipple_kick.simulate.scenario import DEFAULTS, UnusedFieldError
+    try:
+        return assembly.preflight(scenario)
+    except UnusedFieldError as exc:
+        default = DEFAULTS[exc.field]
+        leave = ("leave it out" if default is None or default is False
+                 else f"leave it at its default ({_flag_value(exc.field, default)})")
+        raise InputError(f"{_flag_value(exc.field, getattr(scenario, exc.field))} is read only by "
+                         f"{_in_flags(exc.why)}, which this run does not use: {leave}; it would be ignored") from None
+
+
 def _check_loads(bicycle, loads):
     """Refuse a ``--fz`` no rider can put on ``bicycle``'s rear tyre, naming the real range in N.
 
@@ -791,7 +842,6 @@ def _print_summary(result, out, files):
 
 
 def _simulate(argv):
-    from whipple_kick.simulate import assembly
     args = _simulate_parser().parse_args(argv)
     if args.quiet:   # summary.json lists the tyre files' data warnings (tyres.data_warnings)
         import warnings
@@ -799,7 +849,7 @@ def _simulate(argv):
         from whipple_kick.library.tyres import DataQualityWarning
         warnings.filterwarnings("ignore", category=DataQualityWarning)   # within _run's warnings block only
     given = _flags_given(argv) if args.compat is not None or args.scenario is not None else ()
-    scenario = assembly.preflight(_scenario_from_args(args, given))
+    scenario = _preflight(_scenario_from_args(args, given))
     movie_options = _animation_options(args)
     with _output_folder(args.out or _default_out(scenario), args.force, _OUTPUT_FILES) as job:
         out = job.out
@@ -1112,7 +1162,7 @@ def _stability_parser():
 def _stability(argv):
     import time
 
-    from whipple_kick.simulate import assembly, provenance
+    from whipple_kick.simulate import provenance
     from whipple_kick.simulate.scenario import Scenario
     from whipple_kick.studies import stability
     args = _stability_parser().parse_args(argv)
@@ -1120,7 +1170,7 @@ def _stability(argv):
     speeds = stability.parse_speeds(args.speeds)
     scenario = Scenario(**_model_fields(args), symmetric_tyres=args.tyre_offsets == "zero",
                                    speed=float(speeds[0]))
-    assembly.preflight(scenario)
+    _preflight(scenario)
     with _output_folder(args.out or _default_out(scenario, "stability"), args.force, _STABILITY_FILES) as job:
         out = job.out
         job.written.extend(_STABILITY_FILES)   # written together at the end: any of them may be there
@@ -1196,7 +1246,6 @@ def _validate_parser():
 def _validate(argv):
     import time
 
-    from whipple_kick.simulate import assembly
     from whipple_kick.studies import validation
     args = _validate_parser().parse_args(argv)
     started = time.perf_counter()
@@ -1206,7 +1255,7 @@ def _validate(argv):
                                     kick_displacement=args.kick_displacement, kick_profile=args.kick_profile,
                                     duration=args.duration, rtol=args.rtol)
     for case in validation.experiments.load().cases.values():   # every flag checked before any run or folder
-        assembly.preflight(base.with_changes(fz_n=case.fz_n, pressure_kpa=case.pressure_kpa))
+        _preflight(base.with_changes(fz_n=case.fz_n, pressure_kpa=case.pressure_kpa))
     with _output_folder(args.out or _new_folder("validation"), args.force, _VALIDATE_FILES) as job:
         out = job.out
         job.written.extend(_VALIDATE_FILES)   # what a failure before the end removes

@@ -614,8 +614,9 @@ class Scenario:
 
     def _refuse_unused(self):
         for name, why in self.unused_fields().items():
-            raise InputError(f"{name} = {getattr(self, name)!r} is read only by {why}, which this scenario does not "
-                             f"use: leave it at its default {DEFAULTS[name]!r} (it would be ignored)")
+            raise UnusedFieldError(f"{name} = {_with_unit(name, getattr(self, name))} is read only by {why}, which "
+                                   f"this scenario does not use: leave it at its default "
+                                   f"{_with_unit(name, DEFAULTS[name])} (it would be ignored)", field=name, why=why)
 
     def to_dict(self) -> dict:
         """Fields as a plain dict (JSON-ready)."""
@@ -727,6 +728,40 @@ class Scenario:
 
 #: Every field's default, by name.
 DEFAULTS = {f.name: f.default for f in fields(Scenario)}
+
+#: The unit of every number field, as a file writes it ("1": a factor or a fraction): the uncertainty study checks
+#: an input's ``unit`` against it, and the refusals name it.
+UNITS = {
+    "fz_n": "N", "rider_mass_kg": "kg", "rear_load_share": "1", "pressure_kpa": "kPa", "pressure_front_kpa": "kPa",
+    "pressure_rear_kpa": "kPa", "speed": "m/s", "design_speed": "m/s", "gain_scale": "1", "thesis_load_n": "N",
+    "kick_displacement": "m", "kick_duration": "s", "kick_accel": "m/s^2", "settle": "s", "duration": "s",
+    "rtol": "1", "output_rate": "Hz", "fall_angle_deg": "deg", "steer_limit_deg": "deg",
+    "carcass_damping": "N s/m", "carcass_viscosity": "N s/m", "carcass_stiffness_scale": "1",
+    **{f.name: f.unit for f in parts.fields()},
+    "reflex_delay": "s", "reflex_roll": "N m/rad", "reflex_roll_rate": "N m s/rad", "reflex_steer": "N m/rad",
+    "reflex_steer_rate": "N m s/rad",
+}
+
+
+def _with_unit(name, value):
+    """A field's value as a message writes it: with its unit (:data:`UNITS`) where it is a number."""
+    unit = UNITS.get(name)
+    if unit is None or isinstance(value, bool) or not isinstance(value, (int, float)):
+        return repr(value)
+    return f"{value!r} (unit 1)" if unit == "1" else f"{value!r} {unit}"
+
+
+class UnusedFieldError(InputError):
+    """A field given other than its default that no mechanism of the scenario reads (:meth:`Scenario.unused_fields`).
+
+    ``field`` and ``why`` (the mechanism and when it is in use) let a caller name the field as its user gave
+    it: the command line names the flag.
+    """
+
+    def __init__(self, message, *, field=None, why=None):
+        super().__init__(message)
+        self.field, self.why = field, why
+
 
 #: Fields that may hold a file path (written absolute by :meth:`Scenario.to_file`).
 _PATH_FIELDS = ("bicycle", "kick_table")
