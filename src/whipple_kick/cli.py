@@ -302,7 +302,8 @@ def _body_options(p, default):
                         "off (default): no mechanical effect on the bar")
     # The declared parts' fields (the leaning upper body's hip, the arms' spring-damper) get their flags from
     # the declarations.
-    declared = tuple((f"--{f.name.replace('_', '-')}", f.name, f.unit, _metavar(f.unit), f"{f.label} of {part.title}")
+    declared = tuple((f"--{f.name.replace('_', '-')}", f.name, f.unit, _metavar(f.unit),
+                      f"{f.label} of {part.title}, {'(' if f.refuse_low else '['}{f.low:g}, {f.high:g}]")
                      for part in parts.REGISTRY.values() for f in part.fields)
     for flag, field, unit, meta, what in (
             *declared,
@@ -321,15 +322,15 @@ def _body_options(p, default):
 
 def _simulate_parser():
     from whipple_kick.library.inputs import DIRECTIONS, PROFILES
-    from whipple_kick.simulate.scenario import KICK_HEADINGS, PLATE_STOPS, START_PITCHES, STARTS
+    from whipple_kick.simulate.scenario import KICK_HEADINGS, MAX_DURATION, PLATE_STOPS, START_PITCHES, STARTS
     p = _OneLineParser(
         prog="simulate", allow_abbrev=False,
         description="Kick-plate test on the nonlinear Carvallo-Whipple bicycle-rider model with "
                     "Magic-Formula tyres (Dell'Orto 2025, Chapter 8): steady running, then the plate "
                     "under the rear wheel jumps sideways; an LQR steer-torque rider recovers or the "
-                    "bicycle falls. Writes trajectory.csv, summary.json and response.png (and, with --animate, "
-                    "animation.mp4).",
-        epilog="Time is measured from the kick start. Defaults are the thesis' settings: "
+                    "bicycle falls. Writes trajectory.csv, summary.json, scenario.toml (the run's settings, to "
+                    "rerun it with --scenario) and response.png (and, with --animate, animation.mp4 or .gif).",
+        epilog="Time is measured from the kick start. Defaults: "
                "balanceassist_v1 + Yeadon rider for 635 N on the rear tyre, T03 at 400 kPa, 3 m/s, "
                "LQR designed at the run's speed (the thesis: 3 m/s), 150 mm kick in 0.150 s (13.3 m/s^2), 6 s. "
                "See docs/simulate.md.")
@@ -381,7 +382,7 @@ def _simulate_parser():
                         "front contact on the ground) or uncompressed (solved without them, as the authors' code: "
                         "the front contact starts a few mm below the ground); needs --start upright")
     g.add_argument("--duration", type=_number("s"), default=6.0, metavar="S",
-                   help="simulated time after the kick start in s (default 6)")
+                   help=f"simulated time after the kick start in s (default 6, at most {MAX_DURATION:g})")
     g.add_argument("--settle", type=_number("s"), default=0.5, metavar="S",
                    help="steady running shown before the kick in s (default 0.5)")
     g.add_argument("--rtol", type=_number("relative"), default=1e-10, metavar="RTOL",
@@ -911,6 +912,7 @@ def simulate_main(argv=None):
 
 def _recommend(argv):
     from whipple_kick.library import tyres
+    from whipple_kick.simulate.scenario import MAX_DURATION
     from whipple_kick.studies import recommend
     p = _OneLineParser(
         prog="recommend-pressure",
@@ -939,7 +941,7 @@ def _recommend(argv):
                         "of their first peaks; last-peak: the thesis' rule, time of the last yaw-rate peak "
                         "above 8 %% of the largest")
     p.add_argument("--duration", type=_number("s"), metavar="S",
-                   help="simulated time after the kick in s (default 6)")
+                   help=f"simulated time after the kick in s (default 6, at most {MAX_DURATION:g})")
     p.add_argument("--workers", type=int, metavar="N",
                    help="worker processes (default: one per CPU core)")
     p.add_argument("--out", metavar="DIR",
@@ -1070,12 +1072,24 @@ def _verdict_pair(study, criterion):
     return tuple(sorted(first["pressure_kpa"].iloc[:2]))
 
 
+def _out_given(argv):
+    """The ``--out`` folder of a command line (as argparse takes it: ``--out DIR``, ``--out=DIR``, an
+    abbreviation), or None."""
+    for k, arg in enumerate(argv):
+        flag, eq, value = str(arg).partition("=")
+        if len(flag) >= 3 and "--out".startswith(flag):
+            return value if eq else (argv[k + 1] if k + 1 < len(argv) else None)
+    return None
+
+
 def recommend_main(argv=None):
     """Console script ``recommend-pressure`` (see ``recommend-pressure --help``)."""
     from whipple_kick.studies.sweep_engine import SweepFailed, SweepInterrupted
+    out = _out_given(sys.argv[1:] if argv is None else argv)
+    kept = ("no results were kept (--out DIR keeps the finished cases, and a rerun on it resumes)" if out is None
+            else f"the finished cases are kept in {out}: run again with --out {out} to resume")
     try:
-        status = _run(_recommend, argv, "recommend-pressure",
-                      "finished cases are kept in the --out folder (if given); run again on it to resume")
+        status = _run(_recommend, argv, "recommend-pressure", kept)
     except (SweepInterrupted, SweepFailed) as exc:   # lost workers, or every case failed: not the user's to fix
         print(f"recommend-pressure: {exc}", file=sys.stderr)
         status = 1
@@ -1203,6 +1217,7 @@ _VALIDATE_FILES = ("validation.csv", "summary.json", "validation.png")
 
 
 def _validate_parser():
+    from whipple_kick.simulate.scenario import MAX_DURATION
     from whipple_kick.studies import validation
     p = _OneLineParser(
         prog="validate", allow_abbrev=False,
@@ -1235,7 +1250,8 @@ def _validate_parser():
                    help="also run every tyre transient form and say whether the best pressure depends on it "
                         "(summary.json by_tyre_transient; 3x the runs)")
     g.add_argument("--duration", type=_number("s"), default=validation.DURATION, metavar="S",
-                   help=f"simulated time after the kick in s (default {validation.DURATION:g})")
+                   help=f"simulated time after the kick in s (default {validation.DURATION:g}, at most "
+                        f"{MAX_DURATION:g})")
     g.add_argument("--rtol", type=_number("relative"), default=1e-10, metavar="RTOL",
                    help="LSODA relative tolerance (default 1e-10)")
     g.add_argument("--workers", type=int, metavar="N", help="worker processes (default: one per CPU core)")
