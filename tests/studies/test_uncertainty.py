@@ -1,7 +1,9 @@
 """The uncertainty study: known answers of its statistics, pairing, seeds, executors, refusals, the CLI."""
 import dataclasses
+import json
 import math
 import pathlib
+import warnings
 
 import numpy as np
 import pandas as pd
@@ -423,3 +425,20 @@ def test_a_study_on_sampled_bicycles_runs_and_names_their_parameters(tmp_path):
     assert len(set(study.inputs["bicycle.c"])) > 1
     assert (study.outcomes["status"] == "ok").all() and len(study.outcomes) == 24
 
+
+def test_the_defaults_warning_comes_once_per_study(tmp_path, recwarn):
+    """Issue 40 item 9: a BicycleParameters bicycle's ~600-character defaults warning came once per sampled
+    bicycle (each case reset the warnings' once-registry). The study warns once; a case does not."""
+    path = tmp_path / "bike.toml"
+    path.write_text(BIKE_FILE.replace('"mB", "seating.lst"', '"mB"'))
+    base = BASE.with_changes(duration=0.2)
+    uncertainty.run_study(path, samples=2, seed=0, loads=(635.0,), pressures=(300.0, 500.0), base=base, workers=1)
+    defaults = [w for w in recwarn if issubclass(w.category, wk.errors.DefaultValueWarning)]
+    assert len(defaults) == 1 and "'Sampled': tyres from defaults" in str(defaults[0].message)
+    folder = uncertainty.sampled_bicycle("balanceassist_v1", {"bicycle.c": 0.051})
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        record = wk.sweep_engine.run_case(base.with_changes(bicycle=folder), "c0")
+    assert record["status"] == "ok", record["error"]
+    assert not [w for w in caught if issubclass(w.category, wk.errors.DefaultValueWarning)]
+    assert "tyres" in json.loads(record["summary"])["bicycle"]["defaults"]   # the summary still says so
