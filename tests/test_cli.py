@@ -1,6 +1,7 @@
 """The ``simulate`` command: files written, output folder rules, and one-line errors with status 2."""
 import json
 import os
+import re
 import subprocess
 import sys
 
@@ -10,6 +11,7 @@ import pytest
 from conftest import run_console
 import whipple_kick as wk
 from whipple_kick.cli import simulate_main
+from whipple_kick.errors import InputError
 
 
 def _simulate(argv, capsys):
@@ -271,6 +273,20 @@ BAD_INPUTS = {
                                ["rear load share = 0.75", "[0.5467, 0.7032]", "0.15 m", "unit 1"]),
     "rear-share-on-a-preset": (["--rear-share", "0.68", "--bicycle", "balanceassist_635N"],
                                ["rear load share = 0.68", "would be ignored", "balanceassist_635N"]),
+    # A flag its mechanism does not read: named as given, the flag with its unit, and the flag that would
+    # switch the mechanism on (issue 40 item 11: it named the Python fields and gave no unit).
+    "hip-stiffness-without-the-leaning-body": (
+        ["--hip-stiffness", "500"],
+        ["--hip-stiffness 500 N m/rad is read only by the leaning upper body (--rider-body leaning)",
+         "leave it at its default (--hip-stiffness 128 N m/rad); it would be ignored"]),
+    "carcass-damping-without-the-carcass": (
+        ["--tyre-transient", "force_lag", "--carcass-damping", "5"],
+        ["--carcass-damping 5 N s/m is read only by the carcass tyre (--tyre-transient carcass)"]),
+    "design-speed-without-the-lqr-rider": (["--controller", "off", "--design-speed", "3"],
+                                           ["--design-speed 3 m/s is read only by the LQR rider (--controller lqr)",
+                                            "leave it out"]),
+    "leaning-with-a-negative-hip-stiffness": (["--rider-body", "leaning", "--hip-stiffness", "-1"],
+                                              ["hip stiffness = -1.0 N m/rad", "(0, 1e+06] N m/rad"]),
 }
 
 
@@ -624,7 +640,8 @@ def test_rider_body_flags_reach_the_run_and_a_scenario_file(tmp_path, capsys):
         "leaning", "simulated", 40.0, 0.05, 0.2)
     status, _, err = _simulate(["--scenario", str(out / "scenario.toml"), "--reflex-delay", "0.05",
                                 "--out", str(tmp_path / "refused")], capsys)
-    assert status == 2 and "reflex_delay = 0.05 is read only by the reflex" in err
+    # Named as it was given: the flag, with its unit (issue 40 item 11).
+    assert status == 2 and "--reflex-delay 0.05 s is read only by the reflex (a reflex gain other than 0)" in err
 
 
 def test_stability_takes_the_rider_body_flags(tmp_path, capsys):
@@ -637,7 +654,9 @@ def test_stability_takes_the_rider_body_flags(tmp_path, capsys):
                                                        "2,3", "--out", str(out), "--no-plot", "--quiet"], capsys)
     assert status == 0, err
     summary = json.loads((out / "summary.json").read_text())
-    assert "lean" in json.dumps(summary)
+    # The upper body's lean mode at both speeds, with the hip the flags gave (not only the flags echoed back).
+    assert summary["slip"]["open"]["modes"]["lean"]["speeds_m_s"] == [2.0, 3.0]
+    assert "the leaning upper body (hip stiffness 400 N m/rad, hip damping 5 N m s/rad)" in summary["title"]
 
 
 # ------------------------------------------------------------ issue 31: nothing silent
@@ -722,3 +741,39 @@ def test_item15_help_gives_the_reflex_gains_sign(capsys):
     text = " ".join(capsys.readouterr().out.split())
     assert "T = -(gain x state)" in text and "a positive --reflex-roll steers out of the lean, against the roll" in text
     assert "T = -gain x roll (a positive gain steers against the roll)" in text
+
+
+@pytest.mark.parametrize("command", ["simulate", "recommend", "validate"])
+def test_help_gives_the_duration_cap_and_every_file_written(command, capsys):
+    """Issue 40 item 16: --help did not say --duration is at most 120 s, nor that simulate writes scenario.toml."""
+    from whipple_kick.simulate.scenario import MAX_DURATION
+    with pytest.raises(SystemExit):
+        getattr(wk.cli, f"{command}_main")(["--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert re.search(rf"--duration S [^-]*at most {MAX_DURATION:g}\)", text), text
+    with pytest.raises(InputError, match=rf"\(0, {MAX_DURATION:g}\] s"):
+        wk.Scenario(duration=MAX_DURATION + 1).validate()
+    if command == "simulate":
+        for name in wk.cli._OUTPUT_FILES:
+            assert name.split(".")[0] in text, name   # animation.mp4 or .gif
+        assert "scenario.toml" in text
+
+
+@pytest.mark.parametrize("given", [False, True])
+def test_an_ended_recommendation_says_what_it_kept(given, tmp_path, capsys, monkeypatch):
+    """Issue 40 item 16: SIGTERM's (and Ctrl-C's) line said "kept in the --out folder (if given)"; it says where,
+    or that nothing was kept."""
+    from whipple_kick.errors import Terminated
+
+    def ended(argv):
+        raise Terminated("terminated (SIGTERM)")
+    monkeypatch.setattr(wk.cli, "_recommend", ended)
+    out = tmp_path / "sweep"
+    code, _, err = run_console(wk.cli.recommend_main, ["--fz", "635", *(["--out", str(out)] if given else [])],
+                               capsys)
+    assert code == wk.cli.EXIT_TERMINATED and err.count("\n") == 1 and "if given" not in err
+    if given:
+        assert f"the finished cases are kept in {out}: run again with --out {out} to resume" in err
+    else:
+        assert "no results were kept (--out DIR keeps the finished cases" in err
+    assert wk.cli._out_given(["--fz", "635", f"--ou={out}"]) == str(out)

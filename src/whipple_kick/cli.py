@@ -302,7 +302,8 @@ def _body_options(p, default):
                         "off (default): no mechanical effect on the bar")
     # The declared parts' fields (the leaning upper body's hip, the arms' spring-damper) get their flags from
     # the declarations.
-    declared = tuple((f"--{f.name.replace('_', '-')}", f.name, f.unit, _metavar(f.unit), f"{f.label} of {part.title}")
+    declared = tuple((f"--{f.name.replace('_', '-')}", f.name, f.unit, _metavar(f.unit),
+                      f"{f.label} of {part.title}, {'(' if f.refuse_low else '['}{f.low:g}, {f.high:g}]")
                      for part in parts.REGISTRY.values() for f in part.fields)
     for flag, field, unit, meta, what in (
             *declared,
@@ -321,15 +322,15 @@ def _body_options(p, default):
 
 def _simulate_parser():
     from whipple_kick.library.inputs import DIRECTIONS, PROFILES
-    from whipple_kick.simulate.scenario import KICK_HEADINGS, PLATE_STOPS, START_PITCHES, STARTS
+    from whipple_kick.simulate.scenario import KICK_HEADINGS, MAX_DURATION, PLATE_STOPS, START_PITCHES, STARTS
     p = _OneLineParser(
         prog="simulate", allow_abbrev=False,
         description="Kick-plate test on the nonlinear Carvallo-Whipple bicycle-rider model with "
                     "Magic-Formula tyres (Dell'Orto 2025, Chapter 8): steady running, then the plate "
                     "under the rear wheel jumps sideways; an LQR steer-torque rider recovers or the "
-                    "bicycle falls. Writes trajectory.csv, summary.json and response.png (and, with --animate, "
-                    "animation.mp4).",
-        epilog="Time is measured from the kick start. Defaults are the thesis' settings: "
+                    "bicycle falls. Writes trajectory.csv, summary.json, scenario.toml (the run's settings, to "
+                    "rerun it with --scenario) and response.png (and, with --animate, animation.mp4 or .gif).",
+        epilog="Time is measured from the kick start. Defaults: "
                "balanceassist_v1 + Yeadon rider for 635 N on the rear tyre, T03 at 400 kPa, 3 m/s, "
                "LQR designed at the run's speed (the thesis: 3 m/s), 150 mm kick in 0.150 s (13.3 m/s^2), 6 s. "
                "See docs/simulate.md.")
@@ -381,7 +382,7 @@ def _simulate_parser():
                         "front contact on the ground) or uncompressed (solved without them, as the authors' code: "
                         "the front contact starts a few mm below the ground); needs --start upright")
     g.add_argument("--duration", type=_number("s"), default=6.0, metavar="S",
-                   help="simulated time after the kick start in s (default 6)")
+                   help=f"simulated time after the kick start in s (default 6, at most {MAX_DURATION:g})")
     g.add_argument("--settle", type=_number("s"), default=0.5, metavar="S",
                    help="steady running shown before the kick in s (default 0.5)")
     g.add_argument("--rtol", type=_number("relative"), default=1e-10, metavar="RTOL",
@@ -483,6 +484,57 @@ def _model_fields(args):
     if args.pressure is None:
         fields["pressure_kpa"] = 400.0
     return fields
+
+
+def _flag(field):
+    """The flag that sets a Scenario field (:data:`_FIELD_FLAGS`; the rest by the flag of the field's own name)."""
+    return "--" + _FIELD_FLAGS.get(field, (field,))[0].replace("_", "-")
+
+
+def _flag_value(field, value):
+    """``field = value`` as flags give it: ``--hip-stiffness 500 N m/rad``, ``--plate-stop resolve``, ``--lqr-heading``."""
+    from whipple_kick.simulate.scenario import UNITS
+    if isinstance(value, bool):
+        return _flag(field) if value else f"no {_flag(field)}"
+    unit = UNITS.get(field)
+    if unit is None or not isinstance(value, (int, float)):
+        return f"{_flag(field)} {value}"
+    return f"{_flag(field)} {value:g}" + (" (unit 1)" if unit == "1" else f" {unit}")
+
+
+def _in_flags(words):
+    """A mechanism's condition (:data:`whipple_kick.simulate.scenario.MECHANISM_FIELDS`) in flags: "rider_body
+    'leaning'" -> "--rider-body leaning", "pressure_front_kpa" -> "--pressure-front"."""
+    import re
+
+    from whipple_kick.simulate.scenario import DEFAULTS
+
+    def quoted(match):
+        if match[1] not in DEFAULTS:
+            return match[0]
+        return f"{_flag(match[1])} {match[2]}" + match[3].replace("'", "")
+
+    words = re.sub(r"\b([a-z][a-z0-9_]*) '([^']*)'((?: or '[^']*')*)", quoted, words)
+    return re.sub(r"(?<![-\w])([a-z0-9]+_[a-z0-9_]+)\b",
+                  lambda m: _flag(m[1]) if m[1] in DEFAULTS else m[0], words)
+
+
+def _preflight(scenario):
+    """:func:`whipple_kick.simulate.assembly.preflight`, a field its mechanism does not read refused by its flag.
+
+    The scenario's own refusal (:class:`~whipple_kick.simulate.scenario.UnusedFieldError`) names the Python
+    field; a user of the command line gave a flag.
+    """
+    from whipple_kick.simulate import assembly
+    from whipple_kick.simulate.scenario import DEFAULTS, UnusedFieldError
+    try:
+        return assembly.preflight(scenario)
+    except UnusedFieldError as exc:
+        default = DEFAULTS[exc.field]
+        leave = ("leave it out" if default is None or default is False
+                 else f"leave it at its default ({_flag_value(exc.field, default)})")
+        raise InputError(f"{_flag_value(exc.field, getattr(scenario, exc.field))} is read only by "
+                         f"{_in_flags(exc.why)}, which this run does not use: {leave}; it would be ignored") from None
 
 
 def _check_loads(bicycle, loads):
@@ -791,7 +843,6 @@ def _print_summary(result, out, files):
 
 
 def _simulate(argv):
-    from whipple_kick.simulate import assembly
     args = _simulate_parser().parse_args(argv)
     if args.quiet:   # summary.json lists the tyre files' data warnings (tyres.data_warnings)
         import warnings
@@ -799,7 +850,7 @@ def _simulate(argv):
         from whipple_kick.library.tyres import DataQualityWarning
         warnings.filterwarnings("ignore", category=DataQualityWarning)   # within _run's warnings block only
     given = _flags_given(argv) if args.compat is not None or args.scenario is not None else ()
-    scenario = assembly.preflight(_scenario_from_args(args, given))
+    scenario = _preflight(_scenario_from_args(args, given))
     movie_options = _animation_options(args)
     with _output_folder(args.out or _default_out(scenario), args.force, _OUTPUT_FILES) as job:
         out = job.out
@@ -861,6 +912,7 @@ def simulate_main(argv=None):
 
 def _recommend(argv):
     from whipple_kick.library import tyres
+    from whipple_kick.simulate.scenario import MAX_DURATION
     from whipple_kick.studies import recommend
     p = _OneLineParser(
         prog="recommend-pressure",
@@ -889,7 +941,7 @@ def _recommend(argv):
                         "of their first peaks; last-peak: the thesis' rule, time of the last yaw-rate peak "
                         "above 8 %% of the largest")
     p.add_argument("--duration", type=_number("s"), metavar="S",
-                   help="simulated time after the kick in s (default 6)")
+                   help=f"simulated time after the kick in s (default 6, at most {MAX_DURATION:g})")
     p.add_argument("--workers", type=int, metavar="N",
                    help="worker processes (default: one per CPU core)")
     p.add_argument("--out", metavar="DIR",
@@ -1020,12 +1072,24 @@ def _verdict_pair(study, criterion):
     return tuple(sorted(first["pressure_kpa"].iloc[:2]))
 
 
+def _out_given(argv):
+    """The ``--out`` folder of a command line (as argparse takes it: ``--out DIR``, ``--out=DIR``, an
+    abbreviation), or None."""
+    for k, arg in enumerate(argv):
+        flag, eq, value = str(arg).partition("=")
+        if len(flag) >= 3 and "--out".startswith(flag):
+            return value if eq else (argv[k + 1] if k + 1 < len(argv) else None)
+    return None
+
+
 def recommend_main(argv=None):
     """Console script ``recommend-pressure`` (see ``recommend-pressure --help``)."""
     from whipple_kick.studies.sweep_engine import SweepFailed, SweepInterrupted
+    out = _out_given(sys.argv[1:] if argv is None else argv)
+    kept = ("no results were kept (--out DIR keeps the finished cases, and a rerun on it resumes)" if out is None
+            else f"the finished cases are kept in {out}: run again with --out {out} to resume")
     try:
-        status = _run(_recommend, argv, "recommend-pressure",
-                      "finished cases are kept in the --out folder (if given); run again on it to resume")
+        status = _run(_recommend, argv, "recommend-pressure", kept)
     except (SweepInterrupted, SweepFailed) as exc:   # lost workers, or every case failed: not the user's to fix
         print(f"recommend-pressure: {exc}", file=sys.stderr)
         status = 1
@@ -1112,7 +1176,7 @@ def _stability_parser():
 def _stability(argv):
     import time
 
-    from whipple_kick.simulate import assembly, provenance
+    from whipple_kick.simulate import provenance
     from whipple_kick.simulate.scenario import Scenario
     from whipple_kick.studies import stability
     args = _stability_parser().parse_args(argv)
@@ -1120,7 +1184,7 @@ def _stability(argv):
     speeds = stability.parse_speeds(args.speeds)
     scenario = Scenario(**_model_fields(args), symmetric_tyres=args.tyre_offsets == "zero",
                                    speed=float(speeds[0]))
-    assembly.preflight(scenario)
+    _preflight(scenario)
     with _output_folder(args.out or _default_out(scenario, "stability"), args.force, _STABILITY_FILES) as job:
         out = job.out
         job.written.extend(_STABILITY_FILES)   # written together at the end: any of them may be there
@@ -1153,6 +1217,7 @@ _VALIDATE_FILES = ("validation.csv", "summary.json", "validation.png")
 
 
 def _validate_parser():
+    from whipple_kick.simulate.scenario import MAX_DURATION
     from whipple_kick.studies import validation
     p = _OneLineParser(
         prog="validate", allow_abbrev=False,
@@ -1185,7 +1250,8 @@ def _validate_parser():
                    help="also run every tyre transient form and say whether the best pressure depends on it "
                         "(summary.json by_tyre_transient; 3x the runs)")
     g.add_argument("--duration", type=_number("s"), default=validation.DURATION, metavar="S",
-                   help=f"simulated time after the kick in s (default {validation.DURATION:g})")
+                   help=f"simulated time after the kick in s (default {validation.DURATION:g}, at most "
+                        f"{MAX_DURATION:g})")
     g.add_argument("--rtol", type=_number("relative"), default=1e-10, metavar="RTOL",
                    help="LSODA relative tolerance (default 1e-10)")
     g.add_argument("--workers", type=int, metavar="N", help="worker processes (default: one per CPU core)")
@@ -1196,7 +1262,6 @@ def _validate_parser():
 def _validate(argv):
     import time
 
-    from whipple_kick.simulate import assembly
     from whipple_kick.studies import validation
     args = _validate_parser().parse_args(argv)
     started = time.perf_counter()
@@ -1206,7 +1271,7 @@ def _validate(argv):
                                     kick_displacement=args.kick_displacement, kick_profile=args.kick_profile,
                                     duration=args.duration, rtol=args.rtol)
     for case in validation.experiments.load().cases.values():   # every flag checked before any run or folder
-        assembly.preflight(base.with_changes(fz_n=case.fz_n, pressure_kpa=case.pressure_kpa))
+        _preflight(base.with_changes(fz_n=case.fz_n, pressure_kpa=case.pressure_kpa))
     with _output_folder(args.out or _new_folder("validation"), args.force, _VALIDATE_FILES) as job:
         out = job.out
         job.written.extend(_VALIDATE_FILES)   # what a failure before the end removes

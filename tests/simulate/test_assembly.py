@@ -83,6 +83,7 @@ def test_yaw_angle_gain_needs_straight_steady_running():
         run(Scenario(duration=0.3), gains={"kq3": -1.0})
     message = str(err.value)
     assert "kq3 needs straight steady running" in message and "rad/s" in message and "\n" not in message
+    assert "(the flag --symmetric-tyres; symmetric_tyres=True in Python)" in message   # issue 40 item 16
 
 
 def test_upright_start_without_a_steady_motion_is_judged_about_upright_running(monkeypatch):

@@ -49,6 +49,11 @@ def test_with_changes_copies_and_leaves_the_original():
     ({"kick_accel": 0.0}, "kick peak acceleration = 0.0 m/s^2 is outside"),
     ({"rear_load_share": 1.0}, "rear load share = 1.0 (unit 1) is outside the allowed range (0, 1) (unit 1)"),
     ({"rear_load_share": 0.0}, "rear load share = 0.0 (unit 1) is outside the allowed range (0, 1)"),
+    # With the leaning body the hip's 0 is refused: one range, (0, 1e+06], below 0 as at 0 (issue 40 item 16).
+    ({"rider_body": "leaning", "hip_stiffness": -1.0},
+     "hip stiffness = -1.0 N m/rad is outside the allowed range (0, 1e+06] N m/rad"),
+    ({"rider_body": "leaning", "hip_stiffness": 0.0}, "nothing to hold it up; allowed (0, 1e+06] N m/rad"),
+    ({"hip_stiffness": -1.0}, "hip stiffness = -1.0 N m/rad is outside the allowed range [0, 1e+06] N m/rad"),
 ])
 def test_fields_out_of_range_are_one_line_input_errors(changes, fragment):
     with pytest.raises(InputError, match=re.escape(fragment)) as info:
@@ -143,3 +148,34 @@ def test_every_field_is_in_exactly_one_group():
     thesis, authors = Scenario.thesis(500.0), Scenario.authors_code()
     assert thesis.physics == authors.physics and thesis.numerics == authors.numerics
     assert thesis.compatibility != authors.compatibility
+
+
+def test_every_number_field_has_its_unit():
+    """UNITS names the unit of every number field (the uncertainty study checks an input's unit against it; the
+    refusals name it), a part's field's from its declaration."""
+    import dataclasses
+
+    from whipple_kick.model import parts
+    from whipple_kick.simulate.scenario import UNITS
+    numbers = {f.name for f in dataclasses.fields(Scenario) if "float" in str(f.type)}
+    assert set(UNITS) == numbers
+    assert all(UNITS[f.name] == f.unit for f in parts.fields())
+
+
+def test_the_docstring_says_what_the_defaults_and_the_choices_are():
+    """Issue 40 item 16: the class said its defaults were the thesis' simulation settings (rtol, tyre transient,
+    coefficient set and design speed are not), and listed two of plate_stop's three choices."""
+    from whipple_kick.model import carcass
+    from whipple_kick.simulate import scenario
+    doc = Scenario.__doc__
+    assert "thesis' simulation settings" not in doc and "thesis' settings as" not in scenario.__doc__
+    for field, choices in (("plate_stop", scenario.PLATE_STOPS), ("kick_heading", scenario.KICK_HEADINGS),
+                           ("camber_sign", scenario.CAMBER_SIGNS), ("start", scenario.STARTS),
+                           ("start_pitch", scenario.START_PITCHES), ("slip_speed", scenario.SLIP_SPEEDS),
+                           ("rider_body", scenario.RIDER_BODIES), ("lqr_model", scenario.LQR_MODELS),
+                           ("arms", scenario.ARMS), ("controller", scenario.CONTROLLERS),
+                           ("tyre_transient", scenario.TYRE_TRANSIENTS), ("carcass_sliding", carcass.SLIDING_LAWS)):
+        listed = re.search(rf"^    {field} : {{(.*)}}$", doc, re.MULTILINE)
+        assert listed and sorted(re.findall(r'"(\w+)"', listed[1])) == sorted(choices), field
+    # The hip's range as validate applies it with the leaning body: its 0 is refused.
+    assert "[N m/rad], more than 0 to 1e+06; default 128" in doc

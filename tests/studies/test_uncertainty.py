@@ -1,6 +1,9 @@
 """The uncertainty study: known answers of its statistics, pairing, seeds, executors, refusals, the CLI."""
 import dataclasses
+import json
 import math
+import pathlib
+import warnings
 
 import numpy as np
 import pandas as pd
@@ -191,6 +194,78 @@ def test_inputs_naming_nothing_or_ignored_are_refused(tmp_path, block, message):
     assert "\n" not in str(info.value)
 
 
+def _shipped(tmp_path, old, new):
+    text = pathlib.Path(uncertain.available()[uncertain.DEFAULT]).read_text()
+    assert text.count(old) == 1
+    path = tmp_path / "u.toml"
+    path.write_text(text.replace(old, new))
+    return uncertain.load(path)
+
+
+def test_an_unknown_fixed_field_is_one_line_with_the_fields(tmp_path):
+    """Issue 40 item 1: a misspelt [fixed] field was a TypeError traceback (the fixed fields were applied before
+    they were checked)."""
+    path = tmp_path / "u.toml"
+    path.write_text(TINY.replace("duration = {", "durration = {"))
+    with pytest.raises(InputError, match=r"fixed\.durration: 'durration' is no scenario field \(did you mean "
+                                         r"'duration'\?\); the fields: bicycle, fz_n, .*, slip_speed$") as info:
+        uncertainty.run_study(path, samples=2, base=BASE)
+    assert "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize("old, new, message", [
+    # Issue 40 item 3: the unit was never checked (km/h ran as m/s).
+    ('unit = "m/s"', 'unit = "km/h"', r"inputs\.speed\.unit: 'km/h' is not the unit of speed, 'm/s': give the "
+                                      r"distribution in m/s$"),
+    # Issue 40 item 4: a bound, an option or a fixed value the scenario refuses, named by its key, with the value,
+    # the allowed range and the unit (it failed only when a sample hit it, and named the whole row).
+    ("high = 2.0", "high = 20.0", r"inputs\.speed\.high: speed = 20\.0 m/s is outside the allowed range "
+                                  r"\(0, 15\] m/s$"),
+    ('distribution = "uniform"\nunit = "m/s"\nlow = 1.92\nhigh = 2.0',
+     'distribution = "normal"\nunit = "m/s"\nmean = 2.0\nsd = 0.5',
+     r"inputs\.speed \(a normal not truncated below: its samples reach -1\.5\d* m/s; give 'low'\): speed = "
+     r"-1\.5\d* m/s is outside the allowed range \(0, 15\] m/s$"),
+    ('value = "left"', 'value = "leftt"', r"inputs\.kick_direction\.options\[1\] \(left\): kick direction "
+                                          r"'leftt' is unknown"),
+    ("value = 3.0", "value = -3.0", r"fixed\.duration: duration = -3\.0 s is outside the allowed range "
+                                    r"\(0, 120\] s$"),
+])
+def test_units_bounds_options_and_fixed_values_are_checked_at_load(tmp_path, old, new, message):
+    path = tmp_path / "u.toml"
+    assert TINY.count(old) == 1
+    path.write_text(TINY.replace(old, new))
+    with pytest.raises(InputError, match=message) as info:
+        uncertainty.check_inputs(uncertain.load(path), BASE)
+    assert str(info.value).startswith(f"{path}: ") and "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize("old, new, message", [
+    # Issue 40 item 5: a misspelt option was reported as the hip stiffness' problem (no sample leaned).
+    ('rider_body = "leaning"', 'rider_body = "leening"',
+     r"inputs\.rider\.options\[2\] \(leaning body\): rider body 'leening' is unknown; choose one of rigid, "
+     r"leaning$"),
+    # A bound of a field only some rows read is checked on a row that reads it (the leaning body's).
+    ("high = 1000.0", "high = 2e6", r"inputs\.hip_stiffness\.high: hip stiffness = 2000000\.0 N m/rad is outside "
+                                    r"the allowed range \(0, 1e\+06\] N m/rad$"),
+    ('label = "plate peak"\nprobability = 0.5\nvalue = "plate"', 'label = "plate peak"\nprobability = 0.5\n'
+                                                                  'value = "plates"',
+     r"inputs\.friction\.options\[1\] \(plate peak\): friction = 'plates' is unknown"),
+])
+def test_the_shipped_file_with_one_mistake_names_it(tmp_path, old, new, message):
+    spec = _shipped(tmp_path, old, new)
+    with pytest.raises(InputError, match=message):
+        uncertainty.check_inputs(spec, Scenario())
+
+
+def test_a_tyre_measured_at_one_pressure_is_named_with_it():
+    """Issue 40 item 6: ``--uncertain --tyre T01`` said the study "needs at least one rear load and two
+    pressures", not that T01 was measured at 400 kPa only."""
+    with pytest.raises(InputError, match=r"needs at least two, got 400 kPa; tyre T01 \(table7_9\) was measured at "
+                                         r"400 kPa only, .* choose a tyre measured at two or more \(T02 \(300, 400 "
+                                         r"kPa\), T03 \(300, 400, 500 kPa\)"):
+        uncertainty.run_study(uncertain.DEFAULT, samples=2, base=Scenario(tyre="T01"), pressures=[400.0])
+
+
 def test_pressures_outside_the_tyres_range_are_refused(tiny):
     with pytest.raises(InputError, match=r"pressure of tyre T03 = 600(\.0)? kPa is outside the allowed range \[300, 500\] kPa"):
         uncertainty.run_study(tiny, samples=2, pressures=[300.0, 600.0], base=BASE)
@@ -217,6 +292,12 @@ def test_cli_bad_file_and_misplaced_options_exit_2(tmp_path, capsys):
     assert code == 2 and "--samples and --seed belong to the uncertainty study" in err
     code, _, err = run_console(wk.cli.recommend_main, ["--fz", "635", "--uncertain", "--fine"], capsys)
     assert code == 2 and "--fine cannot go with --uncertain" in err
+    # Issue 40 item 2: a negative seed was NumPy's ValueError traceback (status 1).
+    code, _, err = run_console(wk.cli.recommend_main, ["--fz", "635", "--uncertain", "--seed", "-1"], capsys)
+    assert code == 2 and err == "error: seed = -1 is outside the allowed range: a whole number >= 0\n"
+    # Issue 40 item 6, from the command line.
+    code, _, err = run_console(wk.cli.recommend_main, ["--fz", "635", "--uncertain", "--tyre", "T01"], capsys)
+    assert code == 2 and err.count("\n") == 1 and "T01 (table7_9) was measured at 400 kPa only" in err
 
 
 def test_cli_writes_tables_and_figures(tiny, tmp_path, capsys):
@@ -343,3 +424,21 @@ def test_a_study_on_sampled_bicycles_runs_and_names_their_parameters(tmp_path):
     assert {"bicycle.c", "bicycle.lam", "bicycle.mB"} <= set(study.inputs.columns)
     assert len(set(study.inputs["bicycle.c"])) > 1
     assert (study.outcomes["status"] == "ok").all() and len(study.outcomes) == 24
+
+
+def test_the_defaults_warning_comes_once_per_study(tmp_path, recwarn):
+    """Issue 40 item 9: a BicycleParameters bicycle's ~600-character defaults warning came once per sampled
+    bicycle (each case reset the warnings' once-registry). The study warns once; a case does not."""
+    path = tmp_path / "bike.toml"
+    path.write_text(BIKE_FILE.replace('"mB", "seating.lst"', '"mB"'))
+    base = BASE.with_changes(duration=0.2)
+    uncertainty.run_study(path, samples=2, seed=0, loads=(635.0,), pressures=(300.0, 500.0), base=base, workers=1)
+    defaults = [w for w in recwarn if issubclass(w.category, wk.errors.DefaultValueWarning)]
+    assert len(defaults) == 1 and "'Sampled': tyres from defaults" in str(defaults[0].message)
+    folder = uncertainty.sampled_bicycle("balanceassist_v1", {"bicycle.c": 0.051})
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        record = wk.sweep_engine.run_case(base.with_changes(bicycle=folder), "c0")
+    assert record["status"] == "ok", record["error"]
+    assert not [w for w in caught if issubclass(w.category, wk.errors.DefaultValueWarning)]
+    assert "tyres" in json.loads(record["summary"])["bicycle"]["defaults"]   # the summary still says so

@@ -144,7 +144,7 @@ def assemble(scenario, kick, *, tyres=None, gains=None) -> Assembly:
         # In a steady turn the yaw angle grows without bound, and so would kq3's torque.
         raise InputError(f"a yaw-angle gain kq3 needs straight steady running, but the steady yaw rate is "
                          f"{steady_yaw_rate:.3g} rad/s (allowed |yaw rate| <= {STRAIGHT_YAW_RATE:g} rad/s): "
-                         f"use tyres without zero-slip offsets (symmetric_tyres=True)")
+                         "use tyres without zero-slip offsets (the flag --symmetric-tyres; symmetric_tyres=True in Python)")
     return Assembly(rear, front, notes, moore, info, gains, poles, controller, start.params, found, start, stability)
 
 

@@ -251,7 +251,7 @@ def _evaluations(jac, nfev, njev):
 
 
 class _PastTheLimit(Exception):
-    """Raised inside the fast path once the roll limit is passed."""
+    """Raised inside the fast path once the roll limit (the fall angle) or the steer limit is passed."""
 
 
 def _guarded(rhs, roll_index, fall_angle, steer_index, steer_limit):

@@ -1,9 +1,10 @@
 """One kick-plate run described: the :class:`Scenario` dataclass and its validation.
 
 A :class:`Scenario` holds everything a run of the thesis' kick-plate test
-(Dell'Orto 2025, Sections 8.3-8.4) depends on, with the thesis' settings as
-defaults: the bicycle and rider, the tyres, the speed, the rider's control,
-the kick (:mod:`whipple_kick.library.inputs` turns its fields into the plate's
+(Dell'Orto 2025, Sections 8.3-8.4) depends on, with the project's choices as
+defaults (:meth:`Scenario.thesis` gives the thesis' own): the bicycle and
+rider, the tyres, the speed, the rider's control, the kick
+(:mod:`whipple_kick.library.inputs` turns its fields into the plate's
 motion), the numerics. :meth:`Scenario.validate` checks every field and
 raises one-line :class:`~whipple_kick.errors.InputError` messages naming
 the value, the allowed range and the unit. docs/simulate.md lists every
@@ -54,6 +55,8 @@ ARMS = ("off", "on")
 #: ``upright`` (upright straight running, not an equilibrium with measured tyres:
 #: the authors' published code).
 STARTS = ("steady", "upright")
+#: The longest run [s] after the kick start (``duration``).
+MAX_DURATION = 120.0
 #: Pitch of an upright start: ``compressed`` (solved with the tyres' compressions: the front contact on
 #: the ground) or ``uncompressed`` (solved with both tyres uncompressed, the compressions set after: the
 #: front contact starts below the ground; the authors' published code).
@@ -87,8 +90,9 @@ def _with_part_fields(cls):
                 annotations[f.name] = float
                 if hasattr(cls, name):   # defaults where the class has them (Scenario), none in a view
                     setattr(cls, f.name, f.default)
+                low = f"more than {f.low:g}" if f.refuse_low else f"{f.low:g}"   # its low end is refused (validate)
                 documented.append(f"    {f.name} : float\n        The {f.label} of {part.title or part.name} "
-                                  f"[{f.unit}], {f.low:g} to {f.high:g}; default {f.default:g}: {f.source}.\n")
+                                  f"[{f.unit}], {low} to {f.high:g}; default {f.default:g}: {f.source}.\n")
     cls.__annotations__ = annotations
     # The entries join the docstring's list of fields: before its Notes, or at its end.
     notes = "\n    Notes\n    -----"
@@ -100,7 +104,7 @@ def _with_part_fields(cls):
 @dataclass(frozen=True)
 @_with_part_fields
 class Scenario:
-    """One kick-plate run; the defaults are the thesis' simulation settings.
+    """One kick-plate run; the defaults are the project's choices, not all the thesis' (:meth:`thesis` has its).
 
     Units are SI except pressures [kPa]. ``None`` means "the default rule"
     described per field.
@@ -253,11 +257,13 @@ class Scenario:
         :data:`whipple_kick.model.carcass.SLIDING_VISCOSITY`). Smaller is closer
         to the Coulomb plateau and stiffer (at least 1e-3 N s/m: below,
         LSODA stalls); docs/validation.md shows the results converged.
-    plate_stop : {"impulse", "resolve"}
+    plate_stop : {"impulse", "resolve", "keep_speeds"}
         Speeds across the constant-acceleration profile's instant plate
-        stop: the rear no-slip constraint's impulse (default) or a re-solve
+        stop: the rear no-slip constraint's impulse (default), a re-solve
         of the dependent speeds only (the earlier model, which removes
-        energy no force accounts for). The other profiles stop the plate
+        energy no force accounts for), or no jump at all with the rear
+        contact left sliding along its heading (the authors' published
+        code, :data:`PLATE_STOPS`). The other profiles stop the plate
         smoothly.
     kick_heading : {"fixed", "settled"}
         ``fixed`` (default): the post-kick run starts from the exact steady
@@ -515,7 +521,7 @@ class Scenario:
         check_range("speed", self.speed, 0.0, 15.0, "m/s", low_open=True)
         if self.design_speed is not None:
             check_range("design speed", self.design_speed, 0.0, 15.0, "m/s", low_open=True)
-        check_range("duration", self.duration, 0.0, 120.0, "s", low_open=True)
+        check_range("duration", self.duration, 0.0, MAX_DURATION, "s", low_open=True)
         check_range("settle time", self.settle, 0.0, 60.0, "s")
         check_range("rtol", self.rtol, 1e-14, 1e-3, "(relative)")
         check_range("output rate", self.output_rate, 1.0, 1e5, "Hz")
@@ -529,10 +535,14 @@ class Scenario:
         check_range("carcass stiffness scale", self.carcass_stiffness_scale, 0.05, 20.0, "(factor)")
         for part in parts.REGISTRY.values():   # the declared parts' fields (the leaning upper body's hip)
             for f in part.fields:
-                value = check_range(f.label, getattr(self, f.name), f.low, f.high, f.unit)
-                if f.refuse_low and value == f.low and part.selected(self):
+                # With its part selected, a field that refuses its low end is allowed (low, high]: one range in
+                # every message (the low end itself is refused with its reason).
+                open_low = bool(f.refuse_low) and part.selected(self)
+                value = getattr(self, f.name)
+                if open_low and value == f.low:
                     raise InputError(f"{f.label} = {value:g} {f.unit} {f.refuse_low}; allowed "
-                                     f"({f.low:g}, {f.high:g}] {f.unit}")
+                                     f"({f.low:g}, {f.high:g}] {f.unit} with {part.title or part.name}")
+                check_range(f.label, value, f.low, f.high, f.unit, low_open=open_low)
         check_range("reflex delay", self.reflex_delay, 0.0, 0.5, "s")
         for label, value, unit in (("reflex roll gain", self.reflex_roll, "N m/rad"),
                                    ("reflex roll-rate gain", self.reflex_roll_rate, "N m s/rad"),
@@ -614,8 +624,9 @@ class Scenario:
 
     def _refuse_unused(self):
         for name, why in self.unused_fields().items():
-            raise InputError(f"{name} = {getattr(self, name)!r} is read only by {why}, which this scenario does not "
-                             f"use: leave it at its default {DEFAULTS[name]!r} (it would be ignored)")
+            raise UnusedFieldError(f"{name} = {_with_unit(name, getattr(self, name))} is read only by {why}, which "
+                                   f"this scenario does not use: leave it at its default "
+                                   f"{_with_unit(name, DEFAULTS[name])} (it would be ignored)", field=name, why=why)
 
     def to_dict(self) -> dict:
         """Fields as a plain dict (JSON-ready)."""
@@ -727,6 +738,40 @@ class Scenario:
 
 #: Every field's default, by name.
 DEFAULTS = {f.name: f.default for f in fields(Scenario)}
+
+#: The unit of every number field, as a file writes it ("1": a factor or a fraction): the uncertainty study checks
+#: an input's ``unit`` against it, and the refusals name it.
+UNITS = {
+    "fz_n": "N", "rider_mass_kg": "kg", "rear_load_share": "1", "pressure_kpa": "kPa", "pressure_front_kpa": "kPa",
+    "pressure_rear_kpa": "kPa", "speed": "m/s", "design_speed": "m/s", "gain_scale": "1", "thesis_load_n": "N",
+    "kick_displacement": "m", "kick_duration": "s", "kick_accel": "m/s^2", "settle": "s", "duration": "s",
+    "rtol": "1", "output_rate": "Hz", "fall_angle_deg": "deg", "steer_limit_deg": "deg",
+    "carcass_damping": "N s/m", "carcass_viscosity": "N s/m", "carcass_stiffness_scale": "1",
+    **{f.name: f.unit for f in parts.fields()},
+    "reflex_delay": "s", "reflex_roll": "N m/rad", "reflex_roll_rate": "N m s/rad", "reflex_steer": "N m/rad",
+    "reflex_steer_rate": "N m s/rad",
+}
+
+
+def _with_unit(name, value):
+    """A field's value as a message writes it: with its unit (:data:`UNITS`) where it is a number."""
+    unit = UNITS.get(name)
+    if unit is None or isinstance(value, bool) or not isinstance(value, (int, float)):
+        return repr(value)
+    return f"{value!r} (unit 1)" if unit == "1" else f"{value!r} {unit}"
+
+
+class UnusedFieldError(InputError):
+    """A field given other than its default that no mechanism of the scenario reads (:meth:`Scenario.unused_fields`).
+
+    ``field`` and ``why`` (the mechanism and when it is in use) let a caller name the field as its user gave
+    it: the command line names the flag.
+    """
+
+    def __init__(self, message, *, field=None, why=None):
+        super().__init__(message)
+        self.field, self.why = field, why
+
 
 #: Fields that may hold a file path (written absolute by :meth:`Scenario.to_file`).
 _PATH_FIELDS = ("bicycle", "kick_table")

@@ -34,7 +34,7 @@ import warnings
 
 import numpy as np
 
-from whipple_kick.errors import InputError, Terminated, UnstableRiderWarning, terminate_raises
+from whipple_kick.errors import DefaultValueWarning, InputError, Terminated, UnstableRiderWarning, terminate_raises
 from whipple_kick.model import slip
 from whipple_kick.simulate import simulation
 from whipple_kick.simulate.results import flatten_summary
@@ -224,9 +224,11 @@ def run_case(scenario, case_id, trajectory=None):
         # time drops alike); with two workers on two cores the spinning also
         # steals the other worker's core. Scoped to the case, so a caller's
         # own process keeps its settings.
-        # The table records linear stability (linear_stability.stable, .message): no warning per case.
+        # The table records linear stability (linear_stability.stable, .message): no warning per case. Nor of a
+        # BicycleParameters bicycle's defaults: the summary lists them, and the sweep warns once (_warn_defaults).
         with _blas_controller().limit(limits=1), warnings.catch_warnings():
             warnings.simplefilter("ignore", UnstableRiderWarning)
+            warnings.simplefilter("ignore", DefaultValueWarning)
             result = simulation.run(scenario)
         _keep(record, result, trajectory)   # a numerical failure keeps what ran before it
         if not result.success:
@@ -242,6 +244,19 @@ def run_case(scenario, case_id, trajectory=None):
         "worker": f"{socket.gethostname()}:{os.getpid()}",
     }
     return record
+
+
+def _warn_defaults(scenarios):
+    """The defaults warning (DefaultValueWarning) of each BicycleParameters bicycle the cases name, here, once per
+    bicycle (identical texts once): each case ignores it (:func:`run_case`), where it came once per case and
+    worker (the uncertainty study's hundreds of sampled bicycles, all with the same ~600-character text)."""
+    from whipple_kick.library import bicycleparameters
+    for name in dict.fromkeys(str(sc.bicycle) for sc in scenarios):
+        if bicycleparameters.is_bicycleparameters_path(name):
+            try:
+                bicycleparameters.load_bicycle(name)
+            except InputError:
+                pass   # each of its cases fails, and its record says why
 
 
 _blas = (None, -1)   # (threadpoolctl controller, len(sys.modules) when it looked)
@@ -367,6 +382,7 @@ def sweep(grid=None, cases=None, *, base=None, folder=None, executor=None, worke
 
     unique = list({cid: sc for _, sc, cid in case_list}.items())
     todo = [(cid, sc) for cid, sc in unique if not finished(cid)]
+    _warn_defaults(sc for _, sc in todo)
     lost, interrupted, own = [], False, False
     try:
         with terminate_raises():

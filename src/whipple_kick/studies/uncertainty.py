@@ -54,7 +54,7 @@ import numpy as np
 
 from whipple_kick.errors import InputError, check_range
 from whipple_kick.library import uncertain
-from whipple_kick.simulate.scenario import MECHANISM_FIELDS, Scenario
+from whipple_kick.simulate.scenario import DEFAULTS, MECHANISM_FIELDS, UNITS, Scenario
 
 from .recommend import _num, pressure_grid
 from .sweep_engine import check_some_ok, make_cases, sweep
@@ -138,53 +138,129 @@ class UncertaintyStudy:
 
 
 def check_inputs(spec, base):
-    """Refuse an uncertain input that names no scenario field, one the study sets, or one the run ignores.
+    """Refuse, before any run, what the file gets wrong, in one line naming the file's key.
+
+    An input or ``[fixed]`` entry that names no scenario field (with the fields' names) or one the study
+    sets; an input whose ``unit`` is not its field's (:data:`whipple_kick.simulate.scenario.UNITS`); a
+    ``[fixed]`` value, a choice's option or a continuous input's bound (an untruncated normal's farthest
+    sample) that the scenario refuses (its message names the value, the allowed range and the unit); an
+    input that no sample's mechanism reads (it would be ignored). ``base`` is the scenario the file
+    changes, with or without its ``[fixed]`` fields.
 
     Raises
     ------
     InputError
-        One line naming the input and the field.
+        One line naming the key and the problem.
     """
-    fields = {f.name for f in dataclasses.fields(Scenario)}
     for inp in spec.inputs:
         if inp.field and inp.field.startswith(uncertain.BICYCLE_PREFIX) and spec.measured_bicycle is None:
             raise InputError(f"{spec.path}: inputs.{inp.name}: a measured bicycle's parameters are sampled from a "
                              "[bicycle] table (measured = ..., parameters = [...]), not named as inputs")
     for field in spec.fixed:
-        if field not in fields:
-            raise InputError(f"{spec.path}: fixed.{field}: {field!r} is no scenario field")
+        if field not in DEFAULTS:
+            raise InputError(f"{spec.path}: fixed.{field}: {field!r} is no scenario field{_close(field)}; the "
+                             f"fields: {', '.join(DEFAULTS)}")
         if field in _STUDY_FIELDS:
             raise InputError(f"{spec.path}: fixed.{field}: the study sets {field} itself")
     for inp in _scenario_inputs(spec):
         for field in inp.fields:
-            if field not in fields:
-                raise InputError(f"{spec.path}: inputs.{inp.name}: {field!r} is no scenario field "
+            if field not in DEFAULTS:
+                raise InputError(f"{spec.path}: inputs.{inp.name}: {field!r} is no scenario field{_close(field)} "
                                  f"(see help(whipple_kick.Scenario))")
             if field in _STUDY_FIELDS:
                 raise InputError(f"{spec.path}: inputs.{inp.name}: the study sets {field} itself "
                                  f"(pressures and loads are its grid)")
+        if inp.distribution != "choice":
+            unit = UNITS.get(inp.field)
+            if unit is None:
+                raise InputError(f"{spec.path}: inputs.{inp.name}: {inp.field} is not a number: a {inp.distribution} "
+                                 f"distribution cannot give it (a choice can: options with a value each)")
+            if " ".join(inp.unit.split()) != unit:
+                raise InputError(f"{spec.path}: inputs.{inp.name}.unit: {inp.unit!r} is not the unit of {inp.field}, "
+                                 f"{unit!r}: give the distribution in {unit}")
+    plain = base
+    for k, field in enumerate(spec.fixed):   # in file order, each with those before it (a table after its profile)
+        _check_changes(f"{spec.path}: fixed.{field}", plain, dict(itertools.islice(spec.fixed.items(), k + 1)))
+    base = base.with_changes(**spec.fixed)
+    for inp in spec.inputs:
+        for k, option in enumerate(inp.options):
+            _check_changes(f"{spec.path}: inputs.{inp.name}.options[{k}] ({option.label})", base, option.values)
     candidates = _candidates(spec, base)
     for inp in _scenario_inputs(spec):
         for field in inp.fields:
-            mechanisms = [(m, cond, active) for m, cond, active, names in MECHANISM_FIELDS if field in names]
-            if mechanisms and not any(all(active(sc) for _, _, active in mechanisms) for sc in candidates):
-                what = " and ".join(f"{m} ({cond})" for m, cond, _ in mechanisms)
+            if not any(_reads(sc, field) for sc in candidates):
+                what = " and ".join(f"{m} ({cond})" for m, cond, _, names in MECHANISM_FIELDS if field in names)
                 raise InputError(f"{spec.path}: inputs.{inp.name}: {field} is read only by {what}, which no sample "
                                  "uses: it would be ignored")
+    combinations = [base.with_changes(**values) for values in _combinations(spec)]
+    for inp in _scenario_inputs(spec):
+        if inp.distribution != "choice":
+            _check_ends(spec, inp, combinations)
+
+
+def _reads(scenario, field):
+    """Whether every mechanism that reads ``field`` (:data:`~whipple_kick.simulate.scenario.MECHANISM_FIELDS`) is
+    in use in ``scenario`` (a field no mechanism owns is always read)."""
+    return all(active(scenario) for _, _, active, names in MECHANISM_FIELDS if field in names)
+
+
+def _close(field):
+    """" (did you mean ...?)" for a misspelt scenario field, or ""."""
+    import difflib
+    close = difflib.get_close_matches(field, DEFAULTS, n=1)
+    return f" (did you mean {close[0]!r}?)" if close else ""
+
+
+def _check_changes(where, base, changes):
+    """``base`` with ``changes`` passes the run's checks (the fields the changed mechanisms do not read left at
+    ``base``'s, as a sample row leaves them); else InputError ``<where>: <the check's message>``."""
+    from whipple_kick.simulate import assembly
+    scenario = base.with_changes(**changes)
+    unread = {f: getattr(base, f) for f in scenario.unused_fields() if f in changes}
+    try:
+        assembly.preflight(scenario.with_changes(**unread))
+    except InputError as exc:
+        raise InputError(f"{where}: {exc}") from None
+
+
+def _check_ends(spec, inp, combinations):
+    """A continuous input's bounds (an untruncated normal's farthest samples) pass the run's checks, with the
+    first combination of the choices' options that is valid and reads the input's field."""
+    ends = []
+    for end, bound, u in (("low", inp.low, uncertain._EDGE), ("high", inp.high, 1.0 - uncertain._EDGE)):
+        if bound is not None:
+            ends.append((f"inputs.{inp.name}.{end}", float(bound)))
+        else:   # an untruncated normal: as far as the sampling goes
+            value = float(inp.ppf([u])[0])
+            ends.append((f"inputs.{inp.name} (a normal not truncated {'below' if end == 'low' else 'above'}: its "
+                         f"samples reach {value:g} {inp.unit}; give '{end}')", value))
+    for base in combinations:
+        if not _reads(base, inp.field):
+            continue
+        try:
+            _check_changes("", base, {})
+        except InputError:
+            continue   # a combination the scenario refuses whatever this input: each sample row says so
+        for where, value in ends:
+            _check_changes(f"{spec.path}: {where}", base, {inp.field: value})
+        return
+
+
+def _combinations(spec):
+    """The fields each combination of the choices' options sets (at most :data:`_MAX_COMBINATIONS`)."""
+    choices = [i for i in spec.inputs if i.distribution == "choice"]
+    for combo in itertools.islice(itertools.product(*(i.options for i in choices)), _MAX_COMBINATIONS):
+        values = {}
+        for option in combo:
+            values.update(option.values)
+        yield values
 
 
 def _candidates(spec, base):
     """One scenario per combination of the choices' options (continuous inputs at their medians): what the
     samples can switch on. At most :data:`_MAX_COMBINATIONS`."""
-    choices = [i for i in spec.inputs if i.distribution == "choice"]
     medians = {i.field: float(i.ppf([0.5])[0]) for i in _scenario_inputs(spec) if i.distribution != "choice"}
-    out = []
-    for combo in itertools.islice(itertools.product(*(i.options for i in choices)), _MAX_COMBINATIONS):
-        values = {**spec.fixed, **medians}
-        for option in combo:
-            values.update(option.values)
-        out.append(base.with_changes(**values))
-    return out
+    return [base.with_changes(**{**spec.fixed, **medians, **values}) for values in _combinations(spec)]
 
 
 def sample(spec, samples, seed):
@@ -196,6 +272,8 @@ def sample(spec, samples, seed):
 
     from SALib.sample import sobol as sobol_sample
     samples = int(check_range("samples", samples, 2, 1e6, "(base samples N)"))
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise InputError(f"seed = {seed!r} is outside the allowed range: a whole number >= 0")
     d = len(spec.inputs)
     with warnings.catch_warnings():
         # SALib warns when N is not a power of 2 (the Sobol' sequence's balance); any N is valid.
@@ -320,13 +398,21 @@ def run_study(spec=uncertain.DEFAULT, samples=64, seed=0, loads=LOADS, pressures
     """
     if not isinstance(spec, uncertain.UncertainSet):
         spec = uncertain.load(spec)
-    base = (Scenario() if base is None else base).with_changes(**spec.fixed)
-    check_inputs(spec, base)
+    base = Scenario() if base is None else base
+    check_inputs(spec, base)   # before the [fixed] fields are applied: one may name no field
+    base = base.with_changes(**spec.fixed)
     loads = list(dict.fromkeys(check_range("rear-tyre load fz", f, 0.0, None, "N", low_open=True) for f in loads))
+    if not loads:
+        raise InputError("the study needs at least one rear load (N)")
     # Within the tyre's measured range (checked here: inside the sweep a bad pressure would fail every run at it).
-    pressures = pressure_grid(base.tyre, list(pressures), coefficient_set=base.coefficient_set)[0]
-    if not loads or len(pressures) < 2:
-        raise InputError("the study needs at least one rear load and two pressures")
+    pressures, measured = pressure_grid(base.tyre, list(pressures), coefficient_set=base.coefficient_set)
+    if len(pressures) < 2:
+        from whipple_kick.library import tyres
+        others = [f"{name} ({_kpa(p)})" for name, p, _ in tyres.available() if len(p) > 1]
+        raise InputError(f"the study compares pressures: it needs at least two, got {_kpa(pressures)}; tyre "
+                         f"{base.tyre} ({base.coefficient_set}) was measured at {_kpa(measured)} only, and a "
+                         f"pressure must lie within its measured range: choose a tyre measured at two or more "
+                         f"({', '.join(others)})")
     unit, blocks = sample(spec, samples, seed)
     cases, keys = study_cases(spec, unit, loads, pressures, base)
     for k in range(0, len(cases), len(pressures)):   # one per row and load: the pressures do not change validity
@@ -341,6 +427,11 @@ def run_study(spec=uncertain.DEFAULT, samples=64, seed=0, loads=LOADS, pressures
     table = sweep(cases=cases, base=base, **sweep_options)
     check_some_ok(table)
     return analyse(spec, samples, seed, unit, blocks, keys, ids, table, base.duration)
+
+
+def _kpa(pressures):
+    """Pressures as a message lists them: "300, 400 kPa"."""
+    return ", ".join(f"{p:g}" for p in sorted(pressures)) + " kPa"
 
 
 def analyse(spec, samples, seed, unit, blocks, keys, ids, table, duration):
