@@ -20,7 +20,15 @@ import numpy as np
 from whipple_kick.model import parts
 
 from . import fileio
-from .errors import BuildError, CacheError, InputError, SimulationError, Terminated, terminate_raises
+from .errors import (
+    BuildError,
+    CacheError,
+    CompilerNotFoundError,
+    InputError,
+    SimulationError,
+    Terminated,
+    terminate_raises,
+)
 
 #: Exit status of a command interrupted by Ctrl-C (128 + SIGINT, as shells report it).
 EXIT_INTERRUPTED = 130
@@ -91,6 +99,9 @@ def _run(main, argv, prog="whipple_kick", kept="no results were kept"):
         return EXIT_BROKEN_PIPE
     except InputError as exc:
         print(f"error: {exc}", file=sys.stderr)
+        return 2
+    except CompilerNotFoundError as exc:   # the machine lacks a compiler: the user's to install (status 2)
+        print(f"{prog}: cannot build the compiled model: {exc}", file=sys.stderr)
         return 2
     except BuildError as exc:
         print(f"{prog}: cannot build the compiled model: {exc}", file=sys.stderr)
