@@ -261,7 +261,8 @@ def test_load_refuses_a_truncated_trajectory(tmp_path):
     (lambda text: text.replace("time [s]", "t [s]", 1), "no time column"),
     (lambda text: text.replace("\n0.1", "\nabc", 1), "not a number"),
     (lambda text: "\n".join(line for k, line in enumerate(text.split("\n")) if k != 200), "time"),
-], ids=["time column renamed", "text in a row", "a row missing in the middle"])
+    (lambda text: text.split("\n", 1)[0] + "\n", "is empty: it has the header but no rows"),
+], ids=["time column renamed", "text in a row", "a row missing in the middle", "the header alone"])
 def test_load_refuses_a_malformed_trajectory(edit, fragment, tmp_path):
     folder = tmp_path / "run"
     _saved_run(folder)

@@ -323,6 +323,8 @@ def check_trajectory(frame, summary, scenario, path):
     where = f"{str(path)!r}"
     if "time" not in frame:
         raise InputError(f"{where} has no time column ('time [s]'): not a trajectory of simulate")
+    if frame.empty:   # the header alone (a copy cut after its first line): every column reads as text
+        raise InputError(f"{where} is empty: it has the header but no rows (a truncated or damaged file)")
     if not all(str(t).startswith(("float", "int")) for t in frame.dtypes):
         bad = next(c for c, t in frame.dtypes.items() if not str(t).startswith(("float", "int")))
         raise InputError(f"{where}: column {bad!r} holds a value that is not a number (a damaged file)")
