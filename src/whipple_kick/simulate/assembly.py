@@ -120,6 +120,7 @@ def assemble(scenario, kick, *, tyres=None, gains=None) -> Assembly:
     if tyres is None:
         rear, front, notes = build_tyres(scenario.tyre_spec)
     else:
+        _refuse_tyre_fields(scenario)
         rear, front = tyres
         notes = [f"custom tyre objects (the scenario's tyre and pressures are not used): "
                  f"rear {rear!r}, front {front!r}"]
@@ -146,6 +147,22 @@ def assemble(scenario, kick, *, tyres=None, gains=None) -> Assembly:
                          f"{steady_yaw_rate:.3g} rad/s (allowed |yaw rate| <= {STRAIGHT_YAW_RATE:g} rad/s): "
                          f"use tyres without zero-slip offsets (symmetric_tyres=True)")
     return Assembly(rear, front, notes, moore, info, gains, poles, controller, start.params, found, start, stability)
+
+
+#: Scenario fields the tyre objects of ``run(scenario, tyres=...)`` replace (what :func:`build_tyres` reads).
+CUSTOM_TYRE_FIELDS = ("tyre", "pressure_kpa", "pressure_front_kpa", "pressure_rear_kpa", "coefficient_set", "friction")
+
+
+def _refuse_tyre_fields(scenario):
+    """Tyre objects given replace the scenario's tyre, pressures, coefficient set and friction: one given as well
+    would be ignored (a note in the summary is lost in a sweep), so it is refused, naming each such field."""
+    given = [f for f in CUSTOM_TYRE_FIELDS if getattr(scenario, f) != DEFAULTS[f]]
+    if given:
+        raise InputError("tyres=(rear, front) replace the scenario's tyre fields, so "
+                         + ", ".join(f"{f} = {getattr(scenario, f)!r}" for f in given)
+                         + " would be ignored: leave " + ("it" if len(given) == 1 else "them") + " at the default ("
+                         + ", ".join(f"{f} = {DEFAULTS[f]!r}" for f in given) + ") or load the tyres with "
+                         "those options (whipple_kick.library.tyres.load)")
 
 
 # ------------------------------------------------------------------ the parts
