@@ -109,6 +109,13 @@ def test_rider_benchmark_is_lumped_into_the_rear_frame(v1_folder):
     assert "mB" not in bike.uncertainties and "w" in bike.uncertainties
     with pytest.raises(InputError, match="has not seated rider 'Nobody'"):
         bp.load(v1_folder / "bicycles" / "Balanceassistv1", rider="Nobody")
+    # A rider file's mass outside a person's range (23-200 kg, riders.MIN_RIDER_MASS_KG) is refused in one line.
+    light = v1_folder / "riders" / "Light" / "Parameters" / "LightBalanceassistv1Benchmark.txt"
+    light.parent.mkdir(parents=True)
+    light.write_text("".join(_line(k, 3.35 if k == "mB" else v) for k, v in seated.benchmark().items()))
+    with pytest.raises(InputError, match=r"LightBalanceassistv1Benchmark\.txt: mB = 3\.35 kg is outside a rider's "
+                                         r"allowed range \[23, 200\] kg$"):
+        bp.load(v1_folder / "bicycles" / "Balanceassistv1", rider="Light")
 
 
 def test_yeadon_files_give_the_shipped_rider(tmp_path):

@@ -275,8 +275,10 @@ def _rider_benchmark(path):
     _missing(path, values, [n for n in RIDER_UNITS if n != "yB"])
     if values.get("yB", 0.0) != 0.0:
         raise InputError(f"{path}: yB = {values['yB']!r} m: the rider must sit in the bicycle's mid-plane (yB = 0)")
-    if not values["mB"] > 0.0:
-        raise InputError(f"{path}: mB = {values['mB']!r} kg must be > 0 kg")
+    from .riders import MAX_RIDER_MASS_KG, MIN_RIDER_MASS_KG
+    if not MIN_RIDER_MASS_KG <= values["mB"] <= MAX_RIDER_MASS_KG:   # a person's (riders.MIN_RIDER_MASS_KG says how)
+        raise InputError(f"{path}: mB = {values['mB']!r} kg is outside a rider's allowed range "
+                         f"[{MIN_RIDER_MASS_KG:g}, {MAX_RIDER_MASS_KG:g}] kg")
     inertia = np.array([[values["IBxx"], 0.0, values["IBxz"]], [0.0, values["IByy"], 0.0],
                         [values["IBxz"], 0.0, values["IBzz"]]])
     return values["mB"], np.array([values["xB"], 0.0, values["zB"]]), inertia
