@@ -95,3 +95,16 @@ def test_attributes_sharing_a_description_get_one_entry_each():
         ":ivar fz_n: Rear load [N] or", "    the rider's mass [kg].",
         ":ivar rider_mass_kg: Rear load [N] or", "    the rider's mass [kg].",
         ":vartype fz_n: float or None", ":vartype rider_mass_kg: float or None", "Notes"]
+
+
+def test_citation_names_the_developers_and_no_invented_person():
+    """Issue 40 item 16: CITATION.cff named a placeholder ("the whipple_kick authors"). Its authors are the one
+    entity the project knows, "the whipple_kick developers": no person is invented, and the thesis author (the
+    source of the model and data) is a reference, not an author of the software. Its version is the package's."""
+    yaml = pytest.importorskip("yaml")
+    root = DOCS.parent
+    citation = yaml.safe_load((root / "CITATION.cff").read_text(encoding="utf-8"))
+    assert citation["authors"] == [{"name": "the whipple_kick developers"}]
+    version = re.search(r'^version = "([^"]+)"', (root / "pyproject.toml").read_text(encoding="utf-8"), re.MULTILINE)[1]
+    assert citation["version"] == version
+    assert any(ref["authors"][0].get("family-names") == "Dell'Orto" for ref in citation["references"])
