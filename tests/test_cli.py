@@ -194,11 +194,13 @@ BAD_INPUTS = {
     "negative-load": (["--fz", "-100"], ["-100", "N", "range"]),
     # 0 N and 10 N state the same, real range: the loads a rider can put on this bicycle
     # (before: "(0, inf] N" for 0 N, "(165.09, 1535.65] N" for 10 N).
-    "zero-load": (["--fz", "0"], ["fz = 0.0 N", "allowed range (165.09, 1535.65] N for 'balanceassist_v1'"]),
+    "zero-load": (["--fz", "0"], ["fz = 0.0 N", "allowed range [322.71, 1535.65] N for 'balanceassist_v1'"]),
     "load-below-the-bicycle's-own": (["--fz", "10"], ["fz = 10.0 N",
-                                                      "allowed range (165.09, 1535.65] N for 'balanceassist_v1'"]),
+                                                      "allowed range [322.71, 1535.65] N for 'balanceassist_v1'"]),
+    # Issue 40 item 7: the loads of a rider of a human mass (23-200 kg), not of a rider of no mass.
+    "load-of-a-rider-too-light": (["--fz", "200"], ["fz = 200.0 N", "[322.71, 1535.65] N", "a 23 kg rider"]),
     "load-too-large": (["--fz", "5000"], ["5000", "N", "range"]),
-    "negative-rider-mass": (["--rider-mass", "-3"], ["-3", "kg", "(0, 200]"]),
+    "negative-rider-mass": (["--rider-mass", "-3"], ["-3", "kg", "[23, 200]"]),
     "unknown-tyre": (["--tyre", "T99"], ["T99", "T01", "T05"]),
     "unknown-coefficient-set": (["--tyre", "T01", "--coefficient-set", "chapter8"], ["chapter8", "T01"]),
     "unknown-bicycle": (["--bicycle", "nope"], ["nope", "balanceassist_v1"]),
@@ -226,6 +228,9 @@ BAD_INPUTS = {
     "malformed-design-speed": (["--design-speed", "x"], ["--design-speed", "m/s"]),
     "zero-design-speed": (["--design-speed", "0"], ["design speed = 0.0 m/s", "(0, 15] m/s"]),
     "preset-with-rider-and-load": (["--bicycle", "balanceassist_635N", "--fz", "635"], ["already includes"]),
+    "no-rider-on-a-bicycle-alone": (["--rider", "none"], ["rider 'none'", "'balanceassist_v1'", "includes_rider = false"]),
+    "no-rider-and-a-load": (["--bicycle", "balanceassist_635N", "--rider", "none", "--fz", "635"], ["already includes"]),
+    "unknown-rider": (["--rider", "nobody"], ["unknown rider 'nobody'", "jason"]),
     "unknown-profile": (["--kick-profile", "fast"], ["--kick-profile", "'fast'", "constant", "smooth", "table"]),
     "table-profile-without-file": (["--kick-profile", "table"], ["--kick-profile table", "--kick-table FILE"]),
     "missing-table": (["--kick-table", "nope.csv"], ["kick table 'nope.csv'", "does not exist"]),

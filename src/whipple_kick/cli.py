@@ -20,7 +20,15 @@ import numpy as np
 from whipple_kick.model import parts
 
 from . import fileio
-from .errors import BuildError, CacheError, InputError, SimulationError, Terminated, terminate_raises
+from .errors import (
+    BuildError,
+    CacheError,
+    CompilerNotFoundError,
+    InputError,
+    SimulationError,
+    Terminated,
+    terminate_raises,
+)
 
 #: Exit status of a command interrupted by Ctrl-C (128 + SIGINT, as shells report it).
 EXIT_INTERRUPTED = 130
@@ -91,6 +99,9 @@ def _run(main, argv, prog="whipple_kick", kept="no results were kept"):
         return EXIT_BROKEN_PIPE
     except InputError as exc:
         print(f"error: {exc}", file=sys.stderr)
+        return 2
+    except CompilerNotFoundError as exc:   # the machine lacks a compiler: the user's to install (status 2)
+        print(f"{prog}: cannot build the compiled model: {exc}", file=sys.stderr)
         return 2
     except BuildError as exc:
         print(f"{prog}: cannot build the compiled model: {exc}", file=sys.stderr)
@@ -187,7 +198,7 @@ def _model_options(p, symmetric_flag=True, design_default="the run's --speed", c
     arms and reflex, ``--carcass-stiffness-scale`` and ``--lqr-model``.
     Returns the "riding and control" group, for the caller's speed option.
     """
-    from whipple_kick.library import tyres
+    from whipple_kick.library import riders, tyres
     from whipple_kick.model.carcass import SLIDING_LAWS
     from whipple_kick.model.transient import DEFAULT_TRANSIENT
     from whipple_kick.simulate.scenario import (
@@ -247,6 +258,12 @@ def _model_options(p, symmetric_flag=True, design_default="the run's --speed", c
                    help="bicycle parameter set or .toml path (default balanceassist_v1; presets "
                         "with the rider included: balanceassist_635N, balanceassist_701N, browser_with_rider), "
                         "or a BicycleParameters bicycle folder (<data>/bicycles/<Name>) or <Name>Benchmark.txt")
+    g.add_argument("--rider", default=default("rider"), metavar="NAME",
+                   help="Yeadon rider seated on a bicycle-only set (default %s; available: %s), or none: the "
+                        "bicycle's parameters include its rider (a BicycleParameters Benchmark.txt whose rear frame "
+                        "holds the rider, as the Meijaard benchmark's mB = 85 kg), which then runs as it is, with "
+                        "its own load share (no --fz, --rider-mass or --rear-share)"
+                        % (default("rider"), ", ".join(riders.available())))
     if case_options:
         who = g.add_mutually_exclusive_group()
         who.add_argument("--fz", type=_number("N"), metavar="N",
@@ -467,7 +484,7 @@ def _model_fields(args):
         bicycle=args.bicycle, tyre=args.tyre, coefficient_set=args.coefficient_set, friction=args.friction,
         controller=args.controller, design_speed=args.design_speed, gain_scale=args.gain_scale,
         low_inertia=args.low_inertia, tyre_transient=args.tyre_transient, camber_sign=args.camber_sign,
-        slip_speed=args.slip_speed,
+        slip_speed=args.slip_speed, rider=args.rider,
         carcass_sliding=args.carcass_sliding, carcass_damping=args.carcass_damping,
     )
     if hasattr(args, "rider_body"):
@@ -479,7 +496,7 @@ def _model_fields(args):
         raise InputError("--pressure sets both tyres; do not combine it with --pressure-front/--pressure-rear")
     if (fronts[0] is None) != (fronts[1] is None):
         raise InputError("give both --pressure-front KPA and --pressure-rear KPA (or --pressure KPA for both)")
-    _check_loads(args.bicycle, [args.fz] if args.fz is not None else [])
+    _check_loads(args.bicycle, [args.fz] if args.fz is not None else [], args.rider)
     fields.update({field: getattr(args, option) for field, option in _CASE_FIELDS.items()})
     if args.pressure is None:
         fields["pressure_kpa"] = 400.0
@@ -537,7 +554,7 @@ def _preflight(scenario):
                          f"{_in_flags(exc.why)}, which this run does not use: {leave}; it would be ignored") from None
 
 
-def _check_loads(bicycle, loads):
+def _check_loads(bicycle, loads, rider=None):
     """Refuse a ``--fz`` no rider can put on ``bicycle``'s rear tyre, naming the real range in N.
 
     Checked here, before the scenario's own check (a load above 0 N), so that
@@ -547,12 +564,12 @@ def _check_loads(bicycle, loads):
     if not loads:
         return   # nothing to check (the bicycle itself is checked with the scenario)
     from whipple_kick.library import bicycleparameters, riders
-    bike = bicycleparameters.load_bicycle(bicycle)
+    bike = bicycleparameters.load_bicycle(bicycle, rider)
     if bike.includes_rider:
         return   # refused later in one line (the preset already includes its rider)
-    low, high, _ = riders.rear_load_range(bike)
+    low, high, per_kg = riders.rear_load_range(bike)
     for fz in loads:
-        riders.within_rear_load_range(bike, fz, low, high)
+        riders.within_rear_load_range(bike, fz, low, high, per_kg)
 
 
 def _scenario_from_args(args, given=()):

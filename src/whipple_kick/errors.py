@@ -7,7 +7,8 @@ malformed parameter file. Numerical trouble is *not* an InputError: a run
 that fails numerically raises :class:`SimulationError`, carrying what was
 computed before the failure. A C compiler that cannot build the model is
 :class:`BuildError` (the machine's set-up, not the user's input: exit
-status 1). A cache folder that cannot be used is :class:`CacheError` (also
+status 1); no C compiler at all is its :class:`CompilerNotFoundError` (one
+line saying to install one, exit status 2). A cache folder that cannot be used is :class:`CacheError` (also
 the machine's set-up: exit status 1). SIGTERM inside :func:`terminate_raises`
 raises :class:`Terminated`, which the command-line entry points turn into one
 line and exit status 143, as Ctrl-C's KeyboardInterrupt into 130.
@@ -75,6 +76,16 @@ class BuildError(RuntimeError):
 
     The message is one line naming the compiler and where its full output
     was saved.
+    """
+
+
+class CompilerNotFoundError(BuildError):
+    """No C compiler to build the model with (none on PATH, or ``$CC`` names none): the machine's set-up.
+
+    A :class:`BuildError` (the model cannot be built), but one the user fixes by
+    installing a compiler: the message is one line saying so, and the
+    command-line entry points exit with status 2, as for an input error,
+    without a traceback.
     """
 
 

@@ -109,6 +109,13 @@ def test_rider_benchmark_is_lumped_into_the_rear_frame(v1_folder):
     assert "mB" not in bike.uncertainties and "w" in bike.uncertainties
     with pytest.raises(InputError, match="has not seated rider 'Nobody'"):
         bp.load(v1_folder / "bicycles" / "Balanceassistv1", rider="Nobody")
+    # A rider file's mass outside a person's range (23-200 kg, riders.MIN_RIDER_MASS_KG) is refused in one line.
+    light = v1_folder / "riders" / "Light" / "Parameters" / "LightBalanceassistv1Benchmark.txt"
+    light.parent.mkdir(parents=True)
+    light.write_text("".join(_line(k, 3.35 if k == "mB" else v) for k, v in seated.benchmark().items()))
+    with pytest.raises(InputError, match=r"LightBalanceassistv1Benchmark\.txt: mB = 3\.35 kg is outside a rider's "
+                                         r"allowed range \[23, 200\] kg$"):
+        bp.load(v1_folder / "bicycles" / "Balanceassistv1", rider="Light")
 
 
 def test_yeadon_files_give_the_shipped_rider(tmp_path):
@@ -225,6 +232,42 @@ def test_benchmark_folder_through_simulate_and_stability(bench_folder, tmp_path,
                                                   "--no-plot", "--quiet"], capsys)
     assert status == 0, err
     assert (tmp_path / "stab" / "eigenvalues.csv").is_file()
+
+
+def test_a_bicycle_that_includes_its_rider_runs_as_it_is_with_rider_none(bench_folder, tmp_path, capsys):
+    """Issue 40 item 7: the benchmark bicycle's Benchmark.txt holds its rider (mB = 85 kg), which BicycleParameters
+    cannot say; the default 635 N then seated a 3.35 kg Yeadon rider on top without a word. Now that rider is
+    refused (no person: 23-200 kg), the message says how to say "includes its rider", and with rider "none" the
+    bicycle runs as it is: no rider seated, its own static loads, and a load, mass or share given is refused."""
+    bike = bp.load(bench_folder)
+    low, high, per_kg = riders.rear_load_range(bike)
+    assert (635.0 - low) / per_kg == pytest.approx(3.35, abs=0.01)        # the rider that was seated silently
+    with pytest.raises(InputError) as info:
+        wk.assembly.build_bicycle(wk.Scenario(bicycle=str(bench_folder)).bicycle_spec)
+    text = str(info.value)
+    assert "\n" not in text and "fz = 635.0 N is outside the allowed range" in text and "a 23 kg rider" in text
+    assert "give rider 'none' (--rider none)" in text, text
+    with pytest.raises(InputError, match=r"^rider mass = 3\.35 kg is outside the allowed range \[23, 200\] kg$"):
+        wk.riders.yeadon_rider("jason", mass_kg=3.35)
+
+    scenario = wk.Scenario(bicycle=str(bench_folder), rider="none")
+    moore, _, info = wk.assembly.build_bicycle(scenario.bicycle_spec)
+    assert info["rider_mass_kg"] is None and info["includes_rider_preset"] is True
+    rear, front = riders.static_loads(bike)                           # the bicycle's own load share
+    assert (info["static_load_rear_n"], info["static_load_front_n"]) == (rear, front)
+    assert moore == dict(bp.load(bench_folder, includes_rider=True).moore)
+    for given in (dict(fz_n=635.0), dict(rider_mass_kg=70.0), dict(rear_load_share=0.6)):
+        with pytest.raises(InputError, match=r"already includes its rider|would be ignored"):
+            wk.assembly.preflight(wk.Scenario(bicycle=str(bench_folder), rider="none", **given))
+
+    out = tmp_path / "run"
+    status, _, err = _cli(["--bicycle", str(bench_folder), "--rider", "none", "--duration", "0.3", "--no-plot",
+                           "--out", str(out)], capsys)
+    assert status == 0, err
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["bicycle"]["rider_mass_kg"] is None and summary["scenario"]["rider"] == "none"
+    assert summary["bicycle"]["static_load_rear_n"] == pytest.approx(rear, rel=1e-12)
+    assert summary["bicycle"]["total_mass_kg"] == pytest.approx(2 + 85 + 4 + 3, abs=1e-9)   # Meijaard's masses
 
 
 # ----------------------------------------------------------------- the field's code as oracle

@@ -33,6 +33,43 @@ def test_critical_speeds(moore):
     assert abs(classic.capsize_speed(moore) - benchmark.CAPSIZE_SPEED) < 1e-8
 
 
+def _their_bicycle(name):
+    """A bicycle folder the installed bicycleparameters ships (its app data), read by our reader."""
+    pytest.importorskip("bicycleparameters", reason="bicycleparameters (the test extra) ships the bicycles")
+    from importlib import resources
+
+    from whipple_kick.library import bicycleparameters as bp
+    folder = resources.files("bicycleparameters") / "app-data" / "bicycles" / name
+    if not (folder / "Parameters").is_dir():
+        pytest.skip(f"the installed bicycleparameters ships no {name} folder")
+    with pytest.warns(wk.errors.DefaultValueWarning):
+        return bp.load(folder)
+
+
+@pytest.mark.parametrize("name, published", [("Benchmark", benchmark.CAPSIZE_SPEED), ("Browser", None)])
+def test_capsize_speed_is_found_outside_a_fixed_bracket(name, published):
+    """The capsize crossing is bracketed by scanning the eigenvalues over speed: Browser capsizes at 4.336 m/s,
+    below the 5-7 m/s the search once assumed (a ValueError then); the benchmark folder (BicycleParameters'
+    copy of Meijaard et al. 2007's Table 1) gives the published 6.024 m/s to 1e-8 m/s. Browser's value is
+    checked against the eigenvalues themselves: the largest real one changes sign there and nowhere below
+    (above the merging speed of the weave pair)."""
+    bike = _their_bicycle(name)
+    speed = classic.capsize_speed(bike)
+    if published is not None:
+        assert abs(speed - published) < 1e-8
+    else:
+        assert speed == pytest.approx(4.336, abs=5e-4)
+        assert classic._capsize_eigenvalue(bike, speed - 0.01) < 0.0 < classic._capsize_eigenvalue(bike, speed + 0.01)
+
+
+def test_no_capsize_crossing_is_one_line():
+    """Yellowrev (the Yellow bicycle with its fork reversed) is capsize-stable to 30 m/s: one line, the range."""
+    bike = _their_bicycle("Yellowrev")
+    with pytest.raises(ValueError, match=r"^no capsize speed in \[0.1, 30\] m/s: ") as info:
+        classic.capsize_speed(bike)
+    assert "\n" not in str(info.value)
+
+
 @pytest.mark.parametrize("speed", [0.0, 3.0, 5.0, 8.0])
 def test_state_space_equals_published_canonical_form(moore, speed):
     pub = benchmark.canonical_matrices()

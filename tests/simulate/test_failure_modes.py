@@ -91,6 +91,36 @@ def test_failing_compiler_from_simulate_is_status_1_and_leaves_no_folder(tmp_pat
     assert not out.exists()                      # the folder it made is removed
 
 
+def test_missing_compiler_from_simulate_is_status_2_one_line(tmp_path, capsys, monkeypatch):
+    """No C compiler: the user's to install, as an input error is (status 2, one line, no traceback), but named as
+    what it is."""
+    from whipple_kick.errors import CompilerNotFoundError
+
+    def missing(*layout):
+        raise CompilerNotFoundError("no C compiler found (looked for cc, gcc, clang on PATH): install a C compiler "
+                                    "(e.g. gcc) or set CC to one")
+    monkeypatch.setattr(slip.compiled, "library_path", missing)
+    slip.library.cache_clear()
+    try:
+        status, stdout, err = _simulate(["--duration", "0.6", "--no-plot", "--out", str(tmp_path / "run")], capsys)
+    finally:
+        slip.library.cache_clear()
+    assert status == 2 and stdout == "" and "Traceback" not in err
+    assert err.count("\n") == 1 and err.startswith("simulate: cannot build the compiled model: no C compiler found")
+    assert "install a C compiler" in err
+
+
+def test_the_build_announces_itself_as_a_warning_not_a_print(tmp_path, monkeypatch, capsys):
+    """The build's one line is a PerformanceWarning (a library caller filters it; the commands print it once), not
+    text written to stderr behind the caller's back."""
+    from whipple_kick.errors import PerformanceWarning
+    monkeypatch.setenv("WHIPPLE_KICK_CACHE", str(tmp_path / "cache"))
+    monkeypatch.setattr(slip_build, "c_source", lambda *model: "int main(void) { return 0; }\n")
+    with pytest.warns(PerformanceWarning, match="building the slip model"), pytest.raises(BuildError):
+        slip_build.build_library(tmp_path / "cache" / "x.so", "k", shutil.which("false"), ("-O2",))
+    assert capsys.readouterr().err == ""
+
+
 @pytest.mark.slow
 def test_failing_compiler_end_to_end(tmp_path):
     """CC=false on a fresh cache: the build line, then one error line; status 1; no folder (about 30 s)."""
@@ -99,7 +129,7 @@ def test_failing_compiler_end_to_end(tmp_path):
                           capture_output=True, text=True, timeout=600)
     lines = proc.stderr.splitlines()
     assert proc.returncode == 1 and "Traceback" not in proc.stderr
-    assert len(lines) == 2 and lines[0].startswith("whipple_kick: building") and "C compiler" in lines[1]
+    assert len(lines) == 2 and lines[0].startswith("simulate: warning: building the slip model") and "C compiler" in lines[1]
     assert not (tmp_path / "run").exists()
 
 

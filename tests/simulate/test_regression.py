@@ -77,6 +77,8 @@ def trajectory(scenario, columns, tyres=None):
     """The run's ``columns``; a part's column the run's model lacks (the arms' torque of a rider without arms)
     is zero, which its reference must then be throughout (a reference made when the part's terms were in
     every model, multiplied by zero)."""
+    if tyres is not None:   # the tyre objects replace the scenario's tyre fields, which must then be the defaults
+        scenario = dataclasses.replace(scenario, **{f: wk.scenario.DEFAULTS[f] for f in wk.assembly.CUSTOM_TYRE_FIELDS})
     df = simulation.run(scenario, tyres=tyres).trajectory
     return {c: df[c].to_numpy() if c in df or c not in PART_COLUMNS else np.zeros(len(df)) for c in columns}
 

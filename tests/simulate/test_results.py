@@ -183,7 +183,7 @@ def test_load_of_a_folder_that_is_not_a_run_is_one_line(tmp_path):
 _UNIT_SUFFIX = re.compile(r"_(s|rad|rad_s|deg|m|n|n_m|n_per_m|n_s_per_m|j|w|kg|kpa|m_s|m_s2|1_s)$")
 #: Numbers without a unit: counts, ratios and tolerances; the gains' units are in controller.gain_units, the steady
 #: powers' unit in the name of their section (steady_power_w).
-_DIMENSIONLESS = re.compile(r"^(controller\.gain_scale|bicycle\.rear_load_share|controller\.gains\..*|steady_state\.steady_power_w\..*|"
+_DIMENSIONLESS = re.compile(r"^(controller\.gain_scale|bicycle\.(steady_)?rear_load_share|controller\.gains\..*|steady_state\.steady_power_w\..*|"
                             r"steady_state\.residual|metrics\.n_peaks|metrics\.(log_decrement|damping_ratio)_\d_\d|"
                             r"numerics\.(rtol|nfev|njev|evaluations|budget\..*))$")
 
@@ -206,6 +206,25 @@ def test_every_number_in_the_summary_has_a_unit_in_its_key(base):
     peaks = [k for k in keys if k.startswith(("peaks.", "metrics.", "recovery.")) and "peak" in k
              and "time" not in k and not k.startswith("metrics.n_")]   # the response's (not the plate's) peaks
     assert peaks and all("absolute" in k or "from_steady" in k for k in peaks), peaks
+
+
+def test_the_summary_gives_the_static_and_the_steady_loads_each_named(base):
+    """Issue 40 item 15: the summary gave only the no-compression statics (635 N) as the run's load. Both are given,
+    named for which they are: the static ones are what the rider is sized for, the steady ones the tyres' normal
+    forces in the state the run starts from (the trajectory's first sample, exactly) and sum to the weight's
+    support to the steady motion's accuracy. Measured in the default run: 635.000 N / 0.63675 static, 636.004 N /
+    0.63775 steady; bound: the steady load 0.1-5 N above the static (the frame pitches forward-up as the tyres
+    compress) and the sum within 1e-6 of the static sum."""
+    b = base.summary["bicycle"]
+    assert b["static_load_rear_n"] == pytest.approx(635.0, abs=1e-9)
+    first = base.trajectory.iloc[0]
+    assert b["steady_load_rear_n"] == first["fz_rear"] and b["steady_load_front_n"] == first["fz_front"]
+    assert 0.1 < b["steady_load_rear_n"] - b["static_load_rear_n"] < 5.0
+    total = b["static_load_rear_n"] + b["static_load_front_n"]
+    assert b["steady_load_rear_n"] + b["steady_load_front_n"] == pytest.approx(total, rel=1e-6)
+    assert b["steady_rear_load_share"] == pytest.approx(b["steady_load_rear_n"] / total, rel=1e-6)
+    assert b["rear_load_share"] == pytest.approx(635.0 / total, rel=1e-12)
+    assert "static_load_* and rear_load_share: rigid-contact statics" in b["loads_are"]
 
 
 def test_recovered_says_whether_all_three_rates_settled(base):
@@ -261,7 +280,8 @@ def test_load_refuses_a_truncated_trajectory(tmp_path):
     (lambda text: text.replace("time [s]", "t [s]", 1), "no time column"),
     (lambda text: text.replace("\n0.1", "\nabc", 1), "not a number"),
     (lambda text: "\n".join(line for k, line in enumerate(text.split("\n")) if k != 200), "time"),
-], ids=["time column renamed", "text in a row", "a row missing in the middle"])
+    (lambda text: text.split("\n", 1)[0] + "\n", "is empty: it has the header but no rows"),
+], ids=["time column renamed", "text in a row", "a row missing in the middle", "the header alone"])
 def test_load_refuses_a_malformed_trajectory(edit, fragment, tmp_path):
     folder = tmp_path / "run"
     _saved_run(folder)

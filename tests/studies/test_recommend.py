@@ -34,8 +34,8 @@ def test_recommend_pressure_prints_table_and_recommendation_for_thesis_loads():
 
 
 @pytest.mark.parametrize("args, message", [
-    (("--fz", "-3"), "rear-tyre load fz = -3.0 N is outside the allowed range (165.09, 1535.65] N"),
-    (("--fz", "635", "10"), "rear-tyre load fz = 10.0 N is outside the allowed range (165.09, 1535.65] N"),
+    (("--fz", "-3"), "rear-tyre load fz = -3.0 N is outside the allowed range [322.71, 1535.65] N"),
+    (("--fz", "635", "10"), "rear-tyre load fz = 10.0 N is outside the allowed range [322.71, 1535.65] N"),
     (("--fz", "635", "--pressures", "700"), "700.0 kPa is outside the allowed range [300, 500] kPa"),
     (("--fz", "635", "--tyre", "T99"), "tyre = 'T99' is unknown"),
     (("--fz", "x"), "'x' is not a number (N)"),

@@ -235,7 +235,7 @@ def _bicycle_bodies(scenario, summary, params):
     """The rear body (frame lines and rider) and the front body (fork and handlebar) in body axes."""
     from whipple_kick.library import bicycleparameters, riders
 
-    bike = bicycleparameters.load_bicycle(scenario.bicycle)
+    bike = bicycleparameters.load_bicycle(scenario.bicycle, scenario.rider)
     to_c = functools.partial(geometry.benchmark_to_body, parameters=params, body="C")
     to_e = functools.partial(geometry.benchmark_to_body, parameters=params, body="E")
     d1, d2, d3 = params["d1"], params["d2"], params["d3"]

@@ -204,7 +204,7 @@ def is_bicycleparameters_path(text):
     return path.is_dir() or (path.suffix == ".txt" and path.is_file())
 
 
-def load_bicycle(name):
+def load_bicycle(name, rider=None):
     """The bicycle a scenario names: a shipped set, else a BicycleParameters folder or file (:func:`load`), else a
     ``.toml`` path (:func:`bicycles.load`).
 
@@ -213,6 +213,12 @@ def load_bicycle(name):
     name : str or os.PathLike
         A shipped set's name, a ``.toml`` path, or an existing BicycleParameters
         bicycle folder or ``<Name>Benchmark.txt``.
+    rider : str, optional
+        The scenario's rider. ``"none"`` (:data:`whipple_kick.library.riders.NO_RIDER`)
+        says that the bicycle's parameters include its rider: a
+        BicycleParameters bicycle is then read with ``includes_rider=True``
+        (BicycleParameters itself cannot say so); a set whose file says it is
+        the bicycle alone is refused. Any other value changes nothing here.
 
     Returns
     -------
@@ -223,11 +229,18 @@ def load_bicycle(name):
     >>> load_bicycle("balanceassist_v1").name
     'balanceassist_v1'
     """
+    from .riders import NO_RIDER
+
     text = str(name)
     # A shipped name wins over a folder of that name in the working directory (a run's output folder, say).
     if text not in bicycles.available() and not text.endswith(".toml") and is_bicycleparameters_path(text):
-        return load(text)
-    return bicycles.load(text)
+        return load(text, includes_rider=True if rider == NO_RIDER else None)
+    bike = bicycles.load(text)
+    if rider == NO_RIDER and not bike.includes_rider:
+        raise InputError(f"rider {NO_RIDER!r} says that bicycle {bike.name!r} includes its rider, but its file says "
+                         "includes_rider = false (the bicycle alone): give a Yeadon rider (default 'jason') or a set "
+                         "with its rider (balanceassist_635N, balanceassist_701N, browser_with_rider)")
+    return bike
 
 
 def stamp(text):
@@ -262,8 +275,10 @@ def _rider_benchmark(path):
     _missing(path, values, [n for n in RIDER_UNITS if n != "yB"])
     if values.get("yB", 0.0) != 0.0:
         raise InputError(f"{path}: yB = {values['yB']!r} m: the rider must sit in the bicycle's mid-plane (yB = 0)")
-    if not values["mB"] > 0.0:
-        raise InputError(f"{path}: mB = {values['mB']!r} kg must be > 0 kg")
+    from .riders import MAX_RIDER_MASS_KG, MIN_RIDER_MASS_KG
+    if not MIN_RIDER_MASS_KG <= values["mB"] <= MAX_RIDER_MASS_KG:   # a person's (riders.MIN_RIDER_MASS_KG says how)
+        raise InputError(f"{path}: mB = {values['mB']!r} kg is outside a rider's allowed range "
+                         f"[{MIN_RIDER_MASS_KG:g}, {MAX_RIDER_MASS_KG:g}] kg")
     inertia = np.array([[values["IBxx"], 0.0, values["IBxz"]], [0.0, values["IByy"], 0.0],
                         [values["IBxz"], 0.0, values["IBzz"]]])
     return values["mB"], np.array([values["xB"], 0.0, values["zB"]]), inertia

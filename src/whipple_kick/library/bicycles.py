@@ -188,16 +188,34 @@ def load(name):
     return _parse(path, parameters.load_toml(path))
 
 
+#: Plausible range [m] of each geometry length of a bicycle, refused outside (:func:`check_benchmark`). The measured
+#: bicycles BicycleParameters ships (its app data: Benchmark, Browser, Browserins, Crescendo, Fisher, Pista,
+#: Silver, Yellow, Yellowrev) and the project's sets (parameters/bicycles/) span w 0.985-1.121 m, c 0.042-0.190 m,
+#: rR 0.300-0.350 m, rF 0.330-0.352 m (Meijaard et al. 2007's benchmark: w 1.02, c 0.08, rR 0.3, rF 0.35 m).
+#: The bounds widen that spread by judgement, not by a survey: to a child's or a folding bicycle's small wheels and
+#: short wheelbase and a long cargo bicycle's wheelbase, and to a small negative trail (Kooijman et al. 2011,
+#: Science 332:339, built a self-stable bicycle with one), while a length given in the wrong unit (mm or cm read
+#: as m) or a trail of metres is refused (tests/library/test_bicycles.py keeps every set above inside).
+GEOMETRY_RANGES = {"w": (0.5, 2.5), "c": (-0.2, 0.5), "rR": (0.1, 0.6), "rF": (0.1, 0.6)}
+_GEOMETRY_NAMES = {"w": "wheelbase", "c": "trail", "rR": "rear wheel radius", "rF": "front wheel radius"}
+
+
 def check_benchmark(path, bench):
     """Physical sanity of a benchmark-form set; raise InputError naming the key.
 
     Masses, radii, wheelbase, g and the principal inertias must be positive;
-    the steer-axis tilt must lie in (-pi/2, pi/2) rad; each planar inertia
-    tensor [[Ixx, Ixz], [Ixz, Izz]] must be positive definite.
+    wheelbase, trail and wheel radii must lie in their plausible ranges
+    (:data:`GEOMETRY_RANGES`); the steer-axis tilt must lie in (-pi/2, pi/2)
+    rad; each planar inertia tensor [[Ixx, Ixz], [Ixz, Izz]] must be positive
+    definite.
     """
     parameters.positive(path, bench, ("w", "g", "rR", "rF", "mR", "mB", "mH", "mF",
                                       "IRxx", "IRyy", "IFxx", "IFyy", "IBxx", "IByy", "IBzz",
                                       "IHxx", "IHyy", "IHzz"), BENCHMARK_UNITS)
+    for key, (low, high) in GEOMETRY_RANGES.items():
+        if not low <= bench[key] <= high:
+            parameters.fail(path, key, f"{_GEOMETRY_NAMES[key]} {bench[key]!r} m is outside the plausible range "
+                                       f"[{low:g}, {high:g}] m of a bicycle (bicycles.GEOMETRY_RANGES)")
     if not abs(bench["lam"]) < math.pi / 2:
         parameters.fail(path, "lam", f"value {bench['lam']!r} rad is outside (-pi/2, pi/2) rad")
     for body in ("B", "H"):

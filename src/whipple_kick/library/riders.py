@@ -48,8 +48,19 @@ RIDER_DIR = parameters.shipped("riders")
 
 FORMAT = "whipple_kick rider, version 1"
 
-#: Largest rider mass accepted anywhere [kg] (a rider over 200 kg is refused).
+#: The human range of a rider's mass [kg], refused outside (one line naming the value, the range and the unit).
+#: Derived from the WHO's body-mass-index classification (WHO Technical Report Series 854, 1995, and 894, 2000:
+#: BMI < 16 kg/m^2 "severe thinness", its lowest class; BMI >= 40 kg/m^2 obese class III, its highest) at the
+#: standing heights a Yeadon rider can be scaled to here, 1.2-2.3 m (:func:`yeadon_rider`): 16 x 1.2^2 = 23.0 kg
+#: is the lightest person of the shortest height outside severe thinness; above, 200 kg (the project's bound
+#: before this one) lies below 40 x 2.3^2 = 211.6 kg. A rider outside is no person (a 3.35 kg Yeadon "rider",
+#: which a bicycle that already holds its rider would get to reach the default 635 N: give it rider "none").
+MIN_RIDER_MASS_KG = 23.0
+#: Largest rider mass accepted anywhere [kg] (see :data:`MIN_RIDER_MASS_KG`).
 MAX_RIDER_MASS_KG = 200.0
+#: The rider name of a bicycle whose parameters include its rider (:attr:`whipple_kick.Scenario.rider`): no Yeadon
+#: rider is seated and the bicycle runs with its own load share.
+NO_RIDER = "none"
 #: Largest fore-aft shift of the whole seated rider [m] a rear load share may ask for (:func:`for_load_share`).
 #: A judgement, not a measurement: a saddle's rails and setback posts move it some 0.05-0.08 m, a stem's length
 #: the bar some 0.06-0.10 m, and a rider slides about 0.05 m along the saddle; 0.15 m spans these together.
@@ -207,7 +218,7 @@ def yeadon_rider(name="jason", mass_kg=None, height_m=None):
     name : str
         Rider file in ``parameters/riders/`` (see :func:`available`).
     mass_kg : float, optional
-        Rider mass [kg], in (0, 200]; default the file's measured mass.
+        Rider mass [kg], in [23, 200] (:data:`MIN_RIDER_MASS_KG`); default the file's measured mass.
         The body's densities are scaled uniformly, so the mass is met to
         round-off and, at fixed geometry, inertia is proportional to mass.
     height_m : float, optional
@@ -234,11 +245,11 @@ def rider_from_measurements(name, measurements, configuration, source, mass_kg, 
     measurements, configuration : Mapping
         Yeadon's 95 measurements [m] and 21 joint angles [rad], by yeadon's names.
     mass_kg : float
-        Rider mass [kg], in (0, 200].
+        Rider mass [kg], in [23, 200] (:data:`MIN_RIDER_MASS_KG`).
     height_m : float, optional
         Standing height [m], in [1.2, 2.3] (see :func:`yeadon_rider`).
     """
-    mass = check_range("rider mass", mass_kg, 0.0, MAX_RIDER_MASS_KG, "kg", low_open=True)
+    mass = check_range("rider mass", mass_kg, MIN_RIDER_MASS_KG, MAX_RIDER_MASS_KG, "kg")
     meas = dict(measurements)
     scale = 1.0
     if height_m is not None:
@@ -606,10 +617,12 @@ class RearLoadSolution(NamedTuple):
 def rear_load_range(bike, rider="jason", height_m=None):
     """Static rear-tyre loads a rider can produce on ``bike``: (low, high, per_kg).
 
-    ``low`` is the bicycle's own rear load [N] (a rider of no mass, excluded),
+    ``low`` is the bicycle's own rear load [N] (a rider of no mass),
     ``high`` that with a :data:`MAX_RIDER_MASS_KG` rider [N], ``per_kg`` the
     rear load one kilogram of rider adds [N/kg] (the seated posture, hence
-    the rider's mass centre, does not depend on the mass).
+    the rider's mass centre, does not depend on the mass). The loads allowed
+    run from ``low + MIN_RIDER_MASS_KG * per_kg`` to ``high``
+    (:func:`within_rear_load_range`).
     """
     probe = yeadon_rider(rider, height_m=height_m)
     x_rider = place(bike, probe).com[0]
@@ -619,14 +632,19 @@ def rear_load_range(bike, rider="jason", height_m=None):
     return rear_bike, rear_bike + MAX_RIDER_MASS_KG * per_kg, per_kg
 
 
-def within_rear_load_range(bike, fz_n, low, high):
-    """``float(fz_n)`` if ``low < fz_n <= high`` (the :func:`rear_load_range` of ``bike``), else one-line InputError."""
+def within_rear_load_range(bike, fz_n, low, high, per_kg):
+    """``float(fz_n)`` if a rider of a human mass (:data:`MIN_RIDER_MASS_KG` to :data:`MAX_RIDER_MASS_KG`) gives it,
+    else one-line InputError; ``low, high, per_kg`` are the :func:`rear_load_range` of ``bike``."""
     fz = check_range("rear-tyre load fz", fz_n, None, None, "N")  # a finite number
-    if not low < fz <= high:
+    lightest = low + MIN_RIDER_MASS_KG * per_kg
+    if not lightest <= fz <= high:
+        # A bicycle that holds its rider already needs only a few kilograms more (the benchmark bicycle: 3.35 kg).
+        hint = (f"; the bicycle alone puts {low:.2f} N on it: if its parameters include the rider, give rider "
+                f"{NO_RIDER!r} (--rider {NO_RIDER})" if low < fz < lightest else "")
         raise InputError(f"rear-tyre load fz = {fz_n!r} N is outside the allowed range "
-                         f"({low:.2f}, {high:.2f}] N for {bike.name!r}: the bicycle alone puts "
-                         f"{low:.2f} N on its rear tyre and a {MAX_RIDER_MASS_KG:g} kg "
-                         f"rider {high:.2f} N")
+                         f"[{lightest:.2f}, {high:.2f}] N for {bike.name!r}: a {MIN_RIDER_MASS_KG:g} kg rider puts "
+                         f"{lightest:.2f} N on its rear tyre and a {MAX_RIDER_MASS_KG:g} kg rider {high:.2f} N"
+                         + hint)
     return fz
 
 
@@ -644,8 +662,8 @@ def for_rear_load(bike, fz_n, rider="jason", height_m=None, load_range=None):
         Bicycle-only set with seating geometry; its ``g`` is used (9.80665
         m/s^2 for ``balanceassist_v1``, the value of its source).
     fz_n : float
-        Required static rear-tyre normal force [N]; between the bicycle's own
-        rear load (exclusive) and that with a 200 kg rider (:func:`rear_load_range`).
+        Required static rear-tyre normal force [N]; between the loads with a
+        23 kg and a 200 kg rider (:data:`MIN_RIDER_MASS_KG`, :func:`rear_load_range`).
     rider : str
         Rider file name.
     height_m : float, optional
@@ -661,7 +679,7 @@ def for_rear_load(bike, fz_n, rider="jason", height_m=None, load_range=None):
         ``.rear_n`` give the static loads [N].
     """
     rear_bike, high, per_kg = rear_load_range(bike, rider, height_m) if load_range is None else load_range
-    fz = within_rear_load_range(bike, fz_n, rear_bike, high)
+    fz = within_rear_load_range(bike, fz_n, rear_bike, high, per_kg)
     mass = (fz - rear_bike) / per_kg
     combined = seat(bike, yeadon_rider(rider, mass_kg=mass, height_m=height_m))
     achieved = static_loads(combined)[0]
@@ -709,7 +727,7 @@ def for_load_share(bike, share, fz_n=None, rider_mass_kg=None, rider="jason", he
     ------
     InputError
         One line naming the share, the range this bicycle and load allow, and why: a rider mass in
-        (0, :data:`MAX_RIDER_MASS_KG`] kg, a shift within +-:data:`MAX_RIDER_SHIFT_M` m, the rider's mass
+        [:data:`MIN_RIDER_MASS_KG`, :data:`MAX_RIDER_MASS_KG`] kg, a shift within +-:data:`MAX_RIDER_SHIFT_M` m, the rider's mass
         centre inside the wheelbase.
     """
     share_in = share
@@ -726,10 +744,11 @@ def for_load_share(bike, share, fz_n=None, rider_mass_kg=None, rider="jason", he
         mass = fz / (share * g) - m_bike
         what = f"rear load fz = {fz:g} N"
     else:
-        mass = check_range("rider mass", rider_mass_kg, 0.0, MAX_RIDER_MASS_KG, "kg", low_open=True)
+        mass = check_range("rider mass", rider_mass_kg, MIN_RIDER_MASS_KG, MAX_RIDER_MASS_KG, "kg")
         fz = share * g * (m_bike + mass)
         what = f"rider mass {mass:g} kg"
-    x_seated = place(bike, yeadon_rider(rider, mass_kg=mass if 0.0 < mass <= MAX_RIDER_MASS_KG else 70.0,
+    human = MIN_RIDER_MASS_KG <= mass <= MAX_RIDER_MASS_KG
+    x_seated = place(bike, yeadon_rider(rider, mass_kg=mass if human else 70.0,
                                         height_m=height_m)).com[0]
     # The shifts allowed: within +-MAX_RIDER_SHIFT_M and the rider's mass centre inside the wheelbase.
     lo_dx, hi_dx = max(-MAX_RIDER_SHIFT_M, -x_seated), min(MAX_RIDER_SHIFT_M, w - x_seated)
@@ -743,15 +762,16 @@ def for_load_share(bike, share, fz_n=None, rider_mass_kg=None, rider="jason", he
             return (fz - rear_bike) / (g * (1.0 - (x_seated + dx) / w))
         low, high = share_at(hi_dx, mass_at(hi_dx)), share_at(lo_dx, mass_at(lo_dx))
         low = max(low, fz / (g * (m_bike + MAX_RIDER_MASS_KG)))
+        high = min(high, fz / (g * (m_bike + MIN_RIDER_MASS_KG)))
         seated_share = share_at(0.0, mass_at(0.0))
     else:
         low, high = share_at(hi_dx, mass), share_at(lo_dx, mass)
         seated_share = share_at(0.0, mass)
     x_rider = w * (1.0 - (fz - rear_bike) / (g * mass)) if mass > 0.0 else math.nan
     shift = x_rider - x_seated
-    if not (0.0 < mass <= MAX_RIDER_MASS_KG and lo_dx <= shift <= hi_dx):
+    if not (human and lo_dx <= shift <= hi_dx):
         raise InputError(f"rear load share = {share_in!r} (unit 1) is outside the allowed range "
-                         f"[{low:.4f}, {high:.4f}] for {what} on {bike.name!r}: the rider (at most "
+                         f"[{low:.4f}, {high:.4f}] for {what} on {bike.name!r}: the rider ({MIN_RIDER_MASS_KG:g}-"
                          f"{MAX_RIDER_MASS_KG:g} kg) moves at most {MAX_RIDER_SHIFT_M:g} m fore or aft of the "
                          f"seated posture, its mass centre inside the wheelbase; the seated share is "
                          f"{seated_share:.4f}")

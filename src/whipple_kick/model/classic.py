@@ -15,6 +15,7 @@ Linearisation is by complex-step differentiation of the nonlinear equations
 re-solution of the pitch angle from the holonomic constraint.
 """
 import functools
+import math
 
 import numpy as np
 from scipy.optimize import brentq
@@ -279,9 +280,10 @@ def _weave_real_part(moore, v):
 
 
 def _capsize_eigenvalue(moore, v):
+    """Largest real eigenvalue at ``v`` [1/s]; NaN where all four are complex (two oscillating pairs)."""
     ev = np.linalg.eigvals(linear_state_space(moore, v)[0])
     real = sorted(e.real for e in ev if abs(e.imag) <= 1e-9)
-    return max(real)
+    return max(real) if real else math.nan
 
 
 def weave_speed(moore, bracket=(2.0, 5.5), xtol=1e-13):
@@ -289,8 +291,47 @@ def weave_speed(moore, bracket=(2.0, 5.5), xtol=1e-13):
     return brentq(lambda v: _weave_real_part(moore, v), *bracket, xtol=xtol)
 
 
-def capsize_speed(moore, bracket=(5.0, 7.0), xtol=1e-13):
-    """Speed at which the capsize eigenvalue crosses into the right half plane [m/s]."""
+#: Speeds [m/s] :func:`capsize_speed` scans for its bracket, and its step: the bicycles BicycleParameters ships
+#: capsize between 4.28 m/s (Browserins) and 7.87 m/s (Silver), the benchmark at 6.024 m/s; above 30 m/s is no
+#: bicycle's. A step of 0.1 m/s is far below the speed over which the capsize eigenvalue changes sign.
+CAPSIZE_SCAN = (0.1, 30.0, 0.1)
+
+
+def capsize_speed(moore, bracket=None, xtol=1e-13):
+    """Speed at which the capsize eigenvalue crosses into the right half plane [m/s].
+
+    Parameters
+    ----------
+    moore : mapping
+        Moore parameters by name (or a :class:`~whipple_kick.library.bicycles.Bicycle`).
+    bracket : (float, float), optional
+        Speeds [m/s] the crossing lies between. Default: found by scanning
+        the eigenvalues upward over :data:`CAPSIZE_SCAN` for the first step
+        at which the largest real eigenvalue goes from negative to positive
+        (below the weave's merging speed the largest real eigenvalue is the
+        unstable inverted-pendulum pair's, positive, and in between all four
+        may be complex: neither is the capsize crossing).
+    xtol : float
+        Tolerance of the root [m/s].
+
+    Raises
+    ------
+    ValueError
+        No crossing within the scanned speeds (one line naming them).
+    """
+    if bracket is None:
+        low, high, step = CAPSIZE_SCAN
+        speeds = np.arange(low, high + 0.5 * step, step)
+        previous = (speeds[0], _capsize_eigenvalue(moore, speeds[0]))
+        for v in speeds[1:]:
+            value = _capsize_eigenvalue(moore, v)
+            if previous[1] < 0.0 < value:
+                bracket = (previous[0], v)
+                break
+            previous = (v, value)
+        else:
+            raise ValueError(f"no capsize speed in [{low:g}, {high:g}] m/s: the largest real eigenvalue does "
+                             "not cross from negative to positive there")
     return brentq(lambda v: _capsize_eigenvalue(moore, v), *bracket, xtol=xtol)
 
 

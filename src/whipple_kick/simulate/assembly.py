@@ -120,6 +120,7 @@ def assemble(scenario, kick, *, tyres=None, gains=None) -> Assembly:
     if tyres is None:
         rear, front, notes = build_tyres(scenario.tyre_spec)
     else:
+        _refuse_tyre_fields(scenario)
         rear, front = tyres
         notes = [f"custom tyre objects (the scenario's tyre and pressures are not used): "
                  f"rear {rear!r}, front {front!r}"]
@@ -146,6 +147,22 @@ def assemble(scenario, kick, *, tyres=None, gains=None) -> Assembly:
                          f"{steady_yaw_rate:.3g} rad/s (allowed |yaw rate| <= {STRAIGHT_YAW_RATE:g} rad/s): "
                          "use tyres without zero-slip offsets (the flag --symmetric-tyres; symmetric_tyres=True in Python)")
     return Assembly(rear, front, notes, moore, info, gains, poles, controller, start.params, found, start, stability)
+
+
+#: Scenario fields the tyre objects of ``run(scenario, tyres=...)`` replace (what :func:`build_tyres` reads).
+CUSTOM_TYRE_FIELDS = ("tyre", "pressure_kpa", "pressure_front_kpa", "pressure_rear_kpa", "coefficient_set", "friction")
+
+
+def _refuse_tyre_fields(scenario):
+    """Tyre objects given replace the scenario's tyre, pressures, coefficient set and friction: one given as well
+    would be ignored (a note in the summary is lost in a sweep), so it is refused, naming each such field."""
+    given = [f for f in CUSTOM_TYRE_FIELDS if getattr(scenario, f) != DEFAULTS[f]]
+    if given:
+        raise InputError("tyres=(rear, front) replace the scenario's tyre fields, so "
+                         + ", ".join(f"{f} = {getattr(scenario, f)!r}" for f in given)
+                         + " would be ignored: leave " + ("it" if len(given) == 1 else "them") + " at the default ("
+                         + ", ".join(f"{f} = {DEFAULTS[f]!r}" for f in given) + ") or load the tyres with "
+                         "those options (whipple_kick.library.tyres.load)")
 
 
 # ------------------------------------------------------------------ the parts
@@ -203,7 +220,7 @@ def _bicycle_setup(spec, _stamp):
     from whipple_kick.library import bicycleparameters, riders
     from whipple_kick.model import benchmark
 
-    bike = bicycleparameters.load_bicycle(spec.bicycle)
+    bike = bicycleparameters.load_bicycle(spec.bicycle, spec.rider)
     if spec.split and bike.includes_rider:
         raise _lumped_rider_error(bike)
     _refuse_rider_file(bike, spec.rider)
@@ -267,12 +284,13 @@ def _refuse_load_on_preset(bike, fz_n, rider_mass_kg, share):
 
 def _refuse_rider_file(bike, rider_name):
     """A preset with its rider lumped in seats no Yeadon rider: a rider file given with it would be ignored."""
+    from whipple_kick.library import riders
     from whipple_kick.simulate.scenario import Scenario
 
     default = Scenario.__dataclass_fields__["rider"].default
-    if bike.includes_rider and rider_name != default:
+    if bike.includes_rider and rider_name not in (default, riders.NO_RIDER):
         raise InputError(f"bicycle {bike.name!r} already includes its rider; rider {rider_name!r} would be ignored: "
-                         f"leave it at its default {default!r} or choose a bicycle-only set")
+                         f"leave it at its default {default!r} (or {riders.NO_RIDER!r}) or choose a bicycle-only set")
 
 
 def no_slip_plant(moore, design, info):
@@ -375,7 +393,7 @@ def thesis_load(spec):
         return spec.thesis_load_n
     if spec.fz_n is not None:
         return spec.fz_n
-    bike = bicycleparameters.load_bicycle(spec.bicycle)
+    bike = bicycleparameters.load_bicycle(spec.bicycle, spec.rider)
     if bike.includes_rider and bike.thesis_rear_load_n is not None:
         return bike.thesis_rear_load_n
     if spec.rider_mass_kg is None and not bike.includes_rider:
@@ -394,7 +412,7 @@ def thesis_gains_warning(spec):
 
     if spec.controller != "thesis":
         return None
-    bike = bicycleparameters.load_bicycle(spec.bicycle)
+    bike = bicycleparameters.load_bicycle(spec.bicycle, spec.rider)
     own, what = ((bike.thesis_rear_load_n, f"bicycle {bike.name!r} is labelled") if bike.includes_rider
                  else (spec.fz_n, "the rider is seated for"))
     gains = thesis_load(spec)
@@ -437,7 +455,7 @@ def preflight(scenario):
 
     scenario.validate()
     build_tyres(scenario.tyre_spec)
-    bike = bicycleparameters.load_bicycle(scenario.bicycle)
+    bike = bicycleparameters.load_bicycle(scenario.bicycle, scenario.rider)
     if bike.includes_rider:
         _refuse_load_on_preset(bike, scenario.fz_n, scenario.rider_mass_kg, scenario.rear_load_share)
     if bike.includes_rider and (scenario.rider_body != "rigid" or scenario.arms == "on"):

@@ -323,6 +323,8 @@ def check_trajectory(frame, summary, scenario, path):
     where = f"{str(path)!r}"
     if "time" not in frame:
         raise InputError(f"{where} has no time column ('time [s]'): not a trajectory of simulate")
+    if frame.empty:   # the header alone (a copy cut after its first line): every column reads as text
+        raise InputError(f"{where} is empty: it has the header but no rows (a truncated or damaged file)")
     if not all(str(t).startswith(("float", "int")) for t in frame.dtypes):
         bad = next(c for c, t in frame.dtypes.items() if not str(t).startswith(("float", "int")))
         raise InputError(f"{where}: column {bad!r} holds a value that is not a number (a damaged file)")
@@ -570,7 +572,7 @@ def summarise(scenario, kick, assembly, solution, frame, *, custom_tyres=False) 
         "fall_reason": traj.fall_reason,
         "end_time_s": float(frame["time"].iloc[-1]),
         "message": traj.message,
-        "bicycle": assembly.bicycle,
+        "bicycle": _bicycle_section(assembly, start_outputs),
         "tyres": {**_tyres_section(scenario, assembly, custom_tyres),
                   "carcass": _carcass_section(scenario, assembly, start_outputs),
                   "extrapolation": extrapolation(frame, assembly.rear, assembly.front)},
@@ -589,6 +591,22 @@ def summarise(scenario, kick, assembly, solution, frame, *, custom_tyres=False) 
         "provenance": provenance.record(provenance.input_files(scenario, custom_tyres)),
     }
     return clean(summary)
+
+
+#: What the bicycle section's two kinds of load are (summary.json says it beside them; docs/simulate.md).
+LOADS_ARE = ("static_load_* and rear_load_share: rigid-contact statics of the upright bicycle with its rider, no tyre "
+             "compression (what the rider is sized for: fz_n, rear_load_share); steady_load_* and "
+             "steady_rear_load_share: the tyres' normal forces in the steady motion the run starts from (tyres "
+             "compressed, frame pitched, a steady turn's lean)")
+
+
+def _bicycle_section(assembly, start_outputs):
+    """The bicycle with its rider (:func:`~whipple_kick.simulate.assembly.build_bicycle`'s info) and the run's steady
+    normal loads beside its static ones, each named for which it is (:data:`LOADS_ARE`)."""
+    _, out = start_outputs
+    rear, front = float(out[slip.OUT["fz_r"]]), float(out[slip.OUT["fz_f"]])
+    return {**assembly.bicycle, "steady_load_rear_n": rear, "steady_load_front_n": front,
+            "steady_rear_load_share": rear / (rear + front), "loads_are": LOADS_ARE}
 
 
 def _tyres_section(scenario, assembly, custom_tyres):

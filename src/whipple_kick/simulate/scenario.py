@@ -126,7 +126,14 @@ class Scenario:
         load follows; either way the whole rider is moved fore-aft along the bicycle's x axis (posture
         kept, at most 0.15 m) so that the static loads hold (:func:`whipple_kick.library.riders.for_load_share`).
     rider : str
-        Yeadon rider file.
+        Yeadon rider file seated on a bicycle-only set, or ``"none"``
+        (:data:`whipple_kick.library.riders.NO_RIDER`): the bicycle's
+        parameters include its rider (a BicycleParameters ``Benchmark.txt``
+        whose rear frame holds the rider, as the Meijaard benchmark's mB = 85
+        kg: BicycleParameters cannot say so), so no rider is seated and the
+        bicycle runs as it is, with its own load share; ``fz_n``,
+        ``rider_mass_kg`` and ``rear_load_share`` must then be None. A
+        bicycle-only set with ``"none"`` is refused.
     tyre : str
         Tyre on both wheels (default T03, the kick-plate bicycle's tyre).
     pressure_kpa : float
@@ -851,7 +858,7 @@ class BicycleSpec:
     rear_load_share : float or None
         Fraction of the static weight on the rear tyre [1].
     rider : str
-        Yeadon rider file.
+        Yeadon rider file, or "none" (the bicycle includes its rider).
     low_inertia : bool
         Halve the rear frame's inertias and mass-centre height (thesis Figure 8.9).
     rider_body : {"rigid", "leaning"}
@@ -951,6 +958,8 @@ class GainsSpec:
         The rear load [N] or rider mass [kg] the rider is seated for (the row's default).
     bicycle : str
         Bicycle parameter set or path (a preset with rider is labelled with its load).
+    rider : str
+        Yeadon rider file, or "none" (the bicycle includes its rider).
     """
 
     controller: str
@@ -960,6 +969,7 @@ class GainsSpec:
     fz_n: float | None
     rider_mass_kg: float | None
     bicycle: str
+    rider: str
 
 
 @dataclass(frozen=True)

@@ -38,7 +38,10 @@ def run(scenario: Scenario, *, tyres: tuple | None = None, gains: Mapping | None
     tyres : (rear, front), optional
         Tyre objects to use instead of the scenario's tyre and pressures,
         e.g. :func:`whipple_kick.library.tyres.linear_tyre` or a :class:`~whipple_kick.library.tyres.Tyre`
-        loaded with other options. The summary names them.
+        loaded with other options. The summary names them. They replace the
+        scenario's ``tyre``, pressures, ``coefficient_set`` and ``friction``,
+        which must then stay at their defaults (one given is refused, not
+        ignored).
     gains : mapping, optional
         Steer-torque gains by name (``kq4 kq7 ku4 ku7``, the yaw gains
         ``kq3 ku3`` and, for a leaning rider, the upper body's lean gains

@@ -9,7 +9,7 @@ import json
 import os
 import shutil
 
-from whipple_kick.errors import InputError
+from whipple_kick.errors import CompilerNotFoundError
 from whipple_kick.model import cache, rhs_call
 import whipple_kick.model.slip.layout as layouts  # the module by its full name, not through the package
 
@@ -17,16 +17,18 @@ from .layout import _SOURCES
 
 
 def _compiler():
-    """Path of the C compiler: $CC if set (must exist), else cc, gcc or clang on PATH."""
+    """Path of the C compiler: $CC if set (must exist), else cc, gcc or clang on PATH (else CompilerNotFoundError)."""
     requested = os.environ.get("CC")
     if requested:
         cc = shutil.which(requested)
         if not cc:
-            raise InputError(f"CC={requested!r} is not an executable C compiler; install gcc or fix CC")
+            raise CompilerNotFoundError(f"CC={requested!r} is not an executable C compiler: install a C compiler "
+                                        "(e.g. gcc) or set CC to one")
         return cc
     cc = shutil.which("cc") or shutil.which("gcc") or shutil.which("clang")
     if not cc:
-        raise InputError("no C compiler found (looked for cc, gcc, clang on PATH): install gcc or set CC")
+        raise CompilerNotFoundError("no C compiler found (looked for cc, gcc, clang on PATH): install a C compiler "
+                                    "(e.g. gcc) or set CC to one")
     return cc
 
 
@@ -62,7 +64,7 @@ def library_path(L=layouts.BASE):
     generated from, the parts' declarations and build code, the SymPy
     version, the compiler and its flags. A miss runs
     :func:`whipple_kick.model.symbolic.slip_build.build_library` (SymPy,
-    20-30 s, one line on stderr). An entry whose metadata is missing or
+    20-60 s, announced by a :class:`~whipple_kick.errors.PerformanceWarning`). An entry whose metadata is missing or
     records other layouts (states, parameters, outputs) is built again.
     """
     cc = _compiler()

@@ -23,13 +23,14 @@ import functools
 import json
 import subprocess
 import sys
+import warnings
 
 import numpy as np
 import sympy as sm
 from sympy.printing.c import C99CodePrinter
 
 from whipple_kick import fileio
-from whipple_kick.errors import BuildError
+from whipple_kick.errors import BuildError, PerformanceWarning
 from whipple_kick.model import cache, carcass, energy, kane, magic_formula, reflex, transient
 from whipple_kick.model import symbols as S
 import whipple_kick.model.slip.layout as layouts  # the module by its full name, not through the package
@@ -884,8 +885,9 @@ def metadata(key, compiler, flags, L=layouts.BASE):
 def build_library(path, key, compiler, flags, part_names=(), delayed_reflex=False):
     """Generate, compile and describe the slip model: the library at ``path``, source and metadata beside it.
 
-    Prints one line on stderr first: the build takes 20-30 s on a fresh
-    machine (``scripts/bench.py build``) and happens once per version.
+    Says so first in a :class:`~whipple_kick.errors.PerformanceWarning` (the commands print it as one line): the
+    build happens once per version and takes some 20-60 s, by machine and load (README.md gives the
+    measurements and their machines).
 
     Parameters
     ----------
@@ -909,8 +911,8 @@ def build_library(path, key, compiler, flags, part_names=(), delayed_reflex=Fals
         The compiler failed (one line; its full output saved beside the source).
     """
     what = " with " + ", ".join(part_names + ("the reflex delay",) * delayed_reflex) if part_names or delayed_reflex else ""
-    print(f"whipple_kick: building the slip model{what} once for this version (SymPy derivation, C code "
-          "generation and compilation; about 20-30 s)...", file=sys.stderr, flush=True)
+    warnings.warn(f"building the slip model{what} once for this version (SymPy derivation, C code "
+                  "generation and compilation; 20-60 s)...", PerformanceWarning, stacklevel=2)
     folder = cache.cache_dir()
     src_path = folder / f"slip_{key}.c"
     fileio.write_atomic(src_path, c_source(part_names, delayed_reflex), private=True)   # kept next to the library for inspection
