@@ -542,7 +542,7 @@ def test_sigterm_ends_the_sweeps_workers_and_records_interrupted(tmp_path):
     finally:
         proc.kill()
     assert proc.returncode == cli.EXIT_TERMINATED == 143
-    assert stderr.startswith("recommend-pressure: terminated (SIGTERM); finished cases are kept") \
+    assert stderr.startswith("recommend-pressure: terminated (SIGTERM); the finished cases are kept in ") \
         and stderr.count("\n") == 1, stderr
     manifest = json.loads((folder / "manifest.json").read_text())
     assert manifest["status"] == "interrupted" and manifest["n_done"] < manifest["n_cases"] == 201
