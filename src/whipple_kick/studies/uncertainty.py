@@ -53,15 +53,15 @@ import math
 import numpy as np
 
 from whipple_kick.errors import InputError, check_range
-from whipple_kick.library import uncertain
+from whipple_kick.library import thesis, uncertain
 from whipple_kick.simulate.scenario import MECHANISM_FIELDS, Scenario
 
 from .recommend import _num, pressure_grid
 from .sweep_engine import check_some_ok, make_cases, sweep
 
-#: Thesis Chapter 8's pressures [kPa] and rear loads [N] (Tables 8.6-8.8).
-PRESSURES = (300.0, 400.0, 500.0)
-LOADS = (570.0, 635.0, 701.0)
+#: Thesis Chapter 8's pressures [kPa] and rear loads [N] (:mod:`whipple_kick.library.thesis`).
+PRESSURES = thesis.PRESSURES_KPA
+LOADS = thesis.LOADS_N
 #: The two recovery criteria and their table columns (as :data:`whipple_kick.studies.recommend.CRITERIA`).
 CRITERIA = {"settling": "recovery.time_s", "last_peak": "last_peak_time_s"}
 #: Bootstrap resamples of the paired differences' intervals.
