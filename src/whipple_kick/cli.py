@@ -17,6 +17,8 @@ import sys
 
 import numpy as np
 
+from whipple_kick.simulate.criteria import CRITERIA
+
 from . import fileio
 from .errors import BuildError, CacheError, InputError, SimulationError, Terminated, terminate_raises
 
@@ -795,7 +797,7 @@ def _recommend(argv):
         import pandas as pd
 
         from whipple_kick.figures import plotting
-        metric = recommend.CRITERIA[recommend.criterion_key(args.criterion)][0]
+        metric = recommend.CRITERIA[recommend.criterion_key(args.criterion)].column
         for (direction, form), by_load in recs.items():
             name = SWEEP_FIGURE if len(variants) == 1 else SWEEP_FIGURE.replace(".png", f"_{direction}_{form}.png")
             plotting.sweep_figure(pd.concat([rec.table.assign(fz_n=rec.fz_n) for rec in by_load], ignore_index=True),
@@ -809,8 +811,8 @@ def _recommend(argv):
 #: The figure ``recommend-pressure --out`` writes into its sweep folder.
 SWEEP_FIGURE = "recommendation.png"
 #: The figures ``recommend-pressure --uncertain --out DIR`` writes into DIR.
-UNCERTAINTY_FIGURES = ("p_best.png", "recovery_settling.png", "recovery_last_peak.png", "sobol_settling.png",
-                       "sobol_last_peak.png")
+UNCERTAINTY_FIGURES = ("p_best.png", *(f"recovery_{key}.png" for key in CRITERIA),
+                       *(f"sobol_{key}.png" for key in CRITERIA))
 
 
 def _recommend_uncertain(args):
@@ -845,10 +847,9 @@ def _recommend_uncertain(args):
         study_pair = _verdict_pair(study, criterion)
         figures.p_best_figure(study.p_best, out / UNCERTAINTY_FIGURES[0],
                               title=f"P(best), N = {samples} ({len(study.inputs)} rows), 95 % intervals")
-        for name, crit in zip(UNCERTAINTY_FIGURES[1:3], uncertainty.CRITERIA, strict=True):
-            figures.distribution_figure(study.outcomes, crit, out / name)
-        for name, crit in zip(UNCERTAINTY_FIGURES[3:], uncertainty.CRITERIA, strict=True):
-            figures.sobol_figure(study.sobol, crit, study_pair, out / name)
+        for crit in uncertainty.CRITERIA:
+            figures.distribution_figure(study.outcomes, crit, out / f"recovery_{crit}.png")
+            figures.sobol_figure(study.sobol, crit, study_pair, out / f"sobol_{crit}.png")
         print(f"\nwrote the tables (CSV), verdict.txt and {', '.join(UNCERTAINTY_FIGURES)} into {out} "
               f"(the runs in {out / 'runs'}: run again to resume)")
     return 0
