@@ -236,20 +236,32 @@ def _scenario_flags(p, command, scenario_class=None, **context):
             if s.exclusive not in exclusive:
                 exclusive[s.exclusive] = group.add_mutually_exclusive_group()
             group = exclusive[s.exclusive]
-        text = s.help.format(default=_Shown(s.default), none_means=_Shown(s.none_means), **context)
-        options = dict(dest=s.name, default=None, help=text.replace("%", "%%"))
-        kinds = (s.type, *getattr(s.type, "__args__", ()))
-        unit = s.unit.strip("()")
-        if bool in kinds:
-            options.update(action="store_true")
-        elif s.choices:
-            options.update(choices=s.choices)
-        elif float in kinds:
-            options.update(type=_number(unit), metavar=s.metavar or _metavar(unit))
-        else:
-            options.update(metavar=s.metavar or None)
-        group.add_argument(s.option, **options)
+        _field_flag(group, s, help=s.help.format(default=_Shown(s.default), none_means=_Shown(s.none_means),
+                                                 **context))
     return sections
+
+
+def _field_flag(group, s, **overrides):
+    """Add field ``s``'s flag (a :class:`~whipple_kick.simulate.settings.Setting`) to ``group``.
+
+    Its name, destination, choices or number type in the declared unit and its metavar come from the
+    declaration; ``overrides`` are argparse's keywords a command sets itself (``help``, a ``default`` of its
+    own, fewer ``choices``). Without a ``default`` the flag's value is None when it is not given.
+    """
+    options = dict(dest=s.name, default=None)
+    kinds = (s.type, *getattr(s.type, "__args__", ()))
+    unit = s.unit.strip("()")
+    if bool in kinds:
+        options.update(action="store_true")
+    elif s.choices:
+        options.update(choices=s.choices)
+    elif float in kinds:
+        options.update(type=_number(unit), metavar=s.metavar or _metavar(unit))
+    else:
+        options.update(metavar=s.metavar or None)
+    options.update(overrides)
+    options["help"] = options.get("help", "").replace("%", "%%")
+    group.add_argument(s.option, **options)
 
 
 def _scenario_fields(args, command, scenario_class=None):
@@ -1000,6 +1012,7 @@ _VALIDATE_FILES = ("validation.csv", "summary.json", "validation.png")
 
 def _validate_parser():
     from whipple_kick.library import thesis, tyres
+    from whipple_kick.simulate.scenario import SETTINGS
     from whipple_kick.studies import validation
     p = _OneLineParser(
         prog="validate", allow_abbrev=False,
@@ -1015,15 +1028,16 @@ def _validate_parser():
                "--fz). See docs/experiments.md.")
     g = _scenario_flags(p, "validate", tyres=", ".join(t[0] for t in tyres.available()),
                         design_default="the run's --speed")["riding and control"]
-    g.add_argument("--speed", type=_number("m/s"), default=validation.SPEED, metavar="M/S",
-                   help=f"forward speed in m/s (default {validation.SPEED:g}, the measured 1.92-2 m/s)")
+    # The experiments' own speed, kick, duration and tolerance: the fields' flags with validate's defaults.
+    _field_flag(g, SETTINGS["speed"], default=validation.SPEED,
+                help=f"forward speed in m/s (default {validation.SPEED:g}, the measured 1.92-2 m/s)")
     g = p.add_argument_group("kick")
-    g.add_argument("--kick-accel", type=_number("m/s^2"), default=validation.KICK_ACCEL, metavar="M/S2",
-                   help=f"peak plate acceleration in m/s^2 (default {validation.KICK_ACCEL:g}, measured 30-35)")
-    g.add_argument("--kick-displacement", type=_number("m"), default=validation.KICK_DISPLACEMENT, metavar="M",
-                   help=f"plate travel in m (default {validation.KICK_DISPLACEMENT:g})")
-    g.add_argument("--kick-profile", choices=("smooth", "constant"), default="smooth",
-                   help="smooth (default: minimum jerk) or constant acceleration (the thesis' simulations)")
+    _field_flag(g, SETTINGS["kick_accel"], default=validation.KICK_ACCEL,
+                help=f"peak plate acceleration in m/s^2 (default {validation.KICK_ACCEL:g}, measured 30-35)")
+    _field_flag(g, SETTINGS["kick_displacement"], default=validation.KICK_DISPLACEMENT,
+                help=f"plate travel in m (default {validation.KICK_DISPLACEMENT:g})")
+    _field_flag(g, SETTINGS["kick_profile"], choices=("smooth", "constant"), default="smooth",
+                help="smooth (default: minimum jerk) or constant acceleration (the thesis' simulations)")
     g.add_argument("--directions", nargs="+", choices=validation.DIRECTIONS, default=list(validation.DIRECTIONS),
                    help="kick directions to run (default both: the thesis does not give one)")
     g = p.add_argument_group("comparison and output")
@@ -1033,10 +1047,10 @@ def _validate_parser():
     g.add_argument("--compare-transients", action="store_true",
                    help="also run every tyre transient form and say whether the best pressure depends on it "
                         "(summary.json by_tyre_transient; 3x the runs)")
-    g.add_argument("--duration", type=_number("s"), default=validation.DURATION, metavar="S",
-                   help=f"simulated time after the kick in s (default {validation.DURATION:g})")
-    g.add_argument("--rtol", type=_number("relative"), default=1e-10, metavar="RTOL",
-                   help="LSODA relative tolerance (default 1e-10)")
+    _field_flag(g, SETTINGS["duration"], default=validation.DURATION,
+                help=f"simulated time after the kick in s (default {validation.DURATION:g})")
+    _field_flag(g, SETTINGS["rtol"], default=SETTINGS["rtol"].default,
+                help=f"LSODA relative tolerance (default {SETTINGS['rtol'].default:g})")
     g.add_argument("--workers", type=int, metavar="N", help="worker processes (default: one per CPU core)")
     _output_options(g, "validation.png")
     return p

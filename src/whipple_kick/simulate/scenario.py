@@ -668,7 +668,8 @@ class Scenario:
 
     def view(self, name):
         """The frozen view ``name`` (a key of :data:`VIEWS`): the fields declared with it, as the step reads them."""
-        return view_class(type(self), name)(**{f.name: getattr(self, f.name) for f in fields(view_class(type(self), name))})
+        view = view_class(type(self), name)
+        return view(**{f.name: getattr(self, f.name) for f in fields(view)})
 
     def validate(self) -> "Scenario":
         """Check every field; raise :class:`InputError` naming value, range and unit. Returns ``self``.
