@@ -215,7 +215,7 @@ def view_class(cls, name, class_name, base, derived=()):
     (a property) in place of the fields it comes from, at the first one's place.
     """
     replaced = {f: attr for attr, sources in derived for f in sources}
-    members, seen = [], set()
+    members, lines, seen = [], [], set()
     for s in settings(cls).values():
         if name not in s.views:
             continue
@@ -223,9 +223,15 @@ def view_class(cls, name, class_name, base, derived=()):
         if member in seen:
             continue
         seen.add(member)
-        kind = getattr(cls, member).fget.__annotations__.get("return", object) if member != s.name else s.type
+        if member == s.name:
+            kind, doc = s.type, s.doc
+        else:   # a derived attribute: the Scenario's property
+            prop = getattr(cls, member)
+            kind, doc = prop.fget.__annotations__.get("return", object), prop.__doc__ or ""
         members.append((member, kind))
-    lines = "".join(f"    {m} : {getattr(k, '__name__', k)}\n" for m, k in members)
+        first = doc.split(". ")[0].split("\n")[0].rstrip(".")
+        lines.append(f"    {member} : {getattr(kind, '__name__', kind)}\n        {first}.\n")
+    lines = "".join(lines)
     return make_dataclass(class_name, members, bases=(base,), frozen=True, namespace={
         "__doc__": (base.__doc__ or "").rstrip() + "\n\n    Attributes\n    ----------\n" + lines,
         "__module__": base.__module__})
