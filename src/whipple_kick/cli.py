@@ -716,6 +716,7 @@ def simulate_main(argv=None):
 
 def _recommend(argv):
     from whipple_kick.library import thesis, tyres
+    from whipple_kick.simulate.scenario import DEFAULTS
     from whipple_kick.studies import recommend
     p = _OneLineParser(
         prog="recommend-pressure",
@@ -730,8 +731,8 @@ def _recommend(argv):
                "--tyre-transient all say whether the answer depends on them. See docs/sweeps.md.")
     p.add_argument("--fz", type=_number("N"), nargs="+", required=True, metavar="N",
                    help=f"static rear-tyre load(s) in N, e.g. --fz {thesis.loads_text(' ')}")
-    p.add_argument("--tyre", default="T03", metavar="NAME",
-                   help="tyre on both wheels (default T03; available: %s)"
+    p.add_argument("--tyre", default=DEFAULTS["tyre"], metavar="NAME",
+                   help=f"tyre on both wheels (default {DEFAULTS['tyre']}; available: %s)"
                         % ", ".join(t[0] for t in tyres.available()))
     p.add_argument("--pressures", type=_number("kPa"), nargs="+", metavar="KPA",
                    help="pressures to try in kPa (default: the tyre's measured ones)")
@@ -744,7 +745,7 @@ def _recommend(argv):
                         "of their first peaks; last-peak: the thesis' rule, time of the last yaw-rate peak "
                         "above 8 %% of the largest")
     p.add_argument("--duration", type=_number("s"), metavar="S",
-                   help="simulated time after the kick in s (default 6)")
+                   help=f"simulated time after the kick in s (default {DEFAULTS['duration']:g})")
     p.add_argument("--workers", type=int, metavar="N",
                    help="worker processes (default: one per CPU core)")
     p.add_argument("--out", metavar="DIR",
@@ -753,8 +754,8 @@ def _recommend(argv):
                    help="with --out: add these runs to a folder that holds another sweep")
     from whipple_kick.library.inputs import DIRECTIONS
     from whipple_kick.simulate.scenario import TYRE_TRANSIENTS, Scenario
-    p.add_argument("--kick-direction", choices=(*DIRECTIONS, "both"), default="right",
-                   help="direction the plate moves (default right); both: run each direction and say whether "
+    p.add_argument("--kick-direction", choices=(*DIRECTIONS, "both"), default=DEFAULTS["kick_direction"],
+                   help=f"direction the plate moves (default {DEFAULTS['kick_direction']}); both: run each direction and say whether "
                         "the best pressure depends on it (twice the runs)")
     p.add_argument("--tyre-transient", choices=(*TYRE_TRANSIENTS, "all"), default=Scenario.tyre_transient,
                    help=f"tyre transient form (default {Scenario.tyre_transient}); all: run each form and say "
@@ -777,7 +778,7 @@ def _recommend(argv):
         return _recommend_uncertain(args)
     if args.samples is not None or args.seed is not None:
         raise InputError("--samples and --seed belong to the uncertainty study: add --uncertain [FILE]")
-    args.duration = 6.0 if args.duration is None else args.duration
+    args.duration = DEFAULTS["duration"] if args.duration is None else args.duration
     directions = DIRECTIONS if args.kick_direction == "both" else (args.kick_direction,)
     forms = TYRE_TRANSIENTS if args.tyre_transient == "all" else (args.tyre_transient,)
     variants = {(d, f): Scenario(duration=args.duration, kick_direction=d, tyre_transient=f).validate()
@@ -832,11 +833,11 @@ def _recommend_uncertain(args):
     import pathlib
 
     from whipple_kick.figures import uncertainty as figures
-    from whipple_kick.simulate.scenario import Scenario
+    from whipple_kick.simulate.scenario import DEFAULTS, Scenario
     from whipple_kick.studies import recommend, uncertainty
     given = [flag for flag, value in (("--fine", args.fine), ("--extend", args.extend),
                                       ("--duration", args.duration is not None),
-                                      ("--kick-direction", args.kick_direction != "right"),
+                                      ("--kick-direction", args.kick_direction != DEFAULTS["kick_direction"]),
                                       ("--tyre-transient", args.tyre_transient != Scenario.tyre_transient))
              if value]
     if given:
