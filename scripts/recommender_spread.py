@@ -111,7 +111,7 @@ def measure():
 
     spread = {}
     for criterion in VALUES:
-        print(f"## {criterion}: {wk.recommend._CRITERION_TEXT[criterion]}\n")
+        print(f"## {criterion}: {wk.recommend.CRITERIA[criterion].text}\n")
         print("| rear load | " + " | ".join(f"{p:g} kPa [s]" for p in PRESSURES) + " | best | margin [s] |")
         print("|---|" + "---|" * (len(PRESSURES) + 2))
         margins = {}

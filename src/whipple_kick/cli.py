@@ -17,7 +17,7 @@ import sys
 
 import numpy as np
 
-from whipple_kick.model import parts
+from whipple_kick.simulate.criteria import CRITERIA
 
 from . import fileio
 from .errors import (
@@ -187,159 +187,117 @@ def _number(unit):
     return parse
 
 
-def _model_options(p, symmetric_flag=True, design_default="the run's --speed", case_options=True,
-                   body_options=True):
-    """Add the tyre, bicycle-and-rider and controller options of ``simulate`` (shared with ``stability``, ``validate``).
+#: The ``--help`` sections of the scenario's flags (each field's declared ``section``), in order, with their texts.
+SECTIONS = {
+    "tyres": None,
+    "bicycle and rider": None,
+    "rider's body": "the Yeadon rider split into legs, forearms and a leaning upper body (a bicycle-only set such as "
+                    "balanceassist_v1), arms and reflex. The reflex steer torque is T = -(gain x state), delayed: a "
+                    "positive gain steers against its state (a positive --reflex-roll steers out of the lean, against "
+                    "the roll, and the bicycle falls; steering into the lean takes a negative one). Not with "
+                    "--controller off (no rider torque at all)",
+    "riding and control": None,
+    "kick": None,
+    "run and output": None,
+}
 
-    ``symmetric_flag`` adds ``--symmetric-tyres``; ``design_default`` says
-    what the LQR design speed is by default; ``case_options`` adds the
-    pressures, the rear load or rider mass and ``--thesis-load`` (not for a
-    command that sets them per case); ``body_options`` the rider's body,
-    arms and reflex, ``--carcass-stiffness-scale`` and ``--lqr-model``.
-    Returns the "riding and control" group, for the caller's speed option.
+
+class _Shown:
+    """A declared default as ``--help`` shows it: a number in ``g`` format unless the help text says otherwise."""
+
+    def __init__(self, value):
+        self.value = value
+
+    def __format__(self, spec):
+        if not spec and isinstance(self.value, float):
+            spec = "g"
+        return format(self.value, spec)
+
+
+def _metavar(unit):
+    """A flag's metavar from its unit: "N m s/rad" -> "N_M_S_PER_RAD"."""
+    return unit.upper().replace("/", "_PER_").replace(" ", "_")
+
+
+def _scenario_flags(p, command, scenario_class=None, **context):
+    """Add the flag of every Scenario field declared for ``command`` (:mod:`whipple_kick.simulate.settings`).
+
+    Each flag comes from its field's declaration: name, section, choices or a
+    number in the field's unit, metavar, help (``{default}`` the declared
+    default, other ``{names}`` from ``context``) and its mutually exclusive
+    partner. A flag not given leaves its field at None in the parsed
+    arguments (:func:`_scenario_fields` keeps the given ones), so that the
+    Scenario's default is the only one. ``scenario_class`` (default
+    :class:`~whipple_kick.simulate.scenario.Scenario`) may be a subclass with
+    more fields. Returns the sections (argument groups) by title, for the
+    command's own options.
     """
-    from whipple_kick.library import riders, tyres
-    from whipple_kick.model.carcass import SLIDING_LAWS
-    from whipple_kick.model.transient import DEFAULT_TRANSIENT
-    from whipple_kick.simulate.scenario import (
-        CAMBER_SIGNS,
-        CONTROLLERS,
-        LQR_MODELS,
-        SLIP_SPEEDS,
-        TYRE_TRANSIENTS,
-        Scenario,
-    )
+    from whipple_kick.simulate import settings
+    from whipple_kick.simulate.scenario import Scenario
 
-    def default(field):
-        return Scenario.__dataclass_fields__[field].default
-
-    g = p.add_argument_group("tyres")
-    if case_options:
-        g.add_argument("--pressure", type=_number("kPa"), metavar="KPA",
-                       help="inflation pressure of both tyres in kPa (default 400)")
-        g.add_argument("--pressure-front", type=_number("kPa"), metavar="KPA",
-                       help="front tyre pressure in kPa (with --pressure-rear, instead of --pressure)")
-        g.add_argument("--pressure-rear", type=_number("kPa"), metavar="KPA",
-                       help="rear tyre pressure in kPa (with --pressure-front, instead of --pressure)")
-    g.add_argument("--tyre", default="T03", metavar="NAME",
-                   help="tyre on both wheels (default T03; available: %s)" % ", ".join(t[0] for t in tyres.available()))
-    g.add_argument("--coefficient-set", default="table7_9", metavar="SET",
-                   help="Magic-Formula coefficients: table7_9 (default, thesis Table 7.9) or chapter8 "
-                        "(T03 only: the fit the thesis' Chapter 8 code used)")
-    g.add_argument("--friction", choices=tyres.FRICTION_MODES, default="none",
-                   help="friction correction rig -> plate: none (default), plate (peak x 1.30), "
-                        "thesis (whole curves x 1.32, as the thesis' code)")
-    if symmetric_flag:
-        g.add_argument("--symmetric-tyres", action="store_true",
-                       help="zero the tyres' zero-slip offsets (exactly upright steady running)")
-    g.add_argument("--tyre-transient", choices=TYRE_TRANSIENTS, default=DEFAULT_TRANSIENT,
-                   help="how the tyre forces build up: carcass (default: a lateral carcass spring in series with a "
-                        "sliding contact patch; passive, friction-limited, the force lag at small slip), "
-                        "contact_patch (lagged patch slip and camber), slip_lag (the same with a constant "
-                        "relaxation length) or force_lag (the thesis' lagged force)")
-    g.add_argument("--carcass-sliding", choices=SLIDING_LAWS, default="peak",
-                   help="carcass tyre past the curve's peak: peak (default: the force stays at the peak) or curve "
-                        "(it follows the steady curve at the kinematic slip: the fit's falling branch)")
-    g.add_argument("--carcass-damping", type=_number("N s/m"), default=0.0, metavar="N_S_PER_M",
-                   help="lateral damping of each carcass, parallel to its stiffness (default 0: pure relaxation)")
-    if body_options:
-        g.add_argument("--carcass-stiffness-scale", type=_number("factor"),
-                       default=default("carcass_stiffness_scale"), metavar="FACTOR",
-                       help="factor on both carcass stiffnesses C_Fa/sigma0, in [0.05, 20] "
-                            f"(default {default('carcass_stiffness_scale'):g})")
-    g.add_argument("--camber-sign", choices=CAMBER_SIGNS, default="physical",
-                   help="physical (default: a leaning wheel is pushed toward the lean) or reversed (away from it, "
-                        "as the thesis authors' published code; not physical)")
-    g.add_argument("--slip-speed", choices=SLIP_SPEEDS, default="wheel_centre",
-                   help="whose forward speed the tyres' slip angle and relaxation use: wheel_centre (default) or "
-                        "contact_point (as the thesis authors' published code)")
-    g = p.add_argument_group("bicycle and rider")
-    g.add_argument("--bicycle", default="balanceassist_v1", metavar="NAME",
-                   help="bicycle parameter set or .toml path (default balanceassist_v1; presets "
-                        "with the rider included: balanceassist_635N, balanceassist_701N, browser_with_rider), "
-                        "or a BicycleParameters bicycle folder (<data>/bicycles/<Name>) or <Name>Benchmark.txt")
-    g.add_argument("--rider", default=default("rider"), metavar="NAME",
-                   help="Yeadon rider seated on a bicycle-only set (default %s; available: %s), or none: the "
-                        "bicycle's parameters include its rider (a BicycleParameters Benchmark.txt whose rear frame "
-                        "holds the rider, as the Meijaard benchmark's mB = 85 kg), which then runs as it is, with "
-                        "its own load share (no --fz, --rider-mass or --rear-share)"
-                        % (default("rider"), ", ".join(riders.available())))
-    if case_options:
-        who = g.add_mutually_exclusive_group()
-        who.add_argument("--fz", type=_number("N"), metavar="N",
-                         help="static rear-tyre load in N that the rider's mass is chosen for (default 635)")
-        who.add_argument("--rider-mass", type=_number("kg"), metavar="KG", help="rider mass in kg")
-        g.add_argument("--rear-share", type=_number("(unit 1)"), metavar="FRACTION",
-                       help="share of the static weight on the rear tyre, in (0, 1): the rider is moved fore-aft "
-                            "(at most 0.15 m, posture kept) so that it holds, with --fz's load (its mass follows) "
-                            "or --rider-mass (default: the seated posture's share)")
-    g.add_argument("--low-inertia", action="store_true",
-                   help="halve the rear frame's inertias and mass-centre height (thesis Figure 8.9)")
-    if body_options:
-        _body_options(p, default)
-    g = p.add_argument_group("riding and control")
-    g.add_argument("--controller", choices=CONTROLLERS, default="lqr",
-                   help="lqr: designed on the linearised classic model (default); thesis: Table 8.4 "
-                        "gains (570, 635, 701 N only); off: no steer torque")
-    if body_options:
-        g.add_argument("--lqr-model", choices=LQR_MODELS, default=default("lqr_model"),
-                       help="what the LQR rider is designed on: whipple (default: the classic model, full state) or "
-                            "simulated (the model the run simulates, feeding back roll, steer, their rates and the "
-                            "upper body's lean)")
-        g.add_argument("--lqr-heading", action="store_true",
-                       help="with --lqr-model simulated: the rider also holds the heading held before the kick "
-                            "(needs --symmetric-tyres: straight steady running)")
-    g.add_argument("--design-speed", type=_number("m/s"), metavar="M/S",
-                   help=f"LQR design speed in m/s (default: {design_default}, as a real rider adapts; "
-                        "the thesis fixed it at 3)")
-    if case_options:
-        g.add_argument("--thesis-load", type=_number("N"), metavar="N",
-                       help="rear load in N whose Table 8.4 gains --controller thesis uses (570, 635 or 701; "
-                            "default --fz, or the load a preset with rider is labelled with)")
-    g.add_argument("--gain-scale", type=_number("factor"), default=1.0, metavar="FACTOR",
-                   help="multiply every controller gain (default 1; the thesis also ran 0.5)")
-    return g
+    declared = [s for s in settings.settings(scenario_class or Scenario).values() if command in s.commands]
+    used = {s.section for s in declared}
+    sections = {title: p.add_argument_group(title, text) for title, text in SECTIONS.items() if title in used}
+    exclusive = {}
+    for s in declared:
+        if s.section not in sections:   # a section SECTIONS does not list (a subclass's field)
+            sections[s.section] = p.add_argument_group(s.section)
+        group = sections[s.section]
+        if s.exclusive:
+            if s.exclusive not in exclusive:
+                exclusive[s.exclusive] = group.add_mutually_exclusive_group()
+            group = exclusive[s.exclusive]
+        _field_flag(group, s, help=s.help.format(default=_Shown(s.default), none_means=_Shown(s.none_means),
+                                                 **context))
+    return sections
 
 
-def _body_options(p, default):
-    """The "rider's body" option group (:func:`_model_options`); ``default(field)`` is the Scenario's default."""
-    from whipple_kick.simulate.scenario import ARMS, RIDER_BODIES
-    g = p.add_argument_group("rider's body", "the Yeadon rider split into legs, forearms and a leaning upper body "
-                                             "(a bicycle-only set such as balanceassist_v1), arms and reflex. "
-                                             "The reflex steer torque is T = -(gain x state), delayed: a positive "
-                                             "gain steers against its state (a positive --reflex-roll steers out "
-                                             "of the lean, against the roll, and the bicycle falls; steering into "
-                                             "the lean takes a negative one). Not with --controller off (no rider "
-                                             "torque at all)")
-    g.add_argument("--rider-body", choices=RIDER_BODIES, default=default("rider_body"),
-                   help="rigid (default: the rider lumped into the rear frame) or leaning (the upper body leans on "
-                        "the saddle on the hip spring-damper)")
-    g.add_argument("--arms", choices=ARMS, default=default("arms"),
-                   help="on: the forearms turn with the bar and the arms are a spring-damper about the steer axis; "
-                        "off (default): no mechanical effect on the bar")
-    # The declared parts' fields (the leaning upper body's hip, the arms' spring-damper) get their flags from
-    # the declarations.
-    declared = tuple((f"--{f.name.replace('_', '-')}", f.name, f.unit, _metavar(f.unit),
-                      f"{f.label} of {part.title}, {'(' if f.refuse_low else '['}{f.low:g}, {f.high:g}]")
-                     for part in parts.REGISTRY.values() for f in part.fields)
-    for flag, field, unit, meta, what in (
-            *declared,
-            ("--reflex-delay", "reflex_delay", "s", "S",
-             "delay of the rider's reflex steer torque (a Pade filter; at most 0.5 s)"),
-            ("--reflex-roll", "reflex_roll", "N m/rad", "N_M_PER_RAD",
-             "reflex steer-torque gain on roll, T = -gain x roll (a positive gain steers against the roll)"),
-            ("--reflex-roll-rate", "reflex_roll_rate", "N m s/rad", "N_M_S_PER_RAD",
-             "reflex steer-torque gain on roll rate"),
-            ("--reflex-steer", "reflex_steer", "N m/rad", "N_M_PER_RAD", "reflex steer-torque gain on steer"),
-            ("--reflex-steer-rate", "reflex_steer_rate", "N m s/rad", "N_M_S_PER_RAD",
-             "reflex steer-torque gain on steer rate")):
-        g.add_argument(flag, type=_number(unit), default=default(field), metavar=meta,
-                       help=f"{what} in {unit} (default {default(field):g})")
+def _field_flag(group, s, **overrides):
+    """Add field ``s``'s flag (a :class:`~whipple_kick.simulate.settings.Setting`) to ``group``.
+
+    Its name, destination, choices or number type in the declared unit and its metavar come from the
+    declaration; ``overrides`` are argparse's keywords a command sets itself (``help``, a ``default`` of its
+    own, fewer ``choices``). Without a ``default`` the flag's value is None when it is not given.
+    """
+    options = dict(dest=s.name, default=None)
+    kinds = (s.type, *getattr(s.type, "__args__", ()))
+    unit = s.unit.strip("()")
+    if bool in kinds:
+        options.update(action="store_true")
+    elif s.choices:
+        options.update(choices=s.choices)
+    elif float in kinds:
+        options.update(type=_number(unit), metavar=s.metavar or _metavar(unit))
+    else:
+        options.update(metavar=s.metavar or None)
+    options.update(overrides)
+    options["help"] = options.get("help", "").replace("%", "%%")
+    group.add_argument(s.option, **options)
 
 
-def _simulate_parser():
-    from whipple_kick.library.inputs import DIRECTIONS, PROFILES
-    from whipple_kick.simulate.scenario import KICK_HEADINGS, MAX_DURATION, PLATE_STOPS, START_PITCHES, STARTS
+def _scenario_fields(args, command, scenario_class=None):
+    """The Scenario fields whose flags (:func:`_scenario_flags`) were given, by name (pressures checked together)."""
+    from whipple_kick.simulate import settings
+    from whipple_kick.simulate.scenario import DEFAULTS, Scenario
+
+    fields = {s.name: getattr(args, s.name) for s in settings.settings(scenario_class or Scenario).values()
+              if command in s.commands and getattr(args, s.name, None) is not None}
+    if not hasattr(args, "pressure_kpa"):
+        return fields
+    fronts = (args.pressure_front_kpa, args.pressure_rear_kpa)
+    if args.pressure_kpa is not None and any(v is not None for v in fronts):
+        raise InputError("--pressure sets both tyres; do not combine it with --pressure-front/--pressure-rear")
+    if (fronts[0] is None) != (fronts[1] is None):
+        raise InputError("give both --pressure-front KPA and --pressure-rear KPA (or --pressure KPA for both)")
+    _check_loads(fields.get("bicycle", DEFAULTS["bicycle"]), [args.fz_n] if args.fz_n is not None else [],
+                 fields.get("rider", DEFAULTS["rider"]))
+    return fields
+
+
+def _simulate_parser(scenario_class=None):
+    """``simulate``'s parser; its scenario flags are those of ``scenario_class`` (default: :class:`Scenario`)."""
+    from whipple_kick.library import riders, thesis, tyres
+    from whipple_kick.simulate.scenario import DEFAULTS
     p = _OneLineParser(
         prog="simulate", allow_abbrev=False,
         description="Kick-plate test on the nonlinear Carvallo-Whipple bicycle-rider model with "
@@ -348,42 +306,14 @@ def _simulate_parser():
                     "bicycle falls. Writes trajectory.csv, summary.json, scenario.toml (the run's settings, to "
                     "rerun it with --scenario) and response.png (and, with --animate, animation.mp4 or .gif).",
         epilog="Time is measured from the kick start. Defaults: "
-               "balanceassist_v1 + Yeadon rider for 635 N on the rear tyre, T03 at 400 kPa, 3 m/s, "
-               "LQR designed at the run's speed (the thesis: 3 m/s), 150 mm kick in 0.150 s (13.3 m/s^2), 6 s. "
-               "See docs/simulate.md.")
-    g = _model_options(p)
-    g.add_argument("--speed", type=_number("m/s"), default=3.0, metavar="M/S",
-                   help="forward speed in m/s (default 3)")
-    g = p.add_argument_group("kick")
-    how = g.add_mutually_exclusive_group()
-    how.add_argument("--kick-accel", type=_number("m/s^2"), metavar="M/S2",
-                     help="peak plate acceleration in m/s^2 (sets the duration)")
-    how.add_argument("--kick-duration", type=_number("s"), metavar="S",
-                     help="plate travel time in s (default 0.150)")
-    # No default here: an explicit --kick-displacement must be told apart from
-    # the default so that it can be refused with --kick-table.
-    g.add_argument("--kick-displacement", type=_number("m"), metavar="M",
-                   help="plate travel in m (default 0.150)")
-    g.add_argument("--kick-profile", choices=PROFILES,
-                   help="constant acceleration (default, thesis), smooth (minimum jerk) or table "
-                        "(plate displacement from --kick-table)")
-    g.add_argument("--kick-table", metavar="FILE",
-                   help="CSV of the plate's displacement, columns time (from the kick start) and y (+ right), "
-                        "units in the header: 'time [s]' or 'time [ms]', 'y [m]' or 'y [mm]' (none: s, m); "
-                        "a header-less file is read as two columns time [s], y [m]. The plate "
-                        "follows the clamped cubic spline through the rows (implies --kick-profile table; "
-                        "not with --kick-accel/--kick-duration/--kick-displacement)")
-    g.add_argument("--kick-direction", choices=DIRECTIONS, default="right",
-                   help="direction the plate moves (default right)")
-    g.add_argument("--plate-stop", choices=PLATE_STOPS, default="impulse",
-                   help="speeds across the constant profile's instant plate stop: impulse (default: the rear "
-                        "no-slip constraint's impulse), resolve (dependent speeds only, the earlier model) or "
-                        "keep_speeds (no jump; the rear contact is left sliding along its heading, as the "
-                        "authors' published code)")
-    g.add_argument("--kick-heading", choices=KICK_HEADINGS, default="fixed",
-                   help="fixed (default): heading perpendicular to the plate at the kick start, whatever --settle; "
-                        "settled: the steady motion starts so at -settle (the earlier model)")
-    g = p.add_argument_group("run and output")
+               f"{DEFAULTS['bicycle']} + Yeadon rider for {thesis.REFERENCE_LOAD_N:g} N on the rear tyre, "
+               f"{DEFAULTS['tyre']} at {DEFAULTS['pressure_kpa']:g} kPa, {DEFAULTS['speed']:g} m/s, "
+               "LQR designed at the run's speed (the thesis: 3 m/s), 150 mm kick in 0.150 s (13.3 m/s^2), "
+               f"{DEFAULTS['duration']:g} s. See docs/simulate.md.")
+    sections = _scenario_flags(p, "simulate", scenario_class, tyres=", ".join(t[0] for t in tyres.available()),
+                               riders=", ".join(riders.available()),
+                               design_default="the run's --speed")
+    g = sections["run and output"]
     g.add_argument("--compat", choices=("authors-code",),
                    help="authors-code: the thesis authors' published code (bicycle-kickplate-model) as it ran: "
                         "balanceassist_635N, the Table 8.4 rider of the bicycle's load, T03 chapter8 with the thesis friction, force lag, "
@@ -391,23 +321,6 @@ def _simulate_parser():
                         "speeds kept at the plate stop, slip speed of the contact point; --pressure defaults to 500; "
                         "other flags given override its settings. For explaining "
                         "that code's runs, not for predictions")
-    g.add_argument("--start", choices=STARTS, default="steady",
-                   help="steady (default: the solved steady motion) or upright (upright straight running, not an "
-                        "equilibrium with measured tyres, as the authors' code; needs --settle 0)")
-    g.add_argument("--start-pitch", choices=START_PITCHES, default="compressed",
-                   help="pitch of the upright start: compressed (default: solved with the tyres' compressions, the "
-                        "front contact on the ground) or uncompressed (solved without them, as the authors' code: "
-                        "the front contact starts a few mm below the ground); needs --start upright")
-    g.add_argument("--duration", type=_number("s"), default=6.0, metavar="S",
-                   help=f"simulated time after the kick start in s (default 6, at most {MAX_DURATION:g})")
-    g.add_argument("--settle", type=_number("s"), default=0.5, metavar="S",
-                   help="steady running shown before the kick in s (default 0.5)")
-    g.add_argument("--rtol", type=_number("relative"), default=1e-10, metavar="RTOL",
-                   help="LSODA relative tolerance (default 1e-10; the thesis used 1e-12)")
-    g.add_argument("--output-rate", type=_number("Hz"), default=1000.0, metavar="HZ",
-                   help="samples per second of the run in Hz (default 1000: about 1 MB of trajectory.csv per "
-                        "simulated second); the metrics are computed from these samples, e.g. the recovery time "
-                        "to 1/HZ")
     g.add_argument("--scenario", metavar="FILE",
                    help="rerun the scenario of a TOML file (every run folder has scenario.toml); flags given "
                         "override its values")
@@ -444,68 +357,16 @@ def _animation_options(args):
     return options
 
 
-#: Scenario fields of the options ``_model_options(case_options=True)`` adds, by option name.
-_CASE_FIELDS = {"pressure_kpa": "pressure", "pressure_front_kpa": "pressure_front",
-                "pressure_rear_kpa": "pressure_rear", "fz_n": "fz", "rider_mass_kg": "rider_mass",
-                "rear_load_share": "rear_share", "thesis_load_n": "thesis_load"}
-
-#: Scenario fields set by flags of another name (the rest by the flag of the field's own name).
-_FIELD_FLAGS = {**{field: (option,) for field, option in _CASE_FIELDS.items()},
-                "kick_profile": ("kick_profile", "kick_table")}
-
-
 #: Fields a flag's field replaces in a --scenario file or the --compat preset (their alternatives).
 _REPLACED_FIELDS = {"fz_n": ("rider_mass_kg",), "rider_mass_kg": ("fz_n",), "kick_duration": ("kick_accel",),
                     "kick_accel": ("kick_duration",), "pressure_kpa": ("pressure_front_kpa", "pressure_rear_kpa")}
 
 
-def _flags_given(argv):
-    """Destinations of the flags given on the command line (defaults not counted)."""
-    parser = _simulate_parser()
-    for action in parser._actions:
-        action.default = argparse.SUPPRESS
-    return set(vars(parser.parse_args(argv)))
-
-
-#: Scenario fields of the rider's-body options (and the LQR design model, the carcass stiffness scale), each
-#: set by the flag of its own name.
-_BODY_FIELDS = ("rider_body", "arms", *(f.name for f in parts.fields()), "reflex_delay", "reflex_roll", "reflex_roll_rate", "reflex_steer", "reflex_steer_rate",
-                "carcass_stiffness_scale", "lqr_model", "lqr_heading")
-
-
-def _metavar(unit):
-    """A flag's metavar from its unit: "N m s/rad" -> "N_M_S_PER_RAD"."""
-    return unit.upper().replace("/", "_PER_").replace(" ", "_")
-
-
-def _model_fields(args):
-    """Scenario fields of the options added by :func:`_model_options` (without the case options if it had none)."""
-    fields = dict(
-        bicycle=args.bicycle, tyre=args.tyre, coefficient_set=args.coefficient_set, friction=args.friction,
-        controller=args.controller, design_speed=args.design_speed, gain_scale=args.gain_scale,
-        low_inertia=args.low_inertia, tyre_transient=args.tyre_transient, camber_sign=args.camber_sign,
-        slip_speed=args.slip_speed, rider=args.rider,
-        carcass_sliding=args.carcass_sliding, carcass_damping=args.carcass_damping,
-    )
-    if hasattr(args, "rider_body"):
-        fields.update({field: getattr(args, field) for field in _BODY_FIELDS})
-    if not hasattr(args, "pressure"):
-        return fields
-    fronts = (args.pressure_front, args.pressure_rear)
-    if args.pressure is not None and any(v is not None for v in fronts):
-        raise InputError("--pressure sets both tyres; do not combine it with --pressure-front/--pressure-rear")
-    if (fronts[0] is None) != (fronts[1] is None):
-        raise InputError("give both --pressure-front KPA and --pressure-rear KPA (or --pressure KPA for both)")
-    _check_loads(args.bicycle, [args.fz] if args.fz is not None else [], args.rider)
-    fields.update({field: getattr(args, option) for field, option in _CASE_FIELDS.items()})
-    if args.pressure is None:
-        fields["pressure_kpa"] = 400.0
-    return fields
-
-
 def _flag(field):
-    """The flag that sets a Scenario field (:data:`_FIELD_FLAGS`; the rest by the flag of the field's own name)."""
-    return "--" + _FIELD_FLAGS.get(field, (field,))[0].replace("_", "-")
+    """The flag that sets a Scenario field (its declaration's :attr:`~whipple_kick.simulate.settings.Setting.option`)."""
+    from whipple_kick.simulate import settings
+    from whipple_kick.simulate.scenario import Scenario
+    return settings.settings(Scenario)[field].option
 
 
 def _flag_value(field, value):
@@ -572,41 +433,33 @@ def _check_loads(bicycle, loads, rider=None):
         riders.within_rear_load_range(bike, fz, low, high, per_kg)
 
 
-def _scenario_from_args(args, given=()):
-    """The scenario of the parsed flags; with ``--compat``, the preset with the ``given`` flags' fields changed."""
+def _scenario_from_args(args, scenario_class=None):
+    """The scenario of the parsed flags; with ``--compat`` or ``--scenario``, the preset or file with the given
+    flags' fields changed. ``scenario_class`` (default :class:`Scenario`) is the parser's (:func:`_simulate_parser`)."""
     from whipple_kick.simulate.scenario import Scenario
-    fields = _model_fields(args)
-    profile = args.kick_profile
+    cls = scenario_class or Scenario
+    fields = _scenario_fields(args, "simulate", cls)
     if args.kick_table is not None:
+        profile = args.kick_profile
         if profile not in (None, "table"):
             raise InputError(f"--kick-table gives the plate motion; do not combine it with --kick-profile {profile}")
         for flag, value in (("--kick-accel", args.kick_accel), ("--kick-duration", args.kick_duration),
                             ("--kick-displacement", args.kick_displacement)):
             if value is not None:
                 raise InputError(f"--kick-table gives the plate motion; do not combine it with {flag}")
-        profile = "table"
-    elif profile == "table":
+        fields["kick_profile"] = "table"
+    elif args.kick_profile == "table":
         raise InputError("--kick-profile table needs --kick-table FILE (CSV with columns time in s, y in m)")
-    fields.update(
-        symmetric_tyres=args.symmetric_tyres, speed=args.speed,
-        kick_displacement=0.150 if args.kick_displacement is None else args.kick_displacement,
-        kick_duration=args.kick_duration, kick_accel=args.kick_accel,
-        kick_profile="constant" if profile is None else profile, kick_table=args.kick_table,
-        kick_direction=args.kick_direction, settle=args.settle, duration=args.duration, rtol=args.rtol,
-        plate_stop=args.plate_stop, kick_heading=args.kick_heading, start=args.start, start_pitch=args.start_pitch,
-        output_rate=args.output_rate,
-    )
     if args.compat is None and args.scenario is None:
-        return Scenario(**fields)
+        return cls(**fields)
     if args.compat is not None and args.scenario is not None:
         raise InputError("--scenario FILE gives the whole scenario; do not combine it with --compat")
-    changes = {name: value for name, value in fields.items()
-               if any(flag in given for flag in _FIELD_FLAGS.get(name, (name,)))}
-    for name in [n for n in changes if n in _REPLACED_FIELDS]:
+    changes = dict(fields)
+    for name in [n for n in fields if n in _REPLACED_FIELDS]:
         changes = {**dict.fromkeys(_REPLACED_FIELDS[name]), **changes}
     if args.scenario is not None:
-        return Scenario.from_file(args.scenario).with_changes(**changes)
-    return Scenario.authors_code(**changes)
+        return cls.from_file(args.scenario).with_changes(**changes)
+    return cls.authors_code(**changes)
 
 
 #: Every file ``simulate`` may write (``--force`` removes them before a run).
@@ -866,8 +719,7 @@ def _simulate(argv):
 
         from whipple_kick.library.tyres import DataQualityWarning
         warnings.filterwarnings("ignore", category=DataQualityWarning)   # within _run's warnings block only
-    given = _flags_given(argv) if args.compat is not None or args.scenario is not None else ()
-    scenario = _preflight(_scenario_from_args(args, given))
+    scenario = _preflight(_scenario_from_args(args))
     movie_options = _animation_options(args)
     with _output_folder(args.out or _default_out(scenario), args.force, _OUTPUT_FILES) as job:
         out = job.out
@@ -928,8 +780,8 @@ def simulate_main(argv=None):
 # ------------------------------------------------------------ recommend-pressure
 
 def _recommend(argv):
-    from whipple_kick.library import tyres
-    from whipple_kick.simulate.scenario import MAX_DURATION
+    from whipple_kick.library import thesis, tyres
+    from whipple_kick.simulate.scenario import DEFAULTS, MAX_DURATION
     from whipple_kick.studies import recommend
     p = _OneLineParser(
         prog="recommend-pressure",
@@ -943,9 +795,9 @@ def _recommend(argv):
                "The default runs one direction and one tyre transient; --kick-direction both and "
                "--tyre-transient all say whether the answer depends on them. See docs/sweeps.md.")
     p.add_argument("--fz", type=_number("N"), nargs="+", required=True, metavar="N",
-                   help="static rear-tyre load(s) in N, e.g. --fz 570 635 701")
-    p.add_argument("--tyre", default="T03", metavar="NAME",
-                   help="tyre on both wheels (default T03; available: %s)"
+                   help=f"static rear-tyre load(s) in N, e.g. --fz {thesis.loads_text(' ')}")
+    p.add_argument("--tyre", default=DEFAULTS["tyre"], metavar="NAME",
+                   help=f"tyre on both wheels (default {DEFAULTS['tyre']}; available: %s)"
                         % ", ".join(t[0] for t in tyres.available()))
     p.add_argument("--pressures", type=_number("kPa"), nargs="+", metavar="KPA",
                    help="pressures to try in kPa (default: the tyre's measured ones)")
@@ -958,7 +810,8 @@ def _recommend(argv):
                         "of their first peaks; last-peak: the thesis' rule, time of the last yaw-rate peak "
                         "above 8 %% of the largest")
     p.add_argument("--duration", type=_number("s"), metavar="S",
-                   help=f"simulated time after the kick in s (default 6, at most {MAX_DURATION:g})")
+                   help=f"simulated time after the kick in s (default {DEFAULTS['duration']:g}, at most "
+                        f"{MAX_DURATION:g})")
     p.add_argument("--workers", type=int, metavar="N",
                    help="worker processes (default: one per CPU core)")
     p.add_argument("--out", metavar="DIR",
@@ -967,8 +820,8 @@ def _recommend(argv):
                    help="with --out: add these runs to a folder that holds another sweep")
     from whipple_kick.library.inputs import DIRECTIONS
     from whipple_kick.simulate.scenario import TYRE_TRANSIENTS, Scenario
-    p.add_argument("--kick-direction", choices=(*DIRECTIONS, "both"), default="right",
-                   help="direction the plate moves (default right); both: run each direction and say whether "
+    p.add_argument("--kick-direction", choices=(*DIRECTIONS, "both"), default=DEFAULTS["kick_direction"],
+                   help=f"direction the plate moves (default {DEFAULTS['kick_direction']}); both: run each direction and say whether "
                         "the best pressure depends on it (twice the runs)")
     p.add_argument("--tyre-transient", choices=(*TYRE_TRANSIENTS, "all"), default=Scenario.tyre_transient,
                    help=f"tyre transient form (default {Scenario.tyre_transient}); all: run each form and say "
@@ -991,7 +844,7 @@ def _recommend(argv):
         return _recommend_uncertain(args)
     if args.samples is not None or args.seed is not None:
         raise InputError("--samples and --seed belong to the uncertainty study: add --uncertain [FILE]")
-    args.duration = 6.0 if args.duration is None else args.duration
+    args.duration = DEFAULTS["duration"] if args.duration is None else args.duration
     directions = DIRECTIONS if args.kick_direction == "both" else (args.kick_direction,)
     forms = TYRE_TRANSIENTS if args.tyre_transient == "all" else (args.tyre_transient,)
     variants = {(d, f): Scenario(duration=args.duration, kick_direction=d, tyre_transient=f).validate()
@@ -1023,7 +876,7 @@ def _recommend(argv):
         import pandas as pd
 
         from whipple_kick.figures import plotting
-        metric = recommend.CRITERIA[recommend.criterion_key(args.criterion)][0]
+        metric = recommend.CRITERIA[recommend.criterion_key(args.criterion)].column
         for (direction, form), by_load in recs.items():
             name = SWEEP_FIGURE if len(variants) == 1 else SWEEP_FIGURE.replace(".png", f"_{direction}_{form}.png")
             plotting.sweep_figure(pd.concat([rec.table.assign(fz_n=rec.fz_n) for rec in by_load], ignore_index=True),
@@ -1037,8 +890,8 @@ def _recommend(argv):
 #: The figure ``recommend-pressure --out`` writes into its sweep folder.
 SWEEP_FIGURE = "recommendation.png"
 #: The figures ``recommend-pressure --uncertain --out DIR`` writes into DIR.
-UNCERTAINTY_FIGURES = ("p_best.png", "recovery_settling.png", "recovery_last_peak.png", "sobol_settling.png",
-                       "sobol_last_peak.png")
+UNCERTAINTY_FIGURES = ("p_best.png", *(f"recovery_{key}.png" for key in CRITERIA),
+                       *(f"sobol_{key}.png" for key in CRITERIA))
 
 
 def _recommend_uncertain(args):
@@ -1046,11 +899,11 @@ def _recommend_uncertain(args):
     import pathlib
 
     from whipple_kick.figures import uncertainty as figures
-    from whipple_kick.simulate.scenario import Scenario
+    from whipple_kick.simulate.scenario import DEFAULTS, Scenario
     from whipple_kick.studies import recommend, uncertainty
     given = [flag for flag, value in (("--fine", args.fine), ("--extend", args.extend),
                                       ("--duration", args.duration is not None),
-                                      ("--kick-direction", args.kick_direction != "right"),
+                                      ("--kick-direction", args.kick_direction != DEFAULTS["kick_direction"]),
                                       ("--tyre-transient", args.tyre_transient != Scenario.tyre_transient))
              if value]
     if given:
@@ -1073,10 +926,9 @@ def _recommend_uncertain(args):
         study_pair = _verdict_pair(study, criterion)
         figures.p_best_figure(study.p_best, out / UNCERTAINTY_FIGURES[0],
                               title=f"P(best), N = {samples} ({len(study.inputs)} rows), 95 % intervals")
-        for name, crit in zip(UNCERTAINTY_FIGURES[1:3], uncertainty.CRITERIA, strict=True):
-            figures.distribution_figure(study.outcomes, crit, out / name)
-        for name, crit in zip(UNCERTAINTY_FIGURES[3:], uncertainty.CRITERIA, strict=True):
-            figures.sobol_figure(study.sobol, crit, study_pair, out / name)
+        for crit in uncertainty.CRITERIA:
+            figures.distribution_figure(study.outcomes, crit, out / f"recovery_{crit}.png")
+            figures.sobol_figure(study.sobol, crit, study_pair, out / f"sobol_{crit}.png")
         print(f"\nwrote the tables (CSV), verdict.txt and {', '.join(UNCERTAINTY_FIGURES)} into {out} "
               f"(the runs in {out / 'runs'}: run again to resume)")
     return 0
@@ -1163,6 +1015,8 @@ def compare_main(argv=None):
 # ------------------------------------------------------------------ stability
 
 def _stability_parser():
+    from whipple_kick.library import riders, thesis, tyres
+    from whipple_kick.simulate.scenario import DEFAULTS
     from whipple_kick.studies import stability
     start, stop, step = stability.DEFAULT_SPEEDS
     p = _OneLineParser(
@@ -1172,11 +1026,14 @@ def _stability_parser():
                     "(knife-edge) model of the same bicycle: weave, capsize, caster, wobble and the tyre modes, "
                     "named from their eigenvectors and followed across speed. Writes eigenvalues.csv, "
                     "stability.png and summary.json.",
-        epilog="Defaults: balanceassist_v1 + Yeadon rider for 635 N, T03 at 400 kPa with its zero-slip offsets "
+        epilog=f"Defaults: {DEFAULTS['bicycle']} + Yeadon rider for {thesis.REFERENCE_LOAD_N:g} N, {DEFAULTS['tyre']} at "
+               f"{DEFAULTS['pressure_kpa']:g} kPa with its zero-slip offsets "
                "removed (straight running; --tyre-offsets measured linearises about the steady turns the "
                "offsets cause), LQR rider designed at each speed. Speed is constant in the linear model "
                "(the forward-speed mode is left out, as in the no-slip model). See docs/stability.md.")
-    g = _model_options(p, symmetric_flag=False, design_default="each speed of the sweep")
+    g = _scenario_flags(p, "stability", tyres=", ".join(t[0] for t in tyres.available()),
+                               riders=", ".join(riders.available()),
+                        design_default="each speed of the sweep")["riding and control"]
     g.add_argument("--speeds", default=f"{start:g}:{stop:g}:{step:g}", metavar="START:STOP:STEP",
                    help=f"forward speeds in m/s: START:STOP:STEP (STOP included) or V1,V2,... "
                         f"(default {start:g}:{stop:g}:{step:g})")
@@ -1199,7 +1056,7 @@ def _stability(argv):
     args = _stability_parser().parse_args(argv)
     started = time.perf_counter()
     speeds = stability.parse_speeds(args.speeds)
-    scenario = Scenario(**_model_fields(args), symmetric_tyres=args.tyre_offsets == "zero",
+    scenario = Scenario(**_scenario_fields(args, "stability"), symmetric_tyres=args.tyre_offsets == "zero",
                                    speed=float(speeds[0]))
     _preflight(scenario)
     with _output_folder(args.out or _default_out(scenario, "stability"), args.force, _STABILITY_FILES) as job:
@@ -1234,12 +1091,14 @@ _VALIDATE_FILES = ("validation.csv", "summary.json", "validation.png")
 
 
 def _validate_parser():
-    from whipple_kick.simulate.scenario import MAX_DURATION
+    from whipple_kick.library import riders, thesis, tyres
+    from whipple_kick.simulate.scenario import MAX_DURATION, SETTINGS
     from whipple_kick.studies import validation
     p = _OneLineParser(
         prog="validate", allow_abbrev=False,
         description="The model against the thesis' kick-plate measurements (Dell'Orto 2025, Section 8.5, "
-                    "Tables 8.6-8.9): runs the nine measured cases (rear loads 570/635/701 N x 300/400/500 kPa) "
+                    f"Tables 8.6-8.9): runs the nine measured cases (rear loads {thesis.loads_text('/')} N x "
+                    f"{thesis.pressures_text('/')} kPa) "
                     "in both kick directions as the experiments ran, processes the yaw rate as the recordings "
                     "were (100 Hz, 20 Hz zero-phase low-pass, peaks until one is below 8 %) and compares. "
                     "Writes validation.csv, cases/<case>_<direction>/trajectory.csv, validation.png and "
@@ -1247,16 +1106,19 @@ def _validate_parser():
         epilog="Defaults: 2 m/s, 150 mm smooth kick at 35 m/s^2 (0.157 s), LQR rider designed at the run's speed, "
                "both directions, 6 s after the kick; the loads and pressures are the measured ones (no --pressure, "
                "--fz). See docs/experiments.md.")
-    g = _model_options(p, case_options=False)
-    g.add_argument("--speed", type=_number("m/s"), default=validation.SPEED, metavar="M/S",
-                   help=f"forward speed in m/s (default {validation.SPEED:g}, the measured 1.92-2 m/s)")
+    g = _scenario_flags(p, "validate", tyres=", ".join(t[0] for t in tyres.available()),
+                               riders=", ".join(riders.available()),
+                        design_default="the run's --speed")["riding and control"]
+    # The experiments' own speed, kick, duration and tolerance: the fields' flags with validate's defaults.
+    _field_flag(g, SETTINGS["speed"], default=validation.SPEED,
+                help=f"forward speed in m/s (default {validation.SPEED:g}, the measured 1.92-2 m/s)")
     g = p.add_argument_group("kick")
-    g.add_argument("--kick-accel", type=_number("m/s^2"), default=validation.KICK_ACCEL, metavar="M/S2",
-                   help=f"peak plate acceleration in m/s^2 (default {validation.KICK_ACCEL:g}, measured 30-35)")
-    g.add_argument("--kick-displacement", type=_number("m"), default=validation.KICK_DISPLACEMENT, metavar="M",
-                   help=f"plate travel in m (default {validation.KICK_DISPLACEMENT:g})")
-    g.add_argument("--kick-profile", choices=("smooth", "constant"), default="smooth",
-                   help="smooth (default: minimum jerk) or constant acceleration (the thesis' simulations)")
+    _field_flag(g, SETTINGS["kick_accel"], default=validation.KICK_ACCEL,
+                help=f"peak plate acceleration in m/s^2 (default {validation.KICK_ACCEL:g}, measured 30-35)")
+    _field_flag(g, SETTINGS["kick_displacement"], default=validation.KICK_DISPLACEMENT,
+                help=f"plate travel in m (default {validation.KICK_DISPLACEMENT:g})")
+    _field_flag(g, SETTINGS["kick_profile"], choices=("smooth", "constant"), default="smooth",
+                help="smooth (default: minimum jerk) or constant acceleration (the thesis' simulations)")
     g.add_argument("--directions", nargs="+", choices=validation.DIRECTIONS, default=list(validation.DIRECTIONS),
                    help="kick directions to run (default both: the thesis does not give one)")
     g = p.add_argument_group("comparison and output")
@@ -1266,11 +1128,11 @@ def _validate_parser():
     g.add_argument("--compare-transients", action="store_true",
                    help="also run every tyre transient form and say whether the best pressure depends on it "
                         "(summary.json by_tyre_transient; 3x the runs)")
-    g.add_argument("--duration", type=_number("s"), default=validation.DURATION, metavar="S",
-                   help=f"simulated time after the kick in s (default {validation.DURATION:g}, at most "
-                        f"{MAX_DURATION:g})")
-    g.add_argument("--rtol", type=_number("relative"), default=1e-10, metavar="RTOL",
-                   help="LSODA relative tolerance (default 1e-10)")
+    _field_flag(g, SETTINGS["duration"], default=validation.DURATION,
+                help=f"simulated time after the kick in s (default {validation.DURATION:g}, at most "
+                     f"{MAX_DURATION:g})")
+    _field_flag(g, SETTINGS["rtol"], default=SETTINGS["rtol"].default,
+                help=f"LSODA relative tolerance (default {SETTINGS['rtol'].default:g})")
     g.add_argument("--workers", type=int, metavar="N", help="worker processes (default: one per CPU core)")
     _output_options(g, "validation.png")
     return p
@@ -1284,7 +1146,7 @@ def _validate(argv):
     started = time.perf_counter()
     if args.workers is not None and args.workers < 1:
         raise InputError(f"--workers = {args.workers} must be a whole number >= 1")
-    base = validation.base_scenario(**_model_fields(args), speed=args.speed, kick_accel=args.kick_accel,
+    base = validation.base_scenario(**_scenario_fields(args, "validate"), speed=args.speed, kick_accel=args.kick_accel,
                                     kick_displacement=args.kick_displacement, kick_profile=args.kick_profile,
                                     duration=args.duration, rtol=args.rtol)
     for case in validation.experiments.load().cases.values():   # every flag checked before any run or folder

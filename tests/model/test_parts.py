@@ -187,7 +187,10 @@ def test_a_parts_scenario_fields_come_from_its_declaration():
             assert Scenario.__dataclass_fields__[f.name].default == f.default and f.source
             assert f"    {f.name} : float\n        The {f.label} of {part.title} [{f.unit}]" in Scenario.__doc__
             assert f.name in FIELD_GROUPS["physics"] and f.name in BodySpec.__dataclass_fields__
-            assert f.name not in source   # generated, not hand-kept
+            # Written in the class body (static readers see it), its declaration read from the part's.
+            assert f'    {f.name}: float = part_setting("{part.name}", "{f.name}")' in source
+            setting = scenario_module.SETTINGS[f.name]
+            assert (setting.part, setting.unit, setting.low, setting.high) == (part.name, f.unit, f.low, f.high)
         # The fields follow the field that selects the part, in declaration order.
         at = names.index(part.selected_by[0])
         assert names[at + 1:at + 1 + len(part.fields)] == [f.name for f in part.fields]

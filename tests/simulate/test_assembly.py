@@ -181,9 +181,8 @@ def test_the_summary_reports_the_shift_and_the_front_load():
 SPECS = {"bicycle_spec": scenario_module.BicycleSpec, "tyre_spec": scenario_module.TyreSpec,
          "body_spec": scenario_module.BodySpec, "gains_spec": scenario_module.GainsSpec,
          "model_spec": scenario_module.ModelSpec, "design_spec": scenario_module.DesignSpec}
-#: The derived Scenario attributes a view copies, and the fields they come from.
-DERIVED = {"pressures": ("pressure_kpa", "pressure_front_kpa", "pressure_rear_kpa"),
-           "lqr_design_speed": ("speed", "design_speed")}
+#: The derived Scenario attributes a view copies, and the fields they come from (as the views declare them).
+DERIVED = {attr: sources for _, _, derived in scenario_module.VIEWS.values() for attr, sources in derived}
 #: The Scenario fields the design on the simulated model reads (its view's fields are not named after them).
 DESIGN_READS = ("speed", "design_speed", "rider_body", "lqr_heading", "gain_scale",
                 *scenario_module.DESIGN_MODEL_OPTIONS)

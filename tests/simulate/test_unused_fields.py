@@ -231,7 +231,7 @@ def _flag_value(action, other_rider, kick_table):
     flag = action.option_strings[-1]
     if isinstance(action, argparse._StoreTrueAction):
         return [flag]
-    field = {option: field for field, option in cli._CASE_FIELDS.items()}.get(action.dest, action.dest)
+    field = action.dest   # every scenario flag's destination is its field
     if action.choices:   # a choice other than the parser's default and the field's (a default of None)
         return [flag, next(c for c in action.choices if c not in (action.default, DEFAULTS.get(field)))]
     if field == "kick_table":
@@ -251,9 +251,9 @@ def test_every_simulate_flag_reaches_the_scenario(other_rider, kick_table):
         if not action.option_strings or action.option_strings[-1] in NOT_SCENARIO_FLAGS:
             continue
         argv = _flag_value(action, other_rider, kick_table)
-        if action.dest == "pressure_front":
+        if action.dest == "pressure_front_kpa":
             argv += ["--pressure-rear", "400"]
-        elif action.dest == "pressure_rear":
+        elif action.dest == "pressure_rear_kpa":
             argv += ["--pressure-front", "400"]
         try:
             sc = cli._scenario_from_args(parser.parse_args(argv))

@@ -77,7 +77,7 @@ def nine_case_recommendations(tmp_path_factory):
 def test_recommendation_margin_and_no_clear_optimum_rule_on_the_nine_cases(nine_case_recommendations,
                                                                         criterion):
     key = wk.recommend.criterion_key(criterion)
-    column = wk.recommend.CRITERIA[key][0]
+    column = wk.recommend.CRITERIA[key].column
     for rec, fz in zip(nine_case_recommendations[criterion], (570.0, 635.0, 701.0), strict=True):
         assert rec.fz_n == fz and rec.criterion == key and rec.spread_s == wk.recommend.CRITERION_SPREAD_S[key] > 0
         table = rec.table

@@ -17,6 +17,8 @@ import textwrap
 
 import numpy as np
 
+from whipple_kick.library import thesis
+
 #: (column, axis label) of the four panels, top to bottom.
 RESPONSE_PANELS = (
     ("yaw_rate", "yaw rate [rad/s]"),
@@ -522,8 +524,8 @@ def validation_figure(result, path=None, dpi=120):
                        bbox_to_anchor=(0.5, 0.965), frameon=False)
         if column == "dominant_frequency_hz":
             ax.legend(handles=ax.get_legend_handles_labels()[0][-1:], fontsize=7, loc="best")
-    colors = {p: c for p, c in zip((300.0, 400.0, 500.0), ("tab:blue", "tab:red", "tab:olive"), strict=True)}
-    dashes = {570.0: ":", 635.0: "-", 701.0: "--"}
+    colors = dict(zip(thesis.PRESSURES_KPA, ("tab:blue", "tab:red", "tab:olive"), strict=True))
+    dashes = dict(zip(thesis.LOADS_N, (":", "-", "--"), strict=True))
     legend_drawn = False
     for row, direction in enumerate(("right", "left")):
         ax_t = fig.add_subplot(grid[2 + row, 0:2])

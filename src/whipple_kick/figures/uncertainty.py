@@ -9,13 +9,14 @@ import math
 
 import numpy as np
 
+from whipple_kick.simulate.criteria import CRITERIA
+
 from .plotting import _written
 
 #: Colours of the two criteria.
 _COLOURS = {"settling": "tab:blue", "last_peak": "tab:orange"}
-#: The table column of each criterion (the study's CRITERIA; the figures wing sits below the studies).
-_COLUMNS = {"settling": "recovery.time_s", "last_peak": "last_peak_time_s"}
-_CRITERION_TEXT = {"settling": "recovery time (settling)", "last_peak": "last-peak time (thesis)"}
+#: Each criterion's short name (:data:`whipple_kick.simulate.criteria.CRITERIA`).
+_CRITERION_TEXT = {key: c.short for key, c in CRITERIA.items()}
 
 
 def _figure(n_panels, height=3.6):
@@ -66,7 +67,7 @@ def distribution_figure(outcomes, criterion="settling", path=None, title=None, d
 
     The share of runs that did not recover (fell, not settled within the run, failed) is written above each violin.
     """
-    col = _COLUMNS[criterion]
+    col = CRITERIA[criterion].column
     loads = list(dict.fromkeys(outcomes["fz_n"]))
     fig, axes = _figure(len(loads))
     base = outcomes[outcomes["block"].isin(["A", "B"])]

@@ -31,10 +31,14 @@ import pathlib
 import numpy as np
 
 from whipple_kick.errors import InputError, check_range
+from whipple_kick.library import thesis
 from whipple_kick.model import parts, slip
 from whipple_kick.simulate import control, steady
 
-from .scenario import DEFAULTS, LOW_INERTIA_KEYS, THESIS_DESIGN_SPEED
+from .scenario import DEFAULTS, LOW_INERTIA_KEYS, SETTINGS, THESIS_DESIGN_SPEED
+
+#: The rear load [N] a rider is seated for when neither ``fz_n`` nor ``rider_mass_kg`` is given (``fz_n``'s rule).
+DEFAULT_REAR_LOAD_N = SETTINGS["fz_n"].none_means
 
 #: ``|steady yaw rate|`` [rad/s] below which steady running counts as straight (a yaw-angle gain needs it).
 STRAIGHT_YAW_RATE = 1e-9
@@ -229,7 +233,7 @@ def _bicycle_setup(spec, _stamp):
         combined, rider_mass = bike, None
     elif spec.rear_load_share is not None:
         # The rider is shifted fore-aft so that the share holds (riders.for_load_share).
-        fz = 635.0 if spec.fz_n is None and spec.rider_mass_kg is None else spec.fz_n
+        fz = DEFAULT_REAR_LOAD_N if spec.fz_n is None and spec.rider_mass_kg is None else spec.fz_n
         solution = riders.for_load_share(bike, spec.rear_load_share, fz_n=fz, rider_mass_kg=spec.rider_mass_kg,
                                           rider=spec.rider)
         combined, rider_mass, shift = solution.combined, solution.rider_mass_kg, solution.shift_m
@@ -237,7 +241,7 @@ def _bicycle_setup(spec, _stamp):
         rider = riders.yeadon_rider(spec.rider, mass_kg=spec.rider_mass_kg)
         combined, rider_mass = riders.seat(bike, rider), float(spec.rider_mass_kg)
     else:
-        fz = 635.0 if spec.fz_n is None else spec.fz_n
+        fz = DEFAULT_REAR_LOAD_N if spec.fz_n is None else spec.fz_n
         combined, rider_mass = riders.for_rear_load(bike, fz, rider=spec.rider,
                                                     load_range=_rear_load_range(spec.bicycle, _stamp, spec.rider))
     # The static loads and the Whipple model the LQR is designed on are the whole rider's: the split below
@@ -384,7 +388,7 @@ def thesis_load(spec):
     """Rear load [N] whose Table 8.4 row ``controller="thesis"`` uses (``spec``: ``scenario.gains_spec``).
 
     ``thesis_load_n`` if given, else ``fz_n``, else the load a preset with
-    rider is labelled with (``balanceassist_635N``: 635 N), else 635 N for a
+    rider is labelled with (``balanceassist_635N``: 635 N), else :data:`DEFAULT_REAR_LOAD_N` for a
     bicycle whose rider is seated for the default load.
     """
     from whipple_kick.library import bicycleparameters
@@ -397,9 +401,9 @@ def thesis_load(spec):
     if bike.includes_rider and bike.thesis_rear_load_n is not None:
         return bike.thesis_rear_load_n
     if spec.rider_mass_kg is None and not bike.includes_rider:
-        return 635.0
-    raise InputError("controller thesis uses Table 8.4 gains for a rear load of 570, 635 or 701 N: give fz (N), "
-                     "or thesis_load_n (--thesis-load N) for a rider given by mass or a preset with rider")
+        return DEFAULT_REAR_LOAD_N
+    raise InputError(f"controller thesis uses Table 8.4 gains for a rear load of {thesis.loads_text(last=' or ')} N: "
+                     "give fz (N), or thesis_load_n (--thesis-load N) for a rider given by mass or a preset with rider")
 
 
 def thesis_gains_warning(spec):

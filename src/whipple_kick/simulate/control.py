@@ -22,6 +22,7 @@ import warnings
 import numpy as np
 
 from whipple_kick.errors import ConvergenceWarning, InputError, check_range
+from whipple_kick.library import thesis
 from whipple_kick.model import classic, slip
 
 GAIN_ORDER = ("kq4", "kq7", "ku4", "ku7")
@@ -31,11 +32,12 @@ HEADING_GAIN_ORDER = ("kq3",) + GAIN_ORDER
 #: Thesis Table 8.4: gains used for the Chapter 8 simulations, per rear load
 #: [N]; units N m/rad (kq4, kq7) and N m s/rad (ku4, ku7). Applied as
 #: T7 = -(kq4 q4 + kq7 q7 + ku4 u4 + ku7 u7).
-THESIS_GAINS = {
-    570: {"kq4": -18.619, "kq7": 14.721, "ku4": -6.2915, "ku7": 1.5647},
-    635: {"kq4": -19.5679, "kq7": 15.4934, "ku4": -6.7665, "ku7": 1.5876},
-    701: {"kq4": -20.5164, "kq7": 16.2624, "ku4": -7.3074, "ku7": 1.600},
-}
+#: One row per load of :data:`whipple_kick.library.thesis.LOADS_N` (570, 635, 701 N), keyed by the whole newtons.
+THESIS_GAINS = dict(zip((round(load) for load in thesis.LOADS_N), (
+    {"kq4": -18.619, "kq7": 14.721, "ku4": -6.2915, "ku7": 1.5647},
+    {"kq4": -19.5679, "kq7": 15.4934, "ku4": -6.7665, "ku7": 1.5876},
+    {"kq4": -20.5164, "kq7": 16.2624, "ku4": -7.3074, "ku7": 1.600},
+), strict=True))
 
 
 def lqr_gains(moore, speed=3.0, Q=None, R=1.0):
@@ -149,11 +151,12 @@ def gains_dict(K, scale=1.0):
 
 
 def thesis_gains(rear_load_n):
-    """Table 8.4 gains for one of the thesis' rear loads (570, 635 or 701 N)."""
+    """Table 8.4 gains for one of the thesis' rear loads (:data:`whipple_kick.library.thesis.LOADS_N`)."""
     load = check_range("rear load", rear_load_n, 0.0, None, "N", low_open=True)
     key = int(round(load))
     if key not in THESIS_GAINS or abs(load - key) > 1e-9:
-        raise InputError(f"thesis gains exist for rear loads 570, 635 and 701 N only, got {rear_load_n} N")
+        raise InputError(f"thesis gains exist for rear loads {thesis.loads_text(last=' and ')} N only, "
+                         f"got {rear_load_n} N")
     return dict(THESIS_GAINS[key])
 
 

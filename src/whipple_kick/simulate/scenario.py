@@ -5,10 +5,15 @@ A :class:`Scenario` holds everything a run of the thesis' kick-plate test
 defaults (:meth:`Scenario.thesis` gives the thesis' own): the bicycle and
 rider, the tyres, the speed, the rider's control, the kick
 (:mod:`whipple_kick.library.inputs` turns its fields into the plate's
-motion), the numerics. :meth:`Scenario.validate` checks every field and
-raises one-line :class:`~whipple_kick.errors.InputError` messages naming
-the value, the allowed range and the unit. docs/simulate.md lists every
-decision.
+motion), the numerics. Each field is declared once, in the class body
+(:func:`whipple_kick.simulate.settings.setting`): its default, unit, range,
+group, the mechanism that reads it, the assembly steps' views that hold it
+and its command-line flag; the documentation, :meth:`Scenario.validate`'s
+per-field checks, :data:`FIELD_GROUPS`, :data:`MECHANISM_FIELDS`, the views
+and the flags of :mod:`whipple_kick.cli` follow.
+:meth:`Scenario.validate` raises one-line
+:class:`~whipple_kick.errors.InputError` messages naming the value, the
+allowed range and the unit. docs/simulate.md lists every decision.
 
 Example
 -------
@@ -17,12 +22,14 @@ Example
 ((300.0, 300.0), 4.0)
 """
 from dataclasses import asdict, dataclass, fields, replace
-import inspect
 
 from whipple_kick.errors import InputError, check_range
-from whipple_kick.library import inputs
+from whipple_kick.library import inputs, thesis, tyres
 from whipple_kick.model import carcass, parts, transient
 from whipple_kick.model.slip import SLIP_SPEEDS
+
+from . import settings as _settings
+from .settings import CASE_COMMANDS, EVERY_COMMAND, SIMULATE, part_setting, setting
 
 #: Rider models: the LQR designed on the linearised classic model, the thesis' Table 8.4 gains, or none.
 CONTROLLERS = ("lqr", "thesis", "off")
@@ -57,258 +64,93 @@ ARMS = ("off", "on")
 STARTS = ("steady", "upright")
 #: The longest run [s] after the kick start (``duration``).
 MAX_DURATION = 120.0
-#: Pitch of an upright start: ``compressed`` (solved with the tyres' compressions: the front contact on
-#: the ground) or ``uncompressed`` (solved with both tyres uncompressed, the compressions set after: the
-#: front contact starts below the ground; the authors' published code).
+#: Pitch of an upright start: ``compressed`` (solved with the tyres' compressions: the
+#: front contact on the ground) or ``uncompressed`` (solved with both tyres uncompressed,
+#: the compressions set after: the front contact starts below the ground; the authors' published code).
 START_PITCHES = ("compressed", "uncompressed")
 
-#: The declared parts' scenario fields (:class:`whipple_kick.model.parts.Field`) by the field that selects
-#: their part: each part's fields follow that field in :class:`Scenario` and share its group.
-_PART_FIELDS = {}
-for _part in parts.REGISTRY.values():
-    if _part.fields:
-        _PART_FIELDS.setdefault(_part.selected_by[0], []).extend(f.name for f in _part.fields)
-
-
-def _with_part_fields(cls):
-    """Give ``cls`` the declared parts' fields, each after the field that selects its part, and document them.
-
-    For :class:`Scenario` and for the view of the step that reads them (:class:`BodySpec`).
-
-    A part declares its fields once, with range, unit, default and source
-    (:func:`whipple_kick.model.parts.fields`); the dataclass field, its
-    entry in the class's docstring, its range check, its CLI flag and its
-    refusal while the part is off all follow from that declaration.
-    """
-    annotations, documented = {}, []
-    for name, annotation in inspect.get_annotations(cls).items():
-        annotations[name] = annotation
-        for part in parts.REGISTRY.values():
-            if part.selected_by[:1] != (name,):
-                continue
-            for f in part.fields:
-                annotations[f.name] = float
-                if hasattr(cls, name):   # defaults where the class has them (Scenario), none in a view
-                    setattr(cls, f.name, f.default)
-                low = f"more than {f.low:g}" if f.refuse_low else f"{f.low:g}"   # its low end is refused (validate)
-                documented.append(f"    {f.name} : float\n        The {f.label} of {part.title or part.name} "
-                                  f"[{f.unit}], {low} to {f.high:g}; default {f.default:g}: {f.source}.\n")
-    cls.__annotations__ = annotations
-    # The entries join the docstring's list of fields: before its Notes, or at its end.
-    notes = "\n    Notes\n    -----"
-    cls.__doc__ = (cls.__doc__.replace(notes, "".join(documented) + notes, 1) if notes in cls.__doc__
-                   else cls.__doc__.rstrip() + "\n" + "".join(documented))
-    return cls
+_REFLEX_GAINS = ("reflex_roll", "reflex_roll_rate", "reflex_steer", "reflex_steer_rate")
 
 
 @dataclass(frozen=True)
-@_with_part_fields
+class Mechanism:
+    """A mechanism of a run that reads some fields (:attr:`Setting.mechanisms <whipple_kick.simulate.settings.Setting>`).
+
+    ``title`` and ``condition`` are words for the refusal message; ``active(scenario)`` says whether the
+    scenario uses it.
+    """
+
+    title: str
+    condition: str
+    active: object
+
+
+#: The mechanisms the fields name (besides the declared parts, each its own mechanism), in the order a refusal
+#: looks for them. :meth:`Scenario.validate` refuses a field given other than its default while a
+#: mechanism that reads it is off (:meth:`Scenario.unused_fields`): refused rather than warned, because a
+#: warning is lost among a sweep's cases and the run's scenario.toml would still record a value that did nothing.
+MECHANISMS = {
+    "carcass": Mechanism("the carcass tyre", "tyre_transient 'carcass'", lambda s: s.tyre_transient == "carcass"),
+    # "off" is no rider torque at all: neither the voluntary law nor the reflex steers.
+    "steer_control": Mechanism("the rider's steer control",
+                               "controller 'lqr' or 'thesis'; controller 'off' applies no rider torque",
+                               lambda s: s.controller != "off"),
+    "reflex": Mechanism("the reflex", "a reflex gain other than 0",
+                        lambda s: any(getattr(s, g) != 0.0 for g in _REFLEX_GAINS)),
+    "lqr": Mechanism("the LQR rider", "controller 'lqr'", lambda s: s.controller == "lqr"),
+    "lqr_simulated": Mechanism("the LQR rider designed on the model simulated",
+                               "controller 'lqr', lqr_model 'simulated'",
+                               lambda s: s.controller == "lqr" and s.lqr_model == "simulated"),
+    "thesis_rider": Mechanism("the thesis' Table 8.4 rider", "controller 'thesis'", lambda s: s.controller == "thesis"),
+    # The integration applies the plate stop's speed change only where the plate stops instantly.
+    "plate_stop": Mechanism("the instant plate stop", "kick_profile 'constant' and piecewise",
+                            lambda s: s.kick_profile == "constant" and s.piecewise),
+    "steady_start": Mechanism("the steady start", "start 'steady'", lambda s: s.start == "steady"),
+    "upright_start": Mechanism("the upright start", "start 'upright'", lambda s: s.start == "upright"),
+}
+
+
+def _mechanism(key):
+    """The :class:`Mechanism` called ``key``: one of :data:`MECHANISMS`, or a declared part (read while selected)."""
+    if key in MECHANISMS:
+        return MECHANISMS[key]
+    part = parts.REGISTRY[key]
+    return Mechanism(part.title or part.name, f"{part.selected_by[0]} {part.selected_by[1]!r}", part.selected)
+
+
+def mechanism_fields(cls):
+    """``(mechanism, when it is in use (words), when it is in use (test), fields)`` of ``cls``'s declarations.
+
+    The mechanisms of :data:`MECHANISMS` (the carcass tyre first), with each declared part's after the carcass
+    tyre, as :data:`MECHANISM_FIELDS` is for :class:`Scenario`.
+    """
+    declared = {}
+    for s in _settings.settings(cls).values():
+        for key in s.mechanisms:
+            declared.setdefault(key, []).append(s.name)
+    keys = list(MECHANISMS)
+    keys[1:1] = [k for k in declared if k not in MECHANISMS]   # the parts, after the carcass tyre
+    out = []
+    for key in keys:
+        if key in declared:
+            m = _mechanism(key)
+            out.append((m.title, m.condition, m.active, tuple(declared[key])))
+    return tuple(out)
+
+
+_BICYCLE_AND_RIDER, _TYRES, _BODY, _RIDING = "bicycle and rider", "tyres", "rider's body", "riding and control"
+_KICK, _RUN = "kick", "run and output"
+
+
+@_settings.documented
+@dataclass(frozen=True)
 class Scenario:
     """One kick-plate run; the defaults are the project's choices, not all the thesis' (:meth:`thesis` has its).
 
     Units are SI except pressures [kPa]. ``None`` means "the default rule"
-    described per field.
-
-    Attributes
-    ----------
-    bicycle : str
-        Bicycle parameter set (:func:`whipple_kick.library.bicycles.available`) or a
-        path. A set without rider gets the Yeadon rider seated; a preset with
-        the rider included is used as it is (then ``fz_n`` and
-        ``rider_mass_kg`` must be None).
-    fz_n, rider_mass_kg : float or None
-        Static rear-tyre load [N] the rider's mass is chosen for, or the
-        rider's mass [kg]; at most one. Default 635 N for a bicycle without rider.
-    rear_load_share : float or None
-        Fraction of the bicycle-rider's static weight on the rear tyre [1], in (0, 1). None (default): the
-        rider sits in the seated posture and the share follows. Given: with ``fz_n`` (default 635 N) the
-        weight is ``fz_n / rear_load_share``, which fixes the rider's mass; with ``rider_mass_kg`` the rear
-        load follows; either way the whole rider is moved fore-aft along the bicycle's x axis (posture
-        kept, at most 0.15 m) so that the static loads hold (:func:`whipple_kick.library.riders.for_load_share`).
-    rider : str
-        Yeadon rider file seated on a bicycle-only set, or ``"none"``
-        (:data:`whipple_kick.library.riders.NO_RIDER`): the bicycle's
-        parameters include its rider (a BicycleParameters ``Benchmark.txt``
-        whose rear frame holds the rider, as the Meijaard benchmark's mB = 85
-        kg: BicycleParameters cannot say so), so no rider is seated and the
-        bicycle runs as it is, with its own load share; ``fz_n``,
-        ``rider_mass_kg`` and ``rear_load_share`` must then be None. A
-        bicycle-only set with ``"none"`` is refused.
-    tyre : str
-        Tyre on both wheels (default T03, the kick-plate bicycle's tyre).
-    pressure_kpa : float
-        Inflation pressure of both tyres [kPa], unless overridden per wheel by
-        ``pressure_front_kpa`` / ``pressure_rear_kpa``.
-    coefficient_set : str
-        Magic-Formula coefficient set (``"table7_9"`` or, T03 only, ``"chapter8"``,
-        the fit the thesis' Chapter 8 code used).
-    friction : {"none", "plate", "thesis"}
-        Friction mode of both tyres (:data:`whipple_kick.library.tyres.FRICTION_MODES`).
-    symmetric_tyres : bool
-        Zero the tyres' zero-slip offsets, so the steady motion is exactly upright.
-    speed : float
-        Forward speed [m/s] of the steady motion before the kick.
-    controller : {"lqr", "thesis", "off"}
-        LQR designed on the linearised classic model at ``design_speed``;
-        the thesis' Table 8.4 gains (for 570/635/701 N); or no steer torque.
-    design_speed : float or None
-        LQR design speed [m/s]. Default None: the run's ``speed``, as a real
-        rider adapts to the speed. Give 3.0 to fix the rider as the thesis
-        did. Used by ``controller="lqr"`` only (Table 8.4's gains were
-        designed at 3 m/s).
-    gain_scale : float
-        Multiplies every controller gain (thesis Figure 8.7: 0.5).
-    thesis_load_n : float or None
-        Rear load [N] whose Table 8.4 gains ``controller="thesis"`` uses;
-        default ``fz_n``, or for a preset that already includes the rider the
-        load it is labelled with (``balanceassist_635N``: 635 N).
-    low_inertia : bool
-        Halve the rear frame's IBxx, IByy, IBzz, IBxz and mass-centre height zB
-        (thesis Figure 8.9). The LQR is still designed on the unmodified
-        bicycle (the rider's controller does not change, the plant does).
-    kick_displacement : float
-        Plate travel [m] (>= 0; direction by ``kick_direction``). With a
-        table the travel comes from the table: leave it at its default.
-    kick_duration, kick_accel : float or None
-        Plate travel time [s] or peak plate acceleration [m/s^2]; at most
-        one. Default 0.150 s (13.3 m/s^2 for the thesis' 0.150 m). Not with
-        a table.
-    kick_profile : {"constant", "smooth", "table"}
-        Constant acceleration (thesis), minimum-jerk quintic (finite jerk),
-        or the plate displacement tabulated in ``kick_table``.
-    kick_table : str or None
-        CSV of the plate's lateral displacement (``kick_profile="table"``
-        only; see :func:`whipple_kick.library.inputs.load_kick_table`): columns ``time`` [s, from the
-        kick start, the trajectory's clock] and ``y`` [m, + to the right].
-        The plate follows the clamped cubic spline through the rows
-        (:func:`whipple_kick.library.inputs.cubic_segments`), rests at the first
-        row's y before the first time and at the last row's y after the
-        last; the table must lie within [-settle, duration].
-    kick_direction : {"right", "left"}
-        Plate moves to the bicycle's right (+y) or left; ``left`` mirrors a
-        table's y.
-    settle : float
-        Steady running shown before the kick [s].
-    duration : float
-        Simulated time after the kick starts [s].
-    rtol : float
-        LSODA relative tolerance (thesis 1e-12).
-    output_rate : float
-        Samples per second of the trajectory [Hz].
-    fall_angle_deg : float
-        ``|roll|`` [deg] that counts as a fall and ends the run.
-    steer_limit_deg : float or None
-        ``|steer|`` [deg] that also ends the run as lost (``fall_reason``
-        "steer"): past 90 deg the front wheel rolls backwards, which the tyre
-        model (forward rolling, pneumatic trail behind the contact) does not
-        describe, and no rider recovers from a fork turned over. Without
-        steer control the fork turns over before the roll reaches 45 deg.
-        None: no steer limit (a fork past 90 deg spins on, so 180 is not
-        the same as no limit).
-    piecewise : bool
-        Restart the integrator at the kick's start and end (default). False
-        integrates from -settle across the kick and the plate stop in one
-        LSODA run, without the plate stop's impulse (for comparison only;
-        not with a table, whose every interval is its own parameter set).
-    tyre_transient : {"carcass", "contact_patch", "slip_lag", "force_lag"}
-        How the tyre forces build up (:mod:`whipple_kick.model.transient`): a
-        lateral carcass spring in series with a sliding contact patch
-        (default: passive and friction-limited whatever the load does; the
-        force lag at small slip, :mod:`whipple_kick.model.carcass`); lagged
-        contact-patch slip and camber with a slip-dependent relaxation
-        length (friction-limited, not passive under load changes); the same
-        with a constant relaxation length; or the thesis' lagged force.
-    carcass_sliding : {"peak", "curve"}
-        The carcass tyre's friction limit once the patch slides past the
-        curve's peak: the peak itself (default, a Coulomb plateau that uses
-        nothing of the fit past the peak) or the steady curve at the
-        wheel's kinematic slip (steady sliding follows the fit's falling
-        branch). Carcass transient only.
-    carcass_damping : float
-        Lateral damping of each carcass [N s/m], parallel to its stiffness
-        (default 0: the thesis' pure relaxation). Carcass transient only.
-    carcass_stiffness_scale : float
-        Factor on both carcass stiffnesses C_Fa(F_z0)/sigma0 (default 1; the
-        identification of the rider's body varies it, scripts/identify_rider.py). Carcass transient only.
-    lqr_model : {"whipple", "simulated"}
-        The model the LQR rider (``controller="lqr"``) is designed on: the
-        linearised Carvallo-Whipple model (default; full state, roll and
-        steer), or the model the run simulates (tyres, body, arms, reflex),
-        linearised about upright straight running at the design speed, with
-        the law feeding back what the rider feels (roll, steer, their rates,
-        and the upper body's lean and its rate when it leans), its gains
-        LQR-optimal for that law (:func:`whipple_kick.simulate.control.output_feedback_lqr`).
-    lqr_heading : bool
-        With ``lqr_model="simulated"``: the law also feeds back the heading
-        (yaw angle q3, gain kq3), so the rider steers back to the heading held
-        before the kick. Needs straight steady running (``symmetric_tyres``).
-    rider_body : {"rigid", "leaning"}
-        The rider lumped rigidly into the rear frame (default), or an upper
-        body (pelvis, trunk, head, upper arms) leaning on the saddle on the
-        hip spring-damper (:func:`whipple_kick.library.riders.seat_with_body`).
-    arms : {"off", "on"}
-        "on": the forearms and hands turn with the bar and the arms are a
-        spring-damper about the steer axis between the bar and the upper body
-        (the rear frame with a rigid rider). "off" (default): the hands have
-        no mechanical effect on the bar.
-    reflex_delay : float
-        Delay of the rider's reflex [s], a (3,4) Pade filter (:mod:`whipple_kick.model.reflex`); 0 none.
-    reflex_roll, reflex_roll_rate, reflex_steer, reflex_steer_rate : float
-        Reflex steer-torque gains on roll [N m/rad], roll rate [N m s/rad],
-        steer [N m/rad] and steer rate [N m s/rad], ``T = -(g x)`` delayed;
-        separate from the voluntary law (the controller). Default 0.
-    carcass_viscosity : float
-        Numerics: the sliding viscosity [N s/m] that regularises an
-        undamped carcass' friction limit (a patch past the limit slides
-        faster by the excess force over it;
-        :data:`whipple_kick.model.carcass.SLIDING_VISCOSITY`). Smaller is closer
-        to the Coulomb plateau and stiffer (at least 1e-3 N s/m: below,
-        LSODA stalls); docs/validation.md shows the results converged.
-    plate_stop : {"impulse", "resolve", "keep_speeds"}
-        Speeds across the constant-acceleration profile's instant plate
-        stop: the rear no-slip constraint's impulse (default), a re-solve
-        of the dependent speeds only (the earlier model, which removes
-        energy no force accounts for), or no jump at all with the rear
-        contact left sliding along its heading (the authors' published
-        code, :data:`PLATE_STOPS`). The other profiles stop the plate
-        smoothly.
-    kick_heading : {"fixed", "settled"}
-        ``fixed`` (default): the post-kick run starts from the exact steady
-        motion with heading N.x (perpendicular to the plate's motion) and
-        the rear contact at the origin, whatever ``settle``; the settle is
-        integrated separately and is display only. ``settled``: the steady
-        motion starts so at -settle (the earlier model: with a steady turn
-        the heading at the kick then depends on ``settle``).
-    camber_sign : {"physical", "reversed"}
-        Sign of the camber fed to the Magic Formula. ``physical`` (default):
-        a leaning wheel is pushed toward the lean, as measured. ``reversed``:
-        away from it, as in the thesis authors' published code (the curves
-        evaluated at the opposite camber:
-        :func:`whipple_kick.model.magic_formula.camber_reversed`). Not physical;
-        it exists to explain that code's runs.
-    start : {"steady", "upright"}
-        ``steady`` (default): the run starts from the solved steady motion.
-        ``upright``: from upright straight running with the tyre states at
-        their zero-slip values and no rear-wheel torque
-        (:func:`whipple_kick.simulate.steady.upright_state`), as the authors' code
-        starts; with measured tyres this is not an equilibrium (their
-        offsets act from t = 0). Needs ``settle = 0`` (the kick starts the run).
-    start_pitch : {"compressed", "uncompressed"}
-        Pitch of the upright start. ``compressed`` (default): solved with
-        the tyres' compressions, so the front contact is on the ground.
-        ``uncompressed``: solved with both tyres uncompressed and the
-        compressions set after (vertical equilibrium at that pitch), as the
-        authors' code starts: the front contact then starts below the ground
-        by about the rear compression less the front one (3.2 mm at 500 kPa
-        with ``balanceassist_635N``) and stays so (only the constraint's
-        rate is imposed). Needs ``start = "upright"``.
-    slip_speed : {"wheel_centre", "contact_point"}
-        Whose forward speed along the wheel's heading the tyres' slip angle
-        ``atan(v_sy / |v_x|)`` and relaxation ``sigma / |v_x|`` use: the
-        wheel centre's (default) or the geometric contact point's, as the
-        authors' code takes it. They differ while the wheel's centre moves
-        relative to its contact (rolling, pitching, steering); the
-        trajectory's ``rolling_speed_*`` columns are the speed in use.
+    described per field. Each field is declared once, below, with
+    :func:`~whipple_kick.simulate.settings.setting`; its entry here comes
+    from that declaration.
 
     Notes
     -----
@@ -328,60 +170,379 @@ class Scenario:
     :attr:`gains_spec`, :attr:`model_spec`, :attr:`design_spec`.
     """
 
-    bicycle: str = "balanceassist_v1"
-    fz_n: float | None = None
-    rider_mass_kg: float | None = None
-    rear_load_share: float | None = None
-    rider: str = "jason"
-    tyre: str = "T03"
-    pressure_kpa: float = 400.0
-    pressure_front_kpa: float | None = None
-    pressure_rear_kpa: float | None = None
-    coefficient_set: str = "table7_9"
-    friction: str = "none"
-    symmetric_tyres: bool = False
-    speed: float = 3.0
-    controller: str = "lqr"
-    design_speed: float | None = None
-    gain_scale: float = 1.0
-    thesis_load_n: float | None = None
-    low_inertia: bool = False
-    kick_displacement: float = 0.150
-    kick_duration: float | None = None
-    kick_accel: float | None = None
-    kick_profile: str = "constant"
-    kick_table: str | None = None
-    kick_direction: str = "right"
-    settle: float = 0.5
-    duration: float = 6.0
-    rtol: float = 1e-10
-    output_rate: float = 1000.0
-    fall_angle_deg: float = 45.0
-    steer_limit_deg: float | None = 90.0
-    piecewise: bool = True
-    tyre_transient: str = transient.DEFAULT_TRANSIENT
-    carcass_sliding: str = carcass.DEFAULT_SLIDING
-    carcass_damping: float = 0.0
-    carcass_viscosity: float = carcass.SLIDING_VISCOSITY
-    carcass_stiffness_scale: float = 1.0
-    lqr_model: str = "whipple"
-    lqr_heading: bool = False
-    rider_body: str = "rigid"
-    arms: str = "off"
-    reflex_delay: float = 0.0
-    reflex_roll: float = 0.0
-    reflex_roll_rate: float = 0.0
-    reflex_steer: float = 0.0
-    reflex_steer_rate: float = 0.0
-    plate_stop: str = "impulse"
-    kick_heading: str = "fixed"
-    camber_sign: str = "physical"
-    start: str = "steady"
-    start_pitch: str = "compressed"
-    slip_speed: str = "wheel_centre"
+    bicycle: str = setting(
+        "balanceassist_v1",
+        "Bicycle parameter set (:func:`whipple_kick.library.bicycles.available`) or a path. A set without rider "
+        "gets the Yeadon rider seated; a preset with the rider included is used as it is (then ``fz_n`` and "
+        "``rider_mass_kg`` must be None).",
+        views=("bicycle", "gains"), commands=EVERY_COMMAND, section=_BICYCLE_AND_RIDER, metavar="NAME",
+        help="bicycle parameter set or .toml path (default {default}; presets with the rider included: "
+             "balanceassist_635N, balanceassist_701N, browser_with_rider), or a BicycleParameters bicycle folder "
+             "(<data>/bicycles/<Name>) or <Name>Benchmark.txt")
+    fz_n: float | None = setting(
+        None,
+        f"Static rear-tyre load [N] the rider's mass is chosen for; at most one of it and ``rider_mass_kg``. "
+        f"Default {thesis.REFERENCE_LOAD_N:g} N for a bicycle without rider.",
+        unit="N", low=0.0, low_open=True, label="rear-tyre load fz", none_means=thesis.REFERENCE_LOAD_N,
+        views=("bicycle", "gains"), commands=CASE_COMMANDS, section=_BICYCLE_AND_RIDER, flag="--fz", metavar="N",
+        exclusive="who", help="static rear-tyre load in N that the rider's mass is chosen for (default {none_means})")
+    rider_mass_kg: float | None = setting(
+        None, "The rider's mass [kg]; at most one of it and ``fz_n``.",
+        unit="kg", views=("bicycle", "gains"), commands=CASE_COMMANDS, section=_BICYCLE_AND_RIDER,
+        flag="--rider-mass", metavar="KG", exclusive="who", help="rider mass in kg")
+    rear_load_share: float | None = setting(
+        None,
+        "Fraction of the bicycle-rider's static weight on the rear tyre [1], in (0, 1). None (default): the "
+        "rider sits in the seated posture and the share follows. Given: with ``fz_n`` (default "
+        f"{thesis.REFERENCE_LOAD_N:g} N) the weight is ``fz_n / rear_load_share``, which fixes the rider's mass; "
+        "with ``rider_mass_kg`` the rear load follows; either way the whole rider is moved fore-aft along the "
+        "bicycle's x axis (posture kept, at most 0.15 m) so that the static loads hold "
+        "(:func:`whipple_kick.library.riders.for_load_share`).",
+        unit="(unit 1)", low=0.0, high=1.0, low_open=True, high_open=True, label="rear load share",
+        views=("bicycle",), commands=CASE_COMMANDS, section=_BICYCLE_AND_RIDER, flag="--rear-share",
+        metavar="FRACTION",
+        help="share of the static weight on the rear tyre, in (0, 1): the rider is moved fore-aft (at most 0.15 m, "
+             "posture kept) so that it holds, with --fz's load (its mass follows) or --rider-mass (default: the "
+             "seated posture's share)")
+    rider: str = setting(
+        "jason",
+        "Yeadon rider file seated on a bicycle-only set, or ``\"none\"`` (:data:`whipple_kick.library.riders.NO_RIDER`): "
+        "the bicycle's parameters include its rider (a BicycleParameters ``Benchmark.txt`` whose rear frame holds "
+        "the rider, as the Meijaard benchmark's mB = 85 kg: BicycleParameters cannot say so), so no rider is "
+        "seated and the bicycle runs as it is, with its own load share; ``fz_n``, ``rider_mass_kg`` and "
+        "``rear_load_share`` must then be None. A bicycle-only set with ``\"none\"`` is refused.",
+        views=("bicycle", "gains"), commands=EVERY_COMMAND, section=_BICYCLE_AND_RIDER, metavar="NAME",
+        help="Yeadon rider seated on a bicycle-only set (default {default}; available: {riders}), or none: the "
+             "bicycle's parameters include its rider (a BicycleParameters Benchmark.txt whose rear frame holds the "
+             "rider, as the Meijaard benchmark's mB = 85 kg), which then runs as it is, with its own load share "
+             "(no --fz, --rider-mass or --rear-share)")
+    tyre: str = setting(
+        "T03", "Tyre on both wheels (default T03, the kick-plate bicycle's tyre).",
+        views=("tyre",), commands=EVERY_COMMAND, section=_TYRES, metavar="NAME",
+        help="tyre on both wheels (default {default}; available: {tyres})")
+    pressure_kpa: float = setting(
+        thesis.REFERENCE_PRESSURE_KPA,
+        "Inflation pressure of both tyres [kPa], unless overridden per wheel by ``pressure_front_kpa`` / "
+        "``pressure_rear_kpa``.",
+        unit="kPa", low=0.0, low_open=True, label="pressure", views=("tyre",), commands=CASE_COMMANDS,
+        section=_TYRES, flag="--pressure", metavar="KPA",
+        help="inflation pressure of both tyres in kPa (default {default})")
+    pressure_front_kpa: float | None = setting(
+        None, "Front tyre pressure [kPa] (default: ``pressure_kpa``).",
+        unit="kPa", low=0.0, low_open=True, label="front pressure", views=("tyre",), commands=CASE_COMMANDS,
+        section=_TYRES, flag="--pressure-front", metavar="KPA",
+        help="front tyre pressure in kPa (with --pressure-rear, instead of --pressure)")
+    pressure_rear_kpa: float | None = setting(
+        None, "Rear tyre pressure [kPa] (default: ``pressure_kpa``).",
+        unit="kPa", low=0.0, low_open=True, label="rear pressure", views=("tyre",), commands=CASE_COMMANDS,
+        section=_TYRES, flag="--pressure-rear", metavar="KPA",
+        help="rear tyre pressure in kPa (with --pressure-front, instead of --pressure)")
+    coefficient_set: str = setting(
+        "table7_9",
+        "Magic-Formula coefficient set (``\"table7_9\"`` or, T03 only, ``\"chapter8\"``, the fit the thesis' "
+        "Chapter 8 code used).",
+        views=("tyre",), commands=EVERY_COMMAND, section=_TYRES, metavar="SET",
+        help="Magic-Formula coefficients: table7_9 (default, thesis Table 7.9) or chapter8 (T03 only: the fit the "
+             "thesis' Chapter 8 code used)")
+    friction: str = setting(
+        "none", "Friction mode of both tyres (:data:`whipple_kick.library.tyres.FRICTION_MODES`).",
+        choices=tyres.FRICTION_MODES, check_choices=False, views=("tyre",), commands=EVERY_COMMAND, section=_TYRES,
+        help="friction correction rig -> plate: none (default), plate (peak x 1.30), thesis (whole curves x 1.32, "
+             "as the thesis' code)")
+    symmetric_tyres: bool = setting(
+        False, "Zero the tyres' zero-slip offsets, so the steady motion is exactly upright.",
+        views=("model",), commands=("simulate", "validate"), section=_TYRES,
+        help="zero the tyres' zero-slip offsets (exactly upright steady running)")
+    speed: float = setting(
+        3.0, "Forward speed [m/s] of the steady motion before the kick.",
+        unit="m/s", low=0.0, high=15.0, low_open=True, views=("gains", "design"), commands=SIMULATE,
+        section=_RIDING, metavar="M/S", help="forward speed in m/s (default {default})")
+    controller: str = setting(
+        "lqr",
+        f"LQR designed on the linearised classic model at ``design_speed``; the thesis' Table 8.4 gains (for "
+        f"{thesis.loads_text('/')} N); or no steer torque.",
+        choices=CONTROLLERS, views=("gains",), commands=EVERY_COMMAND, section=_RIDING,
+        help=f"lqr: designed on the linearised classic model (default); thesis: Table 8.4 gains "
+             f"({thesis.loads_text()} N only); off: no steer torque")
+    design_speed: float | None = setting(
+        None,
+        "LQR design speed [m/s]. Default None: the run's ``speed``, as a real rider adapts to the speed. Give "
+        "3.0 to fix the rider as the thesis did. Used by ``controller=\"lqr\"`` only (Table 8.4's gains were "
+        "designed at 3 m/s).",
+        unit="m/s", low=0.0, high=15.0, low_open=True, label="design speed", mechanisms=("lqr",),
+        views=("gains", "design"), commands=EVERY_COMMAND, section=_RIDING, metavar="M/S",
+        help=f"LQR design speed in m/s (default: {{design_default}}, as a real rider adapts; the thesis fixed it at "
+             f"{THESIS_DESIGN_SPEED:g})")
+    gain_scale: float = setting(
+        1.0, "Multiplies every controller gain (thesis Figure 8.7: 0.5).",
+        unit="(factor)", low=0.0, high=10.0, mechanisms=("steer_control",), views=("gains", "design"),
+        commands=EVERY_COMMAND, section=_RIDING, metavar="FACTOR",
+        help="multiply every controller gain (default {default}; the thesis also ran 0.5)")
+    thesis_load_n: float | None = setting(
+        None,
+        "Rear load [N] whose Table 8.4 gains ``controller=\"thesis\"`` uses; default ``fz_n``, or for a preset "
+        "that already includes the rider the load it is labelled with (``balanceassist_635N``: 635 N).",
+        unit="N", mechanisms=("thesis_rider",), views=("gains",), commands=CASE_COMMANDS, section=_RIDING,
+        flag="--thesis-load", metavar="N",
+        help=f"rear load in N whose Table 8.4 gains --controller thesis uses ({thesis.loads_text(last=' or ')}; "
+             f"default --fz, or the load a preset with rider is labelled with)")
+    low_inertia: bool = setting(
+        False,
+        "Halve the rear frame's IBxx, IByy, IBzz, IBxz and mass-centre height zB (thesis Figure 8.9). The LQR "
+        "is still designed on the unmodified bicycle (the rider's controller does not change, the plant does).",
+        views=("bicycle",), commands=EVERY_COMMAND, section=_BICYCLE_AND_RIDER,
+        help="halve the rear frame's inertias and mass-centre height (thesis Figure 8.9)")
+    kick_displacement: float = setting(
+        inputs.DEFAULT_DISPLACEMENT,
+        "Plate travel [m] (>= 0; direction by ``kick_direction``). With a table the travel comes from the "
+        "table: leave it at its default.",
+        unit="m", commands=SIMULATE, section=_KICK, metavar="M", help="plate travel in m (default {default:.3f})")
+    kick_duration: float | None = setting(
+        None,
+        f"Plate travel time [s]; at most one of it and ``kick_accel``. Default {inputs.DEFAULT_DURATION:.3f} s "
+        "(13.3 m/s^2 for the thesis' 0.150 m). Not with a table.",
+        unit="s", none_means=inputs.DEFAULT_DURATION, commands=SIMULATE, section=_KICK, metavar="S",
+        exclusive="how", help="plate travel time in s (default {none_means:.3f})")
+    kick_accel: float | None = setting(
+        None, "Peak plate acceleration [m/s^2]; at most one of it and ``kick_duration``. Not with a table.",
+        unit="m/s^2", commands=SIMULATE, section=_KICK, metavar="M/S2", exclusive="how",
+        help="peak plate acceleration in m/s^2 (sets the duration)")
+    kick_profile: str = setting(
+        "constant",
+        "Constant acceleration (thesis), minimum-jerk quintic (finite jerk), or the plate displacement "
+        "tabulated in ``kick_table``.",
+        choices=inputs.PROFILES, check_choices=False, commands=SIMULATE, section=_KICK,
+        help="constant acceleration (default, thesis), smooth (minimum jerk) or table (plate displacement from "
+             "--kick-table)")
+    kick_table: str | None = setting(
+        None,
+        "CSV of the plate's lateral displacement (``kick_profile=\"table\"`` only; see "
+        ":func:`whipple_kick.library.inputs.load_kick_table`): columns ``time`` [s, from the kick start, the "
+        "trajectory's clock] and ``y`` [m, + to the right]. The plate follows the clamped cubic spline through "
+        "the rows (:func:`whipple_kick.library.inputs.cubic_segments`), rests at the first row's y before the "
+        "first time and at the last row's y after the last; the table must lie within [-settle, duration].",
+        commands=SIMULATE, section=_KICK, metavar="FILE",
+        help="CSV of the plate's displacement, columns time (from the kick start) and y (+ right), units in the "
+             "header: 'time [s]' or 'time [ms]', 'y [m]' or 'y [mm]' (none: s, m); a header-less file is read as "
+             "two columns time [s], y [m]. The plate follows the clamped cubic spline through the rows (implies "
+             "--kick-profile table; not with --kick-accel/--kick-duration/--kick-displacement)")
+    kick_direction: str = setting(
+        "right", "Plate moves to the bicycle's right (+y) or left; ``left`` mirrors a table's y.",
+        choices=inputs.DIRECTIONS, check_choices=False, commands=SIMULATE, section=_KICK,
+        help="direction the plate moves (default {default})")
+    settle: float = setting(
+        0.5, "Steady running shown before the kick [s].",
+        unit="s", low=0.0, high=60.0, label="settle time", group="run", commands=SIMULATE, section=_RUN,
+        metavar="S", help="steady running shown before the kick in s (default {default})")
+    duration: float = setting(
+        6.0, "Simulated time after the kick starts [s].",
+        unit="s", low=0.0, high=MAX_DURATION, low_open=True, group="run", commands=SIMULATE, section=_RUN,
+        metavar="S", help=f"simulated time after the kick start in s (default {{default}}, at most {MAX_DURATION:g})")
+    rtol: float = setting(
+        1e-10, "LSODA relative tolerance (thesis 1e-12).",
+        unit="(relative)", low=1e-14, high=1e-3, group="numerics", commands=SIMULATE, section=_RUN,
+        metavar="RTOL", help="LSODA relative tolerance (default {default}; the thesis used 1e-12)")
+    output_rate: float = setting(
+        1000.0, "Samples per second of the trajectory [Hz].",
+        unit="Hz", low=1.0, high=1e5, group="run", commands=SIMULATE, section=_RUN, metavar="HZ",
+        help="samples per second of the run in Hz (default {default}: about 1 MB of trajectory.csv per simulated "
+             "second); the metrics are computed from these samples, e.g. the recovery time to 1/HZ")
+    fall_angle_deg: float = setting(
+        45.0, "``|roll|`` [deg] that counts as a fall and ends the run.",
+        unit="deg", low=0.0, high=90.0, low_open=True, high_open=True, label="fall angle", group="run")
+    steer_limit_deg: float | None = setting(
+        90.0,
+        "``|steer|`` [deg] that also ends the run as lost (``fall_reason`` \"steer\"): past 90 deg the front wheel "
+        "rolls backwards, which the tyre model (forward rolling, pneumatic trail behind the contact) does not "
+        "describe, and no rider recovers from a fork turned over. Without steer control the fork turns over "
+        "before the roll reaches 45 deg. None: no steer limit (a fork past 90 deg spins on, so 180 is not the "
+        "same as no limit).",
+        unit="deg", low=0.0, high=180.0, low_open=True, label="steer limit", group="run")
+    piecewise: bool = setting(
+        True,
+        "Restart the integrator at the kick's start and end (default). False integrates from -settle across "
+        "the kick and the plate stop in one LSODA run, without the plate stop's impulse (for comparison only; "
+        "not with a table, whose every interval is its own parameter set).",
+        group="numerics")
+    tyre_transient: str = setting(
+        transient.DEFAULT_TRANSIENT,
+        "How the tyre forces build up (:mod:`whipple_kick.model.transient`): a lateral carcass spring in series "
+        "with a sliding contact patch (default: passive and friction-limited whatever the load does; the force "
+        "lag at small slip, :mod:`whipple_kick.model.carcass`); lagged contact-patch slip and camber with a "
+        "slip-dependent relaxation length (friction-limited, not passive under load changes); the same with a "
+        "constant relaxation length; or the thesis' lagged force.",
+        choices=TYRE_TRANSIENTS, label="tyre transient", views=("model", "design"), commands=EVERY_COMMAND,
+        section=_TYRES,
+        help="how the tyre forces build up: carcass (default: a lateral carcass spring in series with a sliding "
+             "contact patch; passive, friction-limited, the force lag at small slip), contact_patch (lagged patch "
+             "slip and camber), slip_lag (the same with a constant relaxation length) or force_lag (the thesis' "
+             "lagged force)")
+    carcass_sliding: str = setting(
+        carcass.DEFAULT_SLIDING,
+        "The carcass tyre's friction limit once the patch slides past the curve's peak: the peak itself "
+        "(default, a Coulomb plateau that uses nothing of the fit past the peak) or the steady curve at the "
+        "wheel's kinematic slip (steady sliding follows the fit's falling branch). Carcass transient only.",
+        choices=carcass.SLIDING_LAWS, label="carcass sliding law", mechanisms=("carcass",), views=("model", "design"),
+        commands=EVERY_COMMAND, section=_TYRES,
+        help="carcass tyre past the curve's peak: peak (default: the force stays at the peak) or curve (it follows "
+             "the steady curve at the kinematic slip: the fit's falling branch)")
+    carcass_damping: float = setting(
+        0.0,
+        "Lateral damping of each carcass [N s/m], parallel to its stiffness (default 0: the thesis' pure "
+        "relaxation). Carcass transient only.",
+        unit="N s/m", low=0.0, high=1e4, mechanisms=("carcass",), views=("model", "design"), commands=EVERY_COMMAND,
+        section=_TYRES, metavar="N_S_PER_M",
+        help="lateral damping of each carcass, parallel to its stiffness (default {default}: pure relaxation)")
+    carcass_viscosity: float = setting(
+        carcass.SLIDING_VISCOSITY,
+        "Numerics: the sliding viscosity [N s/m] that regularises an undamped carcass' friction limit (a patch "
+        "past the limit slides faster by the excess force over it; "
+        ":data:`whipple_kick.model.carcass.SLIDING_VISCOSITY`). Smaller is closer to the Coulomb plateau and "
+        "stiffer (at least 1e-3 N s/m: below, LSODA stalls, measured at 5e-4 at the plate stop); "
+        "docs/validation.md shows the results converged.",
+        unit="N s/m", low=1e-3, high=10.0, label="carcass sliding viscosity", group="numerics",
+        mechanisms=("carcass",), views=("model", "design"))
+    carcass_stiffness_scale: float = setting(
+        1.0,
+        "Factor on both carcass stiffnesses C_Fa(F_z0)/sigma0 (default 1; the identification of the rider's "
+        "body varies it, scripts/identify_rider.py). Carcass transient only.",
+        unit="(factor)", low=0.05, high=20.0, mechanisms=("carcass",), views=("model", "design"),
+        commands=EVERY_COMMAND, section=_TYRES, metavar="FACTOR",
+        help="factor on both carcass stiffnesses C_Fa/sigma0, in [0.05, 20] (default {default})")
+    lqr_model: str = setting(
+        "whipple",
+        "The model the LQR rider (``controller=\"lqr\"``) is designed on: the linearised Carvallo-Whipple model "
+        "(default; full state, roll and steer), or the model the run simulates (tyres, body, arms, reflex), "
+        "linearised about upright straight running at the design speed, with the law feeding back what the "
+        "rider feels (roll, steer, their rates, and the upper body's lean and its rate when it leans), its gains "
+        "LQR-optimal for that law (:func:`whipple_kick.simulate.control.output_feedback_lqr`).",
+        choices=LQR_MODELS, label="LQR design model", mechanisms=("lqr",), commands=EVERY_COMMAND, section=_RIDING,
+        help="what the LQR rider is designed on: whipple (default: the classic model, full state) or simulated "
+             "(the model the run simulates, feeding back roll, steer, their rates and the upper body's lean)")
+    lqr_heading: bool = setting(
+        False,
+        "With ``lqr_model=\"simulated\"``: the law also feeds back the heading (yaw angle q3, gain kq3), so the "
+        "rider steers back to the heading held before the kick. Needs straight steady running "
+        "(``symmetric_tyres``).",
+        mechanisms=("lqr_simulated",), views=("design",), commands=EVERY_COMMAND, section=_RIDING,
+        help="with --lqr-model simulated: the rider also holds the heading held before the kick (needs "
+             "--symmetric-tyres: straight steady running)")
+    rider_body: str = setting(
+        "rigid",
+        "The rider lumped rigidly into the rear frame (default), or an upper body (pelvis, trunk, head, upper "
+        "arms) leaning on the saddle on the hip spring-damper (:func:`whipple_kick.library.riders.seat_with_body`; "
+        "the trunk part, :data:`whipple_kick.model.parts.TRUNK`).",
+        choices=RIDER_BODIES, label="rider body", views=("bicycle", "body", "design"), commands=EVERY_COMMAND,
+        section=_BODY,
+        help="rigid (default: the rider lumped into the rear frame) or leaning (the upper body leans on the saddle "
+             "on the hip spring-damper)")
+    hip_stiffness: float = part_setting("trunk", "hip_stiffness")
+    hip_damping: float = part_setting("trunk", "hip_damping")
+    arms: str = setting(
+        "off",
+        "\"on\": the forearms and hands turn with the bar and the arms are a spring-damper about the steer axis "
+        "between the bar and the upper body (the rear frame with a rigid rider). \"off\" (default): the hands "
+        "have no mechanical effect on the bar.",
+        choices=ARMS, label="arms", views=("bicycle", "body"), commands=EVERY_COMMAND, section=_BODY,
+        help="on: the forearms turn with the bar and the arms are a spring-damper about the steer axis; off "
+             "(default): no mechanical effect on the bar")
+    arm_stiffness: float = part_setting("arms", "arm_stiffness")
+    arm_damping: float = part_setting("arms", "arm_damping")
+    reflex_delay: float = setting(
+        0.0, "Delay of the rider's reflex [s], a (3,4) Pade filter (:mod:`whipple_kick.model.reflex`); 0 none.",
+        unit="s", low=0.0, high=0.5, label="reflex delay", mechanisms=("steer_control", "reflex"), views=("body",),
+        commands=EVERY_COMMAND, section=_BODY, metavar="S",
+        help="delay of the rider's reflex steer torque (a Pade filter; at most 0.5 s) in s (default {default})")
+    reflex_roll: float = setting(
+        0.0,
+        "Reflex steer-torque gain on roll [N m/rad], ``T = -(g x)`` delayed; separate from the voluntary law "
+        "(the controller). Default 0.",
+        unit="N m/rad", low=-1e4, high=1e4, label="reflex roll gain", mechanisms=("steer_control",),
+        views=("body",), commands=EVERY_COMMAND, section=_BODY,
+        help="reflex steer-torque gain on roll, T = -gain x roll (a positive gain steers against the roll) in "
+             "N m/rad (default {default})")
+    reflex_roll_rate: float = setting(
+        0.0, "Reflex steer-torque gain on roll rate [N m s/rad] (as ``reflex_roll``).",
+        unit="N m s/rad", low=-1e4, high=1e4, label="reflex roll-rate gain", mechanisms=("steer_control",),
+        views=("body",), commands=EVERY_COMMAND, section=_BODY,
+        help="reflex steer-torque gain on roll rate in N m s/rad (default {default})")
+    reflex_steer: float = setting(
+        0.0, "Reflex steer-torque gain on steer [N m/rad] (as ``reflex_roll``).",
+        unit="N m/rad", low=-1e4, high=1e4, label="reflex steer gain", mechanisms=("steer_control",),
+        views=("body",), commands=EVERY_COMMAND, section=_BODY,
+        help="reflex steer-torque gain on steer in N m/rad (default {default})")
+    reflex_steer_rate: float = setting(
+        0.0, "Reflex steer-torque gain on steer rate [N m s/rad] (as ``reflex_roll``).",
+        unit="N m s/rad", low=-1e4, high=1e4, label="reflex steer-rate gain", mechanisms=("steer_control",),
+        views=("body",), commands=EVERY_COMMAND, section=_BODY,
+        help="reflex steer-torque gain on steer rate in N m s/rad (default {default})")
+    plate_stop: str = setting(
+        "impulse",
+        "Speeds across the constant-acceleration profile's instant plate stop: the rear no-slip constraint's "
+        "impulse (default), a re-solve of the dependent speeds only (the earlier model, which removes energy no "
+        "force accounts for), or no jump with the rear contact left sliding (``keep_speeds``, the authors' "
+        "code). The other profiles stop the plate smoothly.",
+        choices=PLATE_STOPS, label="plate stop", group="compatibility", mechanisms=("plate_stop",),
+        commands=SIMULATE, section=_KICK,
+        help="speeds across the constant profile's instant plate stop: impulse (default: the rear no-slip "
+             "constraint's impulse), resolve (dependent speeds only, the earlier model) or keep_speeds (no jump; "
+             "the rear contact is left sliding along its heading, as the authors' published code)")
+    kick_heading: str = setting(
+        "fixed",
+        "``fixed`` (default): the post-kick run starts from the exact steady motion with heading N.x "
+        "(perpendicular to the plate's motion) and the rear contact at the origin, whatever ``settle``; the "
+        "settle is integrated separately and is display only. ``settled``: the steady motion starts so at "
+        "-settle (the earlier model: with a steady turn the heading at the kick then depends on ``settle``).",
+        choices=KICK_HEADINGS, label="kick heading", group="compatibility", mechanisms=("steady_start",),
+        commands=SIMULATE, section=_KICK,
+        help="fixed (default): heading perpendicular to the plate at the kick start, whatever --settle; settled: "
+             "the steady motion starts so at -settle (the earlier model)")
+    camber_sign: str = setting(
+        "physical",
+        "Sign of the camber fed to the Magic Formula. ``physical`` (default): a leaning wheel is pushed toward "
+        "the lean, as measured. ``reversed``: away from it, as in the thesis authors' published code (the "
+        "curves evaluated at the opposite camber: :func:`whipple_kick.model.magic_formula.camber_reversed`). "
+        "Not physical; it exists to explain that code's runs.",
+        choices=CAMBER_SIGNS, label="camber sign", group="compatibility", views=("model",), commands=EVERY_COMMAND,
+        section=_TYRES,
+        help="physical (default: a leaning wheel is pushed toward the lean) or reversed (away from it, as the "
+             "thesis authors' published code; not physical)")
+    start: str = setting(
+        "steady",
+        "``steady`` (default): the run starts from the solved steady motion. ``upright``: from upright straight "
+        "running with the tyre states at their zero-slip values and no rear-wheel torque "
+        "(:func:`whipple_kick.simulate.steady.upright_state`), as the authors' code starts; with measured tyres "
+        "this is not an equilibrium (their offsets act from t = 0). Needs ``settle = 0`` (the kick starts the "
+        "run).",
+        choices=STARTS, label="start", group="compatibility", commands=SIMULATE, section=_RUN,
+        help="steady (default: the solved steady motion) or upright (upright straight running, not an equilibrium "
+             "with measured tyres, as the authors' code; needs --settle 0)")
+    start_pitch: str = setting(
+        "compressed",
+        "Pitch of the upright start. ``compressed`` (default): solved with the tyres' compressions, so the front "
+        "contact is on the ground. ``uncompressed``: solved with both tyres uncompressed and the compressions "
+        "set after (vertical equilibrium at that pitch), as the authors' code starts: the front contact then "
+        "starts below the ground by about the rear compression less the front one (3.2 mm at 500 kPa with "
+        "``balanceassist_635N``) and stays so (only the constraint's rate is imposed). Needs "
+        "``start = \"upright\"``.",
+        choices=START_PITCHES, label="start pitch", group="compatibility", mechanisms=("upright_start",),
+        commands=SIMULATE, section=_RUN,
+        help="pitch of the upright start: compressed (default: solved with the tyres' compressions, the front "
+             "contact on the ground) or uncompressed (solved without them, as the authors' code: the front contact "
+             "starts a few mm below the ground); needs --start upright")
+    slip_speed: str = setting(
+        "wheel_centre",
+        "Whose forward speed along the wheel's heading the tyres' slip angle ``atan(v_sy / |v_x|)`` and "
+        "relaxation ``sigma / |v_x|`` use: the wheel centre's (default) or the geometric contact point's, as the "
+        "authors' code takes it. They differ while the wheel's centre moves relative to its contact (rolling, "
+        "pitching, steering); the trajectory's ``rolling_speed_*`` columns are the speed in use.",
+        choices=SLIP_SPEEDS, label="slip speed", group="compatibility", views=("model", "design"),
+        commands=EVERY_COMMAND, section=_TYRES,
+        help="whose forward speed the tyres' slip angle and relaxation use: wheel_centre (default) or "
+             "contact_point (as the thesis authors' published code)")
 
     @classmethod
-    def thesis(cls, pressure_kpa=400.0, **changes):
+    def thesis(cls, pressure_kpa=thesis.REFERENCE_PRESSURE_KPA, **changes):
         """The Chapter 8 runs as the authors' code made them.
 
         Bicycle+rider preset ``balanceassist_635N``, the Table 8.4 gains of
@@ -465,7 +626,7 @@ class Scenario:
         return self._group("compatibility")
 
     def _group(self, name):
-        return {field: getattr(self, field) for field in FIELD_GROUPS[name]}
+        return {field: getattr(self, field) for field in _settings.groups(type(self))[name]}
 
     @property
     def lqr_design_speed(self) -> float:
@@ -484,7 +645,7 @@ class Scenario:
     @property
     def bicycle_spec(self) -> "BicycleSpec":
         """What :func:`~whipple_kick.simulate.assembly.build_bicycle` reads (:class:`BicycleSpec`)."""
-        return self._view(BicycleSpec)
+        return self.view("bicycle")
 
     @property
     def tyre_spec(self) -> "TyreSpec":
@@ -495,85 +656,56 @@ class Scenario:
         >>> Scenario(pressure_front_kpa=350.0).tyre_spec
         TyreSpec(tyre='T03', pressures=(400.0, 350.0), coefficient_set='table7_9', friction='none')
         """
-        return self._view(TyreSpec)
+        return self.view("tyre")
 
     @property
     def body_spec(self) -> "BodySpec":
         """What :func:`~whipple_kick.simulate.assembly.rider_body` reads (:class:`BodySpec`)."""
-        return self._view(BodySpec)
+        return self.view("body")
 
     @property
     def gains_spec(self) -> "GainsSpec":
         """What :func:`~whipple_kick.simulate.assembly.controller_gains` reads (:class:`GainsSpec`)."""
-        return self._view(GainsSpec)
+        return self.view("gains")
 
     @property
     def model_spec(self) -> "ModelSpec":
         """What :func:`~whipple_kick.simulate.assembly.model_parameters` reads (:class:`ModelSpec`)."""
-        return self._view(ModelSpec)
+        return self.view("model")
 
     @property
     def design_spec(self) -> "DesignSpec":
         """What the LQR design on the simulated model reads (:class:`DesignSpec`)."""
         return DesignSpec(speed=float(self.lqr_design_speed), leaning=self.rider_body == "leaning",
                           heading=bool(self.lqr_heading), gain_scale=float(self.gain_scale),
-                          model_options=tuple((name, getattr(self, name)) for name in DESIGN_MODEL_OPTIONS))
+                          model_options=tuple((name, getattr(self, name)) for name in design_model_options(type(self))))
 
-    def _view(self, spec_class):
-        # The views' fields are named after the attributes they copy.
-        return spec_class(**{f.name: getattr(self, f.name) for f in fields(spec_class)})
+    def view(self, name):
+        """The frozen view ``name`` (a key of :data:`VIEWS`): the fields declared with it, as the step reads them."""
+        view = view_class(type(self), name)
+        return view(**{f.name: getattr(self, f.name) for f in fields(view)})
 
     def validate(self) -> "Scenario":
-        """Check every field; raise :class:`InputError` naming value, range and unit. Returns ``self``."""
-        check_range("speed", self.speed, 0.0, 15.0, "m/s", low_open=True)
-        if self.design_speed is not None:
-            check_range("design speed", self.design_speed, 0.0, 15.0, "m/s", low_open=True)
-        check_range("duration", self.duration, 0.0, MAX_DURATION, "s", low_open=True)
-        check_range("settle time", self.settle, 0.0, 60.0, "s")
-        check_range("rtol", self.rtol, 1e-14, 1e-3, "(relative)")
-        check_range("output rate", self.output_rate, 1.0, 1e5, "Hz")
-        check_range("fall angle", self.fall_angle_deg, 0.0, 90.0, "deg", low_open=True, high_open=True)
-        if self.steer_limit_deg is not None:
-            check_range("steer limit", self.steer_limit_deg, 0.0, 180.0, "deg", low_open=True)
-        check_range("gain scale", self.gain_scale, 0.0, 10.0, "(factor)")
-        if self.controller not in CONTROLLERS:
-            raise InputError(f"controller {self.controller!r} is unknown; choose one of {', '.join(CONTROLLERS)}")
-        check_range("carcass damping", self.carcass_damping, 0.0, 1e4, "N s/m")
-        check_range("carcass stiffness scale", self.carcass_stiffness_scale, 0.05, 20.0, "(factor)")
-        for part in parts.REGISTRY.values():   # the declared parts' fields (the leaning upper body's hip)
-            for f in part.fields:
-                # With its part selected, a field that refuses its low end is allowed (low, high]: one range in
-                # every message (the low end itself is refused with its reason).
-                open_low = bool(f.refuse_low) and part.selected(self)
-                value = getattr(self, f.name)
-                if open_low and value == f.low:
-                    raise InputError(f"{f.label} = {value:g} {f.unit} {f.refuse_low}; allowed "
-                                     f"({f.low:g}, {f.high:g}] {f.unit} with {part.title or part.name}")
-                check_range(f.label, value, f.low, f.high, f.unit, low_open=open_low)
-        check_range("reflex delay", self.reflex_delay, 0.0, 0.5, "s")
-        for label, value, unit in (("reflex roll gain", self.reflex_roll, "N m/rad"),
-                                   ("reflex roll-rate gain", self.reflex_roll_rate, "N m s/rad"),
-                                   ("reflex steer gain", self.reflex_steer, "N m/rad"),
-                                   ("reflex steer-rate gain", self.reflex_steer_rate, "N m s/rad")):
-            check_range(label, value, -1e4, 1e4, unit)
+        """Check every field; raise :class:`InputError` naming value, range and unit. Returns ``self``.
+
+        Each field against its declared range or choices (in field order), a declared part's field also
+        against its refused low end while the scenario selects the part; then the rules between fields; then
+        the fields given to a mechanism this scenario does not use (:meth:`unused_fields`); then the kick.
+        """
+        for s in _settings.settings(type(self)).values():
+            value = getattr(self, s.name)
+            # With its part selected, a field that refuses its low end is allowed (low, high]: one range in
+            # every message (the low end itself is refused with its reason).
+            if s.refuse_low and parts.REGISTRY[s.part].selected(self):
+                part = parts.REGISTRY[s.part]
+                if value == s.low:
+                    raise InputError(f"{s.words} = {float(value):g} {s.unit} {s.refuse_low}; allowed "
+                                     f"({s.low:g}, {s.high:g}] {s.unit} with {part.title or part.name}")
+                check_range(s.words, value, s.low, s.high, s.unit, low_open=True)
+            s.check(value)
         if self.lqr_heading and (self.controller != "lqr" or self.lqr_model != "simulated"):
             raise InputError("lqr_heading needs the LQR rider designed on the model simulated "
                              "(controller 'lqr', lqr_model 'simulated')")
-        # Below 1e-3 N s/m the plateau is so stiff that LSODA stalls at the plate stop (measured 5e-4).
-        check_range("carcass sliding viscosity", self.carcass_viscosity, 1e-3, 10.0, "N s/m")
-        for label, value, choices in (("tyre transient", self.tyre_transient, TYRE_TRANSIENTS),
-                                      ("carcass sliding law", self.carcass_sliding, carcass.SLIDING_LAWS),
-                                      ("plate stop", self.plate_stop, PLATE_STOPS),
-                                      ("kick heading", self.kick_heading, KICK_HEADINGS),
-                                      ("camber sign", self.camber_sign, CAMBER_SIGNS),
-                                      ("start", self.start, STARTS),
-                                      ("start pitch", self.start_pitch, START_PITCHES),
-                                      ("slip speed", self.slip_speed, SLIP_SPEEDS),
-                                      ("rider body", self.rider_body, RIDER_BODIES),
-                                      ("LQR design model", self.lqr_model, LQR_MODELS),
-                                      ("arms", self.arms, ARMS)):
-            if value not in choices:
-                raise InputError(f"{label} {value!r} is unknown; choose one of {', '.join(choices)}")
         if self.start == "upright" and self.settle != 0.0:
             raise InputError(f"settle time = {self.settle:g} s conflicts with start 'upright' (upright running is "
                              "not a steady motion: the kick starts the run); allowed: 0 s")
@@ -586,6 +718,8 @@ class Scenario:
         if self.controller == "off" and self.gain_scale != 1.0:
             raise InputError(f"gain scale = {self.gain_scale:g} conflicts with controller off "
                              "(there are no gains to scale)")
+        if self.fz_n is not None and self.rider_mass_kg is not None:
+            raise InputError("give the rear-tyre load fz (N) or the rider mass (kg), not both")
         self._refuse_unused()
         if self.low_inertia and (self.rider_body != "rigid" or self.arms != "off"):
             # Halving the rear frame's zB and inertias with the upper body split off it would lower the whole
@@ -593,17 +727,6 @@ class Scenario:
             raise InputError(f"low_inertia halves the rear frame with the whole rider lumped into it (thesis Figure "
                              f"8.9); it conflicts with rider_body {self.rider_body!r} / arms {self.arms!r}: allowed "
                              "with rider_body 'rigid' and arms 'off'")
-        if self.fz_n is not None and self.rider_mass_kg is not None:
-            raise InputError("give the rear-tyre load fz (N) or the rider mass (kg), not both")
-        if self.fz_n is not None:
-            check_range("rear-tyre load fz", self.fz_n, 0.0, None, "N", low_open=True)
-        if self.rear_load_share is not None:
-            check_range("rear load share", self.rear_load_share, 0.0, 1.0, "(unit 1)", low_open=True,
-                        high_open=True)
-        for name, p in (("pressure", self.pressure_kpa), ("front pressure", self.pressure_front_kpa),
-                        ("rear pressure", self.pressure_rear_kpa)):
-            if p is not None:
-                check_range(name, p, 0.0, None, "kPa", low_open=True)
         inputs.kick_of(self)
         return self
 
@@ -620,20 +743,22 @@ class Scenario:
         {'thesis_load_n': "the thesis' Table 8.4 rider (controller 'thesis')"}
         """
         unused = {}
-        for mechanism, condition, active, names in MECHANISM_FIELDS:
+        defaults = {name: s.default for name, s in _settings.settings(type(self)).items()}
+        for mechanism, condition, active, names in mechanism_fields(type(self)):
             for name in names:
-                if name not in unused and getattr(self, name) != DEFAULTS[name] and not active(self):
+                if name not in unused and getattr(self, name) != defaults[name] and not active(self):
                     unused[name] = f"{mechanism} ({condition})"
         if self.pressure_front_kpa is not None and self.pressure_rear_kpa is not None \
-                and self.pressure_kpa != DEFAULTS["pressure_kpa"]:
+                and self.pressure_kpa != defaults["pressure_kpa"]:
             unused["pressure_kpa"] = "a tyre without its own pressure (pressure_front_kpa and pressure_rear_kpa are both given)"
         return unused
 
     def _refuse_unused(self):
         for name, why in self.unused_fields().items():
+            default = _settings.settings(type(self))[name].default
             raise UnusedFieldError(f"{name} = {_with_unit(name, getattr(self, name))} is read only by {why}, which "
                                    f"this scenario does not use: leave it at its default "
-                                   f"{_with_unit(name, DEFAULTS[name])} (it would be ignored)", field=name, why=why)
+                                   f"{_with_unit(name, default)} (it would be ignored)", field=name, why=why)
 
     def to_dict(self) -> dict:
         """Fields as a plain dict (JSON-ready)."""
@@ -743,21 +868,15 @@ class Scenario:
         return replace(self, **changes)
 
 
+
+
 #: Every field's default, by name.
 DEFAULTS = {f.name: f.default for f in fields(Scenario)}
 
-#: The unit of every number field, as a file writes it ("1": a factor or a fraction): the uncertainty study checks
-#: an input's ``unit`` against it, and the refusals name it.
-UNITS = {
-    "fz_n": "N", "rider_mass_kg": "kg", "rear_load_share": "1", "pressure_kpa": "kPa", "pressure_front_kpa": "kPa",
-    "pressure_rear_kpa": "kPa", "speed": "m/s", "design_speed": "m/s", "gain_scale": "1", "thesis_load_n": "N",
-    "kick_displacement": "m", "kick_duration": "s", "kick_accel": "m/s^2", "settle": "s", "duration": "s",
-    "rtol": "1", "output_rate": "Hz", "fall_angle_deg": "deg", "steer_limit_deg": "deg",
-    "carcass_damping": "N s/m", "carcass_viscosity": "N s/m", "carcass_stiffness_scale": "1",
-    **{f.name: f.unit for f in parts.fields()},
-    "reflex_delay": "s", "reflex_roll": "N m/rad", "reflex_roll_rate": "N m s/rad", "reflex_steer": "N m/rad",
-    "reflex_steer_rate": "N m s/rad",
-}
+#: The unit of every number field, as a file writes it ("1": a factor, a fraction, a relative tolerance): the
+#: uncertainty study checks an input's ``unit`` against it, and the refusals name it. From the declarations.
+UNITS = {name: ("1" if s.unit.startswith("(") else s.unit) for name, s in _settings.settings(Scenario).items()
+         if s.unit}
 
 
 def _with_unit(name, value):
@@ -778,7 +897,8 @@ class UnusedFieldError(InputError):
     def __init__(self, message, *, field=None, why=None):
         super().__init__(message)
         self.field, self.why = field, why
-
+#: Every field's declaration (:class:`whipple_kick.simulate.settings.Setting`), by name, in field order.
+SETTINGS = _settings.settings(Scenario)
 
 #: Fields that may hold a file path (written absolute by :meth:`Scenario.to_file`).
 _PATH_FIELDS = ("bicycle", "kick_table")
@@ -790,91 +910,31 @@ def _is_path(name, value):
     return name == "kick_table" or text.endswith(".toml") or "/" in text or "\\" in text
 
 
-_REFLEX_GAINS = ("reflex_roll", "reflex_roll_rate", "reflex_steer", "reflex_steer_rate")
+#: Which mechanism reads which fields, from the declarations (:func:`mechanism_fields`): (mechanism, when it is
+#: in use (words), when it is in use (test), the fields nothing else reads). tests/simulate/test_unused_fields.py
+#: walks every field through every mechanism switch.
+MECHANISM_FIELDS = mechanism_fields(Scenario)
 
-#: Which mechanism reads which fields: (mechanism, when it is in use (words), when it is in use (test),
-#: the fields nothing else reads). :meth:`Scenario.validate` refuses a field given other than its default
-#: while its mechanism is off (:meth:`Scenario.unused_fields`): refused rather than warned, because a
-#: warning is lost among a sweep's cases and the run's scenario.toml would still record a value that
-#: did nothing. tests/simulate/test_unused_fields.py walks every field through every mechanism switch.
-MECHANISM_FIELDS = (
-    ("the carcass tyre", "tyre_transient 'carcass'", lambda s: s.tyre_transient == "carcass",
-     ("carcass_sliding", "carcass_damping", "carcass_viscosity", "carcass_stiffness_scale")),
-    # The declared parts' fields, used while the scenario selects the part (the leaning upper body's hip).
-    *((part.title or part.name, f"{part.selected_by[0]} {part.selected_by[1]!r}", part.selected,
-       tuple(f.name for f in part.fields)) for part in parts.REGISTRY.values() if part.fields),
-    # "off" is no rider torque at all: neither the voluntary law nor the reflex steers.
-    ("the rider's steer control", "controller 'lqr' or 'thesis'; controller 'off' applies no rider torque",
-     lambda s: s.controller != "off", ("gain_scale", "reflex_delay") + _REFLEX_GAINS),
-    ("the reflex", "a reflex gain other than 0", lambda s: any(getattr(s, g) != 0.0 for g in _REFLEX_GAINS),
-     ("reflex_delay",)),
-    ("the LQR rider", "controller 'lqr'", lambda s: s.controller == "lqr", ("design_speed", "lqr_model")),
-    ("the LQR rider designed on the model simulated", "controller 'lqr', lqr_model 'simulated'",
-     lambda s: s.controller == "lqr" and s.lqr_model == "simulated", ("lqr_heading",)),
-    ("the thesis' Table 8.4 rider", "controller 'thesis'", lambda s: s.controller == "thesis", ("thesis_load_n",)),
-    # The integration applies the plate stop's speed change only where the plate stops instantly.
-    ("the instant plate stop", "kick_profile 'constant' and piecewise", lambda s: s.kick_profile == "constant"
-     and s.piecewise, ("plate_stop",)),
-    ("the steady start", "start 'steady'", lambda s: s.start == "steady", ("kick_heading",)),
-    ("the upright start", "start 'upright'", lambda s: s.start == "upright", ("start_pitch",)),
-)
-
-#: Every field of :class:`Scenario` in exactly one group (a test checks it).
-FIELD_GROUPS = {
-    "physics": ("bicycle", "fz_n", "rider_mass_kg", "rear_load_share", "rider", "tyre", "pressure_kpa", "pressure_front_kpa",
-                "pressure_rear_kpa", "coefficient_set", "friction", "symmetric_tyres", "speed", "controller",
-                "design_speed", "gain_scale", "thesis_load_n", "low_inertia", "kick_displacement", "kick_duration",
-                "kick_accel", "kick_profile", "kick_table", "kick_direction", "tyre_transient", "carcass_sliding",
-                "carcass_damping", "carcass_stiffness_scale", "lqr_model", "lqr_heading", "rider_body", *_PART_FIELDS["rider_body"], "arms",
-                *_PART_FIELDS["arms"], "reflex_delay", "reflex_roll", "reflex_roll_rate", "reflex_steer",
-                "reflex_steer_rate"),
-    "run": ("settle", "duration", "output_rate", "fall_angle_deg", "steer_limit_deg"),
-    "numerics": ("rtol", "piecewise", "carcass_viscosity"),
-    "compatibility": ("plate_stop", "kick_heading", "camber_sign", "start", "start_pitch", "slip_speed"),
-}
+#: Every field of :class:`Scenario` in exactly one group, from the declarations (a test checks it).
+FIELD_GROUPS = _settings.groups(Scenario)
 
 
 # ------------------------------------------------------------------ what each step of the assembly reads
 # One frozen (hashable) view per step of :mod:`whipple_kick.simulate.assembly`, built by the matching Scenario
 # property (``scenario.bicycle_spec`` ...). A step takes its view, not the Scenario, so what it reads
-# is declared here, a cache can be keyed on it, and a field outside it cannot change the step's result
-# (tests/simulate/test_assembly.py walks every field). The views hold no defaults: the Scenario's are the only
-# ones. Their fields are named after the Scenario attributes they copy (fields, or the derived
-# ``pressures`` and ``lqr_design_speed``), except :class:`DesignSpec`'s.
+# is declared (each field's ``views``), a cache can be keyed on it, and a field outside it cannot change the
+# step's result (tests/simulate/test_assembly.py walks every field). The views hold no defaults: the Scenario's
+# are the only ones. Their fields are named after the Scenario attributes they copy: the fields declared with
+# the view, or a derived attribute (``pressures``, ``lqr_design_speed``) in place of the fields it comes from.
+# Each view is built for its Scenario class (a subclass's view holds the subclass's fields too); below, the
+# module's names are the views of :class:`Scenario`. :class:`DesignSpec` is written out: its fields are not
+# named after the Scenario's.
 
 
-@dataclass(frozen=True)
-class BicycleSpec:
-    """What :func:`~whipple_kick.simulate.assembly.build_bicycle` reads: the bicycle and the rider seated on it.
+class _BicycleView:
+    """What :func:`~whipple_kick.simulate.assembly.build_bicycle` reads: the bicycle and the rider seated on it."""
 
-    Attributes
-    ----------
-    bicycle : str
-        Bicycle parameter set or path.
-    fz_n : float or None
-        Static rear-tyre load [N] the rider's mass is chosen for.
-    rider_mass_kg : float or None
-        The rider's mass [kg].
-    rear_load_share : float or None
-        Fraction of the static weight on the rear tyre [1].
-    rider : str
-        Yeadon rider file, or "none" (the bicycle includes its rider).
-    low_inertia : bool
-        Halve the rear frame's inertias and mass-centre height (thesis Figure 8.9).
-    rider_body : {"rigid", "leaning"}
-        The rider lumped into the rear frame, or an upper body leaning on the saddle.
-    arms : {"off", "on"}
-        Whether the forearms turn with the bar.
-    """
-
-    bicycle: str
-    fz_n: float | None
-    rider_mass_kg: float | None
-    rear_load_share: float | None
-    rider: str
-    low_inertia: bool
-    rider_body: str
-    arms: str
+    __slots__ = ()
 
     @property
     def split(self) -> bool:
@@ -892,123 +952,59 @@ class BicycleSpec:
         return self.arms == "on"
 
 
-@dataclass(frozen=True)
-class TyreSpec:
-    """What :func:`~whipple_kick.simulate.assembly.build_tyres` reads: the tyres and their pressures.
+class _TyreView:
+    """What :func:`~whipple_kick.simulate.assembly.build_tyres` reads: the tyres and their (rear, front) pressures."""
 
-    Attributes
-    ----------
-    tyre : str
-        Tyre on both wheels.
-    pressures : (float, float)
-        (rear, front) inflation pressures [kPa] (:attr:`Scenario.pressures`).
-    coefficient_set : str
-        Magic-Formula coefficient set.
-    friction : str
-        Friction mode of both tyres.
-    """
-
-    tyre: str
-    pressures: tuple
-    coefficient_set: str
-    friction: str
+    __slots__ = ()
 
 
-@dataclass(frozen=True)
-@_with_part_fields
-class BodySpec:
-    """What :func:`~whipple_kick.simulate.assembly.rider_body` reads: the rider's body, arms and reflex.
+class _BodyView:
+    """What :func:`~whipple_kick.simulate.assembly.rider_body` reads: the rider's body, its parts' fields, arms and reflex."""
 
-    Attributes
-    ----------
-    rider_body : {"rigid", "leaning"}
-        Selects the leaning upper body (the trunk part, :data:`whipple_kick.model.parts.TRUNK`).
-    arms : {"off", "on"}
-        Whether the arms' spring-damper acts about the steer axis.
-    reflex_delay : float
-        Delay of the reflex [s].
-    reflex_roll, reflex_roll_rate, reflex_steer, reflex_steer_rate : float
-        Reflex gains on roll [N m/rad], roll rate [N m s/rad], steer [N m/rad] and steer rate [N m s/rad].
-    """
-
-    rider_body: str
-    arms: str
-    reflex_delay: float
-    reflex_roll: float
-    reflex_roll_rate: float
-    reflex_steer: float
-    reflex_steer_rate: float
+    __slots__ = ()
 
 
-@dataclass(frozen=True)
-class GainsSpec:
-    """What :func:`~whipple_kick.simulate.assembly.controller_gains` and the thesis' gain look-up read.
+class _GainsView:
+    """What :func:`~whipple_kick.simulate.assembly.controller_gains` and the thesis' gain look-up read."""
 
-    Attributes
-    ----------
-    controller : {"lqr", "thesis", "off"}
-        The rider's voluntary law.
-    gain_scale : float
-        Factor on every gain [1].
-    lqr_design_speed : float
-        Speed [m/s] the LQR rider is designed at (:attr:`Scenario.lqr_design_speed`).
-    thesis_load_n : float or None
-        Rear load [N] of the Table 8.4 row ``controller="thesis"`` uses.
-    fz_n, rider_mass_kg : float or None
-        The rear load [N] or rider mass [kg] the rider is seated for (the row's default).
-    bicycle : str
-        Bicycle parameter set or path (a preset with rider is labelled with its load).
-    rider : str
-        Yeadon rider file, or "none" (the bicycle includes its rider).
-    """
-
-    controller: str
-    gain_scale: float
-    lqr_design_speed: float
-    thesis_load_n: float | None
-    fz_n: float | None
-    rider_mass_kg: float | None
-    bicycle: str
-    rider: str
+    __slots__ = ()
 
 
-@dataclass(frozen=True)
-class ModelSpec:
-    """What :func:`~whipple_kick.simulate.assembly.model_parameters` reads: the compiled model's options.
+class _ModelView:
+    """What :func:`~whipple_kick.simulate.assembly.model_parameters` reads: the compiled model's options."""
 
-    Attributes
-    ----------
-    symmetric_tyres : bool
-        Zero the tyres' zero-slip offsets.
-    tyre_transient : str
-        How the tyre forces build up (:mod:`whipple_kick.model.transient`).
-    camber_sign : {"physical", "reversed"}
-        Sign of the camber the Magic Formula is fed.
-    carcass_sliding : {"peak", "curve"}
-        The carcass tyre's friction limit.
-    carcass_damping : float
-        Lateral damping of each carcass [N s/m].
-    carcass_viscosity : float
-        Sliding viscosity [N s/m] regularising the friction limit.
-    carcass_stiffness_scale : float
-        Factor on both carcass stiffnesses [1].
-    slip_speed : {"wheel_centre", "contact_point"}
-        Whose forward speed the tyres' slip angle uses.
-    """
-
-    symmetric_tyres: bool
-    tyre_transient: str
-    camber_sign: str
-    carcass_sliding: str
-    carcass_damping: float
-    carcass_viscosity: float
-    carcass_stiffness_scale: float
-    slip_speed: str
+    __slots__ = ()
 
 
+#: The views: name -> (class name, base with its methods, derived attributes and the fields each replaces).
+VIEWS = {
+    "bicycle": ("BicycleSpec", _BicycleView, ()),
+    "tyre": ("TyreSpec", _TyreView, (("pressures", ("pressure_kpa", "pressure_front_kpa", "pressure_rear_kpa")),)),
+    "body": ("BodySpec", _BodyView, ()),
+    "gains": ("GainsSpec", _GainsView, (("lqr_design_speed", ("speed", "design_speed")),)),
+    "model": ("ModelSpec", _ModelView, ()),
+}
+
+
+def view_class(cls, name):
+    """The frozen view class ``name`` (:data:`VIEWS`) of Scenario class ``cls``."""
+    class_name, base, derived = VIEWS[name]
+    return _settings.view_class(cls, name, class_name, base, derived)
+
+
+def design_model_options(cls):
+    """The options of the compiled model the LQR design on the simulated model uses: the fields declared with
+    both the ``model`` and the ``design`` view."""
+    return tuple(s.name for s in _settings.settings(cls).values() if {"model", "design"} <= set(s.views))
+
+
+BicycleSpec = view_class(Scenario, "bicycle")
+TyreSpec = view_class(Scenario, "tyre")
+BodySpec = view_class(Scenario, "body")
+GainsSpec = view_class(Scenario, "gains")
+ModelSpec = view_class(Scenario, "model")
 #: The options of the compiled model the LQR design on the simulated model uses, in :class:`DesignSpec` order.
-DESIGN_MODEL_OPTIONS = ("tyre_transient", "carcass_sliding", "carcass_damping", "carcass_viscosity", "slip_speed",
-                        "carcass_stiffness_scale")
+DESIGN_MODEL_OPTIONS = design_model_options(Scenario)
 
 
 @dataclass(frozen=True)

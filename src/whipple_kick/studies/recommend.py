@@ -22,36 +22,22 @@ import math
 import numpy as np
 
 from whipple_kick.errors import InputError, check_range
+from whipple_kick.simulate import criteria
 from whipple_kick.simulate.scenario import Scenario
 
 from .sweep_engine import check_some_ok, sweep
 
 # --------------------------------------------------------------- the pressure recommender
 
-#: Recommender criteria: the table columns ranked, the first deciding, the
-#: second breaking ties. ``settling`` (default) is the recovery time of
-#: :func:`whipple_kick.simulate.analysis.recovery`: the time from which yaw, roll and
-#: steer rates all stay within 5 % of their first peaks (``recovery.time_s``).
-#: ``last_peak`` is the thesis' rule (time of the last yaw-rate peak above 8 %
-#: of the largest, Section 8.3, Table 8.9; ``last_peak_time_s``).
-CRITERIA = {"settling": ("recovery.time_s", "last_peak_time_s"),
-            "last_peak": ("last_peak_time_s", "recovery.time_s")}
-_CRITERION_TEXT = {"last_peak": "last-peak time (last yaw-rate peak above 8 % of the largest, thesis)",
-                   "settling": "recovery time (yaw, roll and steer rates within 5 % of their first peaks)"}
-#: Spread [s] of each criterion's value, below which a difference between pressures is not to be
-#: trusted: the largest change of the value over the nine thesis cases (300/400/500 kPa x
-#: 570/635/701 N) when the tyre coefficients change by 1 % (peak, stiffness, curvature, camber
-#: and M_z terms one group at a time, all at once, and eight random draws of every coefficient in
-#: [0.99, 1.01]) or rtol goes from 1e-10 to 1e-8 or 1e-12 (``scripts/recommender_spread.py``,
-#: docs/sweeps.md). Settling: 0.215 s (a random draw at 400 kPa, 570 N); last peak: 0.001 s
-#: (one sample; several draws); rtol moves neither by 1 ms. A margin between the best and
-#: the second-best pressure below the spread is "no clear optimum". Measured on the default
-#: carcass tyre transient (model slip_b574081a; on the contact-patch form they were 0.218 and
-#: 0.005 s, on the thesis' force lag 0.570 and 0.011 s); scripts/doc_numbers.py checks them against
-#: a rerun (group ``spread``). The probability of each pressure being best over the inputs nothing
-#: pins down is the uncertainty study's (``recommend-pressure --uncertain``,
-#: :mod:`whipple_kick.studies.uncertainty`), which uses no fixed spread.
-CRITERION_SPREAD_S = {"settling": 0.215, "last_peak": 0.001}
+#: Recommender criteria (:data:`whipple_kick.simulate.criteria.CRITERIA`): each names the table column ranked
+#: (``CRITERIA[key].column``, its first item), the criterion breaking its ties, its words and its spread.
+CRITERIA = criteria.CRITERIA
+#: Spread [s] of each criterion's value, below which a difference between pressures is not to be trusted
+#: (:attr:`whipple_kick.simulate.criteria.Criterion.spread_s`, where it is declared and measured). A margin
+#: between the best and the second-best pressure below the spread is "no clear optimum". The probability of
+#: each pressure being best over the inputs nothing pins down is the uncertainty study's
+#: (``recommend-pressure --uncertain``, :mod:`whipple_kick.studies.uncertainty`), which uses no fixed spread.
+CRITERION_SPREAD_S = {key: c.spread_s for key, c in CRITERIA.items()}
 
 
 def criterion_key(criterion):
@@ -170,14 +156,14 @@ def _rank(table, criterion):
     """Row order: runs that neither fell nor failed first, by the criterion's columns (missing last), then the
     falls, then the failed cases (which have no result to rank: never ranked like a fall)."""
     keys = [np.where(np.isfinite(v), v, np.inf)
-            for v in (table[col].map(_num).to_numpy(dtype=float) for col in CRITERIA[criterion])]
+            for v in (table[col].map(_num).to_numpy(dtype=float) for col in CRITERIA[criterion].columns)]
     return np.lexsort(keys[::-1] + [_outcome_class(table)])
 
 
 def _ranked_values(rows, criterion):
     """(pressures, values) of the rows with a value of the criterion, best first."""
     order = _rank(rows, criterion)
-    values = rows[CRITERIA[criterion][0]].map(_num).to_numpy(dtype=float)[order]
+    values = rows[CRITERIA[criterion].column].map(_num).to_numpy(dtype=float)[order]
     ok = np.isfinite(values) & ~_did_not_recover(rows)[order]
     return rows["pressure_kpa"].to_numpy(dtype=float)[order][ok], values[ok]
 
@@ -316,9 +302,9 @@ def format_recommendation(rec):
         v = _num(value) * scale
         return fmt.format(v) if math.isfinite(v) else "-"
 
-    column = CRITERIA[rec.criterion][0]
+    column = CRITERIA[rec.criterion].column
     lines = [f"rear load {rec.fz_n:g} N, tyre {rec.tyre}: recovery after the kick, "
-             f"ranked by the {_CRITERION_TEXT[rec.criterion]}",
+             f"ranked by the {CRITERIA[rec.criterion].text}",
              f"{'p [kPa]':>8} {'meas.':>5} {'recovery [s]':>12} {'yaw/roll/steer settle [s]':>25} "
              f"{'last peak [s]':>13} {'zeta 1-3':>8} {'max roll [deg]':>14} {'rank':>4}  note"]
     for _, r in rec.table.iterrows():

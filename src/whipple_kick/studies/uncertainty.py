@@ -53,17 +53,19 @@ import math
 import numpy as np
 
 from whipple_kick.errors import InputError, check_range
-from whipple_kick.library import uncertain
+from whipple_kick.library import thesis, uncertain
+from whipple_kick.simulate import criteria
 from whipple_kick.simulate.scenario import DEFAULTS, MECHANISM_FIELDS, UNITS, Scenario
 
 from .recommend import _num, pressure_grid
 from .sweep_engine import check_some_ok, make_cases, sweep
 
-#: Thesis Chapter 8's pressures [kPa] and rear loads [N] (Tables 8.6-8.8).
-PRESSURES = (300.0, 400.0, 500.0)
-LOADS = (570.0, 635.0, 701.0)
-#: The two recovery criteria and their table columns (as :data:`whipple_kick.studies.recommend.CRITERIA`).
-CRITERIA = {"settling": "recovery.time_s", "last_peak": "last_peak_time_s"}
+#: Thesis Chapter 8's pressures [kPa] and rear loads [N] (:mod:`whipple_kick.library.thesis`).
+PRESSURES = thesis.PRESSURES_KPA
+LOADS = thesis.LOADS_N
+#: The recovery criteria (:data:`whipple_kick.simulate.criteria.CRITERIA`): ``CRITERIA[key].column`` is the
+#: table column of each.
+CRITERIA = criteria.CRITERIA
 #: Bootstrap resamples of the paired differences' intervals.
 BOOTSTRAP = 2000
 #: Confidence level of every interval.
@@ -441,7 +443,7 @@ def analyse(spec, samples, seed, unit, blocks, keys, ids, table, duration):
     from whipple_kick.library import experiments
     inputs = pd.DataFrame([{"sample": r, "block": blocks[r], **spec.labels(u)} for r, u in enumerate(unit)])
     by_id = table.set_index("case_id")
-    wanted = ["status", "error", "fell", *CRITERIA.values(), "run.wall_s", "run.cpu_s", "numerics.integration_wall_s"]
+    wanted = ["status", "error", "fell", *(c.column for c in CRITERIA.values()), "run.wall_s", "run.cpu_s", "numerics.integration_wall_s"]
     for col in wanted:
         if col not in by_id:
             by_id[col] = np.nan
@@ -477,9 +479,9 @@ def analyse(spec, samples, seed, unit, blocks, keys, ids, table, duration):
                           "fell": int(fell_m[:, p_k].sum()),
                           **{f"not_recovered_{c}": int((~failed_m[:, p_k] & ~fell_m[:, p_k] & ~np.isfinite(
                               at[col].map(_num).to_numpy(dtype=float).reshape(shape)[:, p_k])).sum())
-                             for c, col in CRITERIA.items()}})
+                             for c, col in ((key, c.column) for key, c in CRITERIA.items())}})
         best_p = measured.get(fz, {}).get("best_pressure")
-        for criterion, col in CRITERIA.items():
+        for criterion, col in ((key, c.column) for key, c in CRITERIA.items()):
             values = at[col].map(_num).to_numpy(dtype=float).reshape(shape)
             times = np.where(np.isfinite(values) & ~fell_m & ~failed_m, values, np.inf)
             use = base_rows & ~row_failed
@@ -676,7 +678,7 @@ def format_study(study):
     lines = [f"uncertainty study: {study.spec.name}, N = {study.samples} base samples, {len(study.inputs)} rows "
              f"(seed {study.seed}); every row runs at every pressure and load"]
     for criterion in CRITERIA:
-        lines.append(f"\nP(best) by {criterion} ({CRITERIA[criterion]}), 95 % Wilson interval; * measured best")
+        lines.append(f"\nP(best) by {criterion} ({CRITERIA[criterion].column}), 95 % Wilson interval; * measured best")
         pb = study.p_best[study.p_best["criterion"] == criterion]
         for fz, rows in pb.groupby("fz_n", sort=False):
             cells = []

@@ -3,6 +3,7 @@ import math
 
 import numpy as np
 
+from whipple_kick.library import thesis
 from whipple_kick.simulate.scenario import Scenario
 
 from ._constants import DEFAULT_SPEEDS
@@ -11,9 +12,9 @@ from .sweep import analyse, check_speeds, parse_speeds
 
 # ------------------------------------------------------------------ pressure and load
 
-#: The thesis' kick-plate grid: pressures [kPa] and static rear loads [N] (Chapter 8, Table 8.3).
-THESIS_PRESSURES_KPA = (300.0, 400.0, 500.0)
-THESIS_LOADS_N = (570.0, 635.0, 701.0)
+#: The thesis' kick-plate grid: pressures [kPa] and static rear loads [N] (:mod:`whipple_kick.library.thesis`).
+THESIS_PRESSURES_KPA = thesis.PRESSURES_KPA
+THESIS_LOADS_N = thesis.LOADS_N
 
 
 def _at(table, speed, mode):
