@@ -202,3 +202,39 @@ def test_bad_calibration_file_is_one_line_input_error(tmp_path, edit, message):
     with pytest.raises(InputError, match=message) as info:
         priors.load(path)
     assert "\n" not in str(info.value)
+
+
+# ---------------------------------------------------------------------------------------------- the command
+
+def _console(argv, capsys):
+    from whipple_kick import cli
+    with pytest.raises(SystemExit) as info:
+        cli.calibrate_main(argv)
+    out, err = capsys.readouterr()
+    return info.value.code, out, err
+
+
+@pytest.mark.parametrize("argv_of, message", [
+    (lambda bad: ["--spec", str(bad)], "priors.gain_scale: bounds inverted"),
+    (lambda bad: ["--inputs", "rider_mood"], "'rider_mood' have no prior"),
+    (lambda bad: ["--waves", "0"], "--waves = 0"),
+])
+def test_calibrate_command_refuses_bad_inputs_in_one_line(tmp_path, capsys, argv_of, message):
+    text = priors.available()["kickplate_2025"].read_text()
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text.replace("low = 0.5\nhigh = 1.6", "low = 1.6\nhigh = 0.5", 1))
+    code, out, err = _console(["--out", str(tmp_path / "out"), *argv_of(bad)], capsys)
+    assert code == 2 and err.startswith("error: ") and message in err and err.count("\n") == 1
+
+
+@pytest.mark.slow
+def test_calibrate_command_quick_writes_its_tables(tmp_path, capsys):
+    """``calibrate --quick`` on the real model: the three files, a posterior or the stated finding (~2 min)."""
+    import pandas as pd
+
+    code, out, err = _console(["--out", str(tmp_path), "--quick", "--workers", "2"], capsys)
+    assert code == 0, err
+    checks = pd.read_csv(tmp_path / "checks.csv")
+    assert {"emulator_held_out", "non_implausible_fraction", "unsourced"} <= set(checks["check"])
+    features = pd.read_csv(tmp_path / "features.csv")
+    assert len(features) == 9 and (tmp_path / "posterior.csv").exists()
