@@ -1267,7 +1267,8 @@ def calibrate_main(argv=None):
         p.add_argument("--direction", choices=validation.DIRECTIONS, default="right",
                        help="kick direction (the thesis gives none: calibrate per option; default right)")
         p.add_argument("--quick", action="store_true",
-                       help="three cells (570 N 300 kPa, 635 N 400 kPa, 701 N 500 kPa), 1000 sampler steps")
+                       help="three cells (570 N 300 kPa, 635 N 400 kPa, 701 N 500 kPa), 1000 sampler steps (else 9 "
+                            "cells, 5000 steps: the full run's autocorrelation times were 60-80 steps)")
         p.add_argument("--waves", type=int, default=2, metavar="N", help="history-matching waves (default 2)")
         p.add_argument("--seed", type=int, default=0, metavar="N")
         p.add_argument("--workers", type=int, metavar="N", help="worker processes (default: one per CPU core)")
@@ -1283,7 +1284,7 @@ def calibrate_main(argv=None):
         inputs = args.inputs or (["gain_scale", "carcass_stiffness_scale", "carcass_damping", "kick_accel"]
                                  + (["hip_stiffness"] if args.rider_body == "leaning" else []))
         result = calibration.calibrate(spec=args.spec, inputs=inputs, cells=cells, base=base, waves=args.waves,
-                                       steps=1000 if args.quick else 2000, seed=args.seed, workers=args.workers,
+                                       steps=1000 if args.quick else 5000, seed=args.seed, workers=args.workers,
                                        progress=sys.stderr.isatty())
         files = result.write(pathlib.Path(args.out))
         print(f"calibrate: {args.rider_body} rider, kicks to the {args.direction}, "

@@ -81,6 +81,10 @@ FEATURE_UNITS = {"frequency_hz": "Hz", "log_decrement": "-", "last_peak_time_s":
 CUTOFF = 3.0
 #: Printed rounding of the tables' two-decimal values, as a standard deviation: +-0.005 uniform.
 ROUNDING_SD = experiments.PRINT_HALF_STEP / math.sqrt(3.0)
+#: A posterior "piles at a bound" when more than EDGE_PILE of it lies within EDGE_SHARE of the prior's width
+#: of one bound (a uniform posterior would put EDGE_SHARE there): reported, since the data then ask for values
+#: at or beyond that bound (beyond may be unphysical, e.g. a negative damping: the model lacks something).
+EDGE_SHARE, EDGE_PILE = 0.05, 0.25
 #: The features' cap on the model's envelope time [s]: the thesis' 1 s records (Section 8.5.3).
 ENVELOPE_CAP = 1.0
 #: Simulated time after the kick [s] for the features: the 1 s record and the fit's 0.5 s window after
@@ -777,10 +781,20 @@ def _calibrate(simulator, spec, inputs, bounds, features, cells, discrepancy, me
         if short:
             checks.append(("mcmc_warning", "", float(np.max(chain["tau"])),
                            "chain shorter than 50 autocorrelation times after burn-in (emcee's advice)"))
-        for n in names:
+        for k, n in enumerate(names):
             lo, hi = np.quantile(post[n], [0.05, 0.95])
-            p = prior_list[names.index(n)]
-            verdict.append(f"{n}: 90 % credible interval {lo:.4g}-{hi:.4g} {p.unit} (prior {p.low:g}-{p.high:g})")
+            p = prior_list[k]
+            edge = {"low": float(np.mean(U[:, k] < EDGE_SHARE)), "high": float(np.mean(U[:, k] > 1 - EDGE_SHARE))}
+            side = max(edge, key=edge.get)
+            piled = edge[side] > EDGE_PILE
+            if piled:
+                checks.append(("posterior_at_bound", n, edge[side],
+                               f"share of the posterior within {EDGE_SHARE:.0%} of the prior's {side} bound "
+                               f"({p.low if side == 'low' else p.high:g} {p.unit}): the data ask for values at or "
+                               "beyond it"))
+            verdict.append(f"{n}: 90 % credible interval {lo:.4g}-{hi:.4g} {p.unit} (prior {p.low:g}-{p.high:g})"
+                           + (f"; {edge[side]:.0%} of it within {EDGE_SHARE:.0%} of the {side} bound: the data "
+                              "ask for values at or beyond it" if piled else ""))
     else:
         bad = [f"{k} (min I {i:.1f})" for k, i in zip(table["key"], min_I, strict=True) if i > CUTOFF]
         verdict.append("no input in the prior reproduces the measured features at once "
