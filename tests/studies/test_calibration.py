@@ -238,3 +238,14 @@ def test_calibrate_command_quick_writes_its_tables(tmp_path, capsys):
     assert {"emulator_held_out", "non_implausible_fraction", "unsourced"} <= set(checks["check"])
     features = pd.read_csv(tmp_path / "features.csv")
     assert len(features) == 9 and (tmp_path / "posterior.csv").exists()
+
+
+def test_a_posterior_piled_on_a_prior_bound_is_reported():
+    """Truth on the gain scale's lower bound (the toy's frequency and last peak pin it): the check says so."""
+    spec = priors.load()
+    pl = cal.choose_priors(spec, ["gain_scale", "carcass_stiffness_scale"])
+    result, _, _ = cal.known_answer(cal.ToySimulator, pl, np.array([0.0, 0.5]), seed=3, noise_scale=0.0,
+                                    walkers=16, steps=800, waves=1)
+    rows = result.checks.query("check == 'posterior_at_bound'")
+    assert "gain_scale" in set(rows["name"]) and (rows["value"] > cal.EDGE_PILE).all()
+    assert any("gain_scale" in line and "low bound" in line for line in result.verdict)
