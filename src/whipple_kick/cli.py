@@ -1285,7 +1285,7 @@ def calibrate_main(argv=None):
                                  + (["hip_stiffness"] if args.rider_body == "leaning" else []))
         result = calibration.calibrate(spec=args.spec, inputs=inputs, cells=cells, base=base, waves=args.waves,
                                        steps=1000 if args.quick else 5000, seed=args.seed, workers=args.workers,
-                                       progress=sys.stderr.isatty())
+                                       progress=sys.stderr.isatty(), check_runs=4 if args.quick else 8)
         files = result.write(pathlib.Path(args.out))
         print(f"calibrate: {args.rider_body} rider, kicks to the {args.direction}, "
               f"{len(result.measured)} measured features")

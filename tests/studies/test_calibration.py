@@ -245,7 +245,9 @@ def test_a_posterior_piled_on_a_prior_bound_is_reported():
     spec = priors.load()
     pl = cal.choose_priors(spec, ["gain_scale", "carcass_stiffness_scale"])
     result, _, _ = cal.known_answer(cal.ToySimulator, pl, np.array([0.0, 0.5]), seed=3, noise_scale=0.0,
-                                    walkers=16, steps=800, waves=1)
+                                    walkers=16, steps=800, waves=1, check_runs=4)
+    runs = result.checks.set_index("check")["value"]
+    assert runs["posterior_runs_emulator"] >= 0.9 and runs["posterior_runs_non_implausible"] == 1.0
     rows = result.checks.query("check == 'posterior_at_bound'")
     assert "gain_scale" in set(rows["name"]) and (rows["value"] > cal.EDGE_PILE).all()
     assert any("gain_scale" in line and "low bound" in line for line in result.verdict)

@@ -236,7 +236,9 @@ class ModelSimulator:
     (in parallel), with ``base`` (default :func:`whipple_kick.studies.validation.base_scenario`:
     2 m/s, the smooth 35 m/s^2 kick, cut to :data:`FEATURE_DURATION`) for the rest;
     ``Y`` holds :func:`model_features` in :func:`feature_keys` order, NaN where a
-    run failed, fell or gave no peak.
+    run failed, fell or gave no peak. ``last_unstable`` says per row of the last
+    call whether the rider was linearly unstable in any cell (the features look at
+    the first second only and cannot see a rider that would not recover).
     """
 
     def __init__(self, fields, cells, features, base=None, workers=None, progress=False):
@@ -261,6 +263,7 @@ class ModelSimulator:
         ids = [cid for _, _, cid in make_cases(cases=cases, base=self.base)]
         proc = experiments.load().processing
         Y = np.full((len(X), len(self.cells) * len(self.features)), np.nan)
+        self.last_unstable = np.zeros(len(X), bool)
         with tempfile.TemporaryDirectory(prefix="whipple_kick_calibrate_") as folder:
             table = sweep(cases=cases, base=self.base, folder=folder, workers=self.workers, progress=self.progress,
                           trajectory_columns=("time", "yaw_rate"), trajectory_dtype="float64", trajectory_rate=None)
@@ -269,11 +272,13 @@ class ModelSimulator:
                 if not ok.get(cid):
                     continue
                 frame, summary = load_trajectory(folder, cid)
+                i, c = divmod(k, len(self.cells))
+                if not summary.get("linear_stability", {}).get("stable", True):
+                    self.last_unstable[i] = True
                 if summary.get("fell"):
                     continue
                 m = model_features(frame["time"].to_numpy(), frame["yaw_rate"].to_numpy(),
                                    float(summary["steady_state"]["yaw_rate_rad_s"]), processing=proc)
-                i, c = divmod(k, len(self.cells))
                 for j, f in enumerate(self.features):
                     if m[f] is not None:
                         Y[i, c * len(self.features) + j] = m[f]
@@ -693,7 +698,7 @@ def choose_priors(spec, inputs=None, bounds=None):
 
 def calibrate(simulator=None, spec=priors.DEFAULT, inputs=None, bounds=None, features=None, cells=None,
               discrepancy=None, measured=None, base=None, waves=2, first=None, per_wave=None, rank=None,
-              walkers=32, steps=2000, candidates=20000, seed=0, workers=None, progress=False):
+              walkers=32, steps=2000, candidates=20000, seed=0, workers=None, progress=False, check_runs=0):
     """History-match and calibrate (module docstring).
 
     Parameters
@@ -713,6 +718,8 @@ def calibrate(simulator=None, spec=priors.DEFAULT, inputs=None, bounds=None, fea
         Values replacing the measured ones (e.g. synthetic), in :func:`feature_keys` order.
     waves, first, per_wave, rank, candidates : see :func:`history_match`.
     walkers, steps : see :func:`posterior`.
+    check_runs : int
+        Posterior draws run on the simulator itself (``posterior_runs_*`` rows of the checks).
 
     Returns
     -------
@@ -726,11 +733,11 @@ def calibrate(simulator=None, spec=priors.DEFAULT, inputs=None, bounds=None, fea
     # threads made each Cholesky solve 2-3 ms instead of well under 1 ms (the sweep engine limits its runs alike).
     with threadpool_limits(limits=1):
         return _calibrate(simulator, spec, inputs, bounds, features, cells, discrepancy, measured, base, waves,
-                          first, per_wave, rank, walkers, steps, candidates, seed, workers, progress)
+                          first, per_wave, rank, walkers, steps, candidates, seed, workers, progress, check_runs)
 
 
 def _calibrate(simulator, spec, inputs, bounds, features, cells, discrepancy, measured, base, waves, first,
-               per_wave, rank, walkers, steps, candidates, seed, workers, progress):
+               per_wave, rank, walkers, steps, candidates, seed, workers, progress, check_runs):
     import pandas as pd
 
     spec = spec if isinstance(spec, priors.CalibrationSpec) else priors.load(spec)
@@ -777,6 +784,9 @@ def _calibrate(simulator, spec, inputs, bounds, features, cells, discrepancy, me
             checks.append(("mcmc_rhat", n, float(chain["rhat"][k]), "split R-hat over half-chains of the walkers"))
             checks.append(("mcmc_ess", n, float(chain["ess"][k]), "effective samples after burn-in"))
         checks.append(("mcmc_acceptance", "", chain["acceptance"], "mean acceptance fraction (0.2-0.5 is healthy)"))
+        if check_runs:
+            checks += _posterior_runs(simulator, U, low, width, last.emulators, z, var_obs, matcher.rank,
+                                      int(check_runs), seed)
         short = chain["steps"] - chain["burn"] < 50 * float(np.max(chain["tau"]))
         if short:
             checks.append(("mcmc_warning", "", float(np.max(chain["tau"])),
@@ -806,6 +816,28 @@ def _calibrate(simulator, spec, inputs, bounds, features, cells, discrepancy, me
                       + f" ({sum(len(w.design) for w in wave_list)} simulator points)")
     frame = pd.DataFrame(checks, columns=["check", "name", "value", "detail"])
     return Calibration(prior_list, table, wave_list, post, feats, frame, verdict, chain)
+
+
+def _posterior_runs(simulator, U, low, width, emulators, z, var_obs, rank, n, seed):
+    """Run the simulator itself at ``n`` posterior draws: is the emulator right there, and do the runs match?"""
+    pick = U[np.random.default_rng(seed + 3).choice(len(U), min(n, len(U)), replace=False)]
+    Y = np.atleast_2d(simulator(low + pick * width))
+    m, v = emulators.predict(pick)
+    err = (Y - m) / np.sqrt(v)
+    finite = np.isfinite(err)
+    I_run = ranked(np.abs(z - Y) / np.sqrt(var_obs), rank)
+    rows = [("posterior_runs_emulator", "", float(np.mean(np.abs(err[finite]) <= 3)) if finite.any() else math.nan,
+             f"share of the simulator's features at {len(pick)} posterior draws within +-3 emulator sd of the "
+             f"emulator ({int(finite.sum())} values)"),
+            ("posterior_runs_non_implausible", "", float(np.mean(I_run <= CUTOFF)),
+             f"share of {len(pick)} posterior draws whose simulator runs pass the implausibility cut "
+             f"(rank {rank}, without emulator variance)")]
+    unstable = getattr(simulator, "last_unstable", None)
+    if unstable is not None:
+        rows.append(("posterior_runs_unstable_rider", "", float(np.mean(unstable)),
+                     f"share of {len(pick)} posterior draws with a linearly unstable rider in some cell (the "
+                     "features cannot see it: they end 1 s after the kick)"))
+    return rows
 
 
 def _rank(rank, m):
