@@ -172,7 +172,7 @@ def measured_features(spec=priors.DEFAULT, experiment=None, features=None, cells
                 L = v["last_peak_time"]
                 z = L + T / 4.0
                 sd = math.sqrt(spec.errors[f].sd ** 2 + (T / 2.0) ** 2 / 12.0 + ROUNDING_SD ** 2)
-                how = (f"last peak {L:g} s (from peak #{1}) + T/4: the 8 % crossing lies in [L, L + T/2); sd: "
+                how = (f"last peak {L:g} s (from peak #1) + T/4: the 8 % crossing lies in [L, L + T/2); sd: "
                        f"trial prior {spec.errors[f].sd:g} s and the half-period quantisation")
             rows.append({"key": f"{case.case}:{f}", "cell": case.case, "fz_n": fz, "pressure_kpa": p, "feature": f,
                          "unit": FEATURE_UNITS[f], "measured": z, "sd_measurement": sd,
