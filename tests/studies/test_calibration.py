@@ -251,3 +251,19 @@ def test_a_posterior_piled_on_a_prior_bound_is_reported():
     rows = result.checks.query("check == 'posterior_at_bound'")
     assert "gain_scale" in set(rows["name"]) and (rows["value"] > cal.EDGE_PILE).all()
     assert any("gain_scale" in line and "low bound" in line for line in result.verdict)
+
+
+def test_surely_unstable_inputs_are_ruled_out():
+    """The toy's rider is unstable below u1 = 0.35 (its ``last_margin``); truth at u1 = 0.4: with the stability
+    emulator the posterior keeps off the unstable region, which the features alone do not exclude."""
+    spec = priors.load()
+    pl = cal.choose_priors(spec, ["gain_scale", "carcass_stiffness_scale"])
+    g = pl[0]
+    share_below = {}
+    for limit in (None, 0.35):
+        result, _, _ = cal.known_answer(lambda p, c, f: cal.ToySimulator(p, c, f, unstable_below=limit), pl,
+                                        np.array([0.4, 0.5]), seed=5, walkers=16, steps=800, waves=2)
+        u1 = (result.posterior["gain_scale"].to_numpy() - g.low) / g.width
+        share_below[limit] = float(np.mean(u1 < 0.3))
+    assert share_below[None] > 0.05 and share_below[0.35] < 0.01, share_below
+    assert "unstable_runs" in set(result.checks["check"])

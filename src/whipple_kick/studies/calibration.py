@@ -39,7 +39,12 @@ Three steps, each a function of its own:
    out; Vernon, Goldstein & Bower 2010, Bayesian Anal. 5(4), use the second and
    third maxima for many outputs), 1 (the maximum) with fewer than three features.
    Each wave's design is drawn inside what the earlier waves left; its
-   emulators are fitted to the runs inside it.
+   emulators are fitted to the runs inside it. Where the simulator reports
+   the rider's linear stability (``last_margin``: the slowest closed-loop
+   pole's real part), it is emulated too and inputs whose rider is surely
+   unstable (emulated real part more than 3 sd above 0.001 1/s) are ruled
+   out: the features end 1 s after the kick and cannot see a rider that would
+   not recover.
 
 3. **The posterior inside what is left** (:func:`posterior`): emcee's affine-
    invariant ensemble on the last wave's emulators, with the same Gaussian
@@ -81,6 +86,9 @@ FEATURE_UNITS = {"frequency_hz": "Hz", "log_decrement": "-", "last_peak_time_s":
 CUTOFF = 3.0
 #: Printed rounding of the tables' two-decimal values, as a standard deviation: +-0.005 uniform.
 ROUNDING_SD = experiments.PRINT_HALF_STEP / math.sqrt(3.0)
+#: A closed-loop pole with a larger real part [1/s] makes the rider unstable (the project's limit,
+#: whipple_kick.simulate.assembly.UNSTABLE_REAL_PART: slower growth is below 1 % over a 10 s run).
+UNSTABLE_REAL_PART = 1e-3
 #: A posterior "piles at a bound" when more than EDGE_PILE of it lies within EDGE_SHARE of the prior's width
 #: of one bound (a uniform posterior would put EDGE_SHARE there): reported, since the data then ask for values
 #: at or beyond that bound (beyond may be unphysical, e.g. a negative damping: the model lacks something).
@@ -238,7 +246,10 @@ class ModelSimulator:
     ``Y`` holds :func:`model_features` in :func:`feature_keys` order, NaN where a
     run failed, fell or gave no peak. ``last_unstable`` says per row of the last
     call whether the rider was linearly unstable in any cell (the features look at
-    the first second only and cannot see a rider that would not recover).
+    the first second only and cannot see a rider that would not recover), and
+    ``last_margin`` the largest real part of the slowest closed-loop pole over the
+    cells [1/s] (:func:`whipple_kick.simulate.assembly.linear_stability`), which
+    :func:`history_match` emulates to rule out surely unstable riders.
     """
 
     def __init__(self, fields, cells, features, base=None, workers=None, progress=False):
@@ -264,6 +275,7 @@ class ModelSimulator:
         proc = experiments.load().processing
         Y = np.full((len(X), len(self.cells) * len(self.features)), np.nan)
         self.last_unstable = np.zeros(len(X), bool)
+        self.last_margin = np.full(len(X), -np.inf)
         with tempfile.TemporaryDirectory(prefix="whipple_kick_calibrate_") as folder:
             table = sweep(cases=cases, base=self.base, folder=folder, workers=self.workers, progress=self.progress,
                           trajectory_columns=("time", "yaw_rate"), trajectory_dtype="float64", trajectory_rate=None)
@@ -273,8 +285,11 @@ class ModelSimulator:
                     continue
                 frame, summary = load_trajectory(folder, cid)
                 i, c = divmod(k, len(self.cells))
-                if not summary.get("linear_stability", {}).get("stable", True):
+                stability = summary.get("linear_stability", {})
+                if not stability.get("stable", True):
                     self.last_unstable[i] = True
+                if stability.get("slowest_pole_1_s"):
+                    self.last_margin[i] = max(self.last_margin[i], float(stability["slowest_pole_1_s"][0]))
                 if summary.get("fell"):
                     continue
                 m = model_features(frame["time"].to_numpy(), frame["yaw_rate"].to_numpy(),
@@ -282,6 +297,7 @@ class ModelSimulator:
                 for j, f in enumerate(self.features):
                     if m[f] is not None:
                         Y[i, c * len(self.features) + j] = m[f]
+        self.last_margin[~np.isfinite(self.last_margin)] = np.nan
         self.runs += len(cases)
         return Y
 
@@ -295,12 +311,15 @@ class ToySimulator:
     ``frequency = 4 + 3 u1 + 1.5 u2 (p/400) - 0.5 u3``,
     ``log_decrement = 0.4 + 1.2 u2 + 0.3 u1 u3 + 0.2 (fz - 635)/66``,
     ``last_peak = 0.25 + 0.3 (1 - u1) + 0.15 u3^2 + 0.05 (p - 400)/100``.
+    With ``unstable_below`` its ``last_margin`` (the model's slowest pole, 1/s)
+    is ``unstable_below - u1``: a rider unstable at low gains.
     """
 
-    def __init__(self, prior_list, cells, features):
+    def __init__(self, prior_list, cells, features, unstable_below=None):
         self.priors = list(prior_list)
         self.cells = [(float(a), float(b)) for a, b in cells]
         self.features = _check_features(features)
+        self.unstable_below = unstable_below
         self.runs = 0
 
     def __call__(self, X):
@@ -315,6 +334,9 @@ class ToySimulator:
                       "last_peak_time_s": 0.25 + 0.3 * (1 - u1) + 0.15 * u3 ** 2 + 0.05 * (p - 400) / 100}
             cols += [values[f] for f in self.features]
         self.runs += len(X) * len(self.cells)
+        if self.unstable_below is not None:   # a stand-in for the rider's slowest pole: unstable where u1 is low
+            self.last_margin = self.unstable_below - u1
+            self.last_unstable = self.last_margin > UNSTABLE_REAL_PART
         return np.column_stack(cols)
 
 
@@ -447,6 +469,8 @@ class Wave:
     held_out: np.ndarray        # standardised errors (k-fold) of its emulators
     nroy_fraction: float        # share of the prior volume not ruled out after this wave
     candidates: int             # prior-volume sample the fraction is estimated on
+    stability: Emulators = None  # of the slowest closed-loop pole's real part, where the simulator gives it
+    unstable_runs: int = 0      # runs of this wave whose rider was linearly unstable
 
 
 class _Matcher:
@@ -459,7 +483,16 @@ class _Matcher:
         out = np.zeros(len(U), bool)
         for w in self.waves[:upto]:
             m, v = w.emulators.predict(U)
-            out |= ranked(implausibility(m, v, self.z, self.var_obs), self.rank) > self.cutoff
+            out |= self.ruled_out(w, U, m, v)
+        return out
+
+    def ruled_out(self, wave, U, m, v):
+        """Ruled out by one wave, given its feature emulators' predictions: implausible, or surely unstable
+        (the emulated slowest pole's real part more than 3 emulator sd above the unstable limit)."""
+        out = ranked(implausibility(m, v, self.z, self.var_obs), self.rank) > self.cutoff
+        if wave.stability is not None:
+            ms, vs = wave.stability.predict(U)
+            out |= ms[:, 0] - 3.0 * np.sqrt(vs[:, 0]) > UNSTABLE_REAL_PART
         return out
 
 
@@ -520,7 +553,7 @@ def history_match(simulator, prior_list, z, var_observation, waves=2, first=None
     width = np.array([p.width for p in prior_list])
     matcher = _Matcher(np.asarray(z, float), np.asarray(var_observation, float), rank, cutoff)
     probe = _lhs(candidates, d, rng)
-    U_all, Y_all = np.empty((0, d)), np.empty((0, len(z)))
+    U_all, Y_all, G_all = np.empty((0, d)), np.empty((0, len(z))), np.empty(0)
     survivors = probe
     for k in range(waves):
         if k == 0:
@@ -530,13 +563,19 @@ def history_match(simulator, prior_list, z, var_observation, waves=2, first=None
             if len(design) < max(2, d):
                 break
         Y = np.atleast_2d(simulator(low + design * width))
+        margin = getattr(simulator, "last_margin", None)
+        G_all = np.concatenate([G_all, np.full(len(design), np.nan) if margin is None else margin])
         U_all, Y_all = np.vstack([U_all, design]), np.vstack([Y_all, Y])
         train = ~matcher.implausible(U_all) if k else np.ones(len(U_all), bool)
         if np.count_nonzero(train) < 2 * d + 2:
             train = np.ones(len(U_all), bool)
         em = Emulators(seed=seed).fit(U_all[train], Y_all[train])
         held = held_out_errors(U_all[train], Y_all[train], em, folds=min(5, int(np.count_nonzero(train))), seed=seed)
-        matcher.waves.append(Wave(k + 1, design, Y, em, int(np.count_nonzero(train)), held, math.nan, candidates))
+        stab = (Emulators(seed=seed).fit(U_all[train], G_all[train, None])
+                 if np.count_nonzero(np.isfinite(G_all[train])) >= 5 else None)
+        unstable = int(np.count_nonzero(G_all[-len(design):] > UNSTABLE_REAL_PART))
+        matcher.waves.append(Wave(k + 1, design, Y, em, int(np.count_nonzero(train)), held, math.nan, candidates,
+                                  stab, unstable))
         survivors = probe[~matcher.implausible(probe)]
         matcher.waves[-1].nroy_fraction = len(survivors) / len(probe)
         if not len(survivors):
@@ -595,7 +634,7 @@ def posterior(matcher, emulators, z, var_observation, d, start, walkers=32, step
             ok = np.flatnonzero(inside)
             ok = ok[~matcher.implausible(U[ok], upto=-1)]   # the earlier waves; the last one below
             m, v = emulators.predict(U[ok])
-            keep = ranked(implausibility(m, v, z, var_obs), matcher.rank) <= matcher.cutoff
+            keep = ~matcher.ruled_out(matcher.waves[-1], U[ok], m, v)
             ok, m, v = ok[keep], m[keep], v[keep]
             if len(ok):
                 V = v + var_obs
@@ -856,6 +895,10 @@ def _checks(spec, prior_list, wave_list, table):
         per = np.nanmean(np.abs(errs) <= 3, axis=0) if finite.any() else []
         for key, s in zip(table["key"], per, strict=False):
             rows.append(("emulator_held_out_feature", f"wave {w.number} {key}", float(s), "share within +-3"))
+        if w.stability is not None:
+            rows.append(("unstable_runs", f"wave {w.number}", w.unstable_runs,
+                         f"of {len(w.design)} design points had a linearly unstable rider in some cell; surely "
+                         "unstable inputs (emulated slowest pole's real part - 3 sd > 0.001 1/s) are ruled out"))
         rows.append(("non_implausible_fraction", f"wave {w.number}", w.nroy_fraction,
                      f"share of {w.candidates} uniform prior points not ruled out by waves 1-{w.number}"))
     for kind, name, reason in spec.unsourced():
