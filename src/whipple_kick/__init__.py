@@ -41,15 +41,16 @@ _SUBMODULES = {
         "benchmark", "cache", "carcass", "classic", "energy", "geometry", "kane", "magic_formula", "reflex",
         "rhs_call", "slip", "symbolic", "symbols", "transient")},
     **{name: f"library.{name}" for name in (
-        "bicycleparameters", "bicycles", "experiments", "inputs", "parameters", "riders", "tyres",
+        "bicycleparameters", "bicycles", "experiments", "inputs", "parameters", "priors", "riders", "tyres",
         "uncertain")},
     **{name: f"simulate.{name}" for name in (
-        "analysis", "assembly", "control", "integration", "lsoda", "provenance", "results", "scenario",
-        "simulation", "steady")},
+        "analysis", "assembly", "control", "integration", "lsoda", "oscillation", "provenance", "results",
+        "scenario", "simulation", "steady")},
     **{name: f"figures.{name}" for name in ("animation", "plotting")},
     "uncertainty_figures": "figures.uncertainty",
     **{name: f"studies.{name}" for name in (
-        "authors_code", "recommend", "stability", "sweep_engine", "sweep_store", "uncertainty", "validation")},
+        "authors_code", "calibration", "recommend", "stability", "sweep_engine", "sweep_store", "uncertainty",
+        "validation")},
     **{name: name for name in ("cli", "errors", "fileio")},
     **{name: name for name in ("model", "library", "simulate", "figures", "studies")},
 }

@@ -29,7 +29,7 @@ from whipple_kick.errors import InputError
 #: The package whose data are the shipped parameter files.
 DATA_PACKAGE = "whipple_kick.parameter_files"
 #: Kinds of shipped parameter files (sub-folders of the data package).
-KINDS = ("bicycles", "experiments", "riders", "tyres", "uncertainty")
+KINDS = ("bicycles", "experiments", "riders", "tyres", "uncertainty", "calibration")
 
 
 def shipped(kind: str) -> pathlib.Path:
@@ -37,7 +37,7 @@ def shipped(kind: str) -> pathlib.Path:
 
     Parameters
     ----------
-    kind : {"bicycles", "experiments", "riders", "tyres", "uncertainty"}
+    kind : {"bicycles", "experiments", "riders", "tyres", "uncertainty", "calibration"}
 
     Returns
     -------
