@@ -69,12 +69,12 @@ _MIN_STEP = 1e-3
 MAX_SOLVES = 400
 #: Slowest speed [m/s] a speed continuation may start from.
 _MIN_START_SPEED = 0.5
-#: Largest |lean| and |steer| [deg] of a start ("near-upright"): the rider is an LQR designed on the model
+#: Largest absolute lean and steer [deg] of a start ("near-upright"): the rider is an LQR designed on the model
 #: linearised about upright straight running, whose small-angle terms err by 1 - cos(10 deg) = 1.5 % at 10 deg;
 #: and a start is meant to be the straight running of the experiment, not a turn (the turn search also finds
 #: turns at 20 deg of lean, or at 85 deg of steer with the front tyre sliding sideways).
 NEAR_UPRIGHT_DEG = 10.0
-#: Largest |slip| [deg] of either tyre in a start: the slip sweep's extent (thesis Section 7.3, |alpha| up to
+#: Largest absolute slip [deg] of either tyre in a start: the slip sweep's extent (thesis Section 7.3, slip angles up to
 #: 6 deg; the tyre files' ``[measured] slip_deg``). A steady motion with a tyre sliding beyond it is no start.
 #: The camber was measured to +-5 deg only (Section 7.3): a start leaning 5-10 deg rests on the fits' camber
 #: extrapolation (the default rider with arms, designed on the model simulated, starts at 5.2 deg of lean).
