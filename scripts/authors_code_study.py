@@ -176,7 +176,7 @@ def geometry():
             print(f"{label}: steer-axis tilt {b.benchmark['lam']:.6f} rad, trail {b.benchmark['c'] * 1e3:.1f} mm, "
                   f"wheel centres {b.moore['rr']:.4f} / {b.moore['rf']:.4f} m above the ground (less the tyre's "
                   "compression)")
-        result = run(Scenario.authors_code(bicycle=str(path)), tyres=tuple(tyres))
+        result = run(wk.assembly.without_tyre_fields(Scenario.authors_code(bicycle=str(path))), tyres=tuple(tyres))
         t, v = authors_code.first_yaw_peak(result.trajectory)
         d = authors_code.deviations(result.trajectory, stored.samples)
         print(f"mode with their contact positions: {_outcome(result)}, first yaw-rate peak {v:+.3f} at {t:.3f} s, "

@@ -78,7 +78,7 @@ def trajectory(scenario, columns, tyres=None):
     is zero, which its reference must then be throughout (a reference made when the part's terms were in
     every model, multiplied by zero)."""
     if tyres is not None:   # the tyre objects replace the scenario's tyre fields, which must then be the defaults
-        scenario = dataclasses.replace(scenario, **{f: wk.scenario.DEFAULTS[f] for f in wk.assembly.CUSTOM_TYRE_FIELDS})
+        scenario = wk.assembly.without_tyre_fields(scenario)
     df = simulation.run(scenario, tyres=tyres).trajectory
     return {c: df[c].to_numpy() if c in df or c not in PART_COLUMNS else np.zeros(len(df)) for c in columns}
 

@@ -157,6 +157,15 @@ def assemble(scenario, kick, *, tyres=None, gains=None) -> Assembly:
 CUSTOM_TYRE_FIELDS = ("tyre", "pressure_kpa", "pressure_front_kpa", "pressure_rear_kpa", "coefficient_set", "friction")
 
 
+def without_tyre_fields(scenario):
+    """``scenario`` with the fields that tyre objects replace (:data:`CUSTOM_TYRE_FIELDS`) at their defaults.
+
+    For ``run(scenario, tyres=(rear, front))`` where the scenario named the tyres the objects were made from
+    (e.g. built with :func:`build_tyres` from it): the objects carry those settings now.
+    """
+    return scenario.with_changes(**{name: DEFAULTS[name] for name in CUSTOM_TYRE_FIELDS})
+
+
 def _refuse_tyre_fields(scenario):
     """Tyre objects given replace the scenario's tyre, pressures, coefficient set and friction: one given as well
     would be ignored (a note in the summary is lost in a sweep), so it is refused, naming each such field."""
