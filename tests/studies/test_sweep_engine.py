@@ -11,6 +11,7 @@ from conftest import SWEEP_GRID as GRID
 import whipple_kick as wk
 from whipple_kick.errors import InputError
 from whipple_kick.simulate.scenario import Scenario
+from whipple_kick.studies import sweep_engine
 
 
 def test_table_has_one_row_per_case_with_inputs_and_metrics(default_run):
@@ -144,6 +145,18 @@ def test_pool_workers_reuse_the_memory_they_free():
     if kept != "True":
         pytest.skip("not glibc: mallopt is not available")
     assert int(plain) >= 20 and int(after) * 20 <= int(plain), out.stdout
+
+
+def test_a_case_run_by_any_executor_sets_the_memory_setting_once(monkeypatch):
+    """Issue 41 item 5: a Dask worker (any executor's, not the default pool's) ran without the pool's memory
+    setting. :func:`sweep_engine.run_case` sets it from the first case a process runs, and only then."""
+    calls = []
+    monkeypatch.setattr(sweep_engine, "_memory_kept", None)
+    monkeypatch.setattr(sweep_engine, "_keep_freed_memory", lambda: calls.append(1) or True)
+    scenario = wk.Scenario(duration=0.2, symmetric_tyres=True)
+    for k in range(2):
+        assert sweep_engine.run_case(scenario, f"c{k}")["status"] == "ok"
+    assert calls == [1] and sweep_engine._memory_kept is True
 
 
 def test_a_sweep_over_the_rear_load_share_gives_different_rows():
