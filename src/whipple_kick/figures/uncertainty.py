@@ -154,14 +154,9 @@ def sobol_figure(sobol, criterion="settling", pair=None, path=None, title=None, 
                 head += (f"\none not recovered {100 * rows['rows_one_not_recovered'].iloc[0] / n:.0f} %, neither "
                          f"{100 * rows['rows_neither_recovered'].iloc[0] / n:.0f} %")
             ax.set_title(head, fontsize=9)
-    handles, labels = axes[0, 0].get_legend_handles_labels()
-    if handles:
-        fig.legend(handles, labels, fontsize=8, loc="lower center", ncol=2, frameon=False)
     if title is None:
         title = f"what decides which pressure recovers first by the {_CRITERION_TEXT[criterion]}"
-    fig.suptitle(title, fontsize=10)
-    fig.tight_layout(rect=(0, 0.05 / n_rows, 1, 1))
-    return _written(fig, path, dpi)
+    return _finish(fig, axes, title, path, dpi)
 
 
 def paired_figure(outcomes, criterion="settling", path=None, title=None, dpi=120):
@@ -212,11 +207,16 @@ def paired_figure(outcomes, criterion="settling", path=None, title=None, dpi=120
             ax.set_xlabel(f"{_CRITERION_TEXT[criterion]} at {a:g} kPa [s]")
             ax.set_ylabel(f"at {b:g} kPa [s]")
             ax.set_title(f"rear load {fz:g} N ({n} paired rows)", fontsize=9)
+    if title is None:
+        title = f"paired rows: {_CRITERION_TEXT[criterion]} at two pressures on the same inputs"
+    return _finish(fig, axes, title, path, dpi)
+
+
+def _finish(fig, axes, title, path, dpi):
+    """A grid figure's legend (the first panel's, below the panels: it hides nothing), title and layout."""
     handles, labels = axes[0, 0].get_legend_handles_labels()
     if handles:
         fig.legend(handles, labels, fontsize=8, loc="lower center", ncol=2, frameon=False)
-    if title is None:
-        title = f"paired rows: {_CRITERION_TEXT[criterion]} at two pressures on the same inputs"
     fig.suptitle(title, fontsize=10)
-    fig.tight_layout(rect=(0, 0.05 / max(len(pairs), 1), 1, 1))
+    fig.tight_layout(rect=(0, 0.05 / axes.shape[0], 1, 1))
     return _written(fig, path, dpi)
