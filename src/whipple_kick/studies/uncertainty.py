@@ -6,14 +6,50 @@ rear load on inputs sampled from an uncertainty file
 
 * **P(best)** per pressure per load, for both criteria (the recovery time
   ``recovery.time_s`` and the thesis' last-peak time ``last_peak_time_s``),
-  with a 95 % Wilson score interval (:func:`p_best_interval` says why);
+  with a 95 % Wilson score interval (:func:`p_best_interval` says why), pooled
+  and **per option** (``p_best_by_option``): within the rows of each option of
+  a choice (the rider, the kick direction, the friction) and of each half of a
+  continuous input (split at its median: ``gain_scale`` below and above 1.0).
+  The design samples the choices, so this is analysis of the same rows, no new
+  runs; a result that hinges on a choice is reported per option;
 * the recovery-time distribution per pressure, the **paired differences**
-  between pressures, and the fall, not-recovered and failure rates;
-* **Sobol indices** (first order and total, with SALib's 95 % intervals) of the
-  paired recovery-time difference between each two pressures: what the
-  answer hinges on;
-* the measured best pressures (thesis Table 8.9) beside P(best), and whether
-  the model's uncertainty admits the measured ranking.
+  between pressures (:func:`paired_difference`), and the fall, not-recovered
+  and failure rates;
+* **Sobol indices** (first order and total, with SALib's 95 % intervals) of
+  **which of two pressures recovers first** (:func:`first_sign`: +1, -1, or 0
+  for a tie or neither within the run), per pair, load and criterion, with the
+  rows where one or neither run recovered counted beside them, and a caution
+  where N cannot resolve them (:func:`sobol_caution`);
+* the measured ranking (thesis Table 8.9) against the model, with the
+  measurement's own error (:func:`against_measurement`).
+
+Why this Sobol output. The paired difference ``T(b) - T(a)`` is undefined
+where a run did not recover within the run (fell, not settled, failed):
+giving it the run's duration (6 s) made the indices depend on that number
+(and a row where neither recovered a difference of 0): issue 39 found, at
+N = 48, 4-7 % of the rows carrying 20-43 % of the variance, total indices
+summing to 2.1 and 63 of 180 first-order indices negative. Which pressure recovers
+first is defined for every row without a number for the runs that did not
+recover (one that did not is later than any that did; two that did not tie),
+is bounded, and is the paired, ordinal question the study asks (P(best) is its
+three-way form). Its mean is P(a first) - P(b first). The alternatives: the
+indicator "p recovers within t" is not paired (one pressure's, not the
+comparison's), and a rank of the times still needs an order among the runs
+that did not recover. What the order cannot avoid: a longer run lets some of
+the runs that did not recover do so, which changes their rows (a tie becomes a
+win); ``scripts/sobol_censoring.py`` measures how much, at 6 against 8 s.
+
+Against the measurement. The thesis' last-peak times are means of three
+trials, without a printed spread (issue 39 reads differences of 0.04-0.07 s
+between the trials of a cell). The error of a cell is the calibration file's trial prior with the printing's
+rounding (:func:`measurement_error`). Where a measured difference to the
+measured best is within its 95 % error, the measured ranking at that load is
+**not resolved by the measurement** (the model can neither confirm nor
+contradict it). Where every difference is beyond it, each is placed in the
+model's predictive distribution of the paired difference plus the measurement
+error (:func:`predictive_check`): consistent, inconsistent, or not resolved at
+this N. Unlike the former rule ("admitted when the upper end of P(best)'s
+interval reaches 0.05"), fewer rows never make a check pass.
 
 Sampling and pairing. SALib's Saltelli-Sobol' design (``SALib.sample.sobol``,
 first order and total, so ``N (D + 2)`` rows for ``N`` base samples and
@@ -22,7 +58,8 @@ first order and total, so ``N (D + 2)`` rows for ``N`` base samples and
 (common random numbers): a difference between pressures is never a
 difference of inputs. P(best), the distributions and the differences use the
 ``2N`` rows of the design's two base matrices (A and B: each a sample of the
-inputs); the Sobol analysis uses every row, as it must.
+inputs); the Sobol analysis uses every row, as it must. An N that is not a
+power of 2 is valid and said in a note.
 
 Falls and failures (never dropped silently):
 
@@ -33,9 +70,12 @@ Falls and failures (never dropped silently):
 * a run that **failed** numerically is counted; a row with a failure at a
   load is left out of that load's P(best) and differences, and the count is
   printed;
-* for the Sobol analysis (which needs every row) a run that fell, did not
-  recover or failed counts as taking the whole run (its time is censored at
-  the run's duration); the counts are printed beside the indices.
+* the differences count the pairs with one and with both runs not recovered;
+  the mean difference is over the pairs where both recovered, and the
+  probabilities (a first, b first, tie, neither) over every pair;
+* for the Sobol analysis (which needs every row) a failed run counts as not
+  recovered within the run (a note says how many rows); the rows with one or
+  neither run recovered are counted in ``sobol.csv``.
 
 Example
 -------
@@ -96,12 +136,21 @@ class UncertaintyStudy:
     p_best : pandas.DataFrame
         ``fz_n``, ``criterion``, ``pressure_kpa`` (NaN: the ``none`` share), ``p``, ``low``, ``high``,
         ``rows`` (rows used), ``rows_failed`` (left out), ``measured_best``.
-    distributions, differences, rates, sobol, measured : pandas.DataFrame
-        See :func:`run_study`.
+    distributions, differences, rates : pandas.DataFrame
+        Per pressure: quantiles of the recovered runs; per pair: :func:`paired_difference`'s columns; per
+        pressure: fell, not recovered, failed.
+    sobol : pandas.DataFrame
+        :data:`SOBOL_COLUMNS`: per load, criterion, pair and input, the indices of :func:`first_sign` and the
+        rows with one or neither run recovered.
+    measured : pandas.DataFrame
+        :data:`MEASURED_COLUMNS` (:func:`against_measurement`).
     verdict : list of str
-        One line per load: how sure, and what it hinges on.
+        Per load: both criteria's answer (a tie said as one), what it hinges on, P(best) by option; then the
+        measured ranking.
     notes : list of str
-        Counts of what was censored or left out, constant outputs.
+        Counts of what was left out, constant outputs, an N not a power of 2.
+    p_best_by_option : pandas.DataFrame
+        :data:`BY_OPTION_COLUMNS` (:func:`p_best_by_option`).
     """
 
     spec: object
@@ -709,8 +758,9 @@ def p_best_by_option(spec, inputs, times, pressures):
 def measurement_error(calibration=None):
     """Standard deviation [s] of one measured last-peak time (a cell's mean of three trials), with its reason.
 
-    The calibration file's trial prior (``errors.last_peak_time_s.trial_sd``, 0.04 s in the shipped one:
-    the trials of a cell differ by 0.04-0.07 s; :mod:`whipple_kick.library.priors`) and the printing's
+    The calibration file's trial prior (``errors.last_peak_time_s.trial_sd``, 0.04 s in the shipped one, an
+    unsourced prior: issue 39 reads differences of 0.04-0.07 s between a cell's trials;
+    :mod:`whipple_kick.library.priors`) and the printing's
     rounding (two decimals: ``0.005 / sqrt(3)``), as the calibration takes them
     (:func:`whipple_kick.studies.calibration.measured_features`, less the 8 % crossing's quantisation, which
     the last-peak time itself does not have). Taken as the error of the cell's mean, not divided by the
