@@ -160,6 +160,13 @@ def test_tiny_study_counts_every_run(tiny_study):
     assert (study.rates["runs"] == 8).all()
     assert not study.outcomes.drop(columns=["error"]).isna().all().any()
     assert study.verdict and study.verdict[0].startswith("635 N: ")
+    # The real runs through the new tables: P(best) per option of the direction, counted pairs, Sobol rows.
+    bo = study.p_best_by_option[study.p_best_by_option["input"] == "kick_direction"]
+    assert set(bo["option"]) <= {"right", "left"} and bo["rows"].sum() == 4 * 3 * 2   # 4 A/B rows x (2 pressures + none) x 2 criteria
+    d = study.differences
+    assert ((d["pairs_both_recovered"] + d["pairs_one_not_recovered"] + d["pairs_neither_recovered"]) == d["pairs"]).all()
+    assert set(uncertainty.SOBOL_COLUMNS) == set(study.sobol.columns)
+    assert not study.p_best_by_option["p"].isna().any()
 
 
 def test_the_same_seed_gives_the_same_tables_and_the_folder_resumes(tiny, tiny_study):
@@ -317,7 +324,8 @@ def test_cli_writes_tables_and_figures(tiny, tmp_path, capsys):
         "--out", str(out), "--no-progress"], capsys)
     assert code == 0, err
     assert "P(best) by settling" in text and "635 N: " in text
-    for name in ("p_best.csv", "outcomes.csv", "sobol.csv", "verdict.txt", *wk.cli.UNCERTAINTY_FIGURES):
+    for name in ("p_best.csv", "p_best_by_option.csv", "outcomes.csv", "sobol.csv", "differences.csv", "measured.csv",
+                 "verdict.txt", *wk.cli.UNCERTAINTY_FIGURES):
         assert (out / name).stat().st_size > 0, name
 
 

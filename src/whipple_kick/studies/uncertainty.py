@@ -520,6 +520,12 @@ def analyse(spec, samples, seed, unit, blocks, keys, ids, table, duration):
         if np.array_equal(inp.ppf(unit[a_rows, k]), inp.ppf(unit[b_rows, k])):
             notes.append(f"{inp.name}: the design never varies it at N = {samples} (the same value in A and B of "
                          "every base point): its Sobol indices are 0 by construction, not a finding; use a larger N")
+    for inp in spec.inputs:
+        if inp.distribution == "choice":
+            missing = [o.label for o in inp.options if not (inputs.loc[base_rows, inp.name] == o.label).any()]
+            if missing:
+                notes.append(f"{inp.name}: no row of the base matrices has {', '.join(missing)} at N = {samples}: "
+                             "no P(best) for it (p_best_by_option.csv leaves it out); use a larger N")
     winners, times_of = {}, {}
     for fz in loads:
         at = outcomes[outcomes["fz_n"] == fz]
@@ -741,13 +747,15 @@ def p_best_by_option(spec, inputs, times, pressures):
     """P(best) within the rows of each option (:func:`input_groups`), beside the pooled one.
 
     Analysis of the study's rows, no new runs: the design samples every choice, so the rows of one option
-    are a sample of the other inputs with that option. Returns rows of ``p_best_by_option.csv`` (less the
+    are a sample of the other inputs with that option; an option no row has is left out. Returns rows of ``p_best_by_option.csv`` (less the
     load and criterion): ``input, option, rows, pressure_kpa`` (NaN: the ``none`` share), ``p, low, high``
     (:func:`p_best_interval`) and ``pooled_p``.
     """
     pooled = _best_share(times).mean(axis=0) if len(times) else np.full(len(pressures) + 1, math.nan)
     out = []
     for name, option, mask in input_groups(spec, inputs):
+        if not mask.any():
+            continue   # an option no row samples (a small N): no P(best), the table says nothing of it
         p, low, high = p_best_interval(_best_share(times[mask]))
         for k, pressure in enumerate([*pressures, math.nan]):
             out.append({"input": name, "option": option, "rows": int(mask.sum()), "pressure_kpa": pressure,
@@ -946,7 +954,7 @@ def _criterion_line(pb, criterion):
     """"<criterion>: 300 kPa P = .. [..], next ..." with "tie" where the two intervals overlap."""
     top = pb[pb["pressure_kpa"].notna()].sort_values("p", ascending=False)
     none = pb[pb["pressure_kpa"].isna()]
-    name = CRITERIA[criterion].short if hasattr(CRITERIA[criterion], "short") else criterion
+    name = CRITERIA[criterion].short
     first = top.iloc[0]
     cell = f"{first['pressure_kpa']:g} kPa P = {first['p']:.2f} [{first['low']:.2f}, {first['high']:.2f}]"
     if len(top) > 1:
