@@ -13,8 +13,10 @@ file's ``[fixed]`` ``duration`` changed), and reports
   run not recovered at each length, and how many runs' criterion value changed;
 * for the new indices and for the old ones (the difference with the censored
   time, computed here from the same runs for contrast): how many of the 8 s
-  indices lie within the 6 s index's 95 % interval and vice versa, the
-  largest change, and the sums of the indices.
+  indices lie within the 6 s index's 95 % interval and vice versa, and within
+  the two intervals combined (two estimates, each with its error; a bootstrap
+  interval of an index that is exactly 0 in these rows has zero width), the
+  ones outside, the largest change, and the sums of the indices.
 
 Usage::
 
@@ -91,17 +93,25 @@ def old_indices(study, criterion, duration):
 
 
 def compare(a, b, label):
-    """Print how many indices of ``b`` lie within ``a``'s intervals and vice versa, per criterion."""
+    """Print how many indices of ``b`` lie within ``a``'s intervals and the other way, and within the two
+    intervals combined (``sqrt(conf_a^2 + conf_b^2)``: two estimates, each with its error), per criterion."""
     keys = ["criterion", "pressure_a_kpa", "pressure_b_kpa", "input"]
     m = a.merge(b, on=keys, suffixes=("_a", "_b"))
     for criterion, g in m.groupby("criterion", sort=False):
         for idx in ("S1", "ST"):
             d = (g[f"{idx}_b"] - g[f"{idx}_a"]).abs()
-            within_a = int((d <= g[f"{idx}_conf_a"]).sum())
-            within_b = int((d <= g[f"{idx}_conf_b"]).sum())
+            ca, cb = g[f"{idx}_conf_a"], g[f"{idx}_conf_b"]
+            within_a, within_b = int((d <= ca).sum()), int((d <= cb).sum())
+            within = int((d <= np.hypot(ca, cb)).sum())
+            zero = int((ca == 0).sum())
             print(f"  {label} {criterion} {idx}: {within_a} of {len(g)} long-run indices within the short run's "
-                  f"interval, {within_b} of {len(g)} the other way; largest change {d.max():.2f} "
-                  f"(median interval half-width {g[f'{idx}_conf_a'].median():.2f})")
+                  f"interval ({zero} of those intervals of zero width), {within_b} the other way, {within} within "
+                  f"the combined interval; largest change {d.max():.2f} (median half-width {ca.median():.2f})")
+            out = g[d > np.hypot(ca, cb)]
+            for _, r in out.iterrows():
+                print(f"    outside: {r['pressure_a_kpa']:g}/{r['pressure_b_kpa']:g} kPa {r['input']}: "
+                      f"{r[f'{idx}_a']:.2f} +- {r[f'{idx}_conf_a']:.2f} -> {r[f'{idx}_b']:.2f} +- "
+                      f"{r[f'{idx}_conf_b']:.2f}")
         sums = g.groupby(["pressure_a_kpa", "pressure_b_kpa"])[["ST_a", "ST_b", "S1_a", "S1_b"]].sum()
         neg = int((g["S1_a"] < 0).sum()), int((g["S1_b"] < 0).sum())
         print(f"  {label} {criterion}: sums of total indices per pair {_range(sums['ST_a'])} / {_range(sums['ST_b'])}, "

@@ -603,13 +603,15 @@ def test_sobol_caution_names_implausible_sums_and_wide_intervals():
     rows = pd.DataFrame({"input": ["a", "b", "c"], "S1": [0.9, 0.6, -0.3], "S1_conf": [0.1, 0.1, 0.1],
                          "ST": [0.4, 0.3, 0.2], "ST_conf": [0.5, 0.4, 0.3]})
     reasons = uncertainty.sobol_caution(rows)
-    assert any("first-order indices sum to 1.20" in r for r in reasons)
+    assert any("first-order indices sum to 1.20 +- 0.17 (between 0 and 1)" in r for r in reasons)
     assert any("1 of 3 inputs with an index negative" in r for r in reasons)
     assert any("largest total index (a 0.40 +- 0.50) is not resolved from 0" in r for r in reasons)
-    assert any("3 of the 3 total indices >= 0.05 have intervals wider" in r for r in reasons)
+    assert any("3 of the 3 inputs with a total index >= 0.05 have total intervals wider" in r for r in reasons)
     good = pd.DataFrame({"input": ["a", "b"], "S1": [0.7, 0.2], "S1_conf": [0.05, 0.05], "ST": [0.8, 0.25],
                          "ST_conf": [0.05, 0.05]})
     assert uncertainty.sobol_caution(good) == []
+    below = good.assign(S1=[-0.5, -0.4], S1_conf=[0.3, 0.3])   # first-order sum -0.9 +- 0.42: true ones >= 0
+    assert any("first-order indices sum to -0.90 +- 0.42" in r for r in uncertainty.sobol_caution(below))
     top, second, separated = uncertainty.hinge(good)
     assert (top["input"], second["input"], separated) == ("a", "b", True)
     assert not uncertainty.hinge(rows)[2]

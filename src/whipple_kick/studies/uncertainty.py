@@ -911,16 +911,16 @@ def against_measurement(times_of, winners, loads, pressures, p_best, calibration
 def sobol_caution(rows):
     """Why one output's Sobol indices (rows of ``sobol.csv``) are not resolved at this N: a list of reasons.
 
-    Empty when they are. A reason: the first-order indices sum above 1 or the total ones below 1 beyond
-    their combined intervals (true indices cannot); an index negative beyond its interval; the largest total
-    index not resolved from 0 (its interval reaches 0); more than half the indices that matter (total >=
-    0.05) with intervals wider than themselves.
+    Empty when they are. A reason: the first-order indices sum above 1 or below 0, or the total ones below
+    1, beyond their combined intervals (true indices cannot); an index negative beyond its interval; the
+    largest total index not resolved from 0 (its interval reaches 0); more than half the inputs that matter
+    (total >= 0.05) with total, or first-order, intervals wider than their indices.
     """
     reasons = []
     s1, s1c = float(rows["S1"].sum()), math.sqrt(float((rows["S1_conf"] ** 2).sum()))
     st, stc = float(rows["ST"].sum()), math.sqrt(float((rows["ST_conf"] ** 2).sum()))
-    if s1 - s1c > 1.0:
-        reasons.append(f"first-order indices sum to {s1:.2f} +- {s1c:.2f} (at most 1)")
+    if s1 - s1c > 1.0 or s1 + s1c < 0.0:
+        reasons.append(f"first-order indices sum to {s1:.2f} +- {s1c:.2f} (between 0 and 1)")
     if st + stc < 1.0:
         reasons.append(f"total indices sum to {st:.2f} +- {stc:.2f} (at least 1)")
     negative = int(((rows["S1"] + rows["S1_conf"] < 0) | (rows["ST"] + rows["ST_conf"] < 0)).sum())
@@ -931,9 +931,12 @@ def sobol_caution(rows):
         reasons.append(f"the largest total index ({top['input']} {top['ST']:.2f} +- {top['ST_conf']:.2f}) is not "
                        "resolved from 0")
     matter = rows[rows["ST"] >= 0.05]
-    wide = int((matter["ST_conf"] > matter["ST"]).sum())
-    if len(matter) and 2 * wide > len(matter):
-        reasons.append(f"{wide} of the {len(matter)} total indices >= 0.05 have intervals wider than themselves")
+    for name, conf in (("total", "ST_conf"), ("first-order", "S1_conf")):
+        idx = conf[:2]
+        wide = int((matter[conf] > matter[idx].abs()).sum())
+        if len(matter) and 2 * wide > len(matter):
+            reasons.append(f"{wide} of the {len(matter)} inputs with a total index >= 0.05 have {name} intervals "
+                           "wider than their indices")
     return reasons
 
 
@@ -1067,9 +1070,13 @@ def _measured_lines(study):
     joint = m[m["fz_n"].isna()]
     if len(joint):
         j = joint.iloc[0]
-        lines.append(f"measured ranking as a whole (last peak): {j['verdict']} over the loads the measurement "
-                     f"resolves; P = {j['p_best']:.2f} [{j['p_best_low']:.2f}, {j['p_best_high']:.2f}] that one row "
-                     f"gives the measured best at every load (N = {study.samples}, {len(study.inputs)} rows)")
+        resolved = [f"{fz:g} N" for fz, rows in m[m["fz_n"].notna()].groupby("fz_n", sort=False)
+                    if rows["measured_resolved"].all()]
+        head = (f"{j['verdict']} over the loads the measurement resolves ({', '.join(resolved)})" if resolved else
+                "not resolved by the measurement at any load")
+        lines.append(f"measured ranking as a whole (last peak): {head}; P = {j['p_best']:.2f} [{j['p_best_low']:.2f}, "
+                     f"{j['p_best_high']:.2f}] that one row gives the measured best at every load (N = "
+                     f"{study.samples}, {len(study.inputs)} rows)")
     return lines
 
 
