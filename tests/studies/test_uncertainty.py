@@ -580,8 +580,9 @@ def test_p_best_is_given_per_option_and_the_verdict_says_what_it_hinges_on():
     s = study.sobol[study.sobol["criterion"] == "settling"].set_index("input")
     assert s.loc["kick_direction", "ST"] > 0.9 and s.loc["speed", "ST"] < 0.05
     assert not uncertainty.sobol_caution(s.reset_index())
-    assert "p_best_by_option" in uncertainty.format_study(study) or "kick_direction = right" in \
-        uncertainty.format_study(study)
+    text = uncertainty.format_study(study)
+    assert "    kick_direction = right (" in text and "    speed = < 1.96 (" in text   # the choice, the hinge input
+    assert "635 N settling 300/500 kPa: kick_direction " in text and "one not recovered 0 %, neither 0 %" in text
 
 
 def test_unresolved_indices_get_a_caution_and_no_hinge():
