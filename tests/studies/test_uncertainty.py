@@ -616,3 +616,15 @@ def test_sobol_caution_names_implausible_sums_and_wide_intervals():
     top, second, separated = uncertainty.hinge(good)
     assert (top["input"], second["input"], separated) == ("a", "b", True)
     assert not uncertainty.hinge(rows)[2]
+
+
+def test_a_continuous_input_is_split_at_its_default_inside_its_range_else_at_its_median():
+    """gain_scale uniform 0.5-1.6 (the default 1.0 is the project's LQR gains, inside): halves below and above 1.0,
+    not the median 1.05; speed 1.92-2.0 m/s (the default 3 m/s is outside): at the median 1.96 m/s."""
+    inputs = (uncertain.UncertainInput("gain_scale", "uniform", "test", "gain_scale", "1", 0.5, 1.6),
+              uncertain.UncertainInput("speed", "uniform", "test", "speed", "m/s", 1.92, 2.0))
+    spec = uncertain.UncertainSet("t", "", "", inputs, {})
+    table = pd.DataFrame({"gain_scale": [0.6, 1.02, 1.5], "speed": [1.93, 1.95, 1.99]})
+    groups = {(name, option): mask.tolist() for name, option, mask in uncertainty.input_groups(spec, table)}
+    assert groups == {("gain_scale", "< 1"): [True, False, False], ("gain_scale", ">= 1"): [False, True, True],
+                      ("speed", "< 1.96"): [True, True, False], ("speed", ">= 1.96"): [False, False, True]}

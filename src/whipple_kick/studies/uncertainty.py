@@ -9,7 +9,7 @@ rear load on inputs sampled from an uncertainty file
   with a 95 % Wilson score interval (:func:`p_best_interval` says why), pooled
   and **per option** (``p_best_by_option``): within the rows of each option of
   a choice (the rider, the kick direction, the friction) and of each half of a
-  continuous input (split at its median: ``gain_scale`` below and above 1.0).
+  continuous input (:func:`input_groups`: ``gain_scale`` below and above 1.0).
   The design samples the choices, so this is analysis of the same rows, no new
   runs; a result that hinges on a choice is reported per option;
 * the recovery-time distribution per pressure, the **paired differences**
@@ -727,9 +727,10 @@ def input_groups(spec, inputs):
     """The rows of each option of a choice and each half of a continuous input: ``[(input, option, mask)]``.
 
     ``inputs`` is the study's ``inputs`` table (one row per sample row). A continuous input is split at
-    its distribution's median (the shipped ``gain_scale``: 1.0, the project's LQR gains; thesis Table
-    8.4's gains are 1.3-1.6 times them, its sensitivity case halves them), so each half holds about half
-    the rows.
+    its scenario field's default, the value the plain recommender runs at, where that lies well inside the
+    distribution (between its 10 % and 90 % quantiles: ``gain_scale`` at 1.0, the project's LQR gains;
+    thesis Table 8.4's gains are 1.3-1.6 times them, its sensitivity case halves them), and otherwise at
+    the distribution's median (``speed``, whose default 3 m/s is outside the thesis' 1.92-2 m/s).
     """
     out = []
     for inp in spec.inputs:
@@ -738,6 +739,9 @@ def input_groups(spec, inputs):
             out += [(inp.name, o.label, (column == o.label).to_numpy()) for o in inp.options]
         else:
             mid = float(inp.ppf([0.5])[0])
+            default = DEFAULTS.get(inp.field) if inp.field else None
+            if isinstance(default, (int, float)) and float(inp.ppf([0.1])[0]) < default < float(inp.ppf([0.9])[0]):
+                mid = float(default)
             v = column.to_numpy(dtype=float)
             out += [(inp.name, f"< {mid:g}", v < mid), (inp.name, f">= {mid:g}", v >= mid)]
     return out
