@@ -5,7 +5,10 @@ Runs :func:`whipple_kick.studies.uncertainty.run_study` on the shipped
 loads (570/635/701 N) x the N (D + 2) rows of SALib's Saltelli-Sobol' design
 (N base samples, D inputs), every row run at every pressure and load. It
 prints the study (P(best) with intervals beside Table 8.9's measured best,
-rates, verdict) and the cost:
+pooled and by option; rates; the Sobol indices of which pressure recovers
+first; the verdict, with the measured ranking checked against its own error)
+and the cost. Run again with the same ``--out`` it resumes the runs and
+analyses them anew (the tables and verdict are the present analysis'). The cost:
 
 * the study's wall time and its runs;
 * per run: the wall time in its worker (``run.wall_s``) against the

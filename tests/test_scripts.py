@@ -110,3 +110,17 @@ def test_uncertainty_study_reports_its_cost(tmp_path, capsys):
     assert "per run in its worker: wall mean" in out and "N = 500: 2000 rows, 18000 runs" in out
     record = json.loads((tmp_path / "out" / "cost.json").read_text())   # what docs/uncertainty.md's numbers read
     assert (record["runs"], record["rows"], record["distinct"], record["extrapolate_runs"]) == (72, 8, 72, 18000)
+
+
+@pytest.mark.slow
+def test_sobol_censoring_compares_two_run_lengths(tmp_path, capsys):
+    """scripts/sobol_censoring.py at N = 2 (24 rows x 3 pressures, 635 N, 6 and 8 s): it reports the rows without
+    a time at each length and the new and the former indices against each other."""
+    import sobol_censoring
+
+    sobol_censoring.main(["--samples", "2", "--out", str(tmp_path)])
+    out = capsys.readouterr().out
+    assert "shipped file, N = 2 (24 rows), seed 0, 635 N; run length 6 s against 8 s" in out
+    assert "new output (which recovers first), short run against long run:" in out and "old output" in out
+    assert out.count("within the combined interval") == 8   # (new, old) x 2 criteria x (S1, ST)
+    assert "which recovers first changed in" in out

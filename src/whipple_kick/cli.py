@@ -891,7 +891,7 @@ def _recommend(argv):
 SWEEP_FIGURE = "recommendation.png"
 #: The figures ``recommend-pressure --uncertain --out DIR`` writes into DIR.
 UNCERTAINTY_FIGURES = ("p_best.png", *(f"recovery_{key}.png" for key in CRITERIA),
-                       *(f"sobol_{key}.png" for key in CRITERIA))
+                       *(f"paired_{key}.png" for key in CRITERIA), *(f"sobol_{key}.png" for key in CRITERIA))
 
 
 def _recommend_uncertain(args):
@@ -923,22 +923,15 @@ def _recommend_uncertain(args):
     print(uncertainty.format_study(study))
     if out is not None:
         study.write(out)
-        study_pair = _verdict_pair(study, criterion)
         figures.p_best_figure(study.p_best, out / UNCERTAINTY_FIGURES[0],
                               title=f"P(best), N = {samples} ({len(study.inputs)} rows), 95 % intervals")
         for crit in uncertainty.CRITERIA:
             figures.distribution_figure(study.outcomes, crit, out / f"recovery_{crit}.png")
-            figures.sobol_figure(study.sobol, crit, study_pair, out / f"sobol_{crit}.png")
+            figures.paired_figure(study.outcomes, crit, out / f"paired_{crit}.png")
+            figures.sobol_figure(study.sobol, crit, None, out / f"sobol_{crit}.png")   # every pair at every load
         print(f"\nwrote the tables (CSV), verdict.txt and {', '.join(UNCERTAINTY_FIGURES)} into {out} "
               f"(the runs in {out / 'runs'}: run again to resume)")
     return 0
-
-
-def _verdict_pair(study, criterion):
-    """The (lower, higher) pressures of the two most probable best at the first load, for the Sobol figure."""
-    pb = study.p_best[(study.p_best["criterion"] == criterion) & study.p_best["pressure_kpa"].notna()]
-    first = pb[pb["fz_n"] == pb["fz_n"].iloc[0]].sort_values("p", ascending=False)
-    return tuple(sorted(first["pressure_kpa"].iloc[:2]))
 
 
 def _out_given(argv):

@@ -6,14 +6,50 @@ rear load on inputs sampled from an uncertainty file
 
 * **P(best)** per pressure per load, for both criteria (the recovery time
   ``recovery.time_s`` and the thesis' last-peak time ``last_peak_time_s``),
-  with a 95 % Wilson score interval (:func:`p_best_interval` says why);
+  with a 95 % Wilson score interval (:func:`p_best_interval` says why), pooled
+  and **per option** (``p_best_by_option``): within the rows of each option of
+  a choice (the rider, the kick direction, the friction) and of each half of a
+  continuous input (:func:`input_groups`: ``gain_scale`` below and above 1.0).
+  The design samples the choices, so this is analysis of the same rows, no new
+  runs; a result that hinges on a choice is reported per option;
 * the recovery-time distribution per pressure, the **paired differences**
-  between pressures, and the fall, not-recovered and failure rates;
-* **Sobol indices** (first order and total, with SALib's 95 % intervals) of the
-  paired recovery-time difference between each two pressures: what the
-  answer hinges on;
-* the measured best pressures (thesis Table 8.9) beside P(best), and whether
-  the model's uncertainty admits the measured ranking.
+  between pressures (:func:`paired_difference`), and the fall, not-recovered
+  and failure rates;
+* **Sobol indices** (first order and total, with SALib's 95 % intervals) of
+  **which of two pressures recovers first** (:func:`first_sign`: +1, -1, or 0
+  for a tie or neither within the run), per pair, load and criterion, with the
+  rows where one or neither run recovered counted beside them, and a caution
+  where N cannot resolve them (:func:`sobol_caution`);
+* the measured ranking (thesis Table 8.9) against the model, with the
+  measurement's own error (:func:`against_measurement`).
+
+Why this Sobol output. The paired difference ``T(b) - T(a)`` is undefined
+where a run did not recover within the run (fell, not settled, failed):
+giving it the run's duration (6 s) made the indices depend on that number
+(and a row where neither recovered a difference of 0): issue 39 found, at
+N = 48, 4-7 % of the rows carrying 20-43 % of the variance, total indices
+summing to 2.1 and 63 of 180 first-order indices negative. Which pressure recovers
+first is defined for every row without a number for the runs that did not
+recover (one that did not is later than any that did; two that did not tie),
+is bounded, and is the paired, ordinal question the study asks (P(best) is its
+three-way form). Its mean is P(a first) - P(b first). The alternatives: the
+indicator "p recovers within t" is not paired (one pressure's, not the
+comparison's), and a rank of the times still needs an order among the runs
+that did not recover. What the order cannot avoid: a longer run lets some of
+the runs that did not recover do so, which changes their rows (a tie becomes a
+win); ``scripts/sobol_censoring.py`` measures how much, at 6 against 8 s.
+
+Against the measurement. The thesis' last-peak times are means of three
+trials, without a printed spread (issue 39 reads differences of 0.04-0.07 s
+between the trials of a cell). The error of a cell is the calibration file's trial prior with the printing's
+rounding (:func:`measurement_error`). Where a measured difference to the
+measured best is within its 95 % error, the measured ranking at that load is
+**not resolved by the measurement** (the model can neither confirm nor
+contradict it). Where every difference is beyond it, each is placed in the
+model's predictive distribution of the paired difference plus the measurement
+error (:func:`predictive_check`): consistent, inconsistent, or not resolved at
+this N. Unlike the former rule ("admitted when the upper end of P(best)'s
+interval reaches 0.05"), fewer rows never make a check pass.
 
 Sampling and pairing. SALib's Saltelli-Sobol' design (``SALib.sample.sobol``,
 first order and total, so ``N (D + 2)`` rows for ``N`` base samples and
@@ -22,7 +58,8 @@ first order and total, so ``N (D + 2)`` rows for ``N`` base samples and
 (common random numbers): a difference between pressures is never a
 difference of inputs. P(best), the distributions and the differences use the
 ``2N`` rows of the design's two base matrices (A and B: each a sample of the
-inputs); the Sobol analysis uses every row, as it must.
+inputs); the Sobol analysis uses every row, as it must. An N that is not a
+power of 2 is valid and said in a note.
 
 Falls and failures (never dropped silently):
 
@@ -33,9 +70,12 @@ Falls and failures (never dropped silently):
 * a run that **failed** numerically is counted; a row with a failure at a
   load is left out of that load's P(best) and differences, and the count is
   printed;
-* for the Sobol analysis (which needs every row) a run that fell, did not
-  recover or failed counts as taking the whole run (its time is censored at
-  the run's duration); the counts are printed beside the indices.
+* the differences count the pairs with one and with both runs not recovered;
+  the mean difference is over the pairs where both recovered, and the
+  probabilities (a first, b first, tie, neither) over every pair;
+* for the Sobol analysis (which needs every row) a failed run counts as not
+  recovered within the run (a note says how many rows); the rows with one or
+  neither run recovered are counted in ``sobol.csv``.
 
 Example
 -------
@@ -70,9 +110,6 @@ CRITERIA = criteria.CRITERIA
 BOOTSTRAP = 2000
 #: Confidence level of every interval.
 CONFIDENCE = 0.95
-#: A measured best pressure is "admitted" by the model's uncertainty when the upper end of the
-#: interval of its probability is at least this (one chance in twenty).
-ADMIT_PROBABILITY = 0.05
 #: Combinations of the choices' options :func:`check_inputs` looks at (beyond, a mechanism reached only
 #: by a later combination would be refused).
 _MAX_COMBINATIONS = 4096
@@ -99,12 +136,21 @@ class UncertaintyStudy:
     p_best : pandas.DataFrame
         ``fz_n``, ``criterion``, ``pressure_kpa`` (NaN: the ``none`` share), ``p``, ``low``, ``high``,
         ``rows`` (rows used), ``rows_failed`` (left out), ``measured_best``.
-    distributions, differences, rates, sobol, measured : pandas.DataFrame
-        See :func:`run_study`.
+    distributions, differences, rates : pandas.DataFrame
+        Per pressure: quantiles of the recovered runs; per pair: :func:`paired_difference`'s columns; per
+        pressure: fell, not recovered, failed.
+    sobol : pandas.DataFrame
+        :data:`SOBOL_COLUMNS`: per load, criterion, pair and input, the indices of :func:`first_sign` and the
+        rows with one or neither run recovered.
+    measured : pandas.DataFrame
+        :data:`MEASURED_COLUMNS` (:func:`against_measurement`).
     verdict : list of str
-        One line per load: how sure, and what it hinges on.
+        Per load: both criteria's answer (a tie said as one), what it hinges on, P(best) by option; then the
+        measured ranking.
     notes : list of str
-        Counts of what was censored or left out, constant outputs.
+        Counts of what was left out, constant outputs, an N not a power of 2.
+    p_best_by_option : pandas.DataFrame
+        :data:`BY_OPTION_COLUMNS` (:func:`p_best_by_option`).
     """
 
     spec: object
@@ -120,6 +166,7 @@ class UncertaintyStudy:
     measured: object
     verdict: list
     notes: list
+    p_best_by_option: object = None
 
     def write(self, folder):
         """Write every table as CSV into ``folder``; returns the paths."""
@@ -129,8 +176,10 @@ class UncertaintyStudy:
         folder = pathlib.Path(folder)
         folder.mkdir(parents=True, exist_ok=True)
         paths = []
-        for name in ("inputs", "outcomes", "p_best", "distributions", "differences", "rates", "sobol",
-                     "measured"):
+        for name in ("inputs", "outcomes", "p_best", "p_best_by_option", "distributions", "differences", "rates",
+                     "sobol", "measured"):
+            if getattr(self, name) is None:
+                continue
             path = folder / f"{name}.csv"
             fileio.write_atomic(path, getattr(self, name).to_csv(index=False))
             paths.append(path)
@@ -457,7 +506,12 @@ def analyse(spec, samples, seed, unit, blocks, keys, ids, table, duration):
     base_rows = np.array([b in ("A", "B") for b in blocks])
     measured = experiments.load().best
     rng_seed = int(seed)
-    p_best, dists, diffs, rates, sobol, meas, notes = [], [], [], [], [], [], []
+    p_best, dists, diffs, rates, sobol, by_option = [], [], [], [], [], []
+    notes = [f"Sobol output: which of two pressures recovers first within the run's {duration:g} s (+1, -1, or 0 "
+             "for a tie or neither): no time is given to a run that did not recover (see the module's docstring)"]
+    if samples & (samples - 1):
+        notes.append(f"N = {samples} is not a power of 2: the Sobol' sequence's points are not balanced (SALib "
+                     "warns so); the design and its indices are valid, their error somewhat larger than at a power of 2")
     a_rows = np.array([b == "A" for b in blocks])
     b_rows = np.array([b == "B" for b in blocks])
     for k, inp in enumerate(spec.inputs):
@@ -466,7 +520,13 @@ def analyse(spec, samples, seed, unit, blocks, keys, ids, table, duration):
         if np.array_equal(inp.ppf(unit[a_rows, k]), inp.ppf(unit[b_rows, k])):
             notes.append(f"{inp.name}: the design never varies it at N = {samples} (the same value in A and B of "
                          "every base point): its Sobol indices are 0 by construction, not a finding; use a larger N")
-    winners = {}
+    for inp in spec.inputs:
+        if inp.distribution == "choice":
+            missing = [o.label for o in inp.options if not (inputs.loc[base_rows, inp.name] == o.label).any()]
+            if missing:
+                notes.append(f"{inp.name}: no row of the base matrices has {', '.join(missing)} at N = {samples}: "
+                             "no P(best) for it (p_best_by_option.csv leaves it out); use a larger N")
+    winners, times_of = {}, {}
     for fz in loads:
         at = outcomes[outcomes["fz_n"] == fz]
         failed = at["status"].to_numpy() != "ok"
@@ -481,10 +541,12 @@ def analyse(spec, samples, seed, unit, blocks, keys, ids, table, duration):
                               at[col].map(_num).to_numpy(dtype=float).reshape(shape)[:, p_k])).sum())
                              for c, col in ((key, c.column) for key, c in CRITERIA.items())}})
         best_p = measured.get(fz, {}).get("best_pressure")
+        use = base_rows & ~row_failed
         for criterion, col in ((key, c.column) for key, c in CRITERIA.items()):
             values = at[col].map(_num).to_numpy(dtype=float).reshape(shape)
+            # inf: not recovered within the run (fell, not settled, or failed): later than any recovery, never a number
             times = np.where(np.isfinite(values) & ~fell_m & ~failed_m, values, np.inf)
-            use = base_rows & ~row_failed
+            times_of[fz, criterion] = (times, use)
             if row_failed[base_rows].any():
                 notes.append(f"{fz:g} N, {criterion}: {int(row_failed[base_rows].sum())} of {int(base_rows.sum())} "
                              "rows left out of P(best) and the differences (a run failed)")
@@ -498,6 +560,8 @@ def analyse(spec, samples, seed, unit, blocks, keys, ids, table, duration):
                                "rows": int(use.sum()),
                                "rows_failed": int((base_rows & row_failed).sum()),
                                "measured_best": bool(best_p == p)})
+            by_option += [{"fz_n": fz, "criterion": criterion, **r}
+                          for r in p_best_by_option(spec, inputs[use], times[use], pressures)]
             for k, p in enumerate(pressures):
                 ok = times[use][:, k]
                 ok = ok[np.isfinite(ok)]
@@ -507,43 +571,30 @@ def analyse(spec, samples, seed, unit, blocks, keys, ids, table, duration):
                               **{f"q{int(100 * level):02d}_s": float(v)
                                  for level, v in zip((0.05, 0.25, 0.5, 0.75, 0.95), q, strict=True)}})
             for (i, pi), (j, pj) in itertools.combinations(enumerate(pressures), 2):
-                a, b = times[use][:, i], times[use][:, j]
-                both = np.isfinite(a) & np.isfinite(b)
-                d = b[both] - a[both]
-                faster = (a < b).astype(float) + 0.5 * (a == b)   # P(pi recovers before pj); neither: half
-                lo, hi = _bootstrap_means(d[:, None], rng) if d.size else ([math.nan], [math.nan])
-                flo, fhi = _bootstrap_means(faster[:, None], rng) if faster.size else ([math.nan], [math.nan])
                 diffs.append({"fz_n": fz, "criterion": criterion, "pressure_a_kpa": pi, "pressure_b_kpa": pj,
-                              "pairs_both_recovered": int(d.size),
-                              "mean_b_minus_a_s": float(d.mean()) if d.size else math.nan,
-                              "low_s": lo[0], "high_s": hi[0],
-                              "median_b_minus_a_s": float(np.median(d)) if d.size else math.nan,
-                              "p_a_faster": float(faster.mean()) if faster.size else math.nan,
-                              "p_a_faster_low": flo[0], "p_a_faster_high": fhi[0]})
-            censored = np.where(np.isfinite(times), times, duration)
-            n_cens = int((~np.isfinite(times)).sum())
-            if n_cens:
-                notes.append(f"{fz:g} N, {criterion}: {n_cens} of {times.size} runs censored at {duration:g} s "
-                             f"for the Sobol analysis ({int(fell_m.sum())} fell, {int(failed_m.sum())} failed, "
-                             "the rest not recovered)")
+                              **paired_difference(times[use][:, i], times[use][:, j], rng)})
+            n_failed = int(failed_m.any(axis=1).sum())
+            if n_failed:
+                notes.append(f"{fz:g} N, {criterion}: {n_failed} of {n_rows} rows have a failed run: for the Sobol "
+                             "analysis (which needs every row) it counts as not recovered within the run")
             for (i, pi), (j, pj) in itertools.combinations(enumerate(pressures), 2):
-                y = censored[:, j] - censored[:, i]
+                y = first_sign(times[:, i], times[:, j])
+                one = int((np.isfinite(times[:, i]) != np.isfinite(times[:, j])).sum())
+                both = int((~np.isfinite(times[:, i]) & ~np.isfinite(times[:, j])).sum())
                 if np.ptp(y) == 0.0:
-                    notes.append(f"{fz:g} N, {criterion}: the {pj:g}-{pi:g} kPa difference is the same in every "
-                                 "row: no Sobol indices")
+                    notes.append(f"{fz:g} N, {criterion}: which of {pi:g} and {pj:g} kPa recovers first is the same "
+                                 "in every row: no Sobol indices")
                     continue
                 for name, s1, s1c, st, stc in _sobol(spec, y, rng_seed):
                     sobol.append({"fz_n": fz, "criterion": criterion, "pressure_a_kpa": pi, "pressure_b_kpa": pj,
-                                  "input": name, "S1": s1, "S1_conf": s1c, "ST": st, "ST_conf": stc})
+                                  "input": name, "S1": s1, "S1_conf": s1c, "ST": st, "ST_conf": stc, "rows": n_rows,
+                                  "rows_one_not_recovered": one, "rows_neither_recovered": both})
     p_best = pd.DataFrame(p_best)
-    sobol = pd.DataFrame(sobol, columns=["fz_n", "criterion", "pressure_a_kpa", "pressure_b_kpa", "input", "S1",
-                                         "S1_conf", "ST", "ST_conf"])
-    for criterion in CRITERIA:
-        meas.extend(_against_measurement(winners, criterion, loads, pressures, measured, p_best, rng_seed))
+    sobol = pd.DataFrame(sobol, columns=SOBOL_COLUMNS)
+    meas = against_measurement(times_of, winners, loads, pressures, p_best)
     study = UncertaintyStudy(spec, samples, seed, inputs, outcomes, p_best, pd.DataFrame(dists), pd.DataFrame(diffs),
-                             pd.DataFrame(rates), sobol,
-                             pd.DataFrame(meas, columns=["criterion", "fz_n", "measured_best_kpa", "p", "low", "high",
-                                                         "admitted"]), [], notes)
+                             pd.DataFrame(rates), sobol, meas, [], notes,
+                             pd.DataFrame(by_option, columns=BY_OPTION_COLUMNS))
     study.verdict = verdict_lines(study)
     return study
 
@@ -619,76 +670,475 @@ def _sobol(spec, y, seed):
             for k, name in enumerate(spec.names)]
 
 
-def _against_measurement(winners, criterion, loads, pressures, measured, p_best, seed):
-    """Per load and jointly: P(the measured best is the model's best), and whether the uncertainty admits it."""
+def first_sign(t_a, t_b):
+    """Which of two paired runs recovers first: per row +1 (``a``), -1 (``b``) or 0 (a tie, or neither).
+
+    ``inf`` is a run that did not recover within the run (fell, not settled, failed): later than any
+    run that recovered, and tied with another that did not. The value depends on the order of the two
+    times only, never on a number given to a run that did not recover.
+    """
+    t_a, t_b = np.asarray(t_a, dtype=float), np.asarray(t_b, dtype=float)
+    return (t_a < t_b).astype(float) - (t_b < t_a).astype(float)
+
+
+def paired_difference(t_a, t_b, rng):
+    """``differences.csv``'s columns for one pair of pressures over paired rows (``inf``: not recovered).
+
+    Counts the pairs with one and with both runs not recovered (they are never dropped silently); the
+    mean and median of ``T(b) - T(a)`` over the pairs where both recovered (the only ones where it is a
+    number); and the censoring-proof statistics over every pair: P(a first), P(b first), P(tie: both
+    recovered at the same time), P(neither recovered), the mean of :func:`first_sign` (P(a first) -
+    P(b first)) and ``p_a_faster`` (P(a first) + half the ties and neithers), each with its bootstrap
+    interval (:data:`CONFIDENCE`).
+    """
+    t_a, t_b = np.asarray(t_a, dtype=float), np.asarray(t_b, dtype=float)
+    rec_a, rec_b = np.isfinite(t_a), np.isfinite(t_b)
+    both = rec_a & rec_b
+    d = t_b[both] - t_a[both]
+    sign = first_sign(t_a, t_b)
+    faster = (sign == 1.0) + 0.5 * (sign == 0.0)
+    n = len(sign)
+    nan2 = ([math.nan], [math.nan])
+    lo, hi = _bootstrap_means(d[:, None], rng) if d.size else nan2
+    flo, fhi = _bootstrap_means(faster[:, None], rng) if n else nan2
+    slo, shi = _bootstrap_means(sign[:, None], rng) if n else nan2
+
+    def share(mask):
+        return float(mask.mean()) if n else math.nan
+    return {"pairs": n, "pairs_both_recovered": int(both.sum()), "pairs_one_not_recovered": int((rec_a != rec_b).sum()),
+            "pairs_neither_recovered": int((~rec_a & ~rec_b).sum()),
+            "mean_b_minus_a_s": float(d.mean()) if d.size else math.nan, "low_s": lo[0], "high_s": hi[0],
+            "median_b_minus_a_s": float(np.median(d)) if d.size else math.nan,
+            "p_a_first": share(sign == 1.0), "p_b_first": share(sign == -1.0),
+            "p_tie": share((sign == 0.0) & both), "p_neither": share(~rec_a & ~rec_b),
+            "first_sign_mean": float(sign.mean()) if n else math.nan, "first_sign_low": slo[0],
+            "first_sign_high": shi[0], "p_a_faster": float(faster.mean()) if n else math.nan,
+            "p_a_faster_low": flo[0], "p_a_faster_high": fhi[0]}
+
+
+#: Columns of ``sobol.csv``.
+SOBOL_COLUMNS = ["fz_n", "criterion", "pressure_a_kpa", "pressure_b_kpa", "input", "S1", "S1_conf", "ST", "ST_conf",
+                 "rows", "rows_one_not_recovered", "rows_neither_recovered"]
+#: Columns of ``p_best_by_option.csv``.
+BY_OPTION_COLUMNS = ["fz_n", "criterion", "input", "option", "rows", "pressure_kpa", "p", "low", "high", "pooled_p"]
+
+
+def input_groups(spec, inputs):
+    """The rows of each option of a choice and each half of a continuous input: ``[(input, option, mask)]``.
+
+    ``inputs`` is the study's ``inputs`` table (one row per sample row). A continuous input is split at
+    its scenario field's default, the value the plain recommender runs at, where that lies well inside the
+    distribution (between its 10 % and 90 % quantiles: ``gain_scale`` at 1.0, the project's LQR gains;
+    thesis Table 8.4's gains are 1.3-1.6 times them, its sensitivity case halves them), and otherwise at
+    the distribution's median (``speed``, whose default 3 m/s is outside the thesis' 1.92-2 m/s).
+    """
     out = []
-    joint = None
-    for fz in loads:
-        best = measured.get(fz, {}).get("best_pressure")
-        if best is None or best not in pressures:
-            continue
-        rows, share = winners[fz, criterion]
-        col = share[:, pressures.index(best)]
-        series = dict(zip(rows, col, strict=True))
-        joint = series if joint is None else {r: joint[r] * v for r, v in series.items() if r in joint}
-        row = p_best[(p_best["fz_n"] == fz) & (p_best["criterion"] == criterion) & (p_best["pressure_kpa"] == best)]
-        p, hi = float(row["p"].iloc[0]), float(row["high"].iloc[0])
-        out.append({"criterion": criterion, "fz_n": fz, "measured_best_kpa": best, "p": p,
-                    "low": float(row["low"].iloc[0]), "high": hi, "admitted": bool(hi >= ADMIT_PROBABILITY)})
-    if joint:
-        p, lo, hi = p_best_interval(np.array(list(joint.values()))[:, None])
-        out.append({"criterion": criterion, "fz_n": math.nan, "measured_best_kpa": math.nan,
-                    "p": float(p[0]), "low": float(lo[0]), "high": float(hi[0]),
-                    "admitted": bool(hi[0] >= ADMIT_PROBABILITY)})
+    for inp in spec.inputs:
+        column = inputs[inp.name]
+        if inp.distribution == "choice":
+            out += [(inp.name, o.label, (column == o.label).to_numpy()) for o in inp.options]
+        else:
+            mid = float(inp.ppf([0.5])[0])
+            default = DEFAULTS.get(inp.field) if inp.field else None
+            if isinstance(default, (int, float)) and float(inp.ppf([0.1])[0]) < default < float(inp.ppf([0.9])[0]):
+                mid = float(default)
+            v = column.to_numpy(dtype=float)
+            out += [(inp.name, f"< {mid:g}", v < mid), (inp.name, f">= {mid:g}", v >= mid)]
     return out
 
 
+def p_best_by_option(spec, inputs, times, pressures):
+    """P(best) within the rows of each option (:func:`input_groups`), beside the pooled one.
+
+    Analysis of the study's rows, no new runs: the design samples every choice, so the rows of one option
+    are a sample of the other inputs with that option; an option no row has is left out. Returns rows of ``p_best_by_option.csv`` (less the
+    load and criterion): ``input, option, rows, pressure_kpa`` (NaN: the ``none`` share), ``p, low, high``
+    (:func:`p_best_interval`) and ``pooled_p``.
+    """
+    pooled = _best_share(times).mean(axis=0) if len(times) else np.full(len(pressures) + 1, math.nan)
+    out = []
+    for name, option, mask in input_groups(spec, inputs):
+        if not mask.any():
+            continue   # an option no row samples (a small N): no P(best), the table says nothing of it
+        p, low, high = p_best_interval(_best_share(times[mask]))
+        for k, pressure in enumerate([*pressures, math.nan]):
+            out.append({"input": name, "option": option, "rows": int(mask.sum()), "pressure_kpa": pressure,
+                        "p": float(p[k]), "low": float(low[k]), "high": float(high[k]), "pooled_p": float(pooled[k])})
+    return out
+
+
+def measurement_error(calibration=None):
+    """Standard deviation [s] of one measured last-peak time (a cell's mean of three trials), with its reason.
+
+    The calibration file's trial prior (``errors.last_peak_time_s.trial_sd``, 0.04 s in the shipped one, an
+    unsourced prior: issue 39 reads differences of 0.04-0.07 s between a cell's trials;
+    :mod:`whipple_kick.library.priors`) and the printing's
+    rounding (two decimals: ``0.005 / sqrt(3)``), as the calibration takes them
+    (:func:`whipple_kick.studies.calibration.measured_features`, less the 8 % crossing's quantisation, which
+    the last-peak time itself does not have). Taken as the error of the cell's mean, not divided by the
+    square root of the three trials: the thesis prints no spread.
+    """
+    from whipple_kick.library import experiments, priors
+    spec = priors.load() if calibration is None else calibration
+    trial = spec.errors["last_peak_time_s"].sd
+    rounding = experiments.PRINT_HALF_STEP / math.sqrt(3.0)
+    return math.hypot(trial, rounding), (f"trial prior {trial:g} s ({spec.path}: errors.last_peak_time_s) and "
+                                         f"the printing's rounding {rounding:.4f} s")
+
+
+#: The measured criterion: the thesis prints last-peak times (Tables 8.6-8.8) and ranks by them (Table 8.9).
+MEASURED_CRITERION = "last_peak"
+#: Columns of ``measured.csv``.
+MEASURED_COLUMNS = ["criterion", "fz_n", "measured_best_kpa", "pressure_kpa", "measured_diff_s", "measured_sd_s",
+                    "measured_resolved", "rows", "q", "q_low", "q_high", "p_best", "p_best_low", "p_best_high",
+                    "verdict"]
+
+
+def predictive_check(t_best, t_other, measured_diff, sd):
+    """Whether a measured difference ``T(other) - T(best)`` [s], with its error ``sd``, is one the model gives.
+
+    Per paired row the probability that the model's difference plus a measurement error (normal, ``sd``)
+    is at most the measured one, ``Phi((measured - d) / sd)``; a row where only ``other`` did not recover
+    (``inf``) gives 0, only ``best`` 1, neither: unknown, 0 for the lower and 1 for the upper end. Their
+    mean ``q`` is the measured difference's place in the model's predictive distribution. Its interval is
+    :func:`p_best_interval`'s (Wilson) of the lower and upper ends.
+
+    Returns
+    -------
+    (q, low, high, verdict)
+        ``verdict``: ``"consistent"`` when the whole interval lies within ``[a/2, 1 - a/2]`` (``a = 1 -``
+        :data:`CONFIDENCE`), ``"inconsistent"`` when it lies wholly outside, else ``"not resolved at this
+        N"``. The Wilson interval holds its point estimate and widens as the rows get fewer: fewer rows never
+        turn an inconsistent (or undecided) check into a consistent one.
+    """
+    from scipy import stats
+    t_best, t_other = np.asarray(t_best, dtype=float), np.asarray(t_other, dtype=float)
+    if not len(t_best):
+        return math.nan, math.nan, math.nan, "no rows"
+    neither = ~np.isfinite(t_best) & ~np.isfinite(t_other)
+    with np.errstate(invalid="ignore"):
+        d = np.where(neither, 0.0, t_other - t_best)   # +-inf where one did not recover: cdf 0 or 1
+        prob = stats.norm.cdf((measured_diff - d) / sd)
+    lower, upper = np.where(neither, 0.0, prob), np.where(neither, 1.0, prob)
+    low = float(p_best_interval(lower[:, None])[1][0])
+    high = float(p_best_interval(upper[:, None])[2][0])
+    tail = (1.0 - CONFIDENCE) / 2.0
+    if low >= tail and high <= 1.0 - tail:
+        verdict = "consistent"
+    elif high < tail or low > 1.0 - tail:
+        verdict = "inconsistent"
+    else:
+        verdict = "not resolved at this N"
+    return float((lower.mean() + upper.mean()) / 2.0), low, high, verdict
+
+
+def _combine(verdicts):
+    """One verdict of several checks: inconsistent if any is, consistent if all are, else not resolved."""
+    if not verdicts:
+        return "not resolved by the measurement"
+    if "inconsistent" in verdicts:
+        return "inconsistent"
+    return "consistent" if all(v == "consistent" for v in verdicts) else "not resolved at this N"
+
+
+def against_measurement(times_of, winners, loads, pressures, p_best, calibration=None):
+    """``measured.csv``: the model against thesis Table 8.9's measured ranking, with the measurement's own error.
+
+    Per load, for each pressure beside the measured best ``b``: the measured difference ``L(p) - L(b)`` of
+    the last-peak times (Tables 8.6-8.8) and its standard deviation (``sqrt(2)`` times
+    :func:`measurement_error`). The measurement **resolves** the ranking at a load when every such
+    difference exceeds its 95 % half-width (``1.96 sd``); where it does not, the measured best is no
+    finding the model could contradict or confirm ("not resolved by the measurement"). Where it does, the
+    model's paired rows are checked against each measured difference (:func:`predictive_check`), for the
+    last-peak criterion only (the thesis measures no settling time); P(best) of the measured best is
+    given beside, for both criteria. One row per criterion with ``fz_n`` NaN: the probability that one row
+    gives the measured best at every load (the rows are shared by the loads) and the combined verdict of
+    the resolved loads.
+    """
+    import pandas as pd
+    from scipy import stats
+
+    from whipple_kick.library import experiments
+    exp = experiments.load()
+    z = float(stats.norm.ppf(0.5 + CONFIDENCE / 2.0))
+    sd_cell, _ = measurement_error(calibration)
+    sd = math.sqrt(2.0) * sd_cell
+    out = []
+    for criterion in CRITERIA:
+        joint, verdicts = None, []
+        for fz in loads:
+            best = exp.best.get(fz, {}).get("best_pressure")
+            if best is None or best not in pressures:
+                continue
+            rows, share = winners[fz, criterion]
+            series = dict(zip(rows, share[:, pressures.index(best)], strict=True))
+            joint = series if joint is None else {r: joint[r] * v for r, v in series.items() if r in joint}
+            pb = p_best[(p_best["fz_n"] == fz) & (p_best["criterion"] == criterion) & (p_best["pressure_kpa"] == best)]
+            times, use = times_of[fz, criterion]
+            checks = []
+            for other in pressures:
+                if other == best or (fz, other) not in {(c.fz_n, c.pressure_kpa) for c in exp.cases.values()}:
+                    continue
+                diff = exp.case(fz, other).values["last_peak_time"] - exp.case(fz, best).values["last_peak_time"]
+                resolved = bool(diff > z * sd)
+                row = {"criterion": criterion, "fz_n": fz, "measured_best_kpa": best, "pressure_kpa": other,
+                       "measured_diff_s": diff, "measured_sd_s": sd, "measured_resolved": resolved,
+                       "rows": int(use.sum()), "q": math.nan, "q_low": math.nan, "q_high": math.nan,
+                       "p_best": float(pb["p"].iloc[0]), "p_best_low": float(pb["low"].iloc[0]),
+                       "p_best_high": float(pb["high"].iloc[0])}
+                if criterion != MEASURED_CRITERION:
+                    row["verdict"] = "not measured (the thesis gives last-peak times)"
+                else:
+                    q, lo, hi, verdict = predictive_check(times[use][:, pressures.index(best)],
+                                                          times[use][:, pressures.index(other)], diff, sd)
+                    row.update(q=q, q_low=lo, q_high=hi, verdict=verdict)
+                checks.append(row)
+            if criterion == MEASURED_CRITERION and checks:
+                if all(c["measured_resolved"] for c in checks):
+                    verdicts += [c["verdict"] for c in checks]
+                else:
+                    for c in checks:
+                        c["verdict"] = "not resolved by the measurement"
+            out += checks
+        if joint:
+            p, lo, hi = p_best_interval(np.array(list(joint.values()))[:, None])
+            out.append({"criterion": criterion, "fz_n": math.nan, "measured_best_kpa": math.nan,
+                        "pressure_kpa": math.nan, "measured_diff_s": math.nan, "measured_sd_s": sd,
+                        "measured_resolved": bool(verdicts), "rows": len(joint), "q": math.nan, "q_low": math.nan,
+                        "q_high": math.nan, "p_best": float(p[0]), "p_best_low": float(lo[0]),
+                        "p_best_high": float(hi[0]),
+                        "verdict": _combine(verdicts) if criterion == MEASURED_CRITERION
+                        else "not measured (the thesis gives last-peak times)"})
+    return pd.DataFrame(out, columns=MEASURED_COLUMNS)
+
+
+def sobol_caution(rows):
+    """Why one output's Sobol indices (rows of ``sobol.csv``) are not resolved at this N: a list of reasons.
+
+    Empty when they are. A reason: the first-order indices sum above 1 or below 0, or the total ones below
+    1, beyond their combined intervals (true indices cannot); an index negative beyond its interval; the
+    largest total index not resolved from 0 (its interval reaches 0); more than half the inputs that matter
+    (total >= 0.05) with total, or first-order, intervals wider than their indices.
+    """
+    reasons = []
+    s1, s1c = float(rows["S1"].sum()), math.sqrt(float((rows["S1_conf"] ** 2).sum()))
+    st, stc = float(rows["ST"].sum()), math.sqrt(float((rows["ST_conf"] ** 2).sum()))
+    if s1 - s1c > 1.0 or s1 + s1c < 0.0:
+        reasons.append(f"first-order indices sum to {s1:.2f} +- {s1c:.2f} (between 0 and 1)")
+    if st + stc < 1.0:
+        reasons.append(f"total indices sum to {st:.2f} +- {stc:.2f} (at least 1)")
+    negative = int(((rows["S1"] + rows["S1_conf"] < 0) | (rows["ST"] + rows["ST_conf"] < 0)).sum())
+    if negative:
+        reasons.append(f"{negative} of {len(rows)} inputs with an index negative beyond its interval")
+    top = rows.loc[rows["ST"].idxmax()]
+    if top["ST_conf"] >= top["ST"]:
+        reasons.append(f"the largest total index ({top['input']} {top['ST']:.2f} +- {top['ST_conf']:.2f}) is not "
+                       "resolved from 0")
+    matter = rows[rows["ST"] >= 0.05]
+    for name, conf in (("total", "ST_conf"), ("first-order", "S1_conf")):
+        idx = conf[:2]
+        wide = int((matter[conf] > matter[idx].abs()).sum())
+        if len(matter) and 2 * wide > len(matter):
+            reasons.append(f"{wide} of the {len(matter)} inputs with a total index >= 0.05 have {name} intervals "
+                           "wider than their indices")
+    return reasons
+
+
+def hinge(rows):
+    """The input one output hinges most on, when its total index's interval separates from the next one's.
+
+    Returns ``(top row, next row, separated)`` of ``sobol.csv`` rows (next None with one input).
+    """
+    ranked = rows.sort_values("ST", ascending=False)
+    top = ranked.iloc[0]
+    if len(ranked) < 2:
+        return top, None, bool(top["ST"] - top["ST_conf"] > 0)
+    second = ranked.iloc[1]
+    return top, second, bool(top["ST"] - top["ST_conf"] > second["ST"] + second["ST_conf"])
+
+
+def _criterion_line(pb, criterion):
+    """"<criterion>: 300 kPa P = .. [..], next ..." with "tie" where the two intervals overlap."""
+    top = pb[pb["pressure_kpa"].notna()].sort_values("p", ascending=False)
+    none = pb[pb["pressure_kpa"].isna()]
+    name = CRITERIA[criterion].short
+    first = top.iloc[0]
+    cell = f"{first['pressure_kpa']:g} kPa P = {first['p']:.2f} [{first['low']:.2f}, {first['high']:.2f}]"
+    if len(top) > 1:
+        second = top.iloc[1]
+        other = f"{second['pressure_kpa']:g} kPa P = {second['p']:.2f} [{second['low']:.2f}, {second['high']:.2f}]"
+        if second["high"] >= first["low"]:
+            text = f"{name}: a tie, {cell} and {other} (their intervals overlap)"
+        else:
+            text = f"{name}: {cell} is most probable best, next {other}"
+    else:
+        text = f"{name}: {cell}"
+    if len(none) and none["p"].iloc[0] > 0:
+        text += f"; none recovered in {none['p'].iloc[0]:.2f} of the rows"
+    return text, (first["pressure_kpa"], top.iloc[1]["pressure_kpa"]) if len(top) > 1 else None
+
+
+def _option_line(study, fz, criterion):
+    """"by option: rider: A 300 kPa (0.55), ...": the most probable best within each option, for the choices
+    and the continuous input with the largest total index (its two halves)."""
+    bo = study.p_best_by_option
+    if bo is None or not len(bo):
+        return None
+    at = bo[(bo["fz_n"] == fz) & (bo["criterion"] == criterion) & bo["pressure_kpa"].notna()]
+    choices = _shown_inputs(study, fz, criterion)
+    parts = []
+    for name in choices:
+        cells = []
+        for option, rows in at[at["input"] == name].groupby("option", sort=False):
+            if not rows["rows"].iloc[0]:
+                continue
+            top = rows.sort_values("p", ascending=False)
+            first, second = top.iloc[0], top.iloc[1] if len(top) > 1 else None
+            tie = second is not None and second["high"] >= first["low"]
+            cells.append(f"{option} {'tie ' if tie else ''}{first['pressure_kpa']:g}"
+                         + (f"/{second['pressure_kpa']:g}" if tie else "") + f" kPa ({first['p']:.2f}, "
+                         f"{int(first['rows'])} rows)")
+        if cells:
+            parts.append(f"{name}: " + ", ".join(cells))
+    return "by option (most probable best): " + "; ".join(parts) if parts else None
+
+
 def verdict_lines(study, criterion="settling"):
-    """One line per load: the most probable best pressure with its interval, and the input it hinges on most."""
+    """Per load: both criteria's most probable best (a tie said as a tie), what the comparison hinges on (only
+    where the Sobol intervals separate, with a caution where N cannot resolve them) and P(best) by option;
+    then the measured ranking against the model. ``criterion`` comes first and decides the Sobol pair."""
     lines = []
-    pb = study.p_best[(study.p_best["criterion"] == criterion) & study.p_best["pressure_kpa"].notna()]
-    for fz, rows in pb.groupby("fz_n", sort=False):
-        top = rows.sort_values("p", ascending=False)
-        first = top.iloc[0]
-        text = (f"{fz:g} N: {first['pressure_kpa']:g} kPa recovers fastest ({criterion}) with P = {first['p']:.2f} "
-                f"[{first['low']:.2f}, {first['high']:.2f}]")
-        if len(top) > 1:
-            second = top.iloc[1]
-            pair = sorted((first["pressure_kpa"], second["pressure_kpa"]))
+    order = [criterion, *(c for c in CRITERIA if c != criterion)]
+    for fz in dict.fromkeys(study.p_best["fz_n"]):
+        texts, pair = [], None
+        for crit in order:
+            pb = study.p_best[(study.p_best["criterion"] == crit) & (study.p_best["fz_n"] == fz)]
+            if not len(pb):
+                continue
+            text, top_pair = _criterion_line(pb, crit)
+            texts.append(text)
+            pair = pair or top_pair
+        line = f"{fz:g} N: " + "; ".join(texts)
+        if pair is not None:
+            a, b = sorted(pair)
             s = study.sobol[(study.sobol["fz_n"] == fz) & (study.sobol["criterion"] == criterion)
-                            & (study.sobol["pressure_a_kpa"] == pair[0]) & (study.sobol["pressure_b_kpa"] == pair[1])]
-            text += f", next {second['pressure_kpa']:g} kPa ({second['p']:.2f})"
+                            & (study.sobol["pressure_a_kpa"] == a) & (study.sobol["pressure_b_kpa"] == b)]
             if len(s):
-                key = s.sort_values("ST", ascending=False).iloc[0]
-                text += (f"; the {pair[1]:g}-{pair[0]:g} kPa difference hinges most on {key['input']} "
-                         f"(total Sobol {key['ST']:.2f} +- {key['ST_conf']:.2f})")
-        lines.append(text)
-    m = study.measured[study.measured["criterion"] == "last_peak"] if len(study.measured) else study.measured
-    joint = m[m["fz_n"].isna()] if len(m) else m
+                top, second, separated = hinge(s)
+                if separated:
+                    line += (f"; which of {a:g}/{b:g} kPa recovers first ({criterion}) hinges most on {top['input']} "
+                             f"(total Sobol {top['ST']:.2f} +- {top['ST_conf']:.2f}"
+                             + (f", next {second['input']} {second['ST']:.2f} +- {second['ST_conf']:.2f})"
+                                if second is not None else ")"))
+                else:
+                    line += (f"; no single input decides which of {a:g}/{b:g} kPa recovers first ({criterion}): the "
+                             f"largest total Sobol indices' intervals overlap ({top['input']} {top['ST']:.2f} +- "
+                             f"{top['ST_conf']:.2f}"
+                             + (f", {second['input']} {second['ST']:.2f} +- {second['ST_conf']:.2f})"
+                                if second is not None else ")"))
+                reasons = sobol_caution(s)
+                if reasons:
+                    line += (f" [caution: N = {study.samples} does not resolve these indices: "
+                             + "; ".join(reasons) + "]")
+        lines.append(line)
+        option = _option_line(study, fz, criterion)
+        if option:
+            lines.append(f"{fz:g} N {option}")
+    lines += _measured_lines(study)
+    return lines
+
+
+def _measured_lines(study):
+    """The measured ranking (Table 8.9, last peak) against the model, per load and as a whole."""
+    m = study.measured
+    if m is None or not len(m) or "verdict" not in m:
+        return []
+    m = m[m["criterion"] == MEASURED_CRITERION]
+    lines = []
+    for fz, rows in m[m["fz_n"].notna()].groupby("fz_n", sort=False):
+        best = rows["measured_best_kpa"].iloc[0]
+        diffs = ", ".join(f"{r['pressure_kpa']:g} kPa +{r['measured_diff_s']:.2f} s" for _, r in rows.iterrows())
+        half = 1.959964 * rows["measured_sd_s"].iloc[0]
+        head = (f"measured at {fz:g} N (Table 8.9, last peak): {best:g} kPa best ({diffs}; 95 % error of a "
+                f"difference +-{half:.2f} s)")
+        if not rows["measured_resolved"].all():
+            lines.append(f"{head}: not resolved by the measurement (a difference within its error): the model can "
+                         f"neither confirm nor contradict it; model P(best) of {best:g} kPa "
+                         f"{rows['p_best'].iloc[0]:.2f}")
+        else:
+            checks = ", ".join(f"{r['pressure_kpa']:g} kPa {r['verdict']} (q = {r['q']:.2f} [{r['q_low']:.2f}, "
+                               f"{r['q_high']:.2f}])" for _, r in rows.iterrows())
+            lines.append(f"{head}: the model's paired differences: {checks}; model P(best) of {best:g} kPa "
+                         f"{rows['p_best'].iloc[0]:.2f} [{rows['p_best_low'].iloc[0]:.2f}, "
+                         f"{rows['p_best_high'].iloc[0]:.2f}]")
+    joint = m[m["fz_n"].isna()]
     if len(joint):
         j = joint.iloc[0]
-        lines.append(f"measured ranking (Table 8.9, last peak): P = {j['p']:.2f} [{j['low']:.2f}, {j['high']:.2f}] "
-                     f"that the model gives it at every load: {'admitted' if j['admitted'] else 'not admitted'} "
-                     f"by the model's uncertainty (N = {study.samples}, {len(study.inputs)} rows)")
+        resolved = [f"{fz:g} N" for fz, rows in m[m["fz_n"].notna()].groupby("fz_n", sort=False)
+                    if rows["measured_resolved"].all()]
+        head = (f"{j['verdict']} over the loads the measurement resolves ({', '.join(resolved)})" if resolved else
+                "not resolved by the measurement at any load")
+        lines.append(f"measured ranking as a whole (last peak): {head}; P = {j['p_best']:.2f} [{j['p_best_low']:.2f}, "
+                     f"{j['p_best_high']:.2f}] that one row gives the measured best at every load (N = "
+                     f"{study.samples}, {len(study.inputs)} rows)")
     return lines
 
 
 def format_study(study):
-    """Plain-text tables: P(best) beside the measured best, rates, and the verdict."""
+    """Plain-text tables: P(best) beside the measured best, by option, rates, Sobol indices, and the verdict."""
     lines = [f"uncertainty study: {study.spec.name}, N = {study.samples} base samples, {len(study.inputs)} rows "
              f"(seed {study.seed}); every row runs at every pressure and load"]
     for criterion in CRITERIA:
         lines.append(f"\nP(best) by {criterion} ({CRITERIA[criterion].column}), 95 % Wilson interval; * measured best")
         pb = study.p_best[study.p_best["criterion"] == criterion]
         for fz, rows in pb.groupby("fz_n", sort=False):
-            cells = []
-            for _, r in rows.iterrows():
-                name = "none" if math.isnan(r["pressure_kpa"]) else f"{r['pressure_kpa']:g}{'*' if r['measured_best'] else ''}"
-                cells.append(f"{name}: {r['p']:.2f} [{r['low']:.2f}, {r['high']:.2f}]")
-            lines.append(f"  {fz:g} N ({int(rows['rows'].iloc[0])} rows): " + "; ".join(cells))
+            lines.append(f"  {fz:g} N ({int(rows['rows'].iloc[0])} rows): " + _cells(rows))
+            bo = study.p_best_by_option
+            if bo is None or not len(bo):
+                continue
+            at = bo[(bo["fz_n"] == fz) & (bo["criterion"] == criterion)]
+            shown = _shown_inputs(study, fz, criterion)
+            for (name, option), orows in at.groupby(["input", "option"], sort=False):
+                if name in shown:
+                    lines.append(f"    {name} = {option} ({int(orows['rows'].iloc[0])} rows): " + _cells(orows))
     lines.append("\nfall / not recovered (settling) / failed runs per pressure")
     for _, r in study.rates.iterrows():
         lines.append(f"  {r['fz_n']:g} N {r['pressure_kpa']:g} kPa: {int(r['fell'])}/{int(r['not_recovered_settling'])}/"
                      f"{int(r['failed'])} of {int(r['runs'])}")
+    if len(study.sobol):
+        lines.append("\nSobol indices of which pressure recovers first (total, 95 % interval; the 3 largest), with "
+                     "the rows where one / neither run recovered")
+        for (fz, crit, a, b), rows in study.sobol.groupby(["fz_n", "criterion", "pressure_a_kpa", "pressure_b_kpa"],
+                                                          sort=False):
+            r0 = rows.iloc[0]
+            top = rows.sort_values("ST", ascending=False).head(3)
+            cells = ", ".join(f"{r['input']} {r['ST']:.2f} +- {r['ST_conf']:.2f}" for _, r in top.iterrows())
+            caution = sobol_caution(rows)
+            lines.append(f"  {fz:g} N {crit} {a:g}/{b:g} kPa: {cells}; rows {int(r0['rows'])}, one not recovered "
+                         f"{100 * r0['rows_one_not_recovered'] / r0['rows']:.0f} %, neither "
+                         f"{100 * r0['rows_neither_recovered'] / r0['rows']:.0f} %"
+                         + (" (not resolved at this N)" if caution else ""))
     lines += ["", *study.notes, "", *study.verdict]
     return "\n".join(lines)
+
+
+def _cells(rows):
+    """"300*: 0.51 [0.41, 0.61]; ...; none: 0.07 [..]" of P(best) rows."""
+    cells = []
+    for _, r in rows.iterrows():
+        name = "none" if math.isnan(r["pressure_kpa"]) else \
+            f"{r['pressure_kpa']:g}{'*' if r.get('measured_best', False) else ''}"
+        cells.append(f"{name}: {r['p']:.2f} [{r['low']:.2f}, {r['high']:.2f}]")
+    return "; ".join(cells)
+
+
+def _shown_inputs(study, fz, criterion):
+    """The inputs whose options the text shows at a load: the choices and the continuous input with the largest
+    mean total Sobol index there (every input is in ``p_best_by_option.csv``)."""
+    names = [i.name for i in study.spec.inputs if i.distribution == "choice"]
+    continuous = [i.name for i in study.spec.inputs if i.distribution != "choice"]
+    s = study.sobol[(study.sobol["fz_n"] == fz) & (study.sobol["criterion"] == criterion)
+                    & study.sobol["input"].isin(continuous)]
+    if len(s):
+        names.append(s.groupby("input", sort=False)["ST"].mean().idxmax())
+    return names
