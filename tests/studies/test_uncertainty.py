@@ -178,6 +178,21 @@ def test_the_same_seed_gives_the_same_tables_and_the_folder_resumes(tiny, tiny_s
     pd.testing.assert_frame_equal(again.p_best, study.p_best)
 
 
+def test_a_stored_study_is_analysed_again_without_running_and_a_short_one_says_what_it_lacks(tiny, tiny_study):
+    # The N = 512 study's runs outlive the code that analysed them: analyse_folder reads them back by case id.
+    study, folder = tiny_study
+    again = uncertainty.analyse_folder(folder, tiny, samples=2, seed=3, loads=[635.0], pressures=[300.0, 500.0],
+                                       base=BASE)
+    pd.testing.assert_frame_equal(again.outcomes, study.outcomes)
+    for name in ("p_best", "differences", "sobol", "measured"):
+        pd.testing.assert_frame_equal(getattr(again, name), getattr(study, name))
+    with pytest.raises(InputError, match=r"lacks 16 of the design's 32 runs \(at 570 N\)"):
+        uncertainty.analyse_folder(folder, tiny, samples=2, seed=3, loads=[570.0, 635.0],
+                                   pressures=[300.0, 500.0], base=BASE)
+    with pytest.raises(InputError, match="holds no sweep"):
+        uncertainty.analyse_folder(folder.parent, tiny, samples=2, seed=3, base=BASE)
+
+
 def test_dask_gives_the_same_tables_as_the_pool(tiny, tiny_study, dask_client):
     study, _ = tiny_study
     dask = uncertainty.run_study(tiny, samples=2, seed=3, loads=[635.0], pressures=[300.0, 500.0], base=BASE,

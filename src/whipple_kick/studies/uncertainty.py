@@ -99,6 +99,8 @@ from whipple_kick.simulate.scenario import DEFAULTS, MECHANISM_FIELDS, UNITS, Sc
 
 from .recommend import _num, pressure_grid
 from .sweep_engine import check_some_ok, make_cases, sweep
+from .sweep_store import read_log, read_manifest
+from .sweep_store import table as stored_table
 
 #: Thesis Chapter 8's pressures [kPa] and rear loads [N] (:mod:`whipple_kick.library.thesis`).
 PRESSURES = thesis.PRESSURES_KPA
@@ -422,31 +424,8 @@ def study_cases(spec, unit, loads, pressures, base):
     return cases, keys
 
 
-def run_study(spec=uncertain.DEFAULT, samples=64, seed=0, loads=LOADS, pressures=PRESSURES, base=None,
-              **sweep_options):
-    """Run the uncertainty study (see the module's docstring) and analyse it.
-
-    Parameters
-    ----------
-    spec : str, path or UncertainSet
-        The uncertainty file (default: the thesis' kick-plate experiment's).
-    samples : int
-        SALib's base sample count ``N``: ``N (D + 2)`` rows, each run at every
-        pressure and load. A power of 2 keeps the Sobol' sequence balanced.
-    seed : int
-        Seeds the Sobol' scrambling and every bootstrap: the same seed gives the same tables.
-    loads, pressures : sequence of float
-        Rear loads [N] (separate studies on the same rows) and pressures [kPa].
-    base : Scenario, optional
-        What the inputs and the file's ``[fixed]`` fields change (default ``Scenario()``).
-    **sweep_options
-        Passed to :func:`whipple_kick.studies.sweep_engine.sweep` (``folder`` to
-        keep and resume the runs, ``executor``, ``workers``, ``progress``).
-
-    Returns
-    -------
-    UncertaintyStudy
-    """
+def _design(spec, samples, seed, loads, pressures, base):
+    """The study's checked design: ``(spec, base, unit, blocks, cases, keys, ids)`` (nothing is run)."""
     if not isinstance(spec, uncertain.UncertainSet):
         spec = uncertain.load(spec)
     base = Scenario() if base is None else base
@@ -473,9 +452,69 @@ def run_study(spec=uncertain.DEFAULT, samples=64, seed=0, loads=LOADS, pressures
             raise InputError(f"{spec.path}: sample row {keys[k][0]} ({spec.labels(unit[keys[k][0]])}): {exc}") \
                 from None
     ids = [cid for _, _, cid in make_cases(cases=cases, base=base)]
+    return spec, base, unit, blocks, cases, keys, ids
+
+
+def run_study(spec=uncertain.DEFAULT, samples=64, seed=0, loads=LOADS, pressures=PRESSURES, base=None,
+              **sweep_options):
+    """Run the uncertainty study (see the module's docstring) and analyse it.
+
+    Parameters
+    ----------
+    spec : str, path or UncertainSet
+        The uncertainty file (default: the thesis' kick-plate experiment's).
+    samples : int
+        SALib's base sample count ``N``: ``N (D + 2)`` rows, each run at every
+        pressure and load. A power of 2 keeps the Sobol' sequence balanced.
+    seed : int
+        Seeds the Sobol' scrambling and every bootstrap: the same seed gives the same tables.
+    loads, pressures : sequence of float
+        Rear loads [N] (separate studies on the same rows) and pressures [kPa].
+    base : Scenario, optional
+        What the inputs and the file's ``[fixed]`` fields change (default ``Scenario()``).
+    **sweep_options
+        Passed to :func:`whipple_kick.studies.sweep_engine.sweep` (``folder`` to
+        keep and resume the runs, ``executor``, ``workers``, ``progress``).
+
+    Returns
+    -------
+    UncertaintyStudy
+    """
+    spec, base, unit, blocks, cases, keys, ids = _design(spec, samples, seed, loads, pressures, base)
     sweep_options.setdefault("progress", False)
     sweep_options.setdefault("trajectory_columns", None)   # thousands of runs: the table, not the time histories
     table = sweep(cases=cases, base=base, **sweep_options)
+    check_some_ok(table)
+    return analyse(spec, samples, seed, unit, blocks, keys, ids, table, base.duration)
+
+
+def analyse_folder(folder, spec=uncertain.DEFAULT, samples=64, seed=0, loads=LOADS, pressures=PRESSURES,
+                   base=None):
+    """Analyse a study's stored runs again, with this code's analysis, running nothing.
+
+    ``folder`` is the sweep folder :func:`run_study` was given (``folder=``); the
+    other arguments must be the ones it ran with (the same design: each case is
+    found by its id). A subset of its loads may be asked for (a study cut short
+    after its first loads). The runs stay what the code that made them computed
+    (its commit is in the folder's manifest); only the statistics are this code's.
+
+    Raises
+    ------
+    InputError
+        The folder holds no sweep, or lacks some of the design's runs (how many, and for which loads).
+    """
+    spec, base, unit, blocks, cases, keys, ids = _design(spec, samples, seed, loads, pressures, base)
+    if read_manifest(folder) is None:
+        raise InputError(f"{str(folder)!r} holds no sweep (no manifest): give the folder run_study ran in")
+    records = read_log(folder)
+    missing = [key for key, cid in zip(keys, ids, strict=True) if cid not in records]
+    if missing:
+        at = sorted({fz for _, fz, _ in missing})
+        raise InputError(f"{str(folder)!r} lacks {len(missing)} of the design's {len(ids)} runs (at "
+                         f"{', '.join(f'{fz:g}' for fz in at)} N): the same file, samples = {samples} and "
+                         f"seed = {seed}? Finish the study, or analyse only the loads it completed")
+    case_list = make_cases(cases=cases, base=base)
+    table = stored_table(case_list, records)
     check_some_ok(table)
     return analyse(spec, samples, seed, unit, blocks, keys, ids, table, base.duration)
 
