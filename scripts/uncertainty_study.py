@@ -19,6 +19,7 @@ analyses them anew (the tables and verdict are the present analysis'). The cost:
 Usage::
 
     python scripts/uncertainty_study.py --samples 8 --seed 0 [--workers 2] [--out DIR]
+    python scripts/uncertainty_study.py --samples 8 --seed 0 --out DIR --analyse   # again, running nothing
 
 (docs/uncertainty.md quotes a run of this; the full N = 500 study is
 ``recommend-pressure --fz 570 635 701 --uncertain --samples 500 --seed 0 --out DIR``.)
@@ -45,13 +46,27 @@ def main(argv=None):
     p.add_argument("--file", default=uncertain.DEFAULT, help="uncertainty file (default the shipped one)")
     p.add_argument("--out", help="folder for the runs and tables (default: a temporary one)")
     p.add_argument("--extrapolate", type=int, default=500, help="N to extrapolate the cost to (default 500)")
+    p.add_argument("--analyse", action="store_true",
+                   help="analyse the study already run in --out again with this code's statistics, running "
+                        "nothing (its runs stay the code's that made them: see its runs/manifest.json)")
+    p.add_argument("--loads", type=float, nargs="+", default=list(uncertainty.LOADS),
+                   help="rear loads in N (default the thesis' three; with --analyse, the loads the study completed)")
     args = p.parse_args(argv)
     spec = uncertain.load(args.file)
+    if args.analyse:
+        if not args.out:
+            p.error("--analyse needs --out, the folder of the study to analyse")
+        study = uncertainty.analyse_folder(os.path.join(args.out, "runs"), spec, samples=args.samples,
+                                           seed=args.seed, loads=args.loads)
+        study.write(args.out)
+        print(uncertainty.format_study(study))
+        return
     with tempfile.TemporaryDirectory() as tmp:
         out = args.out or tmp
         t0 = time.perf_counter()
         study = uncertainty.run_study(spec, samples=args.samples, seed=args.seed, workers=args.workers,
-                                      folder=os.path.join(out, "runs"), progress=sys.stderr.isatty())
+                                      folder=os.path.join(out, "runs"), progress=sys.stderr.isatty(),
+                                      loads=args.loads)
         wall = time.perf_counter() - t0
         study.write(out)
     print(uncertainty.format_study(study))
@@ -78,7 +93,7 @@ def cost(outcomes, wall, workers, n_inputs, extrapolate=500, resumed=False):
     rows = extrapolate * (n_inputs + 2)
     total = rows * len(uncertainty.PRESSURES) * len(uncertainty.LOADS)
     share = distinct / n
-    return {"runs": n, "rows": n // (len(uncertainty.PRESSURES) * len(uncertainty.LOADS)), "distinct": distinct, "wall_s": wall, "workers": workers, "resumed": resumed,
+    return {"runs": n, "rows": n // (len(uncertainty.PRESSURES) * outcomes["fz_n"].nunique()), "distinct": distinct, "wall_s": wall, "workers": workers, "resumed": resumed,
             "run_wall_mean_s": float(case_wall[ok].mean()), "run_wall_median_s": float(np.median(case_wall[ok])),
             "run_cpu_mean_s": float(case_cpu[ok].mean()), "integration_wall_mean_s": float(integ[ok].mean()),
             "integration_wall_median_s": float(np.median(integ[ok])),

@@ -110,6 +110,12 @@ def test_uncertainty_study_reports_its_cost(tmp_path, capsys):
     assert "per run in its worker: wall mean" in out and "N = 500: 2000 rows, 18000 runs" in out
     record = json.loads((tmp_path / "out" / "cost.json").read_text())   # what docs/uncertainty.md's numbers read
     assert (record["runs"], record["rows"], record["distinct"], record["extrapolate_runs"]) == (72, 8, 72, 18000)
+    first = (tmp_path / "out" / "p_best.csv").read_text()
+    (tmp_path / "out" / "p_best.csv").unlink()
+    capsys.readouterr()
+    uncertainty_study.main(["--file", str(path), "--samples", "2", "--out", str(tmp_path / "out"), "--analyse"])
+    assert "cost:" not in capsys.readouterr().out   # nothing ran
+    assert (tmp_path / "out" / "p_best.csv").read_text() == first   # the same runs, the same statistics
 
 
 @pytest.mark.slow
