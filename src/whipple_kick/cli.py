@@ -794,8 +794,9 @@ def _recommend(argv):
                "simulate default (3 m/s, LQR rider designed at that speed, 150 mm kick to the right in 0.150 s, 6 s). "
                "The default runs one direction and one tyre transient; --kick-direction both and "
                "--tyre-transient all say whether the answer depends on them. See docs/sweeps.md.")
-    p.add_argument("--fz", type=_number("N"), nargs="+", required=True, metavar="N",
-                   help=f"static rear-tyre load(s) in N, e.g. --fz {thesis.loads_text(' ')}")
+    p.add_argument("--fz", type=_number("N"), nargs="+", metavar="N",
+                   help=f"static rear-tyre load(s) in N, e.g. --fz {thesis.loads_text(' ')} (required but with "
+                        "--posterior, where the thesis' loads are the default)")
     p.add_argument("--tyre", default=DEFAULTS["tyre"], metavar="NAME",
                    help=f"tyre on both wheels (default {DEFAULTS['tyre']}; available: %s)"
                         % ", ".join(t[0] for t in tyres.available()))
@@ -834,12 +835,25 @@ def _recommend(argv):
     p.add_argument("--samples", type=int, metavar="N",
                    help="with --uncertain: SALib's base sample count N (N (D + 2) rows for D inputs, each run at "
                         "every pressure and load; default 64)")
-    p.add_argument("--seed", type=int, metavar="S", help="with --uncertain: the seed (default 0)")
+    p.add_argument("--seed", type=int, metavar="S", help="with --uncertain or --posterior: the seed (default 0)")
+    p.add_argument("--posterior", metavar="DIR",
+                   help="the answer under a calibration's posterior (calibrate --out DIR): P(best) per pressure "
+                        "and load from DIR/p_best.csv, or run it (--samples M posterior rows, default 32, each "
+                        "at every pressure and load; the runs kept in DIR/posterior_runs to resume)")
+    p.add_argument("--prior-study", metavar="DIR",
+                   help="with --posterior: a prior uncertainty study's folder (--uncertain --out DIR), its "
+                        "P(best) beside")
     bar = p.add_mutually_exclusive_group()
     bar.add_argument("--progress", action="store_true", default=None,
                      help="show the progress bar (default: only when stderr is a terminal)")
     bar.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
     args = p.parse_args(argv)
+    if args.posterior is not None:
+        return _recommend_posterior(args)
+    if args.prior_study is not None:
+        raise InputError("--prior-study goes with --posterior DIR")
+    if args.fz is None:
+        p.error("the following arguments are required: --fz")
     if args.uncertain is not None:
         return _recommend_uncertain(args)
     if args.samples is not None or args.seed is not None:
@@ -934,6 +948,45 @@ def _recommend_uncertain(args):
     return 0
 
 
+def _recommend_posterior(args):
+    """``recommend-pressure --posterior DIR``: P(best) under a calibration's posterior
+    (whipple_kick.studies.posterior_study), read from DIR or run there."""
+    import pathlib
+
+    from whipple_kick.library import thesis
+    from whipple_kick.simulate.scenario import DEFAULTS, Scenario
+    from whipple_kick.studies import posterior_study
+    given = [flag for flag, value in (("--uncertain", args.uncertain is not None), ("--fine", args.fine),
+                                      ("--extend", args.extend), ("--out", args.out is not None),
+                                      ("--duration", args.duration is not None),
+                                      ("--kick-direction", args.kick_direction != DEFAULTS["kick_direction"]),
+                                      ("--tyre-transient", args.tyre_transient != Scenario.tyre_transient))
+             if value]
+    if given:
+        raise InputError(f"{', '.join(given)} cannot go with --posterior: the calibration's folder holds the "
+                         "answer and its runs, and the calibration's settings and the uncertainty file set the "
+                         "kick, the tyre transient and the run's duration")
+    folder = pathlib.Path(args.posterior)
+    posterior_study.read_calibration(folder)   # a bad folder: one line, before anything else
+    done = posterior_study.from_folder(folder)
+    if done is not None and args.samples is None and args.seed is None and args.prior_study is None \
+            and args.fz is None and args.pressures is None:
+        print((folder / "answer.txt").read_text().rstrip() if (folder / "answer.txt").is_file()
+              else done.to_string(index=False))
+        print(f"\n(read from {folder / 'p_best.csv'}; --samples M runs it again)")
+        return 0
+    study = posterior_study.run(folder, samples=32 if args.samples is None else args.samples,
+                                seed=0 if args.seed is None else args.seed,
+                                loads=args.fz or thesis.LOADS_N, pressures=args.pressures or thesis.PRESSURES_KPA,
+                                prior_study=args.prior_study, tyre=args.tyre, workers=args.workers,
+                                progress=sys.stderr.isatty() if args.progress is None else args.progress)
+    study.write(folder)
+    print(posterior_study.format_study(study))
+    print(f"\nwrote {', '.join(posterior_study.FILES)} into {folder} (the runs in "
+          f"{folder / posterior_study.RUNS}: run again to resume)")
+    return 0
+
+
 def _verdict_pair(study, criterion):
     """The (lower, higher) pressures of the two most probable best at the first load, for the Sobol figure."""
     pb = study.p_best[(study.p_best["criterion"] == criterion) & study.p_best["pressure_kpa"].notna()]
@@ -954,9 +1007,12 @@ def _out_given(argv):
 def recommend_main(argv=None):
     """Console script ``recommend-pressure`` (see ``recommend-pressure --help``)."""
     from whipple_kick.studies.sweep_engine import SweepFailed, SweepInterrupted
-    out = _out_given(sys.argv[1:] if argv is None else argv)
+    words = sys.argv[1:] if argv is None else argv
+    out = _out_given(words)
     kept = ("no results were kept (--out DIR keeps the finished cases, and a rerun on it resumes)" if out is None
             else f"the finished cases are kept in {out}: run again with --out {out} to resume")
+    if any(str(w).startswith("--posterior") for w in words):
+        kept = "the finished runs are kept in the calibration folder's posterior_runs: run again to resume"
     try:
         status = _run(_recommend, argv, "recommend-pressure", kept)
     except (SweepInterrupted, SweepFailed) as exc:   # lost workers, or every case failed: not the user's to fix
@@ -1183,6 +1239,35 @@ def validate_main(argv=None):
     sys.exit(_run(_validate, argv, "validate"))
 
 
+#: The figure ``calibrate --out DIR`` writes: each feature's posterior predictive beside the measurement.
+CALIBRATION_FIGURE = "predictive.png"
+
+
+def _held_out(args, result, base, inputs, cells, progress, options):
+    """``calibrate --held-out``: the checks' table (its rows also appended to ``result.checks``)."""
+    import pandas as pd
+
+    from whipple_kick.studies import calibration
+
+    def factory(prior_list, cells, features, direction):
+        return calibration.ModelSimulator([p.field for p in prior_list], cells, features,
+                                          base.with_changes(kick_direction=direction), args.workers, progress)
+
+    frames = [calibration.held_out(mode, factory, spec=args.spec, inputs=inputs, cells=cells,
+                                   direction=args.direction, draws=4 if args.quick else 8, fitted=result, **options)
+              for mode in dict.fromkeys(args.held_out)]
+    frame = pd.concat(frames, ignore_index=True)
+    result.checks = pd.concat([result.checks, calibration.held_out_checks(frame)], ignore_index=True)
+    return frame
+
+
+def _stale_answer(folder):
+    """Remove an earlier posterior's answer from a calibration folder (its runs stay: a rerun reuses them)."""
+    from whipple_kick.studies import posterior_study
+    for name in (*posterior_study.FILES, posterior_study.BESIDE_PRIOR):
+        (folder / name).unlink(missing_ok=True)
+
+
 def calibrate_main(argv=None):
     """Console script ``calibrate``: history matching and a posterior of the uncertain inputs against the thesis'
     measured kick responses (see ``calibrate --help`` and :mod:`whipple_kick.studies.calibration`)."""
@@ -1216,26 +1301,60 @@ def calibrate_main(argv=None):
         p.add_argument("--waves", type=int, default=2, metavar="N", help="history-matching waves (default 2)")
         p.add_argument("--seed", type=int, default=0, metavar="N")
         p.add_argument("--workers", type=int, metavar="N", help="worker processes (default: one per CPU core)")
+        p.add_argument("--held-out", nargs="+", choices=calibration.HELD_OUT, default=(), metavar="CHECK",
+                       help="held-out checks, rows in checks.csv and held_out.csv: load (calibrate without each "
+                            "rear load in turn and predict it; one calibration per load) and/or direction "
+                            "(predict the measurements with the model kicked the other way)")
+        p.add_argument("--samples", type=int, metavar="M",
+                       help="posterior rows for the answer (P(best) per pressure and load, p_best.csv; each row "
+                            "run at every pressure and load): default 12 with --quick, else 32; 0: no answer")
+        p.add_argument("--prior-study", metavar="DIR",
+                       help="a prior uncertainty study's folder (recommend-pressure --uncertain --out DIR): its "
+                            "P(best) beside the posterior's (p_best_beside_prior.csv)")
         args = p.parse_args(argv)
         if args.workers is not None and args.workers < 1:
             raise InputError(f"--workers = {args.workers} must be a whole number >= 1")
         if args.waves < 1:
             raise InputError(f"--waves = {args.waves} must be a whole number >= 1")
+        samples = (12 if args.quick else 32) if args.samples is None else args.samples
+        if samples == 1 or samples < 0:
+            raise InputError(f"--samples = {samples} must be 0 (no answer) or a whole number >= 2")
         started = time.perf_counter()
         base = validation.base_scenario(duration=calibration.FEATURE_DURATION, rider_body=args.rider_body,
                                         kick_direction=args.direction)
         cells = [(570.0, 300.0), (635.0, 400.0), (701.0, 500.0)] if args.quick else None
         inputs = args.inputs or (["gain_scale", "carcass_stiffness_scale", "carcass_damping", "kick_accel"]
                                  + (["hip_stiffness"] if args.rider_body == "leaning" else []))
-        result = calibration.calibrate(spec=args.spec, inputs=inputs, cells=cells, base=base, waves=args.waves,
-                                       steps=1000 if args.quick else 5000, seed=args.seed, workers=args.workers,
-                                       progress=sys.stderr.isatty(), check_runs=4 if args.quick else 8)
-        files = result.write(pathlib.Path(args.out))
+        progress = sys.stderr.isatty()
+        options = dict(waves=args.waves, steps=1000 if args.quick else 5000, seed=args.seed)
+        result = calibration.calibrate(spec=args.spec, inputs=inputs, cells=cells, base=base, workers=args.workers,
+                                       progress=progress, check_runs=4 if args.quick else 8, **options)
+        if args.held_out:
+            result.held_out = _held_out(args, result, base, inputs, cells, progress, options)
+        out = pathlib.Path(args.out)
+        files = result.write(out)
+        from whipple_kick.figures import calibration as figures
+        figures.predictive_figure(result.features, out / CALIBRATION_FIGURE)
         print(f"calibrate: {args.rider_body} rider, kicks to the {args.direction}, "
               f"{len(result.measured)} measured features")
         for line in result.verdict:
             print("  " + line)
-        print(f"  wrote {', '.join(f.name for f in files)} in {args.out} ({time.perf_counter() - started:.0f} s)")
+        if result.held_out is not None:
+            for _, r in result.checks[result.checks["check"].str.endswith("_share")].iterrows():
+                print(f"  {r['check']}: {r['value']:.2f} ({r['detail']})")
+        print(f"  wrote {', '.join(f.name for f in files)}, {CALIBRATION_FIGURE} in {args.out} "
+              f"({time.perf_counter() - started:.0f} s)")
+        _stale_answer(out)
+        if samples and result.posterior is not None:
+            from whipple_kick.studies import posterior_study
+            study = posterior_study.run(out, samples=min(samples, len(result.posterior)), seed=args.seed,
+                                       prior_study=args.prior_study, workers=args.workers, progress=progress)
+            study.write(out)
+            print(posterior_study.format_study(study))
+            print(f"  wrote {', '.join(posterior_study.FILES)} in {args.out} (the runs in "
+                  f"{out / posterior_study.RUNS}; total {time.perf_counter() - started:.0f} s)")
+        elif samples:
+            print("  no answer under the posterior: nothing in the prior matches the measurements")
         return 0
 
     sys.exit(_run(main, argv, "calibrate"))

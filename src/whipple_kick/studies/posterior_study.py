@@ -326,6 +326,7 @@ def run(folder, samples=32, seed=0, loads=thesis.LOADS_N, pressures=thesis.PRESS
     ids = [cid for _, _, cid in make_cases(cases=overrides, base=base)]
     sweep_options["folder"] = pathlib.Path(folder) / RUNS if runs is None else pathlib.Path(runs)
     sweep_options.setdefault("progress", False)
+    sweep_options.setdefault("extend", True)   # a new posterior's rows join the earlier ones' runs (reused if equal)
     sweep_options.setdefault("trajectory_columns", None)
     table = sweep(cases=overrides, base=base, **sweep_options)
     check_some_ok(table)
