@@ -1,6 +1,7 @@
 """``recommend-pressure --posterior DIR`` and calibrate's answer flags (issue 39 items 3-4): one-line refusals
 with exit status 2, the answer read from the folder or run there."""
-import numpy as np
+import json
+
 import pandas as pd
 import pytest
 
@@ -14,12 +15,15 @@ CELLS3 = [(570.0, 300.0), (635.0, 400.0), (701.0, 500.0)]
 
 @pytest.fixture(scope="module")
 def calibrated(tmp_path_factory):
-    """A calibrate folder from the toy (gain scale and carcass stiffness scale)."""
+    """A calibrate folder written by hand: four posterior rows of the gain scale and carcass stiffness scale
+    and the settings of the default model runner (rigid rider, kicks to the right)."""
     folder = tmp_path_factory.mktemp("calibrated")
-    pl = cal.choose_priors(priors.load(), ["gain_scale", "carcass_stiffness_scale"])
-    result, _, _ = cal.known_answer(cal.ToySimulator, pl, np.array([0.5, 0.5]), seed=0, cells=CELLS3,
-                                    walkers=16, steps=400, waves=1)
-    result.write(folder)
+    spec = priors.load()
+    pl = cal.choose_priors(spec, ["gain_scale", "carcass_stiffness_scale"])
+    pd.DataFrame({"gain_scale": [0.8, 0.9, 1.0, 1.1], "carcass_stiffness_scale": [0.6, 0.7, 0.8, 0.9]}).to_csv(
+        folder / "posterior.csv", index=False)
+    settings = cal.settings(pl, None, CELLS3, list(cal.FEATURE_UNITS), spec)
+    (folder / cal.SETTINGS_FILE).write_text(json.dumps(settings))
     return folder
 
 

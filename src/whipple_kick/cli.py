@@ -908,18 +908,24 @@ UNCERTAINTY_FIGURES = ("p_best.png", *(f"recovery_{key}.png" for key in CRITERIA
                        *(f"sobol_{key}.png" for key in CRITERIA))
 
 
+def _study_flags_given(args):
+    """The flags of a plain recommendation given on a command line of a study that sets them itself."""
+    from whipple_kick.simulate.scenario import DEFAULTS, Scenario
+    return [flag for flag, value in (("--fine", args.fine), ("--extend", args.extend),
+                                     ("--duration", args.duration is not None),
+                                     ("--kick-direction", args.kick_direction != DEFAULTS["kick_direction"]),
+                                     ("--tyre-transient", args.tyre_transient != Scenario.tyre_transient))
+            if value]
+
+
 def _recommend_uncertain(args):
     """``recommend-pressure --uncertain``: the uncertainty study (whipple_kick.studies.uncertainty)."""
     import pathlib
 
     from whipple_kick.figures import uncertainty as figures
-    from whipple_kick.simulate.scenario import DEFAULTS, Scenario
+    from whipple_kick.simulate.scenario import Scenario
     from whipple_kick.studies import recommend, uncertainty
-    given = [flag for flag, value in (("--fine", args.fine), ("--extend", args.extend),
-                                      ("--duration", args.duration is not None),
-                                      ("--kick-direction", args.kick_direction != DEFAULTS["kick_direction"]),
-                                      ("--tyre-transient", args.tyre_transient != Scenario.tyre_transient))
-             if value]
+    given = _study_flags_given(args)
     if given:
         raise InputError(f"{', '.join(given)} cannot go with --uncertain: the uncertainty file samples or fixes "
                          "the kick, the tyre transient and the run's duration")
@@ -954,14 +960,8 @@ def _recommend_posterior(args):
     import pathlib
 
     from whipple_kick.library import thesis
-    from whipple_kick.simulate.scenario import DEFAULTS, Scenario
     from whipple_kick.studies import posterior_study
-    given = [flag for flag, value in (("--uncertain", args.uncertain is not None), ("--fine", args.fine),
-                                      ("--extend", args.extend), ("--out", args.out is not None),
-                                      ("--duration", args.duration is not None),
-                                      ("--kick-direction", args.kick_direction != DEFAULTS["kick_direction"]),
-                                      ("--tyre-transient", args.tyre_transient != Scenario.tyre_transient))
-             if value]
+    given = ["--uncertain"] * (args.uncertain is not None) + _study_flags_given(args) + ["--out"] * (args.out is not None)
     if given:
         raise InputError(f"{', '.join(given)} cannot go with --posterior: the calibration's folder holds the "
                          "answer and its runs, and the calibration's settings and the uncertainty file set the "
