@@ -1307,7 +1307,7 @@ def calibrate_main(argv=None):
                             "(predict the measurements with the model kicked the other way)")
         p.add_argument("--samples", type=int, metavar="M",
                        help="posterior rows for the answer (P(best) per pressure and load, p_best.csv; each row "
-                            "run at every pressure and load): default 12 with --quick, else 32; 0: no answer")
+                            "run at every pressure and load): default 24 with --quick, else 32; 0: no answer")
         p.add_argument("--prior-study", metavar="DIR",
                        help="a prior uncertainty study's folder (recommend-pressure --uncertain --out DIR): its "
                             "P(best) beside the posterior's (p_best_beside_prior.csv)")
@@ -1316,7 +1316,7 @@ def calibrate_main(argv=None):
             raise InputError(f"--workers = {args.workers} must be a whole number >= 1")
         if args.waves < 1:
             raise InputError(f"--waves = {args.waves} must be a whole number >= 1")
-        samples = (12 if args.quick else 32) if args.samples is None else args.samples
+        samples = (24 if args.quick else 32) if args.samples is None else args.samples
         if samples == 1 or samples < 0:
             raise InputError(f"--samples = {samples} must be 0 (no answer) or a whole number >= 2")
         started = time.perf_counter()
