@@ -55,6 +55,17 @@ Three steps, each a function of its own:
    (Gelman et al. 2013; walkers of one ensemble are not independent chains,
    so it is a symptom check, not a proof).
 
+4. **Checks of the posterior against the measurement**: the posterior
+   predictive per feature and cell, from the emulators (400 draws) and from
+   the simulator run at ``check_runs`` posterior draws (``features.csv``'s
+   ``simulator_*`` columns: each run plus the measurement's and the
+   discrepancy's noise); and the held-out checks (:func:`held_out`):
+   calibrate without one rear load and predict it, or calibrate with the
+   model kicked one way and predict the measurements kicked the other.
+
+The answer under the posterior (P(best) per pressure and load) is
+:mod:`whipple_kick.studies.posterior_study`.
+
 If nothing survives, the result says so, with the features no input
 matches at once (each feature's smallest implausibility over the candidates):
 a finding, not a failure.

@@ -244,6 +244,10 @@ def p_best_table(outcomes, loads, pressures, measured_best=None):
         for key, crit in criteria.CRITERIA.items():
             values = at[crit.column].map(_num).to_numpy(float).reshape(shape)
             times = np.where(np.isfinite(values) & ~fell & ~failed, values, np.inf)
+            lost = int(np.count_nonzero(~np.isfinite(times) & ~failed))
+            if lost:
+                notes.append(f"{fz:g} N, {key}: {lost} of {times.size} runs without a value ({int(fell.sum())} "
+                             "fell, the rest did not recover or gave no peak): ranked after every run with one")
             p, low, high = p_best_interval(_best_share(times[~row_failed]))
             for k, pk in enumerate([*pressures, math.nan]):
                 out.append({"fz_n": float(fz), "criterion": key, "pressure_kpa": pk, "p": float(p[k]),
