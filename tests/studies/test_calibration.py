@@ -168,7 +168,7 @@ def test_no_plausible_input_is_a_finding(tmp_path):
     assert result.posterior is None
     assert "no input in the prior reproduces" in result.verdict[-1] and "frequency_hz" in result.verdict[-1]
     paths = result.write(tmp_path)
-    assert {p.name for p in paths} == {"posterior.csv", "features.csv", "checks.csv", "verdict.txt"}
+    assert {p.name for p in paths} == {"posterior.csv", "features.csv", "checks.csv", "verdict.txt", "settings.json"}
 
 
 # ---------------------------------------------------------------------------------------------- bad inputs
