@@ -45,6 +45,17 @@ def test_recommend_posterior_refuses_a_bad_folder_in_one_line(tmp_path, capsys, 
     assert code == 2 and message in err and err.count("\n") == 1, err
 
 
+@pytest.mark.parametrize("argv, message", [
+    (["--samples", "5"], "--samples = 5 is more than the posterior's 4 rows"),
+    (["--samples", "1"], "--samples = 1 posterior rows is outside the allowed range [2, 100000] posterior rows"),
+    (["--pressures", "300", "900"], "pressure of tyre T03 = 900.0 kPa is outside the allowed range [300, 500] kPa"),
+    (["--fz", "-5"], "rear-tyre load fz = -5.0 N is outside the allowed range (0, inf] N"),
+])
+def test_recommend_posterior_refuses_bad_values_before_any_run(calibrated, capsys, argv, message):
+    code, _, err = _console(cli.recommend_main, ["--posterior", str(calibrated), *argv], capsys)
+    assert code == 2 and message in err and err.count("\n") == 1, err
+
+
 def test_recommend_posterior_refuses_other_studies_flags(calibrated, capsys):
     code, _, err = _console(cli.recommend_main, ["--posterior", str(calibrated), "--uncertain", "--fine"], capsys)
     assert code == 2 and "--uncertain, --fine cannot go with --posterior" in err and err.count("\n") == 1

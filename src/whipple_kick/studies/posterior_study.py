@@ -57,7 +57,7 @@ from whipple_kick.simulate import criteria
 from whipple_kick.simulate.scenario import Scenario
 
 from . import calibration
-from .recommend import _num
+from .recommend import _num, pressure_grid
 from .sweep_engine import check_some_ok, make_cases, sweep
 from .uncertainty import _best_share, p_best_interval
 
@@ -306,17 +306,18 @@ def run(folder, samples=32, seed=0, loads=thesis.LOADS_N, pressures=thesis.PRESS
     """
     import pandas as pd
 
-    samples = int(check_range("samples", samples, 2, 1e5, "(posterior rows M)"))
+    samples = int(check_range("--samples", samples, 2, 1e5, "posterior rows"))
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise InputError(f"seed = {seed!r} is outside the allowed range: a whole number >= 0")
     posterior, settings = read_calibration(folder)
     spec = spec if isinstance(spec, uncertain.UncertainSet) else uncertain.load(spec)
     loads = list(dict.fromkeys(check_range("rear-tyre load fz", f, 0.0, None, "N", low_open=True) for f in loads))
-    pressures = list(dict.fromkeys(float(p) for p in pressures))
+    base = study_base(settings, spec, tyre)
+    # within the tyre's measured range, checked here: inside the sweep a bad pressure would fail every run at it
+    pressures, _ = pressure_grid(base.tyre, list(pressures), coefficient_set=base.coefficient_set)
     if len(pressures) < 2 or not loads:
         raise InputError(f"P(best) compares pressures at some load: {len(pressures)} pressure(s), "
                          f"{len(loads)} load(s) given")
-    base = study_base(settings, spec, tyre)
     rows = draw_rows(posterior, settings["fields"], samples, seed, spec, base)
     overrides, keys = cases(rows, loads, pressures, base)
     for k in range(0, len(overrides), len(pressures)):   # one per row and load (before any run)
