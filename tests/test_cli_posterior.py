@@ -78,6 +78,7 @@ def test_recommend_posterior_runs_then_reads_the_answer(calibrated, capsys, tmp_
     table = pd.read_csv(calibrated / "p_best.csv")
     assert list(table.columns) == ps.P_BEST_COLUMNS and len(table) == 2 * 3
     assert "conditional on: rider_body rigid" in out and "prior 0.25 (0.10-0.50)" in out
+    assert (calibrated / cli.ANSWER_FIGURE).stat().st_size > 1000
     beside = pd.read_csv(calibrated / ps.BESIDE_PRIOR)
     assert beside["p_prior"].notna().sum() == 1
     code, out, err = _console(cli.recommend_main, ["--posterior", str(calibrated)], capsys)

@@ -980,9 +980,9 @@ def _recommend_posterior(args):
                                 loads=args.fz or thesis.LOADS_N, pressures=args.pressures or thesis.PRESSURES_KPA,
                                 prior_study=args.prior_study, tyre=args.tyre, workers=args.workers,
                                 progress=sys.stderr.isatty() if args.progress is None else args.progress)
-    study.write(folder)
+    _write_answer(study, folder)
     print(posterior_study.format_study(study))
-    print(f"\nwrote {', '.join(posterior_study.FILES)} into {folder} (the runs in "
+    print(f"\nwrote {', '.join(posterior_study.FILES)}, {ANSWER_FIGURE} into {folder} (the runs in "
           f"{folder / posterior_study.RUNS}: run again to resume)")
     return 0
 
@@ -1261,10 +1261,24 @@ def _held_out(args, result, base, inputs, cells, progress, options):
     return frame
 
 
+#: The figure of the answer under a posterior (P(best) per pressure and load), beside p_best.csv.
+ANSWER_FIGURE = "p_best.png"
+
+
+def _write_answer(study, folder):
+    """The answer's tables and its figure (the uncertainty study's P(best) figure) into ``folder``."""
+    from whipple_kick.figures import uncertainty as figures
+    study.write(folder)
+    c = study.settings["choices"]
+    figures.p_best_figure(study.p_best, folder / ANSWER_FIGURE,
+                          title=f"P(best) under the posterior, {study.samples} rows, 95 % intervals "
+                                f"({c.get('rider_body')} rider, kicks to the {c.get('kick_direction')})")
+
+
 def _stale_answer(folder):
     """Remove an earlier posterior's answer from a calibration folder (its runs stay: a rerun reuses them)."""
     from whipple_kick.studies import posterior_study
-    for name in (*posterior_study.FILES, posterior_study.BESIDE_PRIOR):
+    for name in (*posterior_study.FILES, posterior_study.BESIDE_PRIOR, ANSWER_FIGURE):
         (folder / name).unlink(missing_ok=True)
 
 
@@ -1349,9 +1363,9 @@ def calibrate_main(argv=None):
             from whipple_kick.studies import posterior_study
             study = posterior_study.run(out, samples=min(samples, len(result.posterior)), seed=args.seed,
                                        prior_study=args.prior_study, workers=args.workers, progress=progress)
-            study.write(out)
+            _write_answer(study, out)
             print(posterior_study.format_study(study))
-            print(f"  wrote {', '.join(posterior_study.FILES)} in {args.out} (the runs in "
+            print(f"  wrote {', '.join(posterior_study.FILES)}, {ANSWER_FIGURE} in {args.out} (the runs in "
                   f"{out / posterior_study.RUNS}; total {time.perf_counter() - started:.0f} s)")
         elif samples:
             print("  no answer under the posterior: nothing in the prior matches the measurements")
