@@ -97,8 +97,12 @@ def test_rows_are_paired_and_shares_sum_to_one(calibrated, tmp_path):
     assert study.rows["speed"].between(1.92, 2.0).all() and study.rows["speed"].nunique() == 2
     sums = study.p_best.groupby(["fz_n", "criterion"])["p"].sum()
     assert len(sums) == 4 and sums.to_numpy() == pytest.approx(1.0)
+    class NoRuns:   # an executor that refuses work: the rerun must find every case in the folder
+        def submit(self, *args, **kwargs):
+            raise AssertionError("a resumed study ran a case again")
+
     again = ps.run(calibrated, samples=2, seed=1, loads=[570.0, 701.0], pressures=[300.0, 500.0], runs=runs,
-                   workers=1)
+                   executor=NoRuns())
     pd.testing.assert_frame_equal(again.p_best, study.p_best)
     paths = {p.name for p in study.write(tmp_path)}
     assert set(ps.FILES) <= paths
