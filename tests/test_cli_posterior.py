@@ -88,6 +88,7 @@ def test_recommend_posterior_runs_then_reads_the_answer(calibrated, capsys, tmp_
 @pytest.mark.parametrize("argv, message", [
     (["--samples", "1"], "--samples = 1 must be 0 (no answer) or a whole number >= 2"),
     (["--held-out", "pressure"], "argument --held-out: invalid choice: 'pressure'"),
+    (["--lqr-model", "pid"], "argument --lqr-model: invalid choice: 'pid'"),
 ])
 def test_calibrate_refuses_bad_answer_flags(tmp_path, capsys, argv, message):
     code, out, err = _console(cli.calibrate_main, ["--out", str(tmp_path), *argv], capsys)

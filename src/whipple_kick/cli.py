@@ -1307,6 +1307,10 @@ def calibrate_main(argv=None):
                             "kick_accel)")
         p.add_argument("--rider-body", choices=("rigid", "leaning"), default="rigid",
                        help="the rider model (a modelling choice: calibrate per option; default rigid)")
+        from whipple_kick.simulate.scenario import LQR_MODELS
+        p.add_argument("--lqr-model", choices=LQR_MODELS, default=LQR_MODELS[0],
+                       help="the model the rider's LQR gains are designed on (a modelling choice: calibrate per "
+                            f"option, as the uncertainty file's rider options; default {LQR_MODELS[0]})")
         p.add_argument("--direction", choices=validation.DIRECTIONS, default="right",
                        help="kick direction (the thesis gives none: calibrate per option; default right)")
         p.add_argument("--quick", action="store_true",
@@ -1335,7 +1339,7 @@ def calibrate_main(argv=None):
             raise InputError(f"--samples = {samples} must be 0 (no answer) or a whole number >= 2")
         started = time.perf_counter()
         base = validation.base_scenario(duration=calibration.FEATURE_DURATION, rider_body=args.rider_body,
-                                        kick_direction=args.direction)
+                                        kick_direction=args.direction, lqr_model=args.lqr_model)
         cells = [(570.0, 300.0), (635.0, 400.0), (701.0, 500.0)] if args.quick else None
         inputs = args.inputs or (["gain_scale", "carcass_stiffness_scale", "carcass_damping", "kick_accel"]
                                  + (["hip_stiffness"] if args.rider_body == "leaning" else []))
@@ -1349,7 +1353,7 @@ def calibrate_main(argv=None):
         files = result.write(out)
         from whipple_kick.figures import calibration as figures
         figures.predictive_figure(result.features, out / CALIBRATION_FIGURE)
-        print(f"calibrate: {args.rider_body} rider, kicks to the {args.direction}, "
+        print(f"calibrate: {args.rider_body} rider (LQR on the {args.lqr_model} model), kicks to the {args.direction}, "
               f"{len(result.measured)} measured features")
         for line in result.verdict:
             print("  " + line)
