@@ -48,8 +48,9 @@ _SUBMODULES = {
         "scenario", "simulation", "steady")},
     **{name: f"figures.{name}" for name in ("animation", "plotting")},
     "uncertainty_figures": "figures.uncertainty",
+    "calibration_figures": "figures.calibration",
     **{name: f"studies.{name}" for name in (
-        "authors_code", "calibration", "recommend", "stability", "sweep_engine", "sweep_store", "uncertainty",
+        "authors_code", "calibration", "posterior_study", "recommend", "stability", "sweep_engine", "sweep_store", "uncertainty",
         "validation")},
     **{name: name for name in ("cli", "errors", "fileio")},
     **{name: name for name in ("model", "library", "simulate", "figures", "studies")},

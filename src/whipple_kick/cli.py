@@ -794,8 +794,9 @@ def _recommend(argv):
                "simulate default (3 m/s, LQR rider designed at that speed, 150 mm kick to the right in 0.150 s, 6 s). "
                "The default runs one direction and one tyre transient; --kick-direction both and "
                "--tyre-transient all say whether the answer depends on them. See docs/sweeps.md.")
-    p.add_argument("--fz", type=_number("N"), nargs="+", required=True, metavar="N",
-                   help=f"static rear-tyre load(s) in N, e.g. --fz {thesis.loads_text(' ')}")
+    p.add_argument("--fz", type=_number("N"), nargs="+", metavar="N",
+                   help=f"static rear-tyre load(s) in N, e.g. --fz {thesis.loads_text(' ')} (required but with "
+                        "--posterior, where the thesis' loads are the default)")
     p.add_argument("--tyre", default=DEFAULTS["tyre"], metavar="NAME",
                    help=f"tyre on both wheels (default {DEFAULTS['tyre']}; available: %s)"
                         % ", ".join(t[0] for t in tyres.available()))
@@ -834,12 +835,25 @@ def _recommend(argv):
     p.add_argument("--samples", type=int, metavar="N",
                    help="with --uncertain: SALib's base sample count N (N (D + 2) rows for D inputs, each run at "
                         "every pressure and load; default 64)")
-    p.add_argument("--seed", type=int, metavar="S", help="with --uncertain: the seed (default 0)")
+    p.add_argument("--seed", type=int, metavar="S", help="with --uncertain or --posterior: the seed (default 0)")
+    p.add_argument("--posterior", metavar="DIR",
+                   help="the answer under a calibration's posterior (calibrate --out DIR): P(best) per pressure "
+                        "and load from DIR/p_best.csv, or run it (--samples M posterior rows, default 32, each "
+                        "at every pressure and load; the runs kept in DIR/posterior_runs to resume)")
+    p.add_argument("--prior-study", metavar="DIR",
+                   help="with --posterior: a prior uncertainty study's folder (--uncertain --out DIR), its "
+                        "P(best) beside")
     bar = p.add_mutually_exclusive_group()
     bar.add_argument("--progress", action="store_true", default=None,
                      help="show the progress bar (default: only when stderr is a terminal)")
     bar.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
     args = p.parse_args(argv)
+    if args.posterior is not None:
+        return _recommend_posterior(args)
+    if args.prior_study is not None:
+        raise InputError("--prior-study goes with --posterior DIR")
+    if args.fz is None:
+        p.error("the following arguments are required: --fz")
     if args.uncertain is not None:
         return _recommend_uncertain(args)
     if args.samples is not None or args.seed is not None:
@@ -894,18 +908,24 @@ UNCERTAINTY_FIGURES = ("p_best.png", *(f"recovery_{key}.png" for key in CRITERIA
                        *(f"paired_{key}.png" for key in CRITERIA), *(f"sobol_{key}.png" for key in CRITERIA))
 
 
+def _study_flags_given(args):
+    """The flags of a plain recommendation given on a command line of a study that sets them itself."""
+    from whipple_kick.simulate.scenario import DEFAULTS, Scenario
+    return [flag for flag, value in (("--fine", args.fine), ("--extend", args.extend),
+                                     ("--duration", args.duration is not None),
+                                     ("--kick-direction", args.kick_direction != DEFAULTS["kick_direction"]),
+                                     ("--tyre-transient", args.tyre_transient != Scenario.tyre_transient))
+            if value]
+
+
 def _recommend_uncertain(args):
     """``recommend-pressure --uncertain``: the uncertainty study (whipple_kick.studies.uncertainty)."""
     import pathlib
 
     from whipple_kick.figures import uncertainty as figures
-    from whipple_kick.simulate.scenario import DEFAULTS, Scenario
+    from whipple_kick.simulate.scenario import Scenario
     from whipple_kick.studies import recommend, uncertainty
-    given = [flag for flag, value in (("--fine", args.fine), ("--extend", args.extend),
-                                      ("--duration", args.duration is not None),
-                                      ("--kick-direction", args.kick_direction != DEFAULTS["kick_direction"]),
-                                      ("--tyre-transient", args.tyre_transient != Scenario.tyre_transient))
-             if value]
+    given = _study_flags_given(args)
     if given:
         raise InputError(f"{', '.join(given)} cannot go with --uncertain: the uncertainty file samples or fixes "
                          "the kick, the tyre transient and the run's duration")
@@ -934,6 +954,39 @@ def _recommend_uncertain(args):
     return 0
 
 
+def _recommend_posterior(args):
+    """``recommend-pressure --posterior DIR``: P(best) under a calibration's posterior
+    (whipple_kick.studies.posterior_study), read from DIR or run there."""
+    import pathlib
+
+    from whipple_kick.library import thesis
+    from whipple_kick.studies import posterior_study
+    given = ["--uncertain"] * (args.uncertain is not None) + _study_flags_given(args) + ["--out"] * (args.out is not None)
+    if given:
+        raise InputError(f"{', '.join(given)} cannot go with --posterior: the calibration's folder holds the "
+                         "answer and its runs, and the calibration's settings and the uncertainty file set the "
+                         "kick, the tyre transient and the run's duration")
+    folder = pathlib.Path(args.posterior)
+    posterior_study.read_calibration(folder)   # a bad folder: one line, before anything else
+    done = posterior_study.from_folder(folder)
+    if done is not None and args.samples is None and args.seed is None and args.prior_study is None \
+            and args.fz is None and args.pressures is None:
+        print((folder / "answer.txt").read_text().rstrip() if (folder / "answer.txt").is_file()
+              else done.to_string(index=False))
+        print(f"\n(read from {folder / 'p_best.csv'}; --samples M runs it again)")
+        return 0
+    study = posterior_study.run(folder, samples=32 if args.samples is None else args.samples,
+                                seed=0 if args.seed is None else args.seed,
+                                loads=args.fz or thesis.LOADS_N, pressures=args.pressures or thesis.PRESSURES_KPA,
+                                prior_study=args.prior_study, tyre=args.tyre, workers=args.workers,
+                                progress=sys.stderr.isatty() if args.progress is None else args.progress)
+    _write_answer(study, folder)
+    print(posterior_study.format_study(study))
+    print(f"\nwrote {', '.join(posterior_study.FILES)}, {ANSWER_FIGURE} into {folder} (the runs in "
+          f"{folder / posterior_study.RUNS}: run again to resume)")
+    return 0
+
+
 def _out_given(argv):
     """The ``--out`` folder of a command line (as argparse takes it: ``--out DIR``, ``--out=DIR``, an
     abbreviation), or None."""
@@ -947,9 +1000,12 @@ def _out_given(argv):
 def recommend_main(argv=None):
     """Console script ``recommend-pressure`` (see ``recommend-pressure --help``)."""
     from whipple_kick.studies.sweep_engine import SweepFailed, SweepInterrupted
-    out = _out_given(sys.argv[1:] if argv is None else argv)
+    words = sys.argv[1:] if argv is None else argv
+    out = _out_given(words)
     kept = ("no results were kept (--out DIR keeps the finished cases, and a rerun on it resumes)" if out is None
             else f"the finished cases are kept in {out}: run again with --out {out} to resume")
+    if any(str(w).startswith("--posterior") for w in words):
+        kept = "the finished runs are kept in the calibration folder's posterior_runs: run again to resume"
     try:
         status = _run(_recommend, argv, "recommend-pressure", kept)
     except (SweepInterrupted, SweepFailed) as exc:   # lost workers, or every case failed: not the user's to fix
@@ -1176,6 +1232,49 @@ def validate_main(argv=None):
     sys.exit(_run(_validate, argv, "validate"))
 
 
+#: The figure ``calibrate --out DIR`` writes: each feature's posterior predictive beside the measurement.
+CALIBRATION_FIGURE = "predictive.png"
+
+
+def _held_out(args, result, base, inputs, cells, progress, options):
+    """``calibrate --held-out``: the checks' table (its rows also appended to ``result.checks``)."""
+    import pandas as pd
+
+    from whipple_kick.studies import calibration
+
+    def factory(prior_list, cells, features, direction):
+        return calibration.ModelSimulator([p.field for p in prior_list], cells, features,
+                                          base.with_changes(kick_direction=direction), args.workers, progress)
+
+    frames = [calibration.held_out(mode, factory, spec=args.spec, inputs=inputs, cells=cells,
+                                   direction=args.direction, draws=4 if args.quick else 8, fitted=result, **options)
+              for mode in dict.fromkeys(args.held_out)]
+    frame = pd.concat(frames, ignore_index=True)
+    result.checks = pd.concat([result.checks, calibration.held_out_checks(frame)], ignore_index=True)
+    return frame
+
+
+#: The figure of the answer under a posterior (P(best) per pressure and load), beside p_best.csv.
+ANSWER_FIGURE = "p_best.png"
+
+
+def _write_answer(study, folder):
+    """The answer's tables and its figure (the uncertainty study's P(best) figure) into ``folder``."""
+    from whipple_kick.figures import uncertainty as figures
+    study.write(folder)
+    c = study.settings["choices"]
+    figures.p_best_figure(study.p_best, folder / ANSWER_FIGURE,
+                          title=f"P(best) under the posterior, {study.samples} rows, 95 % intervals "
+                                f"({c.get('rider_body')} rider, kicks to the {c.get('kick_direction')})")
+
+
+def _stale_answer(folder):
+    """Remove an earlier posterior's answer from a calibration folder (its runs stay: a rerun reuses them)."""
+    from whipple_kick.studies import posterior_study
+    for name in (*posterior_study.FILES, posterior_study.BESIDE_PRIOR, ANSWER_FIGURE):
+        (folder / name).unlink(missing_ok=True)
+
+
 def calibrate_main(argv=None):
     """Console script ``calibrate``: history matching and a posterior of the uncertain inputs against the thesis'
     measured kick responses (see ``calibrate --help`` and :mod:`whipple_kick.studies.calibration`)."""
@@ -1201,6 +1300,10 @@ def calibrate_main(argv=None):
                             "kick_accel)")
         p.add_argument("--rider-body", choices=("rigid", "leaning"), default="rigid",
                        help="the rider model (a modelling choice: calibrate per option; default rigid)")
+        from whipple_kick.simulate.scenario import LQR_MODELS
+        p.add_argument("--lqr-model", choices=LQR_MODELS, default=LQR_MODELS[0],
+                       help="the model the rider's LQR gains are designed on (a modelling choice: calibrate per "
+                            f"option, as the uncertainty file's rider options; default {LQR_MODELS[0]})")
         p.add_argument("--direction", choices=validation.DIRECTIONS, default="right",
                        help="kick direction (the thesis gives none: calibrate per option; default right)")
         p.add_argument("--quick", action="store_true",
@@ -1209,26 +1312,60 @@ def calibrate_main(argv=None):
         p.add_argument("--waves", type=int, default=2, metavar="N", help="history-matching waves (default 2)")
         p.add_argument("--seed", type=int, default=0, metavar="N")
         p.add_argument("--workers", type=int, metavar="N", help="worker processes (default: one per CPU core)")
+        p.add_argument("--held-out", nargs="+", choices=calibration.HELD_OUT, default=(), metavar="CHECK",
+                       help="held-out checks, rows in checks.csv and held_out.csv: load (calibrate without each "
+                            "rear load in turn and predict it; one calibration per load) and/or direction "
+                            "(predict the measurements with the model kicked the other way)")
+        p.add_argument("--samples", type=int, metavar="M",
+                       help="posterior rows for the answer (P(best) per pressure and load, p_best.csv; each row "
+                            "run at every pressure and load): default 24 with --quick, else 32; 0: no answer")
+        p.add_argument("--prior-study", metavar="DIR",
+                       help="a prior uncertainty study's folder (recommend-pressure --uncertain --out DIR): its "
+                            "P(best) beside the posterior's (p_best_beside_prior.csv)")
         args = p.parse_args(argv)
         if args.workers is not None and args.workers < 1:
             raise InputError(f"--workers = {args.workers} must be a whole number >= 1")
         if args.waves < 1:
             raise InputError(f"--waves = {args.waves} must be a whole number >= 1")
+        samples = (24 if args.quick else 32) if args.samples is None else args.samples
+        if samples == 1 or samples < 0:
+            raise InputError(f"--samples = {samples} must be 0 (no answer) or a whole number >= 2")
         started = time.perf_counter()
         base = validation.base_scenario(duration=calibration.FEATURE_DURATION, rider_body=args.rider_body,
-                                        kick_direction=args.direction)
+                                        kick_direction=args.direction, lqr_model=args.lqr_model)
         cells = [(570.0, 300.0), (635.0, 400.0), (701.0, 500.0)] if args.quick else None
         inputs = args.inputs or (["gain_scale", "carcass_stiffness_scale", "carcass_damping", "kick_accel"]
                                  + (["hip_stiffness"] if args.rider_body == "leaning" else []))
-        result = calibration.calibrate(spec=args.spec, inputs=inputs, cells=cells, base=base, waves=args.waves,
-                                       steps=1000 if args.quick else 5000, seed=args.seed, workers=args.workers,
-                                       progress=sys.stderr.isatty(), check_runs=4 if args.quick else 8)
-        files = result.write(pathlib.Path(args.out))
-        print(f"calibrate: {args.rider_body} rider, kicks to the {args.direction}, "
+        progress = sys.stderr.isatty()
+        options = dict(waves=args.waves, steps=1000 if args.quick else 5000, seed=args.seed)
+        result = calibration.calibrate(spec=args.spec, inputs=inputs, cells=cells, base=base, workers=args.workers,
+                                       progress=progress, check_runs=4 if args.quick else 8, **options)
+        if args.held_out:
+            result.held_out = _held_out(args, result, base, inputs, cells, progress, options)
+        out = pathlib.Path(args.out)
+        files = result.write(out)
+        from whipple_kick.figures import calibration as figures
+        figures.predictive_figure(result.features, out / CALIBRATION_FIGURE)
+        print(f"calibrate: {args.rider_body} rider (LQR on the {args.lqr_model} model), kicks to the {args.direction}, "
               f"{len(result.measured)} measured features")
         for line in result.verdict:
             print("  " + line)
-        print(f"  wrote {', '.join(f.name for f in files)} in {args.out} ({time.perf_counter() - started:.0f} s)")
+        if result.held_out is not None:
+            for _, r in result.checks[result.checks["check"].str.endswith("_share")].iterrows():
+                print(f"  {r['check']}: {r['value']:.2f} ({r['detail']})")
+        print(f"  wrote {', '.join(f.name for f in files)}, {CALIBRATION_FIGURE} in {args.out} "
+              f"({time.perf_counter() - started:.0f} s)")
+        _stale_answer(out)
+        if samples and result.posterior is not None:
+            from whipple_kick.studies import posterior_study
+            study = posterior_study.run(out, samples=min(samples, len(result.posterior)), seed=args.seed,
+                                       prior_study=args.prior_study, workers=args.workers, progress=progress)
+            _write_answer(study, out)
+            print(posterior_study.format_study(study))
+            print(f"  wrote {', '.join(posterior_study.FILES)}, {ANSWER_FIGURE} in {args.out} (the runs in "
+                  f"{out / posterior_study.RUNS}; total {time.perf_counter() - started:.0f} s)")
+        elif samples:
+            print("  no answer under the posterior: nothing in the prior matches the measurements")
         return 0
 
     sys.exit(_run(main, argv, "calibrate"))

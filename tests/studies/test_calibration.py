@@ -168,7 +168,7 @@ def test_no_plausible_input_is_a_finding(tmp_path):
     assert result.posterior is None
     assert "no input in the prior reproduces" in result.verdict[-1] and "frequency_hz" in result.verdict[-1]
     paths = result.write(tmp_path)
-    assert {p.name for p in paths} == {"posterior.csv", "features.csv", "checks.csv", "verdict.txt"}
+    assert {p.name for p in paths} == {"posterior.csv", "features.csv", "checks.csv", "verdict.txt", "settings.json"}
 
 
 # ---------------------------------------------------------------------------------------------- bad inputs
@@ -229,15 +229,20 @@ def test_calibrate_command_refuses_bad_inputs_in_one_line(tmp_path, capsys, argv
 
 @pytest.mark.slow
 def test_calibrate_command_quick_writes_its_tables(tmp_path, capsys):
-    """``calibrate --quick`` on the real model: the three files, a posterior or the stated finding (~2 min)."""
+    """``calibrate --quick`` on the real model: the tables, the predictive figure and the answer under the
+    posterior (4 rows here; shares summing to 1 per load and criterion) (~2 min)."""
     import pandas as pd
 
-    code, out, err = _console(["--out", str(tmp_path), "--quick", "--workers", "2"], capsys)
+    code, out, err = _console(["--out", str(tmp_path), "--quick", "--workers", "2", "--samples", "4"], capsys)
     assert code == 0, err
     checks = pd.read_csv(tmp_path / "checks.csv")
     assert {"emulator_held_out", "non_implausible_fraction", "unsourced"} <= set(checks["check"])
     features = pd.read_csv(tmp_path / "features.csv")
     assert len(features) == 9 and (tmp_path / "posterior.csv").exists()
+    assert (features["simulator_runs"] > 0).all() and (tmp_path / "predictive.png").stat().st_size > 1000
+    p_best = pd.read_csv(tmp_path / "p_best.csv")
+    assert p_best.groupby(["fz_n", "criterion"])["p"].sum().to_numpy() == pytest.approx(1.0)
+    assert len(p_best) == 3 * 2 * 4 and (p_best["rows"] + p_best["rows_failed"] == 4).all()
 
 
 def test_a_posterior_piled_on_a_prior_bound_is_reported():

@@ -55,6 +55,17 @@ Three steps, each a function of its own:
    (Gelman et al. 2013; walkers of one ensemble are not independent chains,
    so it is a symptom check, not a proof).
 
+4. **Checks of the posterior against the measurement**: the posterior
+   predictive per feature and cell, from the emulators (400 draws) and from
+   the simulator run at ``check_runs`` posterior draws (``features.csv``'s
+   ``simulator_*`` columns: each run plus the measurement's and the
+   discrepancy's noise); and the held-out checks (:func:`held_out`):
+   calibrate without one rear load and predict it, or calibrate with the
+   model kicked one way and predict the measurements kicked the other.
+
+The answer under the posterior (P(best) per pressure and load) is
+:mod:`whipple_kick.studies.posterior_study`.
+
 If nothing survives, the result says so, with the features no input
 matches at once (each feature's smallest implausibility over the candidates):
 a finding, not a failure.
@@ -98,6 +109,12 @@ ENVELOPE_CAP = 1.0
 #: Simulated time after the kick [s] for the features: the 1 s record and the fit's 0.5 s window after
 #: peak #1 (at 0.1 s) fit in it with room for the low-pass filter's ends.
 FEATURE_DURATION = 1.5
+#: The modelling choices a posterior is conditional on (discrete: reported per option, never pooled).
+CHOICE_FIELDS = ("rider_body", "lqr_model", "kick_direction", "friction", "tyre_transient")
+#: What :meth:`Calibration.write` calls the settings file, and its format line.
+SETTINGS_FILE, SETTINGS_FORMAT = "settings.json", "whipple_kick calibration settings, version 1"
+#: The held-out checks (:func:`held_out`): leave one rear load out, or predict the other kick direction.
+HELD_OUT = ("load", "direction")
 
 
 def _check_features(features):
@@ -679,6 +696,12 @@ class Calibration:
         ``check, name, value, detail``: emulator held-out errors, non-implausible fractions, chain
         diagnostics, unsourced values, the finding when nothing survives.
     verdict : list of str
+    chain : dict
+        :func:`posterior`'s, or None.
+    settings : dict
+        What the posterior is conditional on (:func:`settings`; ``settings.json``).
+    held_out : pandas.DataFrame or None
+        :func:`held_out`'s rows (``held_out.csv``), where asked for.
     """
 
     priors: list
@@ -689,6 +712,8 @@ class Calibration:
     checks: object
     verdict: list
     chain: dict = None
+    settings: dict = None
+    held_out: object = None
 
     def interval(self, name, level=0.90):
         """Central credible interval of one input (priors' units)."""
@@ -707,9 +732,17 @@ class Calibration:
         folder.mkdir(parents=True, exist_ok=True)
         post = self.posterior if self.posterior is not None else pd.DataFrame(columns=[p.name for p in self.priors])
         paths = []
-        for name, frame in (("posterior", post), ("features", self.features), ("checks", self.checks)):
+        tables = [("posterior", post), ("features", self.features), ("checks", self.checks)]
+        if self.held_out is not None:
+            tables.append(("held_out", self.held_out))
+        for name, frame in tables:
             path = folder / f"{name}.csv"
             fileio.write_atomic(path, frame.to_csv(index=False))
+            paths.append(path)
+        if self.settings is not None:
+            import json
+            path = folder / SETTINGS_FILE
+            fileio.write_atomic(path, json.dumps(self.settings, indent=1) + "\n")
             paths.append(path)
         path = folder / "verdict.txt"
         fileio.write_atomic(path, "\n".join(self.verdict) + "\n")
@@ -824,8 +857,10 @@ def _calibrate(simulator, spec, inputs, bounds, features, cells, discrepancy, me
             checks.append(("mcmc_ess", n, float(chain["ess"][k]), "effective samples after burn-in"))
         checks.append(("mcmc_acceptance", "", chain["acceptance"], "mean acceptance fraction (0.2-0.5 is healthy)"))
         if check_runs:
-            checks += _posterior_runs(simulator, U, low, width, last.emulators, z, var_obs, matcher.rank,
-                                      int(check_runs), seed)
+            rows, Y_runs = _posterior_runs(simulator, U, low, width, last.emulators, z, var_obs, matcher.rank,
+                                           int(check_runs), seed)
+            checks += rows
+            feats = feats.assign(**_simulator_predictive(Y_runs, z, var_obs, seed))
         short = chain["steps"] - chain["burn"] < 50 * float(np.max(chain["tau"]))
         if short:
             checks.append(("mcmc_warning", "", float(np.max(chain["tau"])),
@@ -854,7 +889,20 @@ def _calibrate(simulator, spec, inputs, bounds, features, cells, discrepancy, me
                       + ", ".join(f"{w.nroy_fraction:.3g}" for w in wave_list)
                       + f" ({sum(len(w.design) for w in wave_list)} simulator points)")
     frame = pd.DataFrame(checks, columns=["check", "name", "value", "detail"])
-    return Calibration(prior_list, table, wave_list, post, feats, frame, verdict, chain)
+    return Calibration(prior_list, table, wave_list, post, feats, frame, verdict, chain,
+                       settings(prior_list, base, cells, features, spec))
+
+
+def settings(prior_list, base, cells, features, spec):
+    """What a posterior is conditional on, as plain data (``settings.json``): each posterior column's scenario
+    field, the modelling choices of the runs (:data:`CHOICE_FIELDS`, never pooled: the posterior of one rider
+    model or kick direction is not another's), the cells and features, the calibration file."""
+    from . import validation
+
+    base = validation.base_scenario(duration=FEATURE_DURATION) if base is None else base
+    return {"format": SETTINGS_FORMAT, "fields": {p.name: p.field for p in prior_list},
+            "choices": {f: getattr(base, f) for f in CHOICE_FIELDS},
+            "cells": [list(c) for c in cells], "features": list(features), "spec": str(spec.path)}
 
 
 def _posterior_runs(simulator, U, low, width, emulators, z, var_obs, rank, n, seed):
@@ -876,7 +924,33 @@ def _posterior_runs(simulator, U, low, width, emulators, z, var_obs, rank, n, se
         rows.append(("posterior_runs_unstable_rider", "", float(np.mean(unstable)),
                      f"share of {len(pick)} posterior draws with a linearly unstable rider in some cell (the "
                      "features cannot see it: they end 1 s after the kick)"))
-    return rows
+    return rows, Y
+
+
+def _simulator_predictive(Y, z, var_obs, seed):
+    """Columns of the posterior predictive from the simulator's own runs at posterior draws ``Y`` (n, m).
+
+    Each run's feature plus the measurement's and the discrepancy's noise (the predictive of a new
+    measurement); the standardised error ``(z - mean) / sqrt(Var_runs + Var_measurement + Var_discrepancy)``.
+    A feature no run gives (every run fell or had no peak) keeps ``simulator_runs`` 0 and no interval (the
+    feature is left out, not set to a number).
+    """
+    import pandas as pd
+
+    Y = np.atleast_2d(np.asarray(Y, float))
+    rng = np.random.default_rng(seed + 4)
+    out = {k: np.full(Y.shape[1], np.nan) for k in ("simulator_mean", "simulator_5", "simulator_95",
+                                                   "simulator_standardised_error")}
+    runs = np.isfinite(Y).sum(axis=0)
+    for j in np.flatnonzero(runs):
+        y = Y[np.isfinite(Y[:, j]), j]
+        # 200 noise draws per run: the interval's quantiles from the mixture, not from a handful of runs
+        draw = (y[:, None] + math.sqrt(var_obs[j]) * rng.standard_normal((len(y), 200))).ravel()
+        out["simulator_mean"][j] = y.mean()
+        out["simulator_5"][j], out["simulator_95"][j] = np.quantile(draw, [0.05, 0.95])
+        var_runs = y.var(ddof=1) if len(y) > 1 else 0.0
+        out["simulator_standardised_error"][j] = (z[j] - y.mean()) / math.sqrt(var_runs + var_obs[j])
+    return {"simulator_runs": pd.array(runs, dtype="int64"), **out}
 
 
 def _rank(rank, m):
@@ -950,3 +1024,126 @@ def known_answer(simulator_factory, prior_list, truth_unit, noise_scale=1.0, see
             lo, hi = result.interval(p.name)
             covered[p.name] = bool(lo <= x <= hi)
     return result, truth, covered
+
+
+# ------------------------------------------------------------------------------------------------ held-out checks
+
+def held_out(mode, simulator_factory, spec=priors.DEFAULT, inputs=None, bounds=None, features=None, cells=None,
+             discrepancy=None, measured=None, direction="right", draws=8, seed=0, fitted=None, **options):
+    """Calibrate on part of the measurements and predict the rest with the simulator at posterior draws.
+
+    Parameters
+    ----------
+    mode : {"load", "direction"}
+        ``load``: per measured rear load, calibrate on the cells of the other loads and predict that
+        load's cells. ``direction``: calibrate with the model kicked to ``direction`` and predict every
+        cell with the model kicked the other way (the thesis gives no direction: the measurements are
+        the same, the model's runs are not).
+    simulator_factory : callable
+        ``factory(prior_list, cells, features, direction) -> simulator``.
+    spec, inputs, bounds, features, cells, discrepancy, measured
+        As :func:`calibrate` (``measured`` in the order of every cell's features).
+    direction : str
+        The kick direction the calibration runs with.
+    draws : int
+        Posterior draws run on the simulator at the predicted cells.
+    fitted : Calibration, optional
+        A calibration on every cell at ``direction`` (``mode="direction"`` predicts from it instead of
+        calibrating again).
+    **options
+        Passed to :func:`calibrate` (``waves``, ``steps`` ...).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per predicted feature: ``mode, held_out, key, cell, feature, unit, measured, sd_observation``
+        (measurement and discrepancy), ``predicted_mean, predictive_5, predictive_95`` (the runs plus the
+        observation noise), ``standardised_error`` (``(measured - mean) / sqrt(Var_runs + sd_observation^2)``),
+        ``runs`` (draws that gave the feature). A calibration that leaves nothing plausible predicts nothing:
+        its rows say so in ``held_out`` with ``runs`` 0.
+    """
+    import pandas as pd
+
+    from .validation import DIRECTIONS
+
+    if mode not in HELD_OUT:
+        raise InputError(f"held-out check {mode!r} unknown: choose {' or '.join(HELD_OUT)}")
+    if direction not in DIRECTIONS:
+        raise InputError(f"kick direction {direction!r} unknown: choose {' or '.join(DIRECTIONS)}")
+    draws = int(draws)
+    if draws < 2:
+        raise InputError(f"held-out draws = {draws} must be a whole number >= 2 (a predictive spread needs two)")
+    spec = spec if isinstance(spec, priors.CalibrationSpec) else priors.load(spec)
+    prior_list = choose_priors(spec, inputs, bounds)
+    table = measured_features(spec, features=features, cells=cells, discrepancy=discrepancy)
+    if measured is not None:
+        measured = np.asarray(measured, float)
+        if measured.shape != (len(table),):
+            raise InputError(f"measured values: {measured.size} given, {len(table)} features expected")
+        table = table.assign(measured=measured)
+    features = list(dict.fromkeys(table["feature"]))
+    cells = list(dict.fromkeys(zip(table["fz_n"], table["pressure_kpa"], strict=True)))
+    if mode == "load":
+        loads = list(dict.fromkeys(fz for fz, _ in cells))
+        if len(loads) < 2:
+            raise InputError(f"held-out load: the cells hold one load ({loads[0]:g} N); leaving it out leaves "
+                             "nothing to calibrate on")
+        groups = [(f"without {fz:g} N", [c for c in cells if c[0] != fz], [c for c in cells if c[0] == fz],
+                   direction) for fz in loads]
+    else:
+        other = next(d for d in DIRECTIONS if d != direction)
+        groups = [(f"calibrated kicking {direction}, predicted kicking {other}", cells, cells, other)]
+    names = [p.name for p in prior_list]
+    file_bounds = {p.name: (p.low, p.high) for p in prior_list
+                   if p.name in spec.priors and (p.low, p.high) != (spec.priors[p.name].low, spec.priors[p.name].high)}
+    rows = []
+    for label, train, test, predict_direction in groups:
+        in_train = table["cell"].isin([experiments.case_name(*c) for c in train]).to_numpy()
+        if fitted is not None and train == cells:
+            result = fitted
+        else:
+            result = calibrate(simulator_factory(prior_list, train, features, direction), spec, names,
+                               file_bounds or None, features, train, discrepancy,
+                               measured=table["measured"].to_numpy()[in_train], seed=seed, **options)
+        te = table[table["cell"].isin([experiments.case_name(*c) for c in test])]
+        var_obs = te["sd_measurement"].to_numpy() ** 2 + te["sd_discrepancy"].to_numpy() ** 2
+        base = {"mode": mode, "held_out": label}
+        if result.posterior is None:
+            rows += [{**base, "key": k, "runs": 0, "held_out": f"{label}: nothing plausible to predict from"}
+                     for k in te["key"]]
+            continue
+        post = result.posterior[names].to_numpy()
+        pick = post[np.random.default_rng(seed + 5).choice(len(post), min(draws, len(post)), replace=False)]
+        Y = np.atleast_2d(simulator_factory(prior_list, test, features, predict_direction)(pick))
+        pred = _simulator_predictive(Y, te["measured"].to_numpy(), var_obs, seed)
+        for j, (_, r) in enumerate(te.iterrows()):
+            rows.append({**base, "key": r["key"], "cell": r["cell"], "feature": r["feature"], "unit": r["unit"],
+                         "measured": r["measured"], "sd_observation": math.sqrt(var_obs[j]),
+                         "predicted_mean": pred["simulator_mean"][j], "predictive_5": pred["simulator_5"][j],
+                         "predictive_95": pred["simulator_95"][j],
+                         "standardised_error": pred["simulator_standardised_error"][j],
+                         "runs": int(pred["simulator_runs"][j])})
+    return pd.DataFrame(rows, columns=["mode", "held_out", "key", "cell", "feature", "unit", "measured",
+                                       "sd_observation", "predicted_mean", "predictive_5", "predictive_95",
+                                       "standardised_error", "runs"])
+
+
+def held_out_checks(frame):
+    """``checks.csv`` rows of :func:`held_out`'s table: one per predicted feature (its standardised error) and,
+    per mode, the share within +-3."""
+    import pandas as pd
+
+    rows = []
+    for _, r in frame.iterrows():
+        if not r["runs"]:
+            rows.append((f"held_out_{r['mode']}", f"{r['key']} ({r['held_out']})", math.nan, "no run gave it"))
+            continue
+        rows.append((f"held_out_{r['mode']}", f"{r['key']} ({r['held_out']})", float(r["standardised_error"]),
+                     f"standardised error; predicted 5-95 % {r['predictive_5']:.3g}-{r['predictive_95']:.3g} "
+                     f"{r['unit']} (mean {r['predicted_mean']:.3g}, {int(r['runs'])} runs), measured "
+                     f"{r['measured']:.3g} +- {r['sd_observation']:.2g} (measurement and discrepancy)"))
+    for mode, part in frame[frame["runs"] > 0].groupby("mode", sort=False):
+        e = part["standardised_error"].to_numpy(float)
+        rows.append((f"held_out_{mode}_share", "", float(np.mean(np.abs(e) <= CUTOFF)),
+                     f"share of {len(e)} held-out features whose standardised error is within +-{CUTOFF:g}"))
+    return pd.DataFrame(rows, columns=["check", "name", "value", "detail"])
