@@ -28,9 +28,10 @@ def _first(names, variable):
     return next((shutil.which(n) for n in names if shutil.which(n)), None)
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="package")
 def server(tmp_path_factory):
-    """``whipple-kick-explorer --port 0 --study docs/uncertainty_study --workers 2``: its address."""
+    """``whipple-kick-explorer --port 0 --study docs/uncertainty_study --workers 2``: its address (one server for
+    the package's tests in a test process)."""
     pytest.importorskip("tornado", reason="the explorer's server needs Tornado: pip install -e '.[app]'")
     workdir = tmp_path_factory.mktemp("explorer_runs")
     proc = subprocess.Popen(

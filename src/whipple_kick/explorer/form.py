@@ -142,8 +142,10 @@ def _value(name, text):
 
 
 def field_of(message):
-    """The page field a message names (the longest field words it starts with), or :data:`GENERAL`."""
-    named = [name for name in PAGE_FIELDS if message.startswith(SETTINGS[name].words + " ")]
+    """The page field a message names (the longest field words it starts with, or follows "unknown" with:
+    "unknown bicycle 'x'"), or :data:`GENERAL`."""
+    named = [name for name in PAGE_FIELDS
+             if message.startswith((SETTINGS[name].words + " ", f"unknown {SETTINGS[name].words} "))]
     return max(named, key=lambda name: len(SETTINGS[name].words), default=GENERAL)
 
 

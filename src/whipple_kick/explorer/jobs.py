@@ -135,9 +135,10 @@ def stability_into(scenario, speeds, folder):
     return [result.summary["title"], *stability.report_lines(result.summary)]
 
 
-def animate_into(folder):
-    """The animation of the run in ``folder`` (:data:`ANIMATION`, ``simulate --animate``'s defaults)."""
+def animate_into(folder, **options):
+    """The animation of the run in ``folder`` (:data:`ANIMATION`; ``simulate --animate``'s defaults unless
+    ``options`` of :func:`whipple_kick.figures.animation.animate` say otherwise)."""
     from whipple_kick.figures import animation
 
-    movie = animation.animate(Result.load(folder), pathlib.Path(folder) / ANIMATION)
+    movie = animation.animate(Result.load(folder), pathlib.Path(folder) / ANIMATION, **options)
     return {"frames": movie.frames, "video_s": movie.video_duration_s, "wall_s": movie.wall_s}

@@ -1,0 +1,83 @@
+"""The explorer's server over HTTP (no browser): it never dies on a request, and a run does not hold up a page."""
+import io
+import json
+import threading
+import time
+import urllib.error
+import urllib.request
+import uuid
+
+import pytest
+
+
+def _request(url, data=None, headers=None, timeout=120):
+    """(status, body) of a request; an HTTP error status is an answer too."""
+    req = urllib.request.Request(url, data=data, headers=headers or {})
+    try:
+        with urllib.request.urlopen(req, timeout=timeout) as response:
+            return response.status, response.read()
+    except urllib.error.HTTPError as exc:
+        return exc.code, exc.read()
+
+
+def _multipart(fields, files=()):
+    """A multipart/form-data body and its header, as a browser sends a form."""
+    boundary = uuid.uuid4().hex
+    out = io.BytesIO()
+    for name, value in fields.items():
+        out.write(f'--{boundary}\r\nContent-Disposition: form-data; name="{name}"\r\n\r\n{value}\r\n'.encode())
+    for name, filename, body in files:
+        out.write(f'--{boundary}\r\nContent-Disposition: form-data; name="{name}"; filename="{filename}"\r\n'
+                  "Content-Type: text/plain\r\n\r\n".encode() + body + b"\r\n")
+    out.write(f"--{boundary}--\r\n".encode())
+    return out.getvalue(), {"Content-Type": f"multipart/form-data; boundary={boundary}"}
+
+
+@pytest.mark.parametrize("path, data, status", [
+    ("nothing/here", None, 404),
+    ("files/0123456789abcdef/response.png", None, 404),     # a run this server never made
+    ("files/../../etc/passwd", None, 404),
+    ("download/not-a-token", None, 404),
+    ("overlay", b"not json", 400),
+    ("overlay", json.dumps({"ids": ["0123456789abcdef", "fedcba9876543210"]}).encode(), 400),
+    ("overlay", json.dumps({"ids": list("abcdefgh")}).encode(), 400),     # more than four
+    ("animate/0123456789abcdef", b"", 400),
+    ("pbest?fz_n=heavy", None, 400),
+    ("run", None, 405),                                     # a GET where a POST is expected
+])
+def test_a_bad_request_gets_one_line_and_the_server_serves_on(server, path, data, status):
+    code, body = _request(server + path, data)
+    assert code == status
+    if code != 405:
+        reply = json.loads(body)
+        assert list(reply) == ["error"] and "\n" not in reply["error"]
+    assert _request(server)[0] == 200
+
+
+def test_a_refused_form_and_a_wrong_bicycle_file_are_one_line_beside_the_field(server):
+    body, headers = _multipart({"pressure_kpa": "1e400", "fz_n": "10"})
+    reply = json.loads(_request(server + "run", body, headers)[1])
+    assert reply == {"errors": {"pressure_kpa": "'1e400' is not a finite number (kPa)"}}
+    body, headers = _multipart({}, [("bicycle_file", "bike.exe", b"MZ")])
+    assert "must be a BicycleParameters" in json.loads(_request(server + "run", body, headers)[1])["errors"]["bicycle"]
+    body, headers = _multipart({}, [("bicycle_file", "BrokenBenchmark.txt", b"not = a bicycle\n")])
+    errors = json.loads(_request(server + "run", body, headers)[1])["errors"]
+    assert len(errors) == 1 and "\n" not in next(iter(errors.values()))
+
+
+def test_a_run_in_progress_does_not_hold_up_another_page(server):
+    """A 30 s run (a few seconds in its worker) is in flight while the page and the P(best) come back at once."""
+    body, headers = _multipart({"duration": "30"})
+    reply = {}
+    thread = threading.Thread(target=lambda: reply.update(json.loads(_request(server + "run", body, headers)[1])))
+    thread.start()
+    time.sleep(0.3)
+    started = time.perf_counter()
+    page, pbest = _request(server), _request(server + "pbest?fz_n=701")
+    waited = time.perf_counter() - started
+    still_running = thread.is_alive()
+    thread.join(timeout=120)
+    assert page[0] == 200 and json.loads(pbest[1])["rows"]["settling"][0]["pressure"] == "300 kPa"
+    assert still_running, "the run ended before the other requests were made: the check proved nothing"
+    assert waited < 1.0, waited   # a page is a few ms; a run blocking the server would add its seconds
+    assert reply["run"]["outcome"] == "completed"
