@@ -58,7 +58,7 @@ def test_a_text_that_is_no_number_gets_the_flags_message(capsys):
 
 
 def test_blank_fields_keep_their_defaults_and_given_ones_are_used():
-    assert form.parse({name: "" for name in form.PAGE_FIELDS}) == Scenario()
+    assert form.parse(dict.fromkeys(form.PAGE_FIELDS, "")) == Scenario()
     sc = form.parse({"pressure_kpa": " 300 ", "fz_n": "701", "kick_direction": "left", "controller": "thesis"})
     assert (sc.pressure_kpa, sc.fz_n, sc.kick_direction, sc.controller) == (300.0, 701.0, "left", "thesis")
 

@@ -30,7 +30,7 @@ def test_a_load_the_study_did_not_compute_has_no_rows():
 
 
 def test_a_folder_without_the_table_is_one_line(tmp_path):
-    with pytest.raises(InputError, match="has no p_best.csv"):
+    with pytest.raises(InputError, match=r"has no p_best\.csv"):
         study.check_folder(tmp_path)
     (tmp_path / study.P_BEST_FILE).write_text("fz_n,p\n635,0.5\n")
     with pytest.raises(InputError, match="lacks the column"):
