@@ -13,31 +13,10 @@ import pytest
 
 from tests.conftest import run_console
 from whipple_kick import cli
+from whipple_kick.explorer.headless import image_shown, set_field, wait
 from whipple_kick.simulate.results import Result
 
 pytestmark = pytest.mark.browser
-
-#: Longest wait [s] for a run's reply on a loaded 2-core machine (a warm run takes about 1 s).
-RUN_TIMEOUT_S = 120
-
-
-def _wait(driver, condition, timeout=RUN_TIMEOUT_S):
-    from selenium.webdriver.support.ui import WebDriverWait
-    return WebDriverWait(driver, timeout, poll_frequency=0.1).until(condition)
-
-
-def _set(driver, name, value):
-    box = driver.find_element("id", f"field-{name}")
-    box.clear()
-    box.send_keys(value)
-
-
-def _shown(driver, element_id):
-    """The image is displayed and loaded (its natural width is known)."""
-    return driver.execute_script(
-        f"const img = document.getElementById('{element_id}');"
-        "return !img.hidden && img.complete && img.naturalWidth > 0;")
-
 
 def test_run_overlay_download_and_error(server, browser, capsys):
     driver = browser
@@ -47,28 +26,28 @@ def test_run_overlay_download_and_error(server, browser, capsys):
     # An out-of-range pressure: the message simulate gives, one line, beside the pressure field; no run.
     status, _, err = run_console(cli.simulate_main, ["--pressure", "1000", "--no-plot"], capsys)
     assert status == 2 and err.count("\n") == 1
-    _set(driver, "pressure_kpa", "1000")
+    set_field(driver, "pressure_kpa", "1000")
     driver.find_element("id", "run").click()
-    error = _wait(driver, lambda d: d.find_element("id", "error-pressure_kpa").text)
+    error = wait(driver, lambda d: d.find_element("id", "error-pressure_kpa").text)
     assert err == f"error: {error}\n"
     assert "1000" in error and "[300, 500] kPa" in error
     assert driver.find_elements("css selector", "#runs li") == []
 
     # A run at 300 kPa and 701 N: its figure and its recovery time appear.
-    _set(driver, "pressure_kpa", "300")
-    _set(driver, "fz_n", "701")
+    set_field(driver, "pressure_kpa", "300")
+    set_field(driver, "fz_n", "701")
     driver.find_element("id", "run").click()
-    _wait(driver, lambda d: _shown(d, "figure"))
+    wait(driver, lambda d: image_shown(d, "figure"))
     assert driver.find_element("id", "error-pressure_kpa").text == ""
     first = driver.find_element("css selector", "#summary li").text
     recovery = re.match(r"Recovered (\d+\.\d{3}) s after the kick", first)
     assert recovery, first
 
     # A second run (500 kPa): the two are overlaid.
-    _set(driver, "pressure_kpa", "500")
+    set_field(driver, "pressure_kpa", "500")
     driver.find_element("id", "run").click()
-    _wait(driver, lambda d: len(d.find_elements("css selector", "#runs li")) == 2)
-    _wait(driver, lambda d: _shown(d, "overlay"))
+    wait(driver, lambda d: len(d.find_elements("css selector", "#runs li")) == 2)
+    wait(driver, lambda d: image_shown(d, "overlay"))
     boxes = driver.find_elements("css selector", ".overlay-choice")
     assert [b.is_selected() for b in boxes] == [True, True]
 
