@@ -18,7 +18,7 @@ from whipple_kick.simulate.results import Result
 
 pytestmark = pytest.mark.browser
 
-def test_run_overlay_download_and_error(server, browser, capsys):
+def test_run_overlay_download_and_error(browser, server, capsys):   # no browser: skipped before the server starts
     driver = browser
     driver.get(server)
     assert driver.title == "whipple_kick kick explorer"
@@ -50,6 +50,7 @@ def test_run_overlay_download_and_error(server, browser, capsys):
     wait(driver, lambda d: image_shown(d, "overlay"))
     boxes = driver.find_elements("css selector", ".overlay-choice")
     assert [b.is_selected() for b in boxes] == [True, True]
+    assert [li.text[:3] for li in driver.find_elements("css selector", "#runs li")] == ["1: ", "2: "]
 
     # The first run's folder, downloaded by the browser: the files simulate writes, read by Result.load.
     driver.find_elements("css selector", "a.download")[0].click()

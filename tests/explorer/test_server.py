@@ -41,6 +41,8 @@ def _multipart(fields, files=()):
     ("overlay", b"not json", 400),
     ("overlay", json.dumps({"ids": ["0123456789abcdef", "fedcba9876543210"]}).encode(), 400),
     ("overlay", json.dumps({"ids": list("abcdefgh")}).encode(), 400),     # more than four
+    ("overlay", json.dumps({"ids": ["0123456789abcdef"] * 2, "numbers": ["one", 2]}).encode(), 400),
+    ("overlay", b"[1, 2]", 400),
     ("animate/0123456789abcdef", b"", 400),
     ("pbest?fz_n=heavy", None, 400),
     ("run", None, 405),                                     # a GET where a POST is expected

@@ -71,6 +71,7 @@ form.addEventListener('submit', async (event) => {
   if (!reply) return;
   if (reply.errors) { showErrors(reply.errors); return; }
   const run = reply.run;
+  run.number = runs.length + 1;   // the runs of this page, numbered as the page shows them
   const summary = $('summary');
   summary.innerHTML = '';
   run.words.forEach((sentence, k) => {
@@ -94,6 +95,7 @@ function addRun(run) {
   box.type = 'checkbox';
   box.className = 'overlay-choice';
   box.value = run.id;
+  box.dataset.number = run.number;
   box.title = 'overlay this run (at most ' + MAX + ')';
   box.checked = document.querySelectorAll('.overlay-choice:checked').length < MAX;
   box.addEventListener('change', () => { limitChoices(); refreshOverlay(); });
@@ -123,10 +125,11 @@ function limitChoices() {
   boxes.forEach(b => { b.disabled = full && !b.checked; });
 }
 async function refreshOverlay() {
-  const ids = Array.from(document.querySelectorAll('.overlay-choice:checked')).map(b => b.value);
+  const ticked = Array.from(document.querySelectorAll('.overlay-choice:checked'));
+  const ids = ticked.map(b => b.value), numbers = ticked.map(b => Number(b.dataset.number));
   const img = $('overlay');
   if (ids.length < 2) { img.hidden = true; img.removeAttribute('src'); return; }
-  const reply = await busy('overlaying ' + ids.length + ' runs', () => post('/overlay', JSON.stringify({ids: ids})));
+  const reply = await busy('overlaying ' + ids.length + ' runs', () => post('/overlay', JSON.stringify({ids: ids, numbers: numbers})));
   if (reply && reply.url) { img.src = reply.url; img.hidden = false; }
   else if (reply && reply.error) { $('error-form').textContent = reply.error; }
 }

@@ -60,8 +60,6 @@ class Explorer:
         self.study = study_folder
         self.workers = workers
         self.folders = {}   # token -> folder (a run's, an overlay's, a stability sweep's)
-        self.runs = 0
-        self.numbers = {}   # a run's token -> its number on the page
 
     def new_folder(self, kind, name):
         """A new folder ``<workdir>/<kind>/<token>/<name>`` and its token."""
@@ -140,12 +138,9 @@ def _app(explorer):
         async def post(self):
             async def work():
                 scenario = await self.scenario()
-                explorer.runs += 1
-                number = explorer.runs
                 token, folder = explorer.new_folder("runs", cli._default_out(scenario).name)
-                explorer.numbers[token] = number
                 outcome = await explorer.submit(jobs.run_into, scenario, folder)
-                self.reply({"run": {**outcome, "id": token, "number": number, "label": _label(scenario),
+                self.reply({"run": {**outcome, "id": token, "label": _label(scenario),
                                     "figure_url": f"/files/{token}/response.png" if outcome["figure"] else None,
                                     "download_url": f"/download/{token}"}})
             await self.guarded(work)
@@ -154,13 +149,17 @@ def _app(explorer):
         async def post(self):
             async def work():
                 try:
-                    ids = json.loads(self.request.body or b"{}")["ids"]
-                except (ValueError, KeyError, TypeError):
-                    raise InputError("the overlay needs a JSON body {\"ids\": [run ids]}") from None
+                    asked = json.loads(self.request.body or b"{}")
+                    ids, numbers = asked["ids"], asked.get("numbers") or list(range(1, len(asked["ids"]) + 1))
+                except (ValueError, KeyError, TypeError, AttributeError):
+                    raise InputError("the overlay needs a JSON body {\"ids\": [run ids], \"numbers\": [their numbers "
+                                     "on the page]}") from None
                 if not isinstance(ids, list) or not 2 <= len(ids) <= page.MAX_OVERLAID:
                     raise InputError(f"overlay 2 to {page.MAX_OVERLAID} runs, not {ids!r}")
+                if not isinstance(numbers, list) or len(numbers) != len(ids) \
+                        or not all(isinstance(n, int) and not isinstance(n, bool) for n in numbers):
+                    raise InputError(f"the overlay's run numbers {numbers!r} must be one whole number per run")
                 folders = [str(explorer.folder(str(i))) for i in ids]
-                numbers = [explorer.numbers.get(str(i), 0) for i in ids]
                 token, folder = explorer.new_folder("overlays", "compare")
                 await explorer.submit(jobs.overlay, folders, numbers, folder / jobs.OVERLAY)
                 self.reply({"url": f"/files/{token}/{jobs.OVERLAY}"})
