@@ -10,6 +10,17 @@ import pytest
 STUDY = pathlib.Path(__file__).resolve().parents[2] / "docs" / "uncertainty_study"
 
 
+class Address(str):
+    """The server's address, and its process id (``pid``)."""
+
+    __slots__ = ("pid",)
+
+    def __new__(cls, url, pid):
+        self = super().__new__(cls, url)
+        self.pid = pid
+        return self
+
+
 @pytest.fixture(scope="package")
 def server(tmp_path_factory):
     """``whipple-kick-explorer --port 0 --study docs/uncertainty_study --workers 2``: its address (one server for
@@ -19,7 +30,7 @@ def server(tmp_path_factory):
 
     proc, url = headless.start_server("--study", STUDY, "--workers", 2,
                                       "--workdir", tmp_path_factory.mktemp("explorer_runs"))
-    yield url
+    yield Address(url, proc.pid)
     headless.stop_server(proc)
 
 

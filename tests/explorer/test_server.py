@@ -1,6 +1,9 @@
 """The explorer's server over HTTP (no browser): it never dies on a request, and a run does not hold up a page."""
 import io
 import json
+import os
+import pathlib
+import signal
 import threading
 import time
 import urllib.error
@@ -83,3 +86,36 @@ def test_a_run_in_progress_does_not_hold_up_another_page(server):
     assert still_running, "the run ended before the other requests were made: the check proved nothing"
     assert waited < 1.0, waited   # a page is a few ms; a run blocking the server would add its seconds
     assert reply["run"]["outcome"] == "completed"
+
+
+def _children(pid):
+    """Process ids whose parent is ``pid`` (Linux: /proc)."""
+    out = []
+    for stat in pathlib.Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:   # the process ended meanwhile
+            continue
+        if int(fields[1]) == pid:
+            out.append(int(stat.parent.name))
+    return out
+
+
+@pytest.mark.skipif(not pathlib.Path("/proc/self/stat").exists(), reason="finds the pool's workers in /proc (Linux)")
+def test_a_worker_that_dies_costs_its_request_one_line_and_the_next_run_works(server):
+    body, headers = _multipart({"duration": "30"})
+    reply = {}
+    thread = threading.Thread(target=lambda: reply.update(
+        dict(zip(("status", "body"), _request(server + "run", body, headers), strict=True))))
+    thread.start()
+    time.sleep(0.5)
+    workers = _children(server.pid)
+    assert len(workers) == 2, workers     # the pool of --workers 2, started with the server
+    for pid in workers:
+        os.kill(pid, signal.SIGKILL)
+    thread.join(timeout=120)
+    assert reply["status"] == 503
+    assert json.loads(reply["body"]) == {"error": "a worker process died during the request (a fresh pool takes "
+                                                  "the next one); try again"}
+    body, headers = _multipart({"duration": "1"})
+    assert json.loads(_request(server + "run", body, headers)[1])["run"]["outcome"] == "completed"

@@ -31,6 +31,15 @@ def pool(workers=None):
     return sweep_engine._default_pool(workers or os.cpu_count() or 1)
 
 
+def start_pool(workers=None):
+    """:func:`pool` with its workers started and warm (imports, the compiled model): forked here, before the
+    server has threads of its own (a fork copies one thread only, and any lock another thread held)."""
+    executor = pool(workers)
+    for future in [executor.submit(sweep_engine._preload) for _ in range(workers or os.cpu_count() or 1)]:
+        future.result()
+    return executor
+
+
 def discard_pool():
     """Drop a broken pool (a worker died); the next :func:`pool` starts a fresh one."""
     sweep_engine._discard_default_pool()

@@ -52,6 +52,10 @@ _TOKEN = re.compile(r"^[0-9a-f]{16}$")
 log = logging.getLogger("whipple_kick.explorer")
 
 
+class JobLost(RuntimeError):
+    """The pool lost the request's job (a worker process died): one line for the page, status 503."""
+
+
 class Explorer:
     """The server's state: its work folder, the folders it made (by token), the study, the pool's size."""
 
@@ -82,7 +86,8 @@ class Explorer:
             return await asyncio.wrap_future(future)
         except cf.process.BrokenProcessPool:
             jobs.discard_pool()   # the next request gets a fresh pool
-            raise RuntimeError("a worker process died during the request; try again") from None
+            raise JobLost("a worker process died during the request (a fresh pool takes the next one); try again") \
+                from None
 
 
 def _app(explorer):
@@ -110,6 +115,9 @@ def _app(explorer):
                 self.reply({"errors": exc.errors}, 200)
             except InputError as exc:
                 self.reply({"error": str(exc)}, 400)
+            except JobLost as exc:
+                log.warning("request %s: %s", self.request.uri, exc)
+                self.reply({"error": str(exc)}, 503)
             except Exception as exc:
                 log.exception("request %s failed", self.request.uri)
                 self.reply({"error": f"internal error: {type(exc).__name__}: {exc}"}, 500)
@@ -304,7 +312,7 @@ def _serve(argv):
     logging.basicConfig(level=logging.WARNING, format="whipple-kick-explorer: %(message)s")
     try:
         explorer = Explorer(workdir, args.study, args.workers)
-        jobs.pool(args.workers)   # forked before the server starts; the compiled model is loaded once, here
+        jobs.start_pool(args.workers)   # forked before the server starts; the compiled model loaded once, here
         try:
             sockets = tornado.netutil.bind_sockets(args.port, HOST)
         except OSError as exc:
