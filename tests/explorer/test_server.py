@@ -119,3 +119,21 @@ def test_a_worker_that_dies_costs_its_request_one_line_and_the_next_run_works(se
                                                   "the next one); try again"}
     body, headers = _multipart({"duration": "1"})
     assert json.loads(_request(server + "run", body, headers)[1])["run"]["outcome"] == "completed"
+
+
+def test_a_bicycleparameters_file_sent_with_the_form_is_the_bicycle(server):
+    """BicycleParameters' own BrowserBenchmark.txt (its app data), sent as the page's file field, runs as
+    ``simulate --bicycle BrowserBenchmark.txt`` would: its summary names the file's bicycle."""
+    bp = pytest.importorskip("bicycleparameters", reason="the test extra's BicycleParameters ships the file")
+    path = pathlib.Path(bp.__file__).parent / "app-data" / "bicycles" / "Browser" / "Parameters" / "BrowserBenchmark.txt"
+    if not path.is_file():
+        pytest.skip(f"this BicycleParameters has no {path.name} in its app data")
+    body, headers = _multipart({"duration": "1"}, [("bicycle_file", path.name, path.read_bytes())])
+    reply = json.loads(_request(server + "run", body, headers)[1])
+    assert reply["run"]["outcome"] == "completed", reply
+    assert reply["run"]["label"].startswith("T03 400/400 kPa")
+    status, data = _request(server + reply["run"]["download_url"].lstrip("/"))
+    import zipfile
+    with zipfile.ZipFile(io.BytesIO(data)) as archive:
+        summary = json.loads(next(archive.read(n) for n in archive.namelist() if n.endswith("summary.json")))
+    assert status == 200 and summary["scenario"]["bicycle"].endswith("BrowserBenchmark.txt")
