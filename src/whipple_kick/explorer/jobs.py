@@ -7,10 +7,13 @@ user's request. A run goes through the sweeps' own worker function
 and its folder gets the files ``simulate`` writes (:meth:`whipple_kick.simulate.results.Result.save` and
 response.png), so that ``compare`` and :meth:`~whipple_kick.simulate.results.Result.load` read it.
 """
+import contextlib
 import json
 import math
 import os
 import pathlib
+import signal
+import threading
 
 from whipple_kick.simulate.results import Result
 from whipple_kick.studies import sweep_engine
@@ -31,13 +34,35 @@ def pool(workers=None):
     return sweep_engine._default_pool(workers or os.cpu_count() or 1)
 
 
+@contextlib.contextmanager
+def _ctrl_c_ignored():
+    """Within the block SIGINT is ignored, so that the pool's workers forked in it ignore Ctrl-C.
+
+    Ctrl-C in a terminal reaches the server and its workers alike; the server says one line and ends its
+    workers, which would otherwise each print a KeyboardInterrupt traceback. (A fork inherits the
+    handler; in the main thread only, where the server submits.)
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def submit(function, *args, workers=None):
+    """``function(*args)`` submitted to :func:`pool` (a future); workers it starts ignore Ctrl-C."""
+    with _ctrl_c_ignored():   # the pool forks its workers at a submit
+        return pool(workers).submit(function, *args)
+
+
 def start_pool(workers=None):
     """:func:`pool` with its workers started and warm (imports, the compiled model): forked here, before the
     server has threads of its own (a fork copies one thread only, and any lock another thread held)."""
-    executor = pool(workers)
-    for future in [executor.submit(sweep_engine._preload) for _ in range(workers or os.cpu_count() or 1)]:
+    for future in [submit(sweep_engine._preload, workers=workers) for _ in range(workers or os.cpu_count() or 1)]:
         future.result()
-    return executor
 
 
 def discard_pool():

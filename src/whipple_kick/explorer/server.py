@@ -82,7 +82,7 @@ class Explorer:
     async def submit(self, function, *args):
         """Run ``function(*args)`` in the sweeps' pool and await it without blocking the server."""
         try:
-            future = jobs.pool(self.workers).submit(function, *args)
+            future = jobs.submit(function, *args, workers=self.workers)
             return await asyncio.wrap_future(future)
         except cf.process.BrokenProcessPool:
             jobs.discard_pool()   # the next request gets a fresh pool
