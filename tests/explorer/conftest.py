@@ -8,6 +8,8 @@ import pathlib
 import pytest
 
 STUDY = pathlib.Path(__file__).resolve().parents[2] / "docs" / "uncertainty_study"
+#: The page's stability sweep in the tests: four speeds (the default 191 take about 9 s).
+STABILITY_SPEEDS = "2:5:1"
 
 
 class Address(str):
@@ -23,12 +25,12 @@ class Address(str):
 
 @pytest.fixture(scope="package")
 def server(tmp_path_factory):
-    """``whipple-kick-explorer --port 0 --study docs/uncertainty_study --workers 2``: its address (one server for
-    the package's tests in a test process)."""
+    """``whipple-kick-explorer --port 0 --study docs/uncertainty_study --workers 2 --speeds 2:5:1``: its address
+    and process id (one server for the package's tests in a test process)."""
     pytest.importorskip("tornado", reason="the explorer's server needs Tornado: pip install -e '.[app]'")
     from whipple_kick.explorer import headless
 
-    proc, url = headless.start_server("--study", STUDY, "--workers", 2,
+    proc, url = headless.start_server("--study", STUDY, "--workers", 2, "--speeds", STABILITY_SPEEDS,
                                       "--workdir", tmp_path_factory.mktemp("explorer_runs"))
     yield Address(url, proc.pid)
     headless.stop_server(proc)

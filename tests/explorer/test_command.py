@@ -17,6 +17,7 @@ def test_a_plain_run_imports_nothing_of_the_explorer():
 def test_bad_options_are_one_line_and_status_2(capsys, tmp_path):
     for argv, words in ((["--study", str(tmp_path)], "has no p_best.csv"),
                         (["--port", "70000"], "outside the allowed range [0, 65535]"),
-                        (["--workers", "0"], "must be a whole number >= 1")):
+                        (["--workers", "0"], "must be a whole number >= 1"),
+                        (["--speeds", "3:1:1"], "STOP 1 m/s is below START 3 m/s")):
         status, out, err = run_console(server.main, argv, capsys)
         assert status == 2 and out == "" and err.count("\n") == 1 and words in err, (argv, err)

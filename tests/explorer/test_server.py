@@ -137,3 +137,20 @@ def test_a_bicycleparameters_file_sent_with_the_form_is_the_bicycle(server):
     with zipfile.ZipFile(io.BytesIO(data)) as archive:
         summary = json.loads(next(archive.read(n) for n in archive.namelist() if n.endswith("summary.json")))
     assert status == 200 and summary["scenario"]["bicycle"].endswith("BrowserBenchmark.txt")
+
+
+def test_stability_against_speed_is_the_stability_commands(server, tmp_path, capsys):
+    """The page's stability of the form's setup prints what ``stability`` prints for the same flags and speeds."""
+    from tests.conftest import run_console
+    from tests.explorer.conftest import STABILITY_SPEEDS
+    from whipple_kick import cli
+
+    body, headers = _multipart({"pressure_kpa": "300", "fz_n": "701", "speed": "4", "kick_direction": "left"})
+    reply = json.loads(_request(server + "stability", body, headers)[1])
+    status, out, _ = run_console(cli.stability_main, ["--pressure", "300", "--fz", "701", "--speeds", STABILITY_SPEEDS,
+                                                      "--out", str(tmp_path / "st")], capsys)
+    assert status == 0
+    printed = out.splitlines()
+    assert printed[0].startswith(f"stability: {reply['lines'][0]}; 4 speeds 2-5 m/s")
+    assert printed[1:-1] == reply["lines"][1:]
+    assert _request(server + reply["url"].lstrip("/"))[0] == 200

@@ -57,10 +57,12 @@ class JobLost(RuntimeError):
 
 
 class Explorer:
-    """The server's state: its work folder, the folders it made (by token), the study, the pool's size."""
+    """The server's state: its work folder, the folders it made (by token), the study, the pool's size, the
+    stability sweep's speeds."""
 
-    def __init__(self, workdir, study_folder=None, workers=None):
+    def __init__(self, workdir, study_folder=None, workers=None, speeds=None):
         self.workdir = pathlib.Path(workdir)
+        self.speeds = speeds   # the stability sweep's speeds [m/s]
         self.study = study_folder
         self.workers = workers
         self.folders = {}   # token -> folder (a run's, an overlay's, a stability sweep's)
@@ -185,11 +187,7 @@ def _app(explorer):
     class StabilityHandler(Handler):
         async def post(self):
             async def work():
-                import numpy as np
-
-                from whipple_kick.studies import stability
-                start, stop, step = stability.DEFAULT_SPEEDS   # the stability command's default sweep
-                speeds = np.round(np.arange(start, stop + step / 2, step), 10)
+                speeds = explorer.speeds
                 scenario = form.stability_scenario(await self.scenario(), speeds[0])
                 token, folder = explorer.new_folder("stability", cli._default_out(scenario, "stability").name)
                 lines = await explorer.submit(jobs.stability_into, scenario, speeds, folder)
@@ -287,6 +285,11 @@ def _parser():
                         "--out DIR writes): the page shows its P(best) for the chosen load")
     p.add_argument("--workers", type=int, metavar="N",
                    help="worker processes of the pool runs go to (default: one per CPU core, as sweeps)")
+    from whipple_kick.studies import stability
+    start, stop, step = stability.DEFAULT_SPEEDS
+    p.add_argument("--speeds", default=f"{start:g}:{stop:g}:{step:g}", metavar="START:STOP:STEP",
+                   help=f"speeds of the page's stability sweep in m/s, as stability --speeds: START:STOP:STEP (STOP "
+                        f"included) or V1,V2,... (default {start:g}:{stop:g}:{step:g}, the stability command's)")
     p.add_argument("--workdir", metavar="DIR",
                    help="folder the runs are written into (default: a temporary folder, removed at exit)")
     return p
@@ -304,6 +307,8 @@ def _serve(argv):
         study.check_folder(args.study)
     if args.workers is not None and args.workers < 1:
         raise InputError(f"--workers {args.workers} must be a whole number >= 1")
+    from whipple_kick.studies import stability
+    speeds = stability.parse_speeds(args.speeds)
     if not 0 <= args.port <= 65535:
         raise InputError(f"--port {args.port} is outside the allowed range [0, 65535]")
     own = args.workdir is None
@@ -311,7 +316,7 @@ def _serve(argv):
     workdir.mkdir(parents=True, exist_ok=True)
     logging.basicConfig(level=logging.WARNING, format="whipple-kick-explorer: %(message)s")
     try:
-        explorer = Explorer(workdir, args.study, args.workers)
+        explorer = Explorer(workdir, args.study, args.workers, speeds)
         jobs.start_pool(args.workers)   # forked before the server starts; the compiled model loaded once, here
         try:
             sockets = tornado.netutil.bind_sockets(args.port, HOST)
