@@ -14,12 +14,13 @@ def test_fields_come_from_the_declarations():
     assert tuple(fields) == form.PAGE_FIELDS
     for name, f in fields.items():
         s = SETTINGS[name]
-        assert f.label == s.words and f.help == s.doc
+        assert f.label == s.words and f.help == form.plain(s.doc) and "`" not in f.help
         assert f.value == ("" if s.default is None else form._text(s.default))
     assert fields["tyre"].choices == tuple(t[0] for t in tyres.available())
     assert fields["controller"].choices == SETTINGS["controller"].choices
     assert "table" not in fields["kick_profile"].choices and "smooth" in fields["kick_profile"].choices
     assert fields["fz_n"].placeholder == "default 635"
+    assert fields["pressure_front_kpa"].placeholder == "default: the pressure"
 
 
 @pytest.mark.parametrize("name", [n for n in form.PAGE_FIELDS if SETTINGS[n].high is not None or SETTINGS[n].low is not None])

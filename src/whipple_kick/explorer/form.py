@@ -89,6 +89,18 @@ def _text(value):
     return f"{value:g}" if isinstance(value, float) else str(value)
 
 
+def plain(doc):
+    """A declaration's text without its reStructuredText markup, for a tooltip.
+
+    Example
+    -------
+    >>> plain("Tyre file (:func:`~whipple_kick.library.tyres.load`); ``None``: the rule.")
+    'Tyre file (whipple_kick.library.tyres.load); None: the rule.'
+    """
+    import re
+    return re.sub(r":[a-z]+:`~?([^`]+)`", r"\1", doc).replace("``", "")
+
+
 def _range_text(s):
     """The declared range as :func:`whipple_kick.errors.check_range` writes it, or "" where there is none."""
     if s.low is None and s.high is None:
@@ -114,11 +126,13 @@ def fields():
             placeholder = _text(s.default)
         elif s.none_means is not None:
             placeholder = f"default {_text(s.none_means)}"
+        elif "(default: ``" in s.doc:   # "(default: ``pressure_kpa``)": that field's value
+            other = s.doc.split("(default: ``")[1].split("``")[0]
+            placeholder = f"default: the {SETTINGS[other].words}" if other in SETTINGS else f"default: {other}"
         else:
-            placeholder = "default: " + s.doc.split("(default: ")[-1].split(")")[0].strip("`") \
-                if "(default: " in s.doc else "its default rule"
+            placeholder = "its default rule"
         out.append(Field(name=name, label=s.words, unit=s.unit.strip("()"), choices=_choices(name),
-                         value=_text(s.default), placeholder=placeholder, range_text=_range_text(s), help=s.doc,
+                         value=_text(s.default), placeholder=placeholder, range_text=_range_text(s), help=plain(s.doc),
                          suggestions=tuple(bicycles.available()) if name == "bicycle" else ()))
     return out
 
