@@ -83,8 +83,9 @@ def test_a_run_in_progress_does_not_hold_up_another_page(server):
     still_running = thread.is_alive()
     thread.join(timeout=120)
     assert page[0] == 200 and json.loads(pbest[1])["rows"]["settling"][0]["pressure"] == "300 kPa"
-    assert still_running, "the run ended before the other requests were made: the check proved nothing"
-    assert waited < 1.0, waited   # a page is a few ms; a run blocking the server would add its seconds
+    # A server that a run blocked would answer the page only after the run's reply.
+    assert still_running, "the page came back only after the run ended: blocked, or a run too short to tell"
+    assert waited < 2.0, waited   # a page is a few ms, also on a loaded machine; the run takes seconds
     assert reply["run"]["outcome"] == "completed"
 
 
