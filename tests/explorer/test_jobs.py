@@ -56,3 +56,10 @@ def test_stability_writes_the_stability_commands_files(tmp_path):
     lines = jobs.stability_into(Scenario(symmetric_tyres=True, speed=3.0), [3.0, 4.0], tmp_path)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["eigenvalues.csv", "stability.png", "summary.json"]
     assert lines[1].strip() == "open loop (no rider control):"
+
+
+def test_the_pool_is_the_sweeps():
+    import os
+
+    from whipple_kick.studies import sweep_engine
+    assert jobs.pool() is sweep_engine._default_pool(os.cpu_count() or 1)

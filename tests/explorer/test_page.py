@@ -68,3 +68,4 @@ def test_run_overlay_download_and_error(browser, server, capsys):   # no browser
     result = Result.load(folder)
     assert result.scenario.pressures == (300.0, 300.0) and result.scenario.fz_n == 701.0
     assert f"{result.summary['recovery']['time_s']:.3f}" == recovery[1]
+

@@ -3,6 +3,7 @@ import io
 import json
 import os
 import pathlib
+import re
 import signal
 import threading
 import time
@@ -155,3 +156,13 @@ def test_stability_against_speed_is_the_stability_commands(server, tmp_path, cap
     assert printed[0].startswith(f"stability: {reply['lines'][0]}; 4 speeds 2-5 m/s")
     assert printed[1:-1] == reply["lines"][1:]
     assert _request(server + reply["url"].lstrip("/"))[0] == 200
+
+
+def test_the_page_loads_nothing_from_elsewhere(server):
+    """No address outside the server: no CDN script, style, font or image (the page works offline)."""
+    status, body = _request(server)
+    text = body.decode()
+    assert status == 200 and "http:" not in text and "https:" not in text
+    addresses = re.findall(r'(?:src|href|action)="([^"]*)"', text)
+    assert addresses and all(a.startswith(("/", "data:")) for a in addresses), addresses
+    assert "fetch('/run'" in text or "post('/run'" in text   # the script talks to this server only
