@@ -82,6 +82,7 @@ def chromium(downloads=None, window=WINDOW):
     """A headless Chromium (a Selenium driver) whose downloads go to ``downloads``; :func:`missing` first."""
     from selenium import webdriver
 
+    os.environ.setdefault("SE_OFFLINE", "true")   # Selenium Manager, should it run, looks nothing up online
     options = webdriver.ChromeOptions()
     options.binary_location = _program(("chromium", "chromium-browser"), "WHIPPLE_KICK_CHROMIUM")
     for arg in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage", "--no-first-run",
