@@ -65,9 +65,10 @@ def start_pool(workers=None):
         future.result()
 
 
-def discard_pool():
-    """Drop a broken pool (a worker died); the next :func:`pool` starts a fresh one."""
-    sweep_engine._discard_default_pool()
+def discard_pool(end_workers=False):
+    """Drop the pool (a broken one: a worker died); the next :func:`pool` starts a fresh one.
+    ``end_workers`` also ends its workers (SIGTERM), as the server does when it stops."""
+    sweep_engine._discard_default_pool(end_workers=end_workers)
 
 
 def run_into(scenario, folder):

@@ -331,7 +331,7 @@ def _serve(argv):
         if own:
             shutil.rmtree(workdir, ignore_errors=True)
         with contextlib.suppress(Exception):
-            jobs.discard_pool()
+            jobs.discard_pool(end_workers=True)   # no worker outlives the server
     return 0
 
 
