@@ -1,6 +1,7 @@
 """The package's shape, read from its source: wings that import only downwards, and no import circles.
 
-The wings, lowest first: ``model`` < ``library`` < ``simulate`` < ``figures`` < ``studies`` < ``cli``;
+The wings, lowest first: ``model`` < ``library`` < ``simulate`` < ``figures`` < ``studies`` < ``cli`` < ``explorer``
+(the web app at the top: it may import every wing, and none imports it);
 ``errors`` and ``fileio`` lie beneath them all, and the package's ``__init__`` (a lazy facade, importing
 nothing at import time) above. Every import counts, also one inside a function: a lazy import still ties
 the two modules together.
@@ -9,7 +10,7 @@ import ast
 import pathlib
 
 PACKAGE = pathlib.Path(__file__).resolve().parents[1] / "src" / "whipple_kick"
-RANK = {"errors": 0, "fileio": 0, "model": 1, "library": 2, "simulate": 3, "figures": 4, "studies": 5, "cli": 6}
+RANK = {"errors": 0, "fileio": 0, "model": 1, "library": 2, "simulate": 3, "figures": 4, "studies": 5, "cli": 6, "explorer": 7}
 
 
 def _modules():
