@@ -300,3 +300,32 @@ def test_a_fall_is_status_1_and_a_success():
     assert result.summary["fell"]
     assert (result.status, result.success) == (1, True)
     assert result.message == result.summary["message"] and "\n" not in result.message
+
+
+@pytest.mark.parametrize("changes", [
+    {},                                                                   # carcass tyre, completed
+    {"tyre_transient": "force_lag"},                                      # no patch columns
+    {"rider_body": "leaning", "duration": 0.8},                           # a part's states and outputs
+    {"controller": "off", "duration": 3.0, "fall_angle_deg": 20.0},       # ends in a fall
+])
+def test_the_lean_path_gives_the_tables_values_and_the_same_summary(changes):
+    # run(columns=...) builds no table: its columns must be the table's, bit for bit (the same sources and
+    # arithmetic), and its summary the table's summary exactly, but for the run's wall times and the date.
+    scenario = Scenario(duration=1.2, settle=0.1).with_changes(**changes)
+    full = run(scenario)
+    lean = run(scenario, columns="all")
+    assert list(lean.trajectory) == list(full.trajectory.columns)
+    for column in full.trajectory.columns:
+        assert np.array_equal(lean.trajectory[column], full.trajectory[column].to_numpy()), column
+
+    def comparable(summary):
+        numerics = {k: v for k, v in summary["numerics"].items() if k not in ("wall_s", "integration_wall_s")}
+        return {**summary, "numerics": numerics, "provenance": None}
+
+    assert comparable(lean.summary) == comparable(full.summary)
+    assert json.dumps(comparable(lean.summary)) == json.dumps(comparable(full.summary))   # -0.0 is not 0.0 here
+    only = run(scenario, columns=("plate_y",))
+    assert "plate_y" in only.trajectory and "camber_front" not in only.trajectory
+    assert comparable(only.summary) == comparable(full.summary)
+    with pytest.raises(wk.errors.InputError, match=r"trajectory column\(s\) \['rol'\] do not exist"):
+        run(scenario, columns=("rol",))
