@@ -6,6 +6,8 @@ Usage:
     python scripts/bench_sweep.py parallel        # the same in both kick directions (18 cases): 1 vs 2 workers
     python scripts/bench_sweep.py blend           # a blended pressure (350 kPa) against a measured one (400 kPa)
     python scripts/bench_sweep.py many --n 1000   # an n-case sweep into a temporary folder
+    python scripts/bench_sweep.py cost            # a case's wall time on each of a sweep's paths
+    python scripts/bench_sweep.py cost --callgrind   # and its instructions (valgrind, ~2 min)
     python scripts/bench_sweep.py all
 
 "Warm" means the compiled model is already in the on-disk cache and this
@@ -30,6 +32,16 @@ load on a shared machine falls on all variants alike.
   each worker has answered, :func:`pool_startup`), and a first sweep on a
   fresh pool is timed for one and two workers (a nine-case sweep must not
   take longer on two).
+* ``cost``: what one case costs on each of a sweep's paths, in this process (:func:`bench_cost`): a
+  plain :func:`whipple_kick.run` (the baseline: a table and a summary), a case that keeps only the table's
+  row (``run_case`` without a trajectory) and one that keeps its trajectory (``run_case`` with the default
+  200 Hz columns, then the folder's ``add``, where the compression happened before issue 41). Wall time:
+  median of interleaved repeats, and each path's ratio to the baseline run beside it in the same repeat
+  (the ratio shrugs off a neighbour's load). Instructions per case: the same paths counted by valgrind's
+  callgrind (``--callgrind``; ``perf stat`` has no counters on a virtual machine), instrumented only
+  while the cases run (client requests around each path, :func:`_callgrind_helper`), so the count is
+  the case's own, not the imports', and does not depend on the machine's load. Running this script with
+  ``PYTHONPATH=<another checkout>/src`` measures that checkout's code with the same bench: a before/after.
 * ``blend``: 350 kPa (T03's 300 and 400 kPa fits blended) against 400 kPa in
   this process: the integration's wall time per evaluation that LSODA counts
   (``numerics.evaluations``, Jacobian columns included), and the compiled
@@ -322,15 +334,167 @@ def bench_many(n, duration, workers, folder):
     return rate / workers
 
 
+#: The paths :func:`bench_cost` compares, in the order printed ("run" is the baseline).
+COST_PATHS = ("run", "table", "kept")
+
+
+def _cost_case(path, scenario, cid, spec, store):
+    """One case on ``path``: (wall time of the worker's part [s], of the parent's part [s])."""
+    import inspect
+
+    from whipple_kick.simulate import simulation
+    from whipple_kick.studies import sweep_engine
+    t0 = time.perf_counter()
+    if path == "run":
+        simulation.run(scenario)
+        return time.perf_counter() - t0, 0.0
+    # packed: the worker compresses the trajectory file (issue 41); code before it has no such keyword.
+    packed = {"packed": True} if "packed" in inspect.signature(sweep_engine.run_case).parameters else {}
+    record = sweep_engine.run_case(scenario, cid, spec if path == "kept" else None, **packed)
+    t1 = time.perf_counter()
+    assert record["status"] == "ok", record["error"]
+    if path == "kept":
+        store.add(record)   # writes the trajectory file (compressing it first where the worker did not)
+    else:
+        sweep_engine.slim(record)   # what the parent keeps of a table-only case
+    return t1 - t0, time.perf_counter() - t1
+
+
+def _cost_setup(n_cases, duration, folder):
+    """The cases, their ids, the default trajectory spec and a sweep folder to save kept cases into."""
+    from whipple_kick.studies import sweep_engine, sweep_store
+    scenarios = _thesis_scenarios(duration)[:n_cases]
+    case_list = [({}, sc, sweep_store.case_id(sc)) for sc in scenarios]
+    spec = sweep_engine._trajectory_spec(sweep_engine.DEFAULT_TRAJECTORY_COLUMNS, "float32", 200.0)
+    store = sweep_store.Folder(folder, case_list, scenarios[0], False, spec)
+    return case_list, spec, store
+
+
+def _cost_warm_up(case_list, spec, store):
+    """Every case on every path once, unmeasured: the per-scenario caches (rider, LQR gains: a cold case
+    costs ~100 ms more) and first-call costs fall here, not on the first path measured."""
+    for path in COST_PATHS:
+        for _, scenario, cid in case_list:
+            _cost_case(path, scenario, cid, spec, store)
+
+
+def bench_cost(repeats, duration, n_cases):
+    """Print each path's wall time per case (worker and parent parts) and its ratio to the baseline run."""
+    from whipple_kick.studies import sweep_engine
+    sweep_engine._keep_freed_memory()   # as in a sweep's worker, for every path alike
+    walls = {p: [] for p in COST_PATHS}
+    parent = {p: [] for p in COST_PATHS}
+    ratios = {p: [] for p in COST_PATHS}
+    with tempfile.TemporaryDirectory() as tmp:
+        case_list, spec, store = _cost_setup(n_cases, duration, os.path.join(tmp, "sweep"))
+        try:
+            _cost_warm_up(case_list, spec, store)
+            for r in range(repeats):
+                per = {}
+                for path in _rotated(list(COST_PATHS), r):
+                    cost = [_cost_case(path, sc, cid, spec, store) for _, sc, cid in case_list]
+                    per[path] = sum(w + q for w, q in cost) / len(cost)
+                    walls[path].append(sum(w for w, _ in cost) / len(cost))
+                    parent[path].append(sum(q for _, q in cost) / len(cost))
+                for path in COST_PATHS:
+                    ratios[path].append(per[path] / per["run"])
+        finally:
+            store.close()
+    print(f"wall per case ({n_cases} thesis cases, {duration:g} s, medians of {repeats} interleaved repeats):")
+    for path in COST_PATHS:
+        print(f"  {path:6s} worker {statistics.median(walls[path]) * 1e3:7.1f} ms + parent "
+              f"{statistics.median(parent[path]) * 1e3:5.1f} ms; / run: {statistics.median(ratios[path]):.3f} "
+              f"(per repeat {', '.join(f'{q:.3f}' for q in ratios[path])})")
+    return {p: statistics.median(ratios[p]) for p in COST_PATHS}
+
+
+_CALLGRIND_C = """
+#include <valgrind/callgrind.h>
+void wk_cg_start(void) { CALLGRIND_ZERO_STATS; CALLGRIND_START_INSTRUMENTATION; }
+void wk_cg_stop(const char *label) { CALLGRIND_DUMP_STATS_AT(label); CALLGRIND_STOP_INSTRUMENTATION; }
+"""
+
+
+def _callgrind_helper(folder):
+    """ctypes library with callgrind's client requests: start counting, dump and stop (no-ops outside valgrind)."""
+    import ctypes
+    import subprocess
+    source = os.path.join(folder, "wk_callgrind.c")
+    library = os.path.join(folder, "wk_callgrind.so")
+    with open(source, "w") as fh:
+        fh.write(_CALLGRIND_C)
+    subprocess.run(["cc", "-shared", "-fPIC", "-O1", "-o", library, source], check=True)
+    lib = ctypes.CDLL(library)
+    lib.wk_cg_stop.argtypes = [ctypes.c_char_p]
+    return lib
+
+
+def _count_inner(duration, n_cases, helper_folder):
+    """Under callgrind: warm every path, then count each path's cases between client requests."""
+    import gc
+
+    from whipple_kick.studies import sweep_engine
+    lib = _callgrind_helper(helper_folder)
+    sweep_engine._keep_freed_memory()
+    with tempfile.TemporaryDirectory() as tmp:
+        case_list, spec, store = _cost_setup(n_cases, duration, os.path.join(tmp, "sweep"))
+        try:
+            _cost_warm_up(case_list, spec, store)
+            for path in COST_PATHS:
+                # Each path starts from an empty young generation: a full collection falling into one path's
+                # cases and not another's (some 1e8 instructions with the package's objects) is not its cost.
+                gc.collect()
+                lib.wk_cg_start()
+                for _, sc, cid in case_list:
+                    _cost_case(path, sc, cid, spec, store)
+                lib.wk_cg_stop(path.encode())
+        finally:
+            store.close()
+
+
+def bench_instructions(duration, n_cases):
+    """Print the instructions per case of each path, counted by callgrind in a child process."""
+    import glob
+    import re
+    import subprocess
+    with tempfile.TemporaryDirectory() as tmp:
+        out = os.path.join(tmp, "callgrind.out")
+        # One BLAS thread in every path (a sweep's worker limits it per case; the plain run would not).
+        env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+        t0 = time.perf_counter()
+        subprocess.run(["valgrind", "--tool=callgrind", "--instr-atstart=no", f"--callgrind-out-file={out}",
+                        sys.executable, os.path.abspath(__file__), "_count", "--duration", str(duration),
+                        "--cases", str(n_cases), "--folder", tmp],
+                       check=True, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        counts = {}
+        for name in glob.glob(out + "*"):
+            with open(name) as fh:
+                text = fh.read()
+            label = re.search(r"^desc: Trigger: Client Request: (\S+)", text, re.MULTILINE)
+            total = re.search(r"^(?:totals|summary): (\d+)", text, re.MULTILINE)
+            if label and total and label.group(1) in COST_PATHS:
+                counts[label.group(1)] = int(total.group(1)) / n_cases
+    print(f"instructions per case (callgrind, {n_cases} thesis cases, {duration:g} s; {time.perf_counter() - t0:.0f} s "
+          "under valgrind):")
+    for path in COST_PATHS:
+        print(f"  {path:6s} {counts[path] / 1e6:8.1f} M; / run: {counts[path] / counts['run']:.3f}")
+    return counts
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    p.add_argument("what", choices=("split", "nine", "parallel", "blend", "many", "all"))
+    p.add_argument("what", choices=("split", "nine", "parallel", "blend", "many", "cost", "all", "_count"))
     p.add_argument("--repeats", type=int, default=3)
     p.add_argument("--n", type=int, default=1000, help="cases of the large sweep")
     p.add_argument("--duration", type=float, default=6.0, help="simulated time after the kick [s]")
     p.add_argument("--workers", type=int, default=None, help="workers of the large sweep (default: cores)")
     p.add_argument("--folder", default=None, help="keep the large sweep's folder here")
+    p.add_argument("--cases", type=int, default=3, help="thesis cases per path of the cost bench (1-9)")
+    p.add_argument("--callgrind", action="store_true", help="cost: also count instructions (valgrind, minutes)")
     args = p.parse_args(argv)
+    if args.what == "_count":   # the child process bench_instructions runs under valgrind
+        _count_inner(args.duration, args.cases, args.folder)
+        return 0
     print(f"{os.cpu_count()} cores; load average {os.getloadavg()[0]:.2f} before the run")
     _warm_up()
     if args.what in ("split", "all"):
@@ -341,6 +505,10 @@ def main(argv=None):
         bench_parallel(args.repeats, args.duration)
     if args.what in ("blend", "all"):
         bench_blend(args.repeats, args.duration)
+    if args.what in ("cost", "all"):
+        bench_cost(args.repeats, args.duration, args.cases)
+        if args.callgrind:
+            bench_instructions(args.duration, args.cases)
     if args.what in ("many", "all"):
         bench_many(args.n, args.duration, args.workers, args.folder)
     return 0

@@ -130,3 +130,17 @@ def test_sobol_censoring_compares_two_run_lengths(tmp_path, capsys):
     assert "new output (which recovers first), short run against long run:" in out and "old output" in out
     assert out.count("within the combined interval") == 8   # (new, old) x 2 criteria x (S1, ST)
     assert "which recovers first changed in" in out
+
+
+def test_the_cost_bench_runs_each_path_and_its_counting_requests_are_inert_outside_valgrind(tmp_path, capsys):
+    """scripts/bench_sweep.py cost (issue 41 item 6): every path runs and gets a ratio to the baseline run;
+    the callgrind client requests compile and do nothing in a process valgrind does not run."""
+    import bench_sweep
+
+    lib = bench_sweep._callgrind_helper(str(tmp_path))
+    lib.wk_cg_start()
+    lib.wk_cg_stop(b"run")
+    ratios = bench_sweep.bench_cost(1, 0.3, 1)
+    assert set(ratios) == set(bench_sweep.COST_PATHS) and ratios["run"] == 1.0
+    assert all(r > 0 for r in ratios.values())
+    assert "instructions" not in capsys.readouterr().out
