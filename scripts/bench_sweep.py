@@ -8,6 +8,7 @@ Usage:
     python scripts/bench_sweep.py many --n 1000   # an n-case sweep into a temporary folder
     python scripts/bench_sweep.py cost            # a case's wall time on each of a sweep's paths
     python scripts/bench_sweep.py cost --callgrind   # and its instructions (valgrind, ~2 min)
+    python scripts/bench_sweep.py tolerance --samples 8 --fz 635 --rtol 1e-8   # a study at two rtols
     python scripts/bench_sweep.py all
 
 "Warm" means the compiled model is already in the on-disk cache and this
@@ -42,6 +43,10 @@ load on a shared machine falls on all variants alike.
   while the cases run (client requests around each path, :func:`_callgrind_helper`), so the count is
   the case's own, not the imports', and does not depend on the machine's load. Running this script with
   ``PYTHONPATH=<another checkout>/src`` measures that checkout's code with the same bench: a before/after.
+* ``tolerance``: the uncertainty study (shipped file, N samples, one load) at the default rtol and at
+  ``--rtol``, on the same sampled rows (:func:`bench_tolerance`): P(best) per pressure and criterion, the
+  recovery-time distributions, the per-case change of each criterion's time and outcome, and the CPU time
+  per case. What a study's ``[fixed] rtol`` (or ``base=Scenario(rtol=...)``) buys and costs.
 * ``blend``: 350 kPa (T03's 300 and 400 kPa fits blended) against 400 kPa in
   this process: the integration's wall time per evaluation that LSODA counts
   (``numerics.evaluations``, Jacobian columns included), and the compiled
@@ -481,9 +486,58 @@ def bench_instructions(duration, n_cases):
     return counts
 
 
+def bench_tolerance(samples, fz, rtol, workers):
+    """Print the uncertainty study at the default rtol and at ``rtol`` side by side (same rows, same seed)."""
+    import numpy as np
+
+    from whipple_kick.simulate.scenario import Scenario
+    from whipple_kick.studies import uncertainty
+    rtols = (Scenario().rtol, rtol)
+    studies, walls = {}, {}
+    for r in rtols:
+        t0 = time.perf_counter()
+        studies[r] = uncertainty.run_study(samples=samples, loads=[fz], base=Scenario(rtol=r), workers=workers)
+        walls[r] = time.perf_counter() - t0
+    ref, new = (studies[r] for r in rtols)
+    n = len(ref.outcomes)
+    print(f"uncertainty study, shipped file, N = {samples}, fz {fz:g} N: {n} cases at each rtol")
+    for r in rtols:
+        o = studies[r].outcomes
+        print(f"  rtol {r:g}: wall {walls[r]:.0f} s, per case (medians) wall {o['run.wall_s'].median() * 1e3:.0f} ms, "
+              f"CPU {o['run.cpu_s'].median() * 1e3:.0f} ms "
+              f"(sum {o['run.cpu_s'].sum():.0f} s), integration median {o['numerics.integration_wall_s'].median() * 1e3:.0f} ms, "
+              f"{int((o['status'] != 'ok').sum())} failed, {int(o['fell'].sum())} fell")
+    keys = ["fz_n", "criterion", "pressure_kpa"]
+    pb = ref.p_best.merge(new.p_best, on=keys, suffixes=("_ref", "_new"), how="outer")
+    print("P(best) [95 % interval], default rtol | --rtol:")
+    for _, row in pb.iterrows():
+        p = "none" if np.isnan(row["pressure_kpa"]) else f"{row['pressure_kpa']:g} kPa"
+        print(f"  {row['criterion']:10s} {p:8s} {row['p_ref']:.3f} [{row['low_ref']:.2f}, {row['high_ref']:.2f}] | "
+              f"{row['p_new']:.3f} [{row['low_new']:.2f}, {row['high_new']:.2f}]")
+    dist = ref.distributions.merge(new.distributions, on=keys, suffixes=("_ref", "_new"))
+    print("recovery-time distributions (recovered rows; median and 5-95 %), default rtol | --rtol:")
+    for _, row in dist.iterrows():
+        print(f"  {row['criterion']:10s} {row['pressure_kpa']:g} kPa: {row['recovered_ref']} recovered, "
+              f"{row['q50_s_ref']:.3f} s ({row['q05_s_ref']:.3f}-{row['q95_s_ref']:.3f}) | {row['recovered_new']}, "
+              f"{row['q50_s_new']:.3f} s ({row['q05_s_new']:.3f}-{row['q95_s_new']:.3f})")
+    pair = ["sample", "fz_n", "pressure_kpa"]
+    both = ref.outcomes.merge(new.outcomes, on=pair, suffixes=("_ref", "_new"))
+    for key, criterion in uncertainty.CRITERIA.items():
+        a, b = (both[f"{criterion.column}{s}"].astype(float).to_numpy() for s in ("_ref", "_new"))
+        finite = np.isfinite(a) & np.isfinite(b)
+        moved = np.abs(a[finite] - b[finite])
+        print(f"  {key}: per case |change| median {np.median(moved) if moved.size else 0.0:.2g} s, "
+              f"max {moved.max(initial=0.0):.2g} s, {int((moved > 1e-6).sum())} of {int(finite.sum())} moved "
+              f"by more than 1 us; "
+              f"{int((np.isfinite(a) != np.isfinite(b)).sum())} cases recovered at one rtol only")
+    print(f"  falls changed in {int((both['fell_ref'] != both['fell_new']).sum())} of {len(both)} cases")
+    return studies
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    p.add_argument("what", choices=("split", "nine", "parallel", "blend", "many", "cost", "all", "_count"))
+    p.add_argument("what", choices=("split", "nine", "parallel", "blend", "many", "cost", "tolerance", "all",
+                                    "_count"))
     p.add_argument("--repeats", type=int, default=3)
     p.add_argument("--n", type=int, default=1000, help="cases of the large sweep")
     p.add_argument("--duration", type=float, default=6.0, help="simulated time after the kick [s]")
@@ -491,6 +545,9 @@ def main(argv=None):
     p.add_argument("--folder", default=None, help="keep the large sweep's folder here")
     p.add_argument("--cases", type=int, default=3, help="thesis cases per path of the cost bench (1-9)")
     p.add_argument("--callgrind", action="store_true", help="cost: also count instructions (valgrind, minutes)")
+    p.add_argument("--samples", type=int, default=8, help="tolerance: the study's N (default 8)")
+    p.add_argument("--fz", type=float, default=635.0, help="tolerance: the rear load [N] (default 635)")
+    p.add_argument("--rtol", type=float, default=1e-8, help="tolerance: the rtol beside the default (1e-8)")
     args = p.parse_args(argv)
     if args.what == "_count":   # the child process bench_instructions runs under valgrind
         _count_inner(args.duration, args.cases, args.folder)
@@ -509,6 +566,8 @@ def main(argv=None):
         bench_cost(args.repeats, args.duration, args.cases)
         if args.callgrind:
             bench_instructions(args.duration, args.cases)
+    if args.what == "tolerance":   # minutes: not part of "all"
+        bench_tolerance(args.samples, args.fz, args.rtol, args.workers)
     if args.what in ("many", "all"):
         bench_many(args.n, args.duration, args.workers, args.folder)
     return 0
