@@ -9,6 +9,7 @@ Usage:
     python scripts/bench_sweep.py cost            # a case's wall time on each of a sweep's paths
     python scripts/bench_sweep.py cost --callgrind   # and its instructions (valgrind, ~2 min)
     python scripts/bench_sweep.py tolerance --samples 8 --fz 635 --rtol 1e-8   # a study at two rtols
+    python scripts/bench_sweep.py flags [--callgrind]   # the model's compiler flags: wall, instructions, bits
     python scripts/bench_sweep.py all
 
 "Warm" means the compiled model is already in the on-disk cache and this
@@ -47,6 +48,11 @@ load on a shared machine falls on all variants alike.
   ``--rtol``, on the same sampled rows (:func:`bench_tolerance`): P(best) per pressure and criterion, the
   recovery-time distributions, the per-case change of each criterion's time and outcome, and the CPU time
   per case. What a study's ``[fixed] rtol`` (or ``base=Scenario(rtol=...)``) buys and costs.
+* ``flags``: the compiled model's C source (the cache's ``.c`` beside the library) built with each of
+  :data:`FLAG_SETS` and run in this process, one library after the other (:func:`bench_flags`): each
+  case's integration wall time as a ratio to the current flags' beside it (interleaved repeats, medians),
+  and its trajectory compared bit for bit with theirs; with ``--callgrind`` the integration's
+  instructions per case (the sets valgrind can run: AVX-512 it cannot).
 * ``blend``: 350 kPa (T03's 300 and 400 kPa fits blended) against 400 kPa in
   this process: the integration's wall time per evaluation that LSODA counts
   (``numerics.evaluations``, Jacobian columns included), and the compiled
@@ -459,26 +465,8 @@ def _count_inner(duration, n_cases, helper_folder):
 
 def bench_instructions(duration, n_cases):
     """Print the instructions per case of each path, counted by callgrind in a child process."""
-    import glob
-    import re
-    import subprocess
-    with tempfile.TemporaryDirectory() as tmp:
-        out = os.path.join(tmp, "callgrind.out")
-        # One BLAS thread in every path (a sweep's worker limits it per case; the plain run would not).
-        env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
-        t0 = time.perf_counter()
-        subprocess.run(["valgrind", "--tool=callgrind", "--instr-atstart=no", f"--callgrind-out-file={out}",
-                        sys.executable, os.path.abspath(__file__), "_count", "--duration", str(duration),
-                        "--cases", str(n_cases), "--folder", tmp],
-                       check=True, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        counts = {}
-        for name in glob.glob(out + "*"):
-            with open(name) as fh:
-                text = fh.read()
-            label = re.search(r"^desc: Trigger: Client Request: (\S+)", text, re.MULTILINE)
-            total = re.search(r"^(?:totals|summary): (\d+)", text, re.MULTILINE)
-            if label and total and label.group(1) in COST_PATHS:
-                counts[label.group(1)] = int(total.group(1)) / n_cases
+    t0 = time.perf_counter()
+    counts = _callgrind_counts("_count", duration, n_cases, COST_PATHS)
     print(f"instructions per case (callgrind, {n_cases} thesis cases, {duration:g} s; {time.perf_counter() - t0:.0f} s "
           "under valgrind):")
     for path in COST_PATHS:
@@ -534,10 +522,155 @@ def bench_tolerance(samples, fz, rtol, workers):
     return studies
 
 
+#: Compiler flag sets :func:`bench_flags` compares, the first the model's own (``slip.compiled._CFLAGS``):
+#: (name, flags, whether valgrind runs it). ``-std=c99`` (not gnu99) keeps GCC from contracting a*b+c
+#: into an FMA, which would round differently.
+FLAG_SETS = (
+    ("O2", ("-O2", "-fPIC", "-shared", "-std=c99"), True),
+    ("O3", ("-O3", "-fPIC", "-shared", "-std=c99"), True),
+    ("O2-v3", ("-O2", "-march=x86-64-v3", "-fPIC", "-shared", "-std=c99"), True),
+    ("O3-v3", ("-O3", "-march=x86-64-v3", "-fPIC", "-shared", "-std=c99"), True),
+    ("O3-native", ("-O3", "-march=native", "-fPIC", "-shared", "-std=c99"), False),
+)
+
+
+def _flag_libraries(folder, names=None):
+    """Build the current model's C source with each flag set into ``folder``: {name: loaded library}."""
+    import pathlib
+    import subprocess
+
+    from whipple_kick.model.slip import compiled, layout
+    base = layout.BASE
+    source = compiled.library_path(base).with_suffix(".c")
+    cc = compiled._compiler()
+    libraries = {}
+    for name, flags, _ in FLAG_SETS:
+        if names is not None and name not in names:
+            continue
+        target = os.path.join(folder, f"slip_{name}.so")
+        subprocess.run([cc, *flags, "-o", target, str(source), "-lm"], check=True)
+        original = compiled.library_path
+        compiled.library_path = lambda L, target=target: pathlib.Path(target)
+        try:
+            libraries[name] = compiled.library.__wrapped__(base)   # the same argument types as the model's
+        finally:
+            compiled.library_path = original
+    return libraries
+
+
+def _integrate_with(library, scenario):
+    """(integration wall [s], states, times) of ``scenario`` with the compiled model ``library``."""
+    from whipple_kick.library import inputs
+    from whipple_kick.model.slip import compiled
+    from whipple_kick.simulate import assembly, integration
+    kick = inputs.kick_of(scenario.validate())
+    model = assembly.assemble(scenario, kick)
+    original = compiled.library
+    compiled.library = lambda L=None: library
+    try:
+        solution = integration.integrate_run(model, scenario, kick)
+    finally:
+        compiled.library = original
+    return solution.wall_s, solution.states.x, solution.states.t
+
+
+def bench_flags(repeats, duration, n_cases):
+    """Print each flag set's integration wall time against the model's own flags, and whether its bits agree."""
+    import numpy as np
+
+    from whipple_kick.studies import sweep_engine
+    scenarios = _thesis_scenarios(duration)[:n_cases]
+    names = [name for name, _, _ in FLAG_SETS]
+    with tempfile.TemporaryDirectory() as tmp:
+        t0 = time.perf_counter()
+        libraries = _flag_libraries(tmp)
+        print(f"built {len(libraries)} variants in {time.perf_counter() - t0:.0f} s")
+        sweep_engine._keep_freed_memory()
+        ratios = {name: [] for name in names}
+        walls = {name: [] for name in names}
+        reference, identical = {}, dict.fromkeys(names, True)
+        with sweep_engine._blas_controller().limit(limits=1):
+            for k, sc in enumerate(scenarios):   # warm: the per-scenario caches, and the reference bits
+                for name in names:
+                    _, x, t = _integrate_with(libraries[name], sc)
+                    if name == names[0]:
+                        reference[k] = (x, t)
+                    else:
+                        identical[name] &= np.array_equal(x, reference[k][0]) and np.array_equal(t, reference[k][1])
+            for r in range(repeats):
+                for k, sc in enumerate(scenarios):
+                    wall = {name: _integrate_with(libraries[name], sc)[0] for name in _rotated(names, r + k)}
+                    for name in names:
+                        walls[name].append(wall[name])
+                        ratios[name].append(wall[name] / wall[names[0]])
+    print(f"integration per case ({n_cases} thesis cases, {duration:g} s, {repeats} interleaved repeats), "
+          f"against {names[0]} ({' '.join(FLAG_SETS[0][1])}) in the same repeat:")
+    for name, flags, _ in FLAG_SETS:
+        print(f"  {name:10s} median {statistics.median(walls[name]) * 1e3:6.1f} ms; ratio median "
+              f"{statistics.median(ratios[name]):.3f} (quartiles "
+              f"{', '.join(f'{q:.3f}' for q in statistics.quantiles(ratios[name], n=4))}); trajectories "
+              f"{'bit-identical' if identical[name] else 'DIFFER'} ({' '.join(flags)})")
+    return ratios, identical
+
+
+def _count_flags_inner(duration, n_cases, helper_folder):
+    """Under callgrind: each valgrind-safe flag set's integrations of the cases, counted between client requests."""
+    import gc
+    lib = _callgrind_helper(helper_folder)
+    names = [name for name, _, safe in FLAG_SETS if safe]
+    libraries = _flag_libraries(helper_folder, names)
+    scenarios = _thesis_scenarios(duration)[:n_cases]
+    for name in names:
+        for sc in scenarios:
+            _integrate_with(libraries[name], sc)
+    for name in names:
+        gc.collect()
+        lib.wk_cg_start()
+        for sc in scenarios:
+            _integrate_with(libraries[name], sc)
+        lib.wk_cg_stop(name.encode())
+
+
+def _callgrind_counts(mode, duration, n_cases, labels):
+    """Run this script's ``mode`` under callgrind; {label: instructions per case} of its client-request dumps."""
+    import glob
+    import re
+    import subprocess
+    with tempfile.TemporaryDirectory() as tmp:
+        out = os.path.join(tmp, "callgrind.out")
+        # One BLAS thread in every path (a sweep's worker limits it per case; the plain run would not).
+        env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+        subprocess.run(["valgrind", "--tool=callgrind", "--instr-atstart=no", f"--callgrind-out-file={out}",
+                        sys.executable, os.path.abspath(__file__), mode, "--duration", str(duration),
+                        "--cases", str(n_cases), "--folder", tmp],
+                       check=True, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        counts = {}
+        for name in glob.glob(out + "*"):
+            with open(name) as fh:
+                text = fh.read()
+            label = re.search(r"^desc: Trigger: Client Request: (\S+)", text, re.MULTILINE)
+            total = re.search(r"^(?:totals|summary): (\d+)", text, re.MULTILINE)
+            if label and total and label.group(1) in labels:
+                counts[label.group(1)] = int(total.group(1)) / n_cases
+    return counts
+
+
+def bench_flag_instructions(duration, n_cases):
+    """Print the integration's instructions per case of each valgrind-safe flag set."""
+    names = [name for name, _, safe in FLAG_SETS if safe]
+    t0 = time.perf_counter()
+    counts = _callgrind_counts("_count_flags", duration, n_cases, names)
+    print(f"integration instructions per case (callgrind, {n_cases} thesis cases, {duration:g} s; "
+          f"{time.perf_counter() - t0:.0f} s under valgrind):")
+    for name in names:
+        print(f"  {name:10s} {counts[name] / 1e6:8.1f} M; / {names[0]}: {counts[name] / counts[names[0]]:.3f}")
+    return counts
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    p.add_argument("what", choices=("split", "nine", "parallel", "blend", "many", "cost", "tolerance", "all",
-                                    "_count"))
+    p.add_argument("what", choices=("split", "nine", "parallel", "blend", "many", "cost", "tolerance", "flags",
+                                    "all", "_count", "_count_flags"))
     p.add_argument("--repeats", type=int, default=3)
     p.add_argument("--n", type=int, default=1000, help="cases of the large sweep")
     p.add_argument("--duration", type=float, default=6.0, help="simulated time after the kick [s]")
@@ -551,6 +684,9 @@ def main(argv=None):
     args = p.parse_args(argv)
     if args.what == "_count":   # the child process bench_instructions runs under valgrind
         _count_inner(args.duration, args.cases, args.folder)
+        return 0
+    if args.what == "_count_flags":   # the child process bench_flag_instructions runs under valgrind
+        _count_flags_inner(args.duration, args.cases, args.folder)
         return 0
     print(f"{os.cpu_count()} cores; load average {os.getloadavg()[0]:.2f} before the run")
     _warm_up()
@@ -566,6 +702,10 @@ def main(argv=None):
         bench_cost(args.repeats, args.duration, args.cases)
         if args.callgrind:
             bench_instructions(args.duration, args.cases)
+    if args.what == "flags":   # builds five libraries: not part of "all"
+        bench_flags(args.repeats, args.duration, args.cases)
+        if args.callgrind:
+            bench_flag_instructions(args.duration, args.cases)
     if args.what == "tolerance":   # minutes: not part of "all"
         bench_tolerance(args.samples, args.fz, args.rtol, args.workers)
     if args.what in ("many", "all"):
