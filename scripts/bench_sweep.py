@@ -522,9 +522,9 @@ def bench_tolerance(samples, fz, rtol, workers):
     return studies
 
 
-#: Compiler flag sets :func:`bench_flags` compares, the first the model's own (``slip.compiled._CFLAGS``):
-#: (name, flags, whether valgrind runs it). ``-std=c99`` (not gnu99) keeps GCC from contracting a*b+c
-#: into an FMA, which would round differently.
+#: Compiler flag sets :func:`bench_flags` compares, the first the reference (the model's flags before issue
+#: 41; ``slip.compiled._CFLAGS`` is now the second): (name, flags, whether valgrind runs it). ``-std=c99``
+#: (not gnu99) keeps GCC from contracting a*b+c into an FMA, which would round differently.
 FLAG_SETS = (
     ("O2", ("-O2", "-fPIC", "-shared", "-std=c99"), True),
     ("O3", ("-O3", "-fPIC", "-shared", "-std=c99"), True),
