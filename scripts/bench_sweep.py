@@ -401,21 +401,24 @@ def bench_cost(repeats, duration, n_cases):
         try:
             _cost_warm_up(case_list, spec, store)
             for r in range(repeats):
-                per = {}
-                for path in _rotated(list(COST_PATHS), r):
-                    cost = [_cost_case(path, sc, cid, spec, store) for _, sc, cid in case_list]
-                    per[path] = sum(w + q for w, q in cost) / len(cost)
-                    walls[path].append(sum(w for w, _ in cost) / len(cost))
-                    parent[path].append(sum(q for _, q in cost) / len(cost))
-                for path in COST_PATHS:
-                    ratios[path].append(per[path] / per["run"])
+                # Case by case, every path back to back in a rotating order: a neighbour's load, which
+                # drifts over seconds on a shared machine, falls on the paths of a case alike.
+                for k, (_, sc, cid) in enumerate(case_list):
+                    cost = {path: _cost_case(path, sc, cid, spec, store)
+                            for path in _rotated(list(COST_PATHS), r + k)}
+                    for path, (worker, saving) in cost.items():
+                        walls[path].append(worker)
+                        parent[path].append(saving)
+                        ratios[path].append(sum(cost[path]) / sum(cost["run"]))
         finally:
             store.close()
-    print(f"wall per case ({n_cases} thesis cases, {duration:g} s, medians of {repeats} interleaved repeats):")
+    print(f"wall per case ({n_cases} thesis cases x {repeats} repeats, {duration:g} s; medians, each case's paths "
+          "back to back):")
     for path in COST_PATHS:
+        quartiles = statistics.quantiles(ratios[path], n=4) if len(ratios[path]) > 1 else ratios[path] * 3
         print(f"  {path:6s} worker {statistics.median(walls[path]) * 1e3:7.1f} ms + parent "
               f"{statistics.median(parent[path]) * 1e3:5.1f} ms; / run: {statistics.median(ratios[path]):.3f} "
-              f"(per repeat {', '.join(f'{q:.3f}' for q in ratios[path])})")
+              f"(quartiles {quartiles[0]:.3f}-{quartiles[2]:.3f})")
     return {p: statistics.median(ratios[p]) for p in COST_PATHS}
 
 
