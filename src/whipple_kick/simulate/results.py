@@ -295,15 +295,16 @@ def trajectory_columns(solution, tyre_transient="carcass", names=None):
     outs = solution.outputs()
     layout = frame_layout(tyre_transient, solution.model)
     every = column_names(tyre_transient, solution.model)
-    wanted = set(every) if names == "all" else set(summary_columns(tyre_transient)) | set(names or ())
-    unknown = wanted - set(every)
+    asked = set(every) if names == "all" else set(names or ())
+    unknown = asked - set(every)
     if unknown:
         raise InputError(f"trajectory column(s) {sorted(unknown)} do not exist; available: {', '.join(every)}")
-    # The finite check covers the table's columns, as trajectory_frame's does, not the outputs it leaves out.
+    wanted = asked | (set(summary_columns(tyre_transient)) & set(every))
+    # The finite check covers the table's columns, as trajectory_frame's does, not the outputs it leaves out
+    # (the whole arrays first: no copy of the columns when all is finite, as it nearly always is).
     states = sorted({index for _, source, index in layout if source == "state"})
     outputs = sorted({index for _, source, index in layout if source == "output"})
-    if not (np.all(np.isfinite(traj.x[:, states])) and np.all(np.isfinite(outs[:, outputs]))
-            and np.all(np.isfinite(traj.t))):
+    if not (_all_finite(traj.x, states) and _all_finite(outs, outputs) and np.all(np.isfinite(traj.t))):
         raise SimulationError("non-finite values in the trajectory")
     source = {name: entry for name, *entry in layout}
     columns = {"time": traj.t + 0.0}
@@ -334,6 +335,11 @@ class _Column:
 
     def to_numpy(self):
         return self.values
+
+
+def _all_finite(values, columns):
+    """Whether ``values[:, columns]`` is finite everywhere (the whole array looked at first, without a copy)."""
+    return bool(np.isfinite(values).all()) or bool(np.isfinite(values[:, columns]).all())
 
 
 def _values(frame, column):
