@@ -6,6 +6,10 @@ Usage:
     python scripts/bench_sweep.py parallel        # the same in both kick directions (18 cases): 1 vs 2 workers
     python scripts/bench_sweep.py blend           # a blended pressure (350 kPa) against a measured one (400 kPa)
     python scripts/bench_sweep.py many --n 1000   # an n-case sweep into a temporary folder
+    python scripts/bench_sweep.py cost            # a case's wall time on each of a sweep's paths
+    python scripts/bench_sweep.py cost --callgrind   # and its instructions (valgrind, ~2 min)
+    python scripts/bench_sweep.py tolerance --samples 8 --fz 635 --rtol 1e-8   # a study at two rtols
+    python scripts/bench_sweep.py flags [--callgrind]   # the model's compiler flags: wall, instructions, bits
     python scripts/bench_sweep.py all
 
 "Warm" means the compiled model is already in the on-disk cache and this
@@ -30,6 +34,25 @@ load on a shared machine falls on all variants alike.
   each worker has answered, :func:`pool_startup`), and a first sweep on a
   fresh pool is timed for one and two workers (a nine-case sweep must not
   take longer on two).
+* ``cost``: what one case costs on each of a sweep's paths, in this process (:func:`bench_cost`): a
+  plain :func:`whipple_kick.run` (the baseline: a table and a summary), a case that keeps only the table's
+  row (``run_case`` without a trajectory) and one that keeps its trajectory (``run_case`` with the default
+  200 Hz columns, then the folder's ``add``, where the compression happened before issue 41). Wall time:
+  median of interleaved repeats, and each path's ratio to the baseline run beside it in the same repeat
+  (the ratio shrugs off a neighbour's load). Instructions per case: the same paths counted by valgrind's
+  callgrind (``--callgrind``; ``perf stat`` has no counters on a virtual machine), instrumented only
+  while the cases run (client requests around each path, :func:`_callgrind_helper`), so the count is
+  the case's own, not the imports', and does not depend on the machine's load. Running this script with
+  ``PYTHONPATH=<another checkout>/src`` measures that checkout's code with the same bench: a before/after.
+* ``tolerance``: the uncertainty study (shipped file, N samples, one load) at the default rtol and at
+  ``--rtol``, on the same sampled rows (:func:`bench_tolerance`): P(best) per pressure and criterion, the
+  recovery-time distributions, the per-case change of each criterion's time and outcome, and the CPU time
+  per case. What a study's ``[fixed] rtol`` (or ``base=Scenario(rtol=...)``) buys and costs.
+* ``flags``: the compiled model's C source (the cache's ``.c`` beside the library) built with each of
+  :data:`FLAG_SETS` and run in this process, one library after the other (:func:`bench_flags`): each
+  case's integration wall time as a ratio to the current flags' beside it (interleaved repeats, medians),
+  and its trajectory compared bit for bit with theirs; with ``--callgrind`` the integration's
+  instructions per case (the sets valgrind can run: AVX-512 it cannot).
 * ``blend``: 350 kPa (T03's 300 and 400 kPa fits blended) against 400 kPa in
   this process: the integration's wall time per evaluation that LSODA counts
   (``numerics.evaluations``, Jacobian columns included), and the compiled
@@ -322,15 +345,352 @@ def bench_many(n, duration, workers, folder):
     return rate / workers
 
 
+#: The paths :func:`bench_cost` compares, in the order printed ("run" is the baseline).
+COST_PATHS = ("run", "table", "kept")
+
+
+def _cost_case(path, scenario, cid, spec, store):
+    """One case on ``path``: (wall time of the worker's part [s], of the parent's part [s])."""
+    import inspect
+
+    from whipple_kick.simulate import simulation
+    from whipple_kick.studies import sweep_engine
+    t0 = time.perf_counter()
+    if path == "run":
+        simulation.run(scenario)
+        return time.perf_counter() - t0, 0.0
+    # packed: the worker compresses the trajectory file (issue 41); code before it has no such keyword.
+    packed = {"packed": True} if "packed" in inspect.signature(sweep_engine.run_case).parameters else {}
+    record = sweep_engine.run_case(scenario, cid, spec if path == "kept" else None, **packed)
+    t1 = time.perf_counter()
+    assert record["status"] == "ok", record["error"]
+    if path == "kept":
+        store.add(record)   # writes the trajectory file (compressing it first where the worker did not)
+    else:
+        sweep_engine.slim(record)   # what the parent keeps of a table-only case
+    return t1 - t0, time.perf_counter() - t1
+
+
+def _cost_setup(n_cases, duration, folder):
+    """The cases, their ids, the default trajectory spec and a sweep folder to save kept cases into."""
+    from whipple_kick.studies import sweep_engine, sweep_store
+    scenarios = _thesis_scenarios(duration)[:n_cases]
+    case_list = [({}, sc, sweep_store.case_id(sc)) for sc in scenarios]
+    spec = sweep_engine._trajectory_spec(sweep_engine.DEFAULT_TRAJECTORY_COLUMNS, "float32", 200.0)
+    store = sweep_store.Folder(folder, case_list, scenarios[0], False, spec)
+    return case_list, spec, store
+
+
+def _cost_warm_up(case_list, spec, store):
+    """Every case on every path once, unmeasured: the per-scenario caches (rider, LQR gains: a cold case
+    costs ~100 ms more) and first-call costs fall here, not on the first path measured."""
+    for path in COST_PATHS:
+        for _, scenario, cid in case_list:
+            _cost_case(path, scenario, cid, spec, store)
+
+
+def bench_cost(repeats, duration, n_cases):
+    """Print each path's wall time per case (worker and parent parts) and its ratio to the baseline run."""
+    from whipple_kick.studies import sweep_engine
+    sweep_engine._keep_freed_memory()   # as in a sweep's worker, for every path alike
+    walls = {p: [] for p in COST_PATHS}
+    parent = {p: [] for p in COST_PATHS}
+    ratios = {p: [] for p in COST_PATHS}
+    with tempfile.TemporaryDirectory() as tmp:
+        case_list, spec, store = _cost_setup(n_cases, duration, os.path.join(tmp, "sweep"))
+        try:
+            _cost_warm_up(case_list, spec, store)
+            for r in range(repeats):
+                # Case by case, every path back to back in a rotating order: a neighbour's load, which
+                # drifts over seconds on a shared machine, falls on the paths of a case alike.
+                for k, (_, sc, cid) in enumerate(case_list):
+                    cost = {path: _cost_case(path, sc, cid, spec, store)
+                            for path in _rotated(list(COST_PATHS), r + k)}
+                    for path, (worker, saving) in cost.items():
+                        walls[path].append(worker)
+                        parent[path].append(saving)
+                        ratios[path].append(sum(cost[path]) / sum(cost["run"]))
+        finally:
+            store.close()
+    print(f"wall per case ({n_cases} thesis cases x {repeats} repeats, {duration:g} s; medians, each case's paths "
+          "back to back):")
+    for path in COST_PATHS:
+        quartiles = statistics.quantiles(ratios[path], n=4) if len(ratios[path]) > 1 else ratios[path] * 3
+        print(f"  {path:6s} worker {statistics.median(walls[path]) * 1e3:7.1f} ms + parent "
+              f"{statistics.median(parent[path]) * 1e3:5.1f} ms; / run: {statistics.median(ratios[path]):.3f} "
+              f"(quartiles {quartiles[0]:.3f}-{quartiles[2]:.3f})")
+    return {p: statistics.median(ratios[p]) for p in COST_PATHS}
+
+
+_CALLGRIND_C = """
+#include <valgrind/callgrind.h>
+void wk_cg_start(void) { CALLGRIND_ZERO_STATS; CALLGRIND_START_INSTRUMENTATION; }
+void wk_cg_stop(const char *label) { CALLGRIND_DUMP_STATS_AT(label); CALLGRIND_STOP_INSTRUMENTATION; }
+"""
+
+
+def _callgrind_helper(folder):
+    """ctypes library with callgrind's client requests: start counting, dump and stop (no-ops outside valgrind)."""
+    import ctypes
+    import subprocess
+    source = os.path.join(folder, "wk_callgrind.c")
+    library = os.path.join(folder, "wk_callgrind.so")
+    with open(source, "w") as fh:
+        fh.write(_CALLGRIND_C)
+    subprocess.run(["cc", "-shared", "-fPIC", "-O1", "-o", library, source], check=True)
+    lib = ctypes.CDLL(library)
+    lib.wk_cg_stop.argtypes = [ctypes.c_char_p]
+    return lib
+
+
+def _count_inner(duration, n_cases, helper_folder):
+    """Under callgrind: warm every path, then count each path's cases between client requests."""
+    import gc
+
+    from whipple_kick.studies import sweep_engine
+    lib = _callgrind_helper(helper_folder)
+    sweep_engine._keep_freed_memory()
+    with tempfile.TemporaryDirectory() as tmp:
+        case_list, spec, store = _cost_setup(n_cases, duration, os.path.join(tmp, "sweep"))
+        try:
+            _cost_warm_up(case_list, spec, store)
+            for path in COST_PATHS:
+                # Each path starts from an empty young generation: a full collection falling into one path's
+                # cases and not another's (some 1e8 instructions with the package's objects) is not its cost.
+                gc.collect()
+                lib.wk_cg_start()
+                for _, sc, cid in case_list:
+                    _cost_case(path, sc, cid, spec, store)
+                lib.wk_cg_stop(path.encode())
+        finally:
+            store.close()
+
+
+def bench_instructions(duration, n_cases):
+    """Print the instructions per case of each path, counted by callgrind in a child process."""
+    t0 = time.perf_counter()
+    counts = _callgrind_counts("_count", duration, n_cases, COST_PATHS)
+    print(f"instructions per case (callgrind, {n_cases} thesis cases, {duration:g} s; {time.perf_counter() - t0:.0f} s "
+          "under valgrind):")
+    for path in COST_PATHS:
+        print(f"  {path:6s} {counts[path] / 1e6:8.1f} M; / run: {counts[path] / counts['run']:.3f}")
+    return counts
+
+
+def bench_tolerance(samples, fz, rtol, workers):
+    """Print the uncertainty study at the default rtol and at ``rtol`` side by side (same rows, same seed)."""
+    import numpy as np
+
+    from whipple_kick.simulate.scenario import Scenario
+    from whipple_kick.studies import uncertainty
+    rtols = (Scenario().rtol, rtol)
+    studies, walls = {}, {}
+    for r in rtols:
+        t0 = time.perf_counter()
+        studies[r] = uncertainty.run_study(samples=samples, loads=[fz], base=Scenario(rtol=r), workers=workers)
+        walls[r] = time.perf_counter() - t0
+    ref, new = (studies[r] for r in rtols)
+    n = len(ref.outcomes)
+    print(f"uncertainty study, shipped file, N = {samples}, fz {fz:g} N: {n} cases at each rtol")
+    for r in rtols:
+        o = studies[r].outcomes
+        print(f"  rtol {r:g}: wall {walls[r]:.0f} s, per case (medians) wall {o['run.wall_s'].median() * 1e3:.0f} ms, "
+              f"CPU {o['run.cpu_s'].median() * 1e3:.0f} ms "
+              f"(sum {o['run.cpu_s'].sum():.0f} s), integration median {o['numerics.integration_wall_s'].median() * 1e3:.0f} ms, "
+              f"{int((o['status'] != 'ok').sum())} failed, {int(o['fell'].sum())} fell")
+    keys = ["fz_n", "criterion", "pressure_kpa"]
+    pb = ref.p_best.merge(new.p_best, on=keys, suffixes=("_ref", "_new"), how="outer")
+    print("P(best) [95 % interval], default rtol | --rtol:")
+    for _, row in pb.iterrows():
+        p = "none" if np.isnan(row["pressure_kpa"]) else f"{row['pressure_kpa']:g} kPa"
+        print(f"  {row['criterion']:10s} {p:8s} {row['p_ref']:.3f} [{row['low_ref']:.2f}, {row['high_ref']:.2f}] | "
+              f"{row['p_new']:.3f} [{row['low_new']:.2f}, {row['high_new']:.2f}]")
+    dist = ref.distributions.merge(new.distributions, on=keys, suffixes=("_ref", "_new"))
+    print("recovery-time distributions (recovered rows; median and 5-95 %), default rtol | --rtol:")
+    for _, row in dist.iterrows():
+        print(f"  {row['criterion']:10s} {row['pressure_kpa']:g} kPa: {row['recovered_ref']} recovered, "
+              f"{row['q50_s_ref']:.3f} s ({row['q05_s_ref']:.3f}-{row['q95_s_ref']:.3f}) | {row['recovered_new']}, "
+              f"{row['q50_s_new']:.3f} s ({row['q05_s_new']:.3f}-{row['q95_s_new']:.3f})")
+    pair = ["sample", "fz_n", "pressure_kpa"]
+    both = ref.outcomes.merge(new.outcomes, on=pair, suffixes=("_ref", "_new"))
+    for key, criterion in uncertainty.CRITERIA.items():
+        a, b = (both[f"{criterion.column}{s}"].astype(float).to_numpy() for s in ("_ref", "_new"))
+        finite = np.isfinite(a) & np.isfinite(b)
+        moved = np.abs(a[finite] - b[finite])
+        print(f"  {key}: per case |change| median {np.median(moved) if moved.size else 0.0:.2g} s, "
+              f"max {moved.max(initial=0.0):.2g} s, {int((moved > 1e-6).sum())} of {int(finite.sum())} moved "
+              f"by more than 1 us; "
+              f"{int((np.isfinite(a) != np.isfinite(b)).sum())} cases recovered at one rtol only")
+    print(f"  falls changed in {int((both['fell_ref'] != both['fell_new']).sum())} of {len(both)} cases")
+    return studies
+
+
+#: Compiler flag sets :func:`bench_flags` compares, the first the reference (the model's flags before issue
+#: 41; ``slip.compiled._CFLAGS`` is now the second): (name, flags, whether valgrind runs it). ``-std=c99``
+#: (not gnu99) keeps GCC from contracting a*b+c into an FMA, which would round differently.
+FLAG_SETS = (
+    ("O2", ("-O2", "-fPIC", "-shared", "-std=c99"), True),
+    ("O3", ("-O3", "-fPIC", "-shared", "-std=c99"), True),
+    ("O2-v3", ("-O2", "-march=x86-64-v3", "-fPIC", "-shared", "-std=c99"), True),
+    ("O3-v3", ("-O3", "-march=x86-64-v3", "-fPIC", "-shared", "-std=c99"), True),
+    ("O3-native", ("-O3", "-march=native", "-fPIC", "-shared", "-std=c99"), False),
+)
+
+
+def _flag_libraries(folder, names=None):
+    """Build the current model's C source with each flag set into ``folder``: {name: loaded library}."""
+    import pathlib
+    import subprocess
+
+    from whipple_kick.model.slip import compiled, layout
+    base = layout.BASE
+    source = compiled.library_path(base).with_suffix(".c")
+    cc = compiled._compiler()
+    libraries = {}
+    for name, flags, _ in FLAG_SETS:
+        if names is not None and name not in names:
+            continue
+        target = os.path.join(folder, f"slip_{name}.so")
+        subprocess.run([cc, *flags, "-o", target, str(source), "-lm"], check=True)
+        original = compiled.library_path
+        compiled.library_path = lambda L, target=target: pathlib.Path(target)
+        try:
+            libraries[name] = compiled.library.__wrapped__(base)   # the same argument types as the model's
+        finally:
+            compiled.library_path = original
+    return libraries
+
+
+def _integrate_with(library, scenario):
+    """(integration wall [s], states, times) of ``scenario`` with the compiled model ``library``."""
+    from whipple_kick.library import inputs
+    from whipple_kick.model.slip import compiled
+    from whipple_kick.simulate import assembly, integration
+    kick = inputs.kick_of(scenario.validate())
+    model = assembly.assemble(scenario, kick)
+    original = compiled.library
+    compiled.library = lambda L=None: library
+    try:
+        solution = integration.integrate_run(model, scenario, kick)
+    finally:
+        compiled.library = original
+    return solution.wall_s, solution.states.x, solution.states.t
+
+
+def bench_flags(repeats, duration, n_cases):
+    """Print each flag set's integration wall time against the model's own flags, and whether its bits agree."""
+    import numpy as np
+
+    from whipple_kick.studies import sweep_engine
+    scenarios = _thesis_scenarios(duration)[:n_cases]
+    names = [name for name, _, _ in FLAG_SETS]
+    with tempfile.TemporaryDirectory() as tmp:
+        t0 = time.perf_counter()
+        libraries = _flag_libraries(tmp)
+        print(f"built {len(libraries)} variants in {time.perf_counter() - t0:.0f} s")
+        sweep_engine._keep_freed_memory()
+        ratios = {name: [] for name in names}
+        walls = {name: [] for name in names}
+        reference, identical = {}, dict.fromkeys(names, True)
+        with sweep_engine._blas_controller().limit(limits=1):
+            for k, sc in enumerate(scenarios):   # warm: the per-scenario caches, and the reference bits
+                for name in names:
+                    _, x, t = _integrate_with(libraries[name], sc)
+                    if name == names[0]:
+                        reference[k] = (x, t)
+                    else:
+                        identical[name] &= np.array_equal(x, reference[k][0]) and np.array_equal(t, reference[k][1])
+            for r in range(repeats):
+                for k, sc in enumerate(scenarios):
+                    wall = {name: _integrate_with(libraries[name], sc)[0] for name in _rotated(names, r + k)}
+                    for name in names:
+                        walls[name].append(wall[name])
+                        ratios[name].append(wall[name] / wall[names[0]])
+    print(f"integration per case ({n_cases} thesis cases, {duration:g} s, {repeats} interleaved repeats), "
+          f"against {names[0]} ({' '.join(FLAG_SETS[0][1])}) in the same repeat:")
+    for name, flags, _ in FLAG_SETS:
+        print(f"  {name:10s} median {statistics.median(walls[name]) * 1e3:6.1f} ms; ratio median "
+              f"{statistics.median(ratios[name]):.3f} (quartiles "
+              f"{', '.join(f'{q:.3f}' for q in statistics.quantiles(ratios[name], n=4))}); trajectories "
+              f"{'bit-identical' if identical[name] else 'DIFFER'} ({' '.join(flags)})")
+    return ratios, identical
+
+
+def _count_flags_inner(duration, n_cases, helper_folder):
+    """Under callgrind: each valgrind-safe flag set's integrations of the cases, counted between client requests."""
+    import gc
+    lib = _callgrind_helper(helper_folder)
+    names = [name for name, _, safe in FLAG_SETS if safe]
+    libraries = _flag_libraries(helper_folder, names)
+    scenarios = _thesis_scenarios(duration)[:n_cases]
+    for name in names:
+        for sc in scenarios:
+            _integrate_with(libraries[name], sc)
+    for name in names:
+        gc.collect()
+        lib.wk_cg_start()
+        for sc in scenarios:
+            _integrate_with(libraries[name], sc)
+        lib.wk_cg_stop(name.encode())
+
+
+def _callgrind_counts(mode, duration, n_cases, labels):
+    """Run this script's ``mode`` under callgrind; {label: instructions per case} of its client-request dumps."""
+    import glob
+    import re
+    import subprocess
+    with tempfile.TemporaryDirectory() as tmp:
+        out = os.path.join(tmp, "callgrind.out")
+        # One BLAS thread in every path (a sweep's worker limits it per case; the plain run would not).
+        env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+        subprocess.run(["valgrind", "--tool=callgrind", "--instr-atstart=no", f"--callgrind-out-file={out}",
+                        sys.executable, os.path.abspath(__file__), mode, "--duration", str(duration),
+                        "--cases", str(n_cases), "--folder", tmp],
+                       check=True, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        counts = {}
+        for name in glob.glob(out + "*"):
+            with open(name) as fh:
+                text = fh.read()
+            label = re.search(r"^desc: Trigger: Client Request: (\S+)", text, re.MULTILINE)
+            total = re.search(r"^(?:totals|summary): (\d+)", text, re.MULTILINE)
+            if label and total and label.group(1) in labels:
+                counts[label.group(1)] = int(total.group(1)) / n_cases
+    return counts
+
+
+def bench_flag_instructions(duration, n_cases):
+    """Print the integration's instructions per case of each valgrind-safe flag set."""
+    names = [name for name, _, safe in FLAG_SETS if safe]
+    t0 = time.perf_counter()
+    counts = _callgrind_counts("_count_flags", duration, n_cases, names)
+    print(f"integration instructions per case (callgrind, {n_cases} thesis cases, {duration:g} s; "
+          f"{time.perf_counter() - t0:.0f} s under valgrind):")
+    for name in names:
+        print(f"  {name:10s} {counts[name] / 1e6:8.1f} M; / {names[0]}: {counts[name] / counts[names[0]]:.3f}")
+    return counts
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    p.add_argument("what", choices=("split", "nine", "parallel", "blend", "many", "all"))
+    p.add_argument("what", choices=("split", "nine", "parallel", "blend", "many", "cost", "tolerance", "flags",
+                                    "all", "_count", "_count_flags"))
     p.add_argument("--repeats", type=int, default=3)
     p.add_argument("--n", type=int, default=1000, help="cases of the large sweep")
     p.add_argument("--duration", type=float, default=6.0, help="simulated time after the kick [s]")
     p.add_argument("--workers", type=int, default=None, help="workers of the large sweep (default: cores)")
     p.add_argument("--folder", default=None, help="keep the large sweep's folder here")
+    p.add_argument("--cases", type=int, default=3, help="thesis cases per path of the cost bench (1-9)")
+    p.add_argument("--callgrind", action="store_true", help="cost: also count instructions (valgrind, minutes)")
+    p.add_argument("--samples", type=int, default=8, help="tolerance: the study's N (default 8)")
+    p.add_argument("--fz", type=float, default=635.0, help="tolerance: the rear load [N] (default 635)")
+    p.add_argument("--rtol", type=float, default=1e-8, help="tolerance: the rtol beside the default (1e-8)")
     args = p.parse_args(argv)
+    if args.what == "_count":   # the child process bench_instructions runs under valgrind
+        _count_inner(args.duration, args.cases, args.folder)
+        return 0
+    if args.what == "_count_flags":   # the child process bench_flag_instructions runs under valgrind
+        _count_flags_inner(args.duration, args.cases, args.folder)
+        return 0
     print(f"{os.cpu_count()} cores; load average {os.getloadavg()[0]:.2f} before the run")
     _warm_up()
     if args.what in ("split", "all"):
@@ -341,6 +701,16 @@ def main(argv=None):
         bench_parallel(args.repeats, args.duration)
     if args.what in ("blend", "all"):
         bench_blend(args.repeats, args.duration)
+    if args.what in ("cost", "all"):
+        bench_cost(args.repeats, args.duration, args.cases)
+        if args.callgrind:
+            bench_instructions(args.duration, args.cases)
+    if args.what == "flags":   # builds five libraries: not part of "all"
+        bench_flags(args.repeats, args.duration, args.cases)
+        if args.callgrind:
+            bench_flag_instructions(args.duration, args.cases)
+    if args.what == "tolerance":   # minutes: not part of "all"
+        bench_tolerance(args.samples, args.fz, args.rtol, args.workers)
     if args.what in ("many", "all"):
         bench_many(args.n, args.duration, args.workers, args.folder)
     return 0

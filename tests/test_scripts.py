@@ -130,3 +130,35 @@ def test_sobol_censoring_compares_two_run_lengths(tmp_path, capsys):
     assert "new output (which recovers first), short run against long run:" in out and "old output" in out
     assert out.count("within the combined interval") == 8   # (new, old) x 2 criteria x (S1, ST)
     assert "which recovers first changed in" in out
+
+
+def test_the_cost_bench_runs_each_path_and_its_counting_requests_are_inert_outside_valgrind(tmp_path, capsys):
+    """scripts/bench_sweep.py cost (issue 41 item 6): every path runs and gets a ratio to the baseline run;
+    the callgrind client requests compile and do nothing in a process valgrind does not run."""
+    import bench_sweep
+
+    lib = bench_sweep._callgrind_helper(str(tmp_path))
+    lib.wk_cg_start()
+    lib.wk_cg_stop(b"run")
+    ratios = bench_sweep.bench_cost(1, 0.3, 1)
+    assert set(ratios) == set(bench_sweep.COST_PATHS) and ratios["run"] == 1.0
+    assert all(r > 0 for r in ratios.values())
+    assert "instructions" not in capsys.readouterr().out
+
+
+def test_the_models_compiler_flags_give_the_bits_of_the_reference_flags(tmp_path):
+    """Issue 41 item 3: the flags the model is built with (slip.compiled._CFLAGS, -O3) were adopted because
+    they give -O2's trajectory bit for bit; this builds the model's C source both ways and integrates a
+    short kick with each (exact equality: a flag that let the compiler reassociate or contract would fail)."""
+    import bench_sweep
+    import numpy as np
+
+    from whipple_kick.model.slip import compiled
+    from whipple_kick.simulate.scenario import Scenario
+
+    shipped = next(name for name, flags, _ in bench_sweep.FLAG_SETS if flags == compiled._CFLAGS)
+    libraries = bench_sweep._flag_libraries(str(tmp_path), [bench_sweep.FLAG_SETS[0][0], shipped])
+    scenario = Scenario(duration=1.0, settle=0.1)
+    (_, x_ref, t_ref), (_, x, t) = (bench_sweep._integrate_with(lib, scenario) for lib in libraries.values())
+    assert len(libraries) == 2 and t.size > 1000
+    assert np.array_equal(t, t_ref) and np.array_equal(x, x_ref)

@@ -300,3 +300,61 @@ def test_a_fall_is_status_1_and_a_success():
     assert result.summary["fell"]
     assert (result.status, result.success) == (1, True)
     assert result.message == result.summary["message"] and "\n" not in result.message
+
+
+@pytest.mark.parametrize("changes", [
+    {},                                                                   # carcass tyre, completed
+    {"tyre_transient": "force_lag"},                                      # no patch columns
+    {"rider_body": "leaning", "duration": 0.8},                           # a part's states and outputs
+    {"controller": "off", "duration": 3.0, "fall_angle_deg": 20.0},       # ends in a fall
+])
+def test_the_lean_path_gives_the_tables_values_and_the_same_summary(changes):
+    # run(columns=...) builds no table: its columns must be the table's, bit for bit (the same sources and
+    # arithmetic), and its summary the table's summary exactly, but for the run's wall times and the date.
+    scenario = Scenario(duration=1.2, settle=0.1).with_changes(**changes)
+    full = run(scenario)
+    lean = run(scenario, columns="all")
+    assert list(lean.trajectory) == list(full.trajectory.columns)
+    for column in full.trajectory.columns:
+        assert np.array_equal(lean.trajectory[column], full.trajectory[column].to_numpy()), column
+
+    def comparable(summary):
+        numerics = {k: v for k, v in summary["numerics"].items() if k not in ("wall_s", "integration_wall_s")}
+        return {**summary, "numerics": numerics, "provenance": None}
+
+    assert comparable(lean.summary) == comparable(full.summary)
+    assert json.dumps(comparable(lean.summary)) == json.dumps(comparable(full.summary))   # -0.0 is not 0.0 here
+    only = run(scenario, columns=("plate_y",))
+    assert "plate_y" in only.trajectory and "camber_front" not in only.trajectory
+    assert comparable(only.summary) == comparable(full.summary)
+    with pytest.raises(wk.errors.InputError, match=r"trajectory column\(s\) \['rol'\] do not exist"):
+        run(scenario, columns=("rol",))
+
+
+def test_the_lean_path_refuses_a_non_finite_value_where_the_table_does():
+    """trajectory_columns checks the table's columns as trajectory_frame does (whole arrays first, then the
+    table's columns): a NaN in an output of the table fails both, one in an output the table leaves out
+    neither."""
+    from whipple_kick.library import inputs
+    from whipple_kick.simulate import assembly, integration
+
+    scenario = Scenario(duration=0.3, settle=0.05, tyre_transient="force_lag")   # its table has no patch slip
+    kick = inputs.kick_of(scenario.validate())
+    solution = integration.integrate_run(assembly.assemble(scenario, kick), scenario, kick)
+    outputs = solution.outputs()
+    layout = results.frame_layout(scenario.tyre_transient, solution.model)
+    used = sorted({index for _, source, index in layout if source == "output"})
+    unused = [k for k in range(outputs.shape[1]) if k not in used]
+    assert unused   # the patch slips the force-lag form's table does not show
+    for column, fails in ((used[3], True), (unused[0], False)):
+        bad = outputs.copy()
+        bad[5, column] = np.nan
+        solution.outputs = lambda bad=bad: bad
+        if fails:
+            for build in (results.trajectory_frame, results.trajectory_columns):
+                with pytest.raises(SimulationError, match="non-finite"):
+                    build(solution, scenario.tyre_transient)
+        else:
+            frame = results.trajectory_frame(solution, scenario.tyre_transient)
+            columns = results.trajectory_columns(solution, scenario.tyre_transient, "all")
+            assert all(np.array_equal(frame[c].to_numpy(), columns[c]) for c in frame.columns)

@@ -228,7 +228,7 @@ def test_a_sweep_whose_every_case_fails_is_an_error_not_a_verdict(monkeypatch):
     from whipple_kick.simulate import simulation
     from whipple_kick.studies.sweep_engine import SweepFailed
 
-    def broken(scenario):
+    def broken(scenario, **options):
         raise ZeroDivisionError("a bug")
     monkeypatch.setattr(simulation, "run", broken)
     with cf.ThreadPoolExecutor(1) as pool, pytest.raises(SweepFailed) as info:

@@ -170,3 +170,29 @@ def test_a_sweep_over_the_rear_load_share_gives_different_rows():
     assert table["bicycle.rider_shift_m"].iloc[1] < table["bicycle.rider_shift_m"].iloc[0]
     assert table["bicycle.rider_mass_kg"].nunique() == 2
     assert table["yaw_rate_peaks_from_steady_rad_s"].nunique() == 2
+
+
+def test_a_packed_case_is_its_trajectory_file_and_its_row_the_full_paths(tmp_path):
+    # A sweep's worker packs the trajectory file itself (the parent only writes the bytes) and computes its
+    # row without the trajectory table: the row must equal the full path's (wk.run) exactly, and the file
+    # must hold what the unpacked record holds.
+    scenario = Scenario(duration=1.0, settle=0.1, fz_n=635.0)
+    spec = wk.sweep_engine._trajectory_spec(("time", "roll", "fy_rear"), "float32", 200.0)
+    packed = wk.sweep_engine.run_case(scenario, "c1", spec, packed=True)
+    plain = wk.sweep_engine.run_case(scenario, "c1", spec)
+    assert isinstance(packed["trajectory"], bytes)
+    volatile = set(wk.sweep_engine.VOLATILE_COLUMNS)
+    direct = wk.results.flatten_summary(wk.run(scenario).summary)
+    assert {k: v for k, v in packed["results"].items() if k not in volatile} == \
+        {k: v for k, v in direct.items() if k not in volatile}
+    (tmp_path / wk.sweep_store.TRAJECTORY_DIR).mkdir()
+    wk.sweep_store._save_trajectory(tmp_path, packed)
+    frame, summary = wk.sweep_store.load_trajectory(tmp_path, "c1")
+    assert list(frame.columns) == ["time", "roll", "fy_rear"]
+    for column in frame.columns:
+        assert np.array_equal(frame[column].to_numpy(), plain["trajectory"][column])
+    assert summary == json.loads(packed["summary"])
+    table_only = wk.sweep_engine.run_case(scenario, "c1")
+    assert table_only["trajectory"] is None
+    assert {k: v for k, v in table_only["results"].items() if k not in volatile} == \
+        {k: v for k, v in direct.items() if k not in volatile}

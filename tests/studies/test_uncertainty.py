@@ -643,3 +643,18 @@ def test_a_continuous_input_is_split_at_its_default_inside_its_range_else_at_its
     groups = {(name, option): mask.tolist() for name, option, mask in uncertainty.input_groups(spec, table)}
     assert groups == {("gain_scale", "< 1"): [True, False, False], ("gain_scale", ">= 1"): [False, True, True],
                       ("speed", "< 1.96"): [True, True, False], ("speed", ">= 1.96"): [False, False, True]}
+
+
+def test_a_study_tolerance_is_a_fixed_entry_and_every_case_runs_at_it(tmp_path):
+    """Issue 41 item 4: a study's rtol is its file's [fixed] rtol (docs/sweeps.md gives what 1e-8 changes);
+    every case runs at it, and a value out of range is one line naming rtol, the range and the unit."""
+    path = tmp_path / "u.toml"
+    path.write_text(TINY.replace("[fixed]\n", '[fixed]\nrtol = { value = 1e-8, reason = "a quicker study" }\n'))
+    uncertainty.run_study(path, samples=2, loads=[635.0], pressures=[300.0, 500.0], base=BASE, workers=1,
+                          folder=tmp_path / "runs")
+    table = pd.read_csv(tmp_path / "runs" / wk.sweep_store.TABLE_FILE)
+    assert len(table) == 16 and (table["rtol"] == 1e-8).all() and (table["numerics.rtol"] == 1e-8).all()
+    path.write_text(TINY.replace("[fixed]\n", '[fixed]\nrtol = { value = 0.1, reason = "too coarse" }\n'))
+    with pytest.raises(InputError, match=r"fixed\.rtol: .*rtol.*0\.1.*1e-14.*0\.001") as info:
+        uncertainty.run_study(path, samples=2, base=BASE)
+    assert "\n" not in str(info.value)

@@ -88,7 +88,8 @@ class Result:
     ----------
     scenario : Scenario
     trajectory : pandas.DataFrame
-        Time histories, columns named as in :data:`UNITS` (time from the kick start).
+        Time histories, columns named as in :data:`UNITS` (time from the kick start); a dict of
+        column arrays from ``run(columns=...)`` (:func:`trajectory_columns`, a study's lean path).
     summary : dict
         JSON-ready summary (no NaN): outcome, model set-up, steady state,
         peaks, recovery metrics, numerics.
@@ -244,17 +245,14 @@ def trajectory_frame(solution, tyre_transient="carcass"):
     # One float64 block, column by column (Fortran order: each column contiguous), instead of a dict of
     # columns that pandas copies into a block: a sweep builds ~1e4 of these tables.
     values = np.empty((traj.t.size, len(layout)), order="F")
-    for k, (name, source, index) in enumerate(layout):
-        if source == "state":
-            values[:, k] = traj.x[:, index]
-        elif source == "output":
-            values[:, k] = outs[:, index]
-        elif name == "time":
-            values[:, k] = traj.t
+    for k, entry in enumerate(layout):
+        if entry[1] != "derived":
+            values[:, k] = _source(entry, traj, outs)
+    values[:, 0] = traj.t
     column = {name: k for k, (name, _, _) in enumerate(layout)}
-    yaw, vx_fixed, vy_fixed = (values[:, column[c]] for c in ("yaw", "velocity_x_fixed", "velocity_y_fixed"))
-    values[:, column["forward_speed"]] = np.cos(yaw) * vx_fixed + np.sin(yaw) * vy_fixed
-    values[:, column["lateral_speed"]] = -np.sin(yaw) * vx_fixed + np.cos(yaw) * vy_fixed
+    speeds = heading_speeds(*(values[:, column[c]] for c in ("yaw", "velocity_x_fixed", "velocity_y_fixed")))
+    for name in HEADING_COLUMNS:
+        values[:, column[name]] = speeds[name]
     # No negative zeros (a switched-off torque, -(0 x), is -0.0): trajectory.csv's rounded "-0" would read
     # back as 0 and a loaded result would not save the same bytes.
     values += 0.0
@@ -264,6 +262,120 @@ def trajectory_frame(solution, tyre_transient="carcass"):
     if not (np.all(np.isfinite(values)) and np.all(np.isfinite(residual))):
         raise SimulationError("non-finite values in the trajectory")
     return frame
+
+
+def trajectory_columns(solution, tyre_transient="carcass", names=None):
+    """Columns of :func:`trajectory_frame` as plain arrays, without the table: the lean path of a study.
+
+    The same values bit for bit (the same sources, the same arithmetic), the
+    same refusal of a non-finite value in any of the table's columns; only
+    the DataFrame is not built, and of the columns only ``names`` and those
+    :func:`summarise` reads (:func:`summary_columns`) are kept. A sweep that
+    keeps no trajectory needs nothing else (issue 41: the table and its
+    pandas look-ups were ~6 ms of a ~140 ms case).
+
+    Parameters
+    ----------
+    solution : whipple_kick.simulate.integration.Solution
+    tyre_transient : str
+    names : iterable of str or "all", optional
+        Columns wanted beside the summary's ("all": every column of the table, in its order).
+
+    Returns
+    -------
+    dict
+        ``{column: 1-D float64 array}``: the table's columns in the table's order.
+
+    Raises
+    ------
+    SimulationError
+        A value in one of the table's columns is not finite (as :func:`trajectory_frame`).
+    """
+    traj = solution.states
+    outs = solution.outputs()
+    layout = frame_layout(tyre_transient, solution.model)
+    every = column_names(tyre_transient, solution.model)
+    asked = set(every) if names == "all" else set(names or ())
+    unknown = asked - set(every)
+    if unknown:
+        raise InputError(f"trajectory column(s) {sorted(unknown)} do not exist; available: {', '.join(every)}")
+    wanted = asked | (set(summary_columns(tyre_transient)) & set(every))
+    # The finite check covers the table's columns, as trajectory_frame's does, not the outputs it leaves out
+    # (the whole arrays first: no copy of the columns when all is finite, as it nearly always is).
+    states = sorted({index for _, source, index in layout if source == "state"})
+    outputs = sorted({index for _, source, index in layout if source == "output"})
+    if not (_all_finite(traj.x, states) and _all_finite(outs, outputs) and np.all(np.isfinite(traj.t))):
+        raise SimulationError("non-finite values in the trajectory")
+    source = {name: entry for name, *entry in layout}
+    columns = {"time": traj.t + 0.0}
+    for name, kind, index in layout:
+        if kind != "derived" and name in wanted:
+            columns[name] = _source((name, kind, index), traj, outs) + 0.0   # + 0.0: no -0.0, as in the table
+    if wanted & set(HEADING_COLUMNS):
+        yaw, vx, vy = (_source((c, *source[c]), traj, outs) for c in ("yaw", "velocity_x_fixed", "velocity_y_fixed"))
+        columns.update({name: value + 0.0 for name, value in heading_speeds(yaw, vx, vy).items()})
+    residual = energy.balance_residual({name: _Column(columns[name]) for name in _BALANCE_INPUTS})
+    if not np.all(np.isfinite(residual)):
+        raise SimulationError("non-finite values in the trajectory")
+    columns[BALANCE_COLUMN] = residual
+    return {name: columns[name] for name in every if name in wanted}
+
+
+class _Column:
+    """An array seen as a table column (``.to_numpy()``), for :func:`whipple_kick.model.energy.balance_residual`.
+
+    That function reads table columns; its module is one of the sources that key the compiled model's cache,
+    so the lean path adapts to it instead of changing it (which would rebuild the model for every user).
+    """
+
+    __slots__ = ("values",)
+
+    def __init__(self, values):
+        self.values = values
+
+    def to_numpy(self):
+        return self.values
+
+
+def _all_finite(values, columns):
+    """Whether ``values[:, columns]`` is finite everywhere (the whole array looked at first, without a copy)."""
+    return bool(np.isfinite(values).all()) or bool(np.isfinite(values[:, columns]).all())
+
+
+def _values(frame, column):
+    """One column of a trajectory table or of :func:`trajectory_columns`' mapping as an array (no copy)."""
+    return np.asarray(frame[column])
+
+
+def _source(entry, traj, outs):
+    """The values of one ``(name, source, index)`` entry of :func:`frame_layout` (a state or an output)."""
+    _, source, index = entry
+    return traj.x[:, index] if source == "state" else outs[:, index]
+
+
+def heading_speeds(yaw, vx_fixed, vy_fixed):
+    """The rear contact's velocity along the heading (:data:`HEADING_COLUMNS`) from yaw and the fixed-axes velocity."""
+    return {"forward_speed": np.cos(yaw) * vx_fixed + np.sin(yaw) * vy_fixed,
+            "lateral_speed": -np.sin(yaw) * vx_fixed + np.cos(yaw) * vy_fixed}
+
+
+#: The energy balance's inputs (:func:`whipple_kick.model.energy.balance_residual`).
+_BALANCE_INPUTS = frozenset((*energy.STORED, *energy.SUPPLIED, *energy.DISSIPATED))
+
+
+def summary_columns(tyre_transient="carcass"):
+    """The trajectory columns :func:`summarise` reads (the metrics, recovery, peaks, tyre ranges, energy, numerics)."""
+    from . import analysis
+
+    patch = [] if tyre_transient == "force_lag" else ["slip_patch_rear", "slip_patch_front"]
+    return ("time", *analysis.COLUMNS, *RECOVERY_STATES, *PEAK_COLUMNS, *patch, "slip_rear", "slip_front",
+            "fz_rear", "fz_front", *[c for c, _ in energy.COLUMNS.values()], *_BALANCE_INPUTS,
+            "holonomic_residual", BALANCE_COLUMN)
+
+
+def column_names(tyre_transient="carcass", model=slip.layout.BASE):
+    """The names of :func:`trajectory_frame`'s columns, in order."""
+    return [name for name, _, _ in frame_layout(tyre_transient, model)] + [BALANCE_COLUMN]
 
 
 @functools.cache
@@ -515,11 +627,11 @@ def _rear_wheel_torque(steady, start_outputs):
 
 def _energy_summary(df, jumps, scenario):
     """Totals of the energy accounting after the kick, the balance residual and the velocity jumps."""
-    after = df["time"].to_numpy() >= 0.0
-    totals = {f"{column}_j": float(df[column].iloc[-1]) for column, _ in energy.COLUMNS.values()}
-    stored = sum(df[c].to_numpy() for c in energy.STORED)
-    dissipation = df["sliding_dissipation"].to_numpy() + df["damper_dissipation"].to_numpy()
-    residual = np.abs(df[BALANCE_COLUMN].to_numpy())
+    after = _values(df, "time") >= 0.0
+    totals = {f"{column}_j": float(_values(df, column)[-1]) for column, _ in energy.COLUMNS.values()}
+    stored = sum(_values(df, c) for c in energy.STORED)
+    dissipation = _values(df, "sliding_dissipation") + _values(df, "damper_dissipation")
+    residual = np.abs(_values(df, BALANCE_COLUMN))
     return {
         "convention": ("works done ON the bicycle and dissipations, cumulative from the kick start (J); "
                        "stored = kinetic + potential + springs (vertical tyre springs, and with a rider's body the hip "
@@ -529,7 +641,7 @@ def _energy_summary(df, jumps, scenario):
         **totals,
         "stored_change_after_kick_j": float(stored[-1] - stored[after][0]) if after.any() else 0.0,
         "balance_residual_max_abs_j": float(residual.max()),
-        "dissipation_largest_decrease_j": float(max(0.0, -np.diff(dissipation).min())) if len(df) > 1 else 0.0,
+        "dissipation_largest_decrease_j": float(max(0.0, -np.diff(dissipation).min())) if after.size > 1 else 0.0,
         "plate_stop": scenario.plate_stop,
         "velocity_jumps": jumps,
     }
@@ -546,8 +658,8 @@ def summarise(scenario, kick, assembly, solution, frame, *, custom_tyres=False) 
     kick : whipple_kick.library.inputs.Kick
     assembly : whipple_kick.simulate.assembly.Assembly
     solution : whipple_kick.simulate.integration.Solution
-    frame : pandas.DataFrame
-        :func:`trajectory_frame` of the solution.
+    frame : pandas.DataFrame or dict
+        :func:`trajectory_frame` of the solution, or :func:`trajectory_columns` (the same summary).
     custom_tyres : bool
         The run used the caller's tyre objects (not the scenario's tyre and pressures).
 
@@ -570,7 +682,7 @@ def summarise(scenario, kick, assembly, solution, frame, *, custom_tyres=False) 
         "fell": bool(traj.fell),
         "fall_time_s": traj.fall_time,
         "fall_reason": traj.fall_reason,
-        "end_time_s": float(frame["time"].iloc[-1]),
+        "end_time_s": float(_values(frame, "time")[-1]),
         "message": traj.message,
         "bicycle": _bicycle_section(assembly, start_outputs),
         "tyres": {**_tyres_section(scenario, assembly, custom_tyres),
@@ -587,7 +699,7 @@ def summarise(scenario, kick, assembly, solution, frame, *, custom_tyres=False) 
         "metrics_unavailable": unavailable,
         "numerics": _numerics_section(scenario, solution, frame),
         "scenario": scenario.to_dict(),
-        "units": {column: UNITS[column] for column in frame.columns},
+        "units": {column: UNITS[column] for column in column_names(scenario.tyre_transient, solution.model)},
         "provenance": provenance.record(provenance.input_files(scenario, custom_tyres)),
     }
     return clean(summary)
@@ -654,8 +766,8 @@ def extrapolation(frame, rear, front):
 
     Parameters
     ----------
-    frame : pandas.DataFrame
-        A trajectory table (:func:`trajectory_frame`).
+    frame : pandas.DataFrame or dict
+        A trajectory table (:func:`trajectory_frame`) or its columns (:func:`trajectory_columns`).
     rear, front : whipple_kick.library.tyres.Tyre
 
     Returns
@@ -663,10 +775,10 @@ def extrapolation(frame, rear, front):
     dict
         ``rear`` and ``front``.
     """
-    rows = frame["time"].to_numpy() >= 0.0
+    rows = _values(frame, "time") >= 0.0
 
     def after(column):   # the column's values after the kick start (no copy of the whole table)
-        return frame[column].to_numpy()[rows]
+        return _values(frame, column)[rows]
 
     t = after("time")
     dt = np.diff(t, append=t[-1]) if t.size else t
@@ -767,9 +879,9 @@ def _steady_section(scenario, assembly, baseline, start_outputs):
 
 
 def _peaks(frame):
-    after = frame["time"].to_numpy() >= 0.0
+    after = _values(frame, "time") >= 0.0
     return {f"max_abs_{name}_absolute_{unit_suffix(UNITS[name])}":
-            float(np.max(np.abs(frame[name].to_numpy()[after]), initial=0.0)) for name in PEAK_COLUMNS}
+            float(np.max(np.abs(_values(frame, name)[after]), initial=0.0)) for name in PEAK_COLUMNS}
 
 
 def _numerics_section(scenario, solution, frame):
@@ -783,7 +895,7 @@ def _numerics_section(scenario, solution, frame):
         "budget": {"allowance": lsoda.DEFAULT_BUDGET.allowance,
                    "per_simulated_second": lsoda.DEFAULT_BUDGET.per_second},
         "integration_wall_s": solution.wall_s,
-        "max_abs_holonomic_m": float(np.max(np.abs(frame["holonomic_residual"]))),
+        "max_abs_holonomic_m": float(np.max(np.abs(_values(frame, "holonomic_residual")))),
         "model_hash": slip.model_hash(solution.model),
     }
 

@@ -28,7 +28,8 @@ from .scenario import Scenario
 __all__ = ["Result", "Scenario", "SimulationError", "run"]
 
 
-def run(scenario: Scenario, *, tyres: tuple | None = None, gains: Mapping | None = None) -> Result:
+def run(scenario: Scenario, *, tyres: tuple | None = None, gains: Mapping | None = None,
+        columns=None) -> Result:
     """Run one kick-plate simulation.
 
     Parameters
@@ -52,6 +53,11 @@ def run(scenario: Scenario, *, tyres: tuple | None = None, gains: Mapping | None
         must stay at their defaults: the gains replace them. A yaw-angle gain
         (e.g. from :func:`whipple_kick.simulate.control.heading_lqr_gains`) needs a
         straight steady motion, so tyres without zero-slip offsets.
+    columns : iterable of str or "all", optional
+        The lean path of a study (:func:`whipple_kick.studies.sweep_engine.run_case`): no trajectory
+        table is built, ``result.trajectory`` is a dict of these columns' arrays (and the summary's own,
+        :func:`whipple_kick.simulate.results.trajectory_columns`); the summary is the same. Default: the
+        whole table, a DataFrame.
 
     Returns
     -------
@@ -93,7 +99,10 @@ def run(scenario: Scenario, *, tyres: tuple | None = None, gains: Mapping | None
         # Said before the long part, the integration; a valid run all the same (the bicycle may well fall).
         warnings.warn(model.stability["message"], UnstableRiderWarning, stacklevel=2)
     solution = integration.integrate_run(model, scenario, kick)
-    frame = results.trajectory_frame(solution, scenario.tyre_transient)
+    if columns is None:
+        frame = results.trajectory_frame(solution, scenario.tyre_transient)
+    else:
+        frame = results.trajectory_columns(solution, scenario.tyre_transient, columns)
     summary = results.summarise(scenario, kick, model, solution, frame, custom_tyres=tyres is not None)
     summary["numerics"]["wall_s"] = time.perf_counter() - started
     return Result(scenario=scenario, trajectory=frame, summary=summary)

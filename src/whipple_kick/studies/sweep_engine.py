@@ -40,7 +40,7 @@ from whipple_kick.simulate import simulation
 from whipple_kick.simulate.results import flatten_summary
 from whipple_kick.simulate.scenario import Scenario
 
-from .sweep_store import Folder, canonical, case_id, slim, table, trajectory_path
+from .sweep_store import Folder, canonical, case_id, pack_trajectory, slim, table, trajectory_path
 
 # Summary sections that are not results of the run (the inputs are already
 # columns; the units are documented in whipple_kick.simulate.results.UNITS).
@@ -168,14 +168,14 @@ def _trajectory_spec(columns, dtype, rate_hz):
             "rate_hz": None if rate_hz is None else float(rate_hz)}
 
 
-def _sampled(df, spec):
-    """The trajectory columns of ``spec`` at (about) its rate, the last sample always kept."""
-    names = list(df.columns) if spec["columns"] == "all" else list(spec["columns"])
-    available = set(df.columns)
-    missing = [n for n in names if n not in available]
-    if missing:
-        raise InputError(f"trajectory column(s) {missing} do not exist; available: {', '.join(df.columns)}")
-    t = df["time"].to_numpy()
+def _sampled(columns, spec):
+    """The trajectory columns of ``spec`` at (about) its rate, the last sample always kept.
+
+    ``columns``: the run's columns (:func:`whipple_kick.simulate.results.trajectory_columns`, which refuses
+    an unknown name), in the table's order.
+    """
+    names = list(columns) if spec["columns"] == "all" else list(spec["columns"])
+    t = columns["time"]
     rows = slice(None)
     if spec["rate_hz"] is not None and t.size > 1:
         # Every k-th sample of the exact solution (no filtering needed: these
@@ -185,10 +185,10 @@ def _sampled(df, spec):
         rows = np.arange(0, t.size, step)
         if rows[-1] != t.size - 1:
             rows = np.append(rows, t.size - 1)
-    return {n: df[n].to_numpy()[rows].astype(spec["dtype"]) for n in names}
+    return {n: columns[n][rows].astype(spec["dtype"]) for n in names}
 
 
-def run_case(scenario, case_id, trajectory=None):
+def run_case(scenario, case_id, trajectory=None, *, packed=False):
     """Run one case; never raises for a failing case (the worker function of :func:`sweep`).
 
     Parameters
@@ -200,13 +200,17 @@ def run_case(scenario, case_id, trajectory=None):
         ``{"columns": names or "all", "dtype": str, "rate_hz": float or None}``:
         the trajectory columns to return, their dtype, and the sampling rate
         they are thinned to (None: every sample). None returns no trajectory.
+    packed : bool
+        Return the trajectory as the bytes of its sweep-folder file
+        (:func:`whipple_kick.studies.sweep_store.pack_trajectory`, compressed here in the worker) instead
+        of a dict of arrays.
 
     Returns
     -------
     dict
         ``case_id``, ``status`` ("ok" or "failed"), ``error`` (``"Type: message"``
         or None), ``results`` (flat, :func:`flatten_summary`), ``summary``
-        (JSON text), ``trajectory`` ({column: array} or None) and ``run``
+        (JSON text), ``trajectory`` ({column: array}, its file's bytes, or None) and ``run``
         (start/end time stamps, wall time, worker host:pid). A numerical
         failure (a :class:`~whipple_kick.simulate.results.Result` whose ``success`` is
         False; error ``"SimulationError: <its message>"``, as before) keeps the
@@ -230,8 +234,9 @@ def run_case(scenario, case_id, trajectory=None):
         with _blas_controller().limit(limits=1), warnings.catch_warnings():
             warnings.simplefilter("ignore", UnstableRiderWarning)
             warnings.simplefilter("ignore", DefaultValueWarning)
-            result = simulation.run(scenario)
-        _keep(record, result, trajectory)   # a numerical failure keeps what ran before it
+            # The lean path: the summary's columns and the kept ones, no trajectory table (the same table row).
+            result = simulation.run(scenario, columns=() if trajectory is None else trajectory["columns"])
+        _keep(record, result, trajectory, packed)   # a numerical failure keeps what ran before it
         if not result.success:
             record.update(status="failed", error=f"SimulationError: {result.message}")
     except Exception as exc:
@@ -280,12 +285,14 @@ def _blas_controller():
     return controller
 
 
-def _keep(record, result, trajectory):
-    """Put a run's flat results, summary and (thinned) trajectory into its record."""
+def _keep(record, result, trajectory, packed=False):
+    """Put a run's flat results, summary and (thinned, or packed into its file) trajectory into its record."""
     record["results"] = flatten_summary(result.summary)
     record["summary"] = json.dumps(result.summary, allow_nan=False)
     if trajectory is not None:
         record["trajectory"] = _sampled(result.trajectory, trajectory)
+        if packed:
+            record["trajectory"] = pack_trajectory(record["trajectory"], record["summary"])
 
 
 # ----------------------------------------------------------------------- the sweep
@@ -393,7 +400,9 @@ def sweep(grid=None, cases=None, *, base=None, folder=None, executor=None, worke
             if own:
                 executor = _default_pool(workers or os.cpu_count() or 1)
             try:
-                _collect(executor, todo, records, store, progress, len(unique), spec, table_interval, lost)
+                # Without a folder no trajectory is kept: the workers make none.
+                _collect(executor, todo, records, store, progress, len(unique), spec if store is not None else None,
+                         table_interval, lost)
             except (KeyboardInterrupt, SweepTerminated):
                 interrupted = True
                 if own:
@@ -533,7 +542,7 @@ def _collect(executor, todo, records, store, progress, total, spec, table_interv
     futures = {}
     try:
         for cid, scenario in todo:
-            futures[executor.submit(run_case, scenario, cid, spec)] = cid
+            futures[executor.submit(run_case, scenario, cid, spec, packed=True)] = cid
         n_failed = 0
         for fut in cf.as_completed(futures):
             try:

@@ -127,11 +127,32 @@ def load_trajectory(folder, case_id):
     return frame, summary
 
 
+def pack_trajectory(trajectory, summary_json):
+    """A case's trajectory file (what :func:`load_trajectory` reads) as bytes: compressed columns and the summary.
+
+    A sweep's workers pack their own cases' files (:func:`whipple_kick.studies.sweep_engine.run_case`), so the
+    compression, ~7 ms a case, is spread over the workers instead of capping the process that saves them
+    (issue 41: ~105 cases/s).
+
+    Parameters
+    ----------
+    trajectory : dict
+        ``{column: 1-D array}``, in the order :func:`load_trajectory` gives them back.
+    summary_json : str
+        The run's summary as JSON text.
+    """
+    import io
+    buffer = io.BytesIO()
+    np.savez_compressed(buffer, columns=np.array(list(trajectory)), summary_json=np.array(summary_json), **trajectory)
+    return buffer.getvalue()
+
+
 def _save_trajectory(folder, record):
+    """Write a record's trajectory file: its packed bytes (:func:`pack_trajectory`), or its columns packed here."""
     traj = record["trajectory"]
-    # A file under its final name is always complete; savez wants a name ending in .npz.
-    with fileio.atomic_path(trajectory_path(folder, record["case_id"])) as tmp, open(tmp, "wb") as fh:
-        np.savez_compressed(fh, columns=np.array(list(traj)), summary_json=np.array(record["summary"]), **traj)
+    data = traj if isinstance(traj, bytes) else pack_trajectory(traj, record["summary"])
+    # A file under its final name is always complete.
+    fileio.write_atomic(trajectory_path(folder, record["case_id"]), data)
 
 
 def table(case_list, records):

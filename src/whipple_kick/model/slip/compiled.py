@@ -32,7 +32,12 @@ def _compiler():
     return cc
 
 
-_CFLAGS = ("-O2", "-fPIC", "-shared", "-std=c99")
+#: -O3 (issue 41 item 3, ``scripts/bench_sweep.py flags``): 0.83x the integration's instructions of -O2 and
+#: 0.94x its wall time, trajectories bit-identical (-std=c99, not gnu99, keeps GCC from contracting a*b+c
+#: into an FMA). -march=native (0.75x with AVX2, -O3 -march=x86-64-v3; 0.86x wall) is not used: the code
+#: would be CPU-specific (the CPU in the cache key, SIGILL on another CPU sharing the cache, a compiler
+#: that may refuse it) and valgrind cannot run its AVX-512, which the instruction counts rely on.
+_CFLAGS = ("-O3", "-fPIC", "-shared", "-std=c99")
 
 
 @functools.cache
