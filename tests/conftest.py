@@ -1,5 +1,6 @@
 """Fixtures shared by several test files."""
 import dataclasses
+import pathlib
 
 import pytest
 
@@ -107,3 +108,50 @@ def _choices(name):
         from whipple_kick.model import carcass
         return carcass.SLIDING_LAWS
     raise AssertionError(f"no choices known for field {name!r}")
+
+
+# ------------------------------------------------------------------ the explorer (tests/explorer)
+# Here, not in tests/explorer/conftest.py: two conftest.py in folders without __init__.py are both the module
+# "conftest", and the second one imported hid this one's helpers from the tests that import them.
+STUDY = pathlib.Path(__file__).resolve().parents[1] / "docs" / "uncertainty_study"
+#: The page's stability sweep in the tests: four speeds (the default 191 take about 9 s).
+STABILITY_SPEEDS = "2:5:1"
+
+
+class Address(str):
+    """The server's address, and its process id (``pid``)."""
+
+    __slots__ = ("pid",)
+
+    def __new__(cls, url, pid):
+        self = super().__new__(cls, url)
+        self.pid = pid
+        return self
+
+
+@pytest.fixture(scope="session")
+def server(tmp_path_factory):
+    """``whipple-kick-explorer --port 0 --study docs/uncertainty_study --workers 2 --speeds 2:5:1``: its address
+    and process id (one server per test process)."""
+    pytest.importorskip("tornado", reason="the explorer's server needs Tornado: pip install -e '.[app]'")
+    from whipple_kick.explorer import headless
+
+    proc, url = headless.start_server("--study", STUDY, "--workers", 2, "--speeds", STABILITY_SPEEDS,
+                                      "--workdir", tmp_path_factory.mktemp("explorer_runs"))
+    yield Address(url, proc.pid)
+    headless.stop_server(proc)
+
+
+@pytest.fixture(scope="module")
+def browser(tmp_path_factory):
+    """A headless Chromium (Selenium) whose downloads go to its own folder (``browser.downloads``)."""
+    from whipple_kick.explorer import headless
+
+    why = headless.missing()
+    if why is not None:
+        pytest.skip(why)
+    downloads = tmp_path_factory.mktemp("downloads")
+    driver = headless.chromium(downloads)
+    driver.downloads = downloads
+    yield driver
+    driver.quit()

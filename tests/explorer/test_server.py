@@ -143,8 +143,7 @@ def test_a_bicycleparameters_file_sent_with_the_form_is_the_bicycle(server):
 
 def test_stability_against_speed_is_the_stability_commands(server, tmp_path, capsys):
     """The page's stability of the form's setup prints what ``stability`` prints for the same flags and speeds."""
-    from tests.conftest import run_console
-    from tests.explorer.conftest import STABILITY_SPEEDS
+    from tests.conftest import STABILITY_SPEEDS, run_console
     from whipple_kick import cli
 
     body, headers = _multipart({"pressure_kpa": "300", "fz_n": "701", "speed": "4", "kick_direction": "left"})
