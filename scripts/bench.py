@@ -372,9 +372,8 @@ def bench_compare(args):
     # method for both libraries. The call from Python: this checkout's as the integrator makes it
     # (slip.CompiledRHS.fast), the other's as its CompiledRHS.__call__ did (contiguous input,
     # x.ctypes, ctypes call, copy).
-    from whipple_kick.model import rhs_call
-    from whipple_kick.model.slip import compiled
-    native = rhs_call.module(compiled._compiler())
+    from whipple_kick.model import compiler, rhs_call
+    native = rhs_call.module(compiler.find())
 
     def c_alone(label, n):
         lib, x, p, _ = libs[label]

@@ -526,7 +526,7 @@ def bench_tolerance(samples, fz, rtol, workers):
 
 
 #: Compiler flag sets :func:`bench_flags` compares, the first the reference (the model's flags before issue
-#: 41; ``slip.compiled._CFLAGS`` is now the second): (name, flags, whether valgrind runs it). ``-std=c99``
+#: 41; ``model.compiler.MODEL_FLAGS`` is now the second): (name, flags, whether valgrind runs it). ``-std=c99``
 #: (not gnu99) keeps GCC from contracting a*b+c into an FMA, which would round differently.
 FLAG_SETS = (
     ("O2", ("-O2", "-fPIC", "-shared", "-std=c99"), True),
@@ -542,10 +542,11 @@ def _flag_libraries(folder, names=None):
     import pathlib
     import subprocess
 
+    from whipple_kick.model import compiler
     from whipple_kick.model.slip import compiled, layout
     base = layout.BASE
     source = compiled.library_path(base).with_suffix(".c")
-    cc = compiled._compiler()
+    cc = compiler.find()
     libraries = {}
     for name, flags, _ in FLAG_SETS:
         if names is not None and name not in names:

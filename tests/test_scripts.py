@@ -147,16 +147,16 @@ def test_the_cost_bench_runs_each_path_and_its_counting_requests_are_inert_outsi
 
 
 def test_the_models_compiler_flags_give_the_bits_of_the_reference_flags(tmp_path):
-    """Issue 41 item 3: the flags the model is built with (slip.compiled._CFLAGS, -O3) were adopted because
+    """Issue 41 item 3: the flags the model is built with (model.compiler.MODEL_FLAGS, -O3) were adopted because
     they give -O2's trajectory bit for bit; this builds the model's C source both ways and integrates a
     short kick with each (exact equality: a flag that let the compiler reassociate or contract would fail)."""
     import bench_sweep
     import numpy as np
 
-    from whipple_kick.model.slip import compiled
+    from whipple_kick.model import compiler
     from whipple_kick.simulate.scenario import Scenario
 
-    shipped = next(name for name, flags, _ in bench_sweep.FLAG_SETS if flags == compiled._CFLAGS)
+    shipped = next(name for name, flags, _ in bench_sweep.FLAG_SETS if flags == compiler.MODEL_FLAGS)
     libraries = bench_sweep._flag_libraries(str(tmp_path), [bench_sweep.FLAG_SETS[0][0], shipped])
     scenario = Scenario(duration=1.0, settle=0.1)
     (_, x_ref, t_ref), (_, x, t) = (bench_sweep._integrate_with(lib, scenario) for lib in libraries.values())

@@ -6,7 +6,7 @@ import sys
 import pytest
 
 from whipple_kick.errors import CacheError, InputError
-from whipple_kick.model import cache
+from whipple_kick.model import cache, compiler
 from whipple_kick.model.slip import compiled
 
 
@@ -49,12 +49,12 @@ def test_missing_compiler_is_a_clear_error(monkeypatch):
     from whipple_kick.errors import BuildError, CompilerNotFoundError
     monkeypatch.setenv("CC", "no-such-compiler-xyz")
     with pytest.raises(CompilerNotFoundError, match=r"CC=.no-such-compiler-xyz.*install a C compiler") as info:
-        compiled._compiler()
+        compiler.find()
     assert not isinstance(info.value, InputError) and isinstance(info.value, BuildError)
     monkeypatch.delenv("CC")
     monkeypatch.setenv("PATH", "")
     with pytest.raises(CompilerNotFoundError, match=r"no C compiler found.*install a C compiler") as info:
-        compiled._compiler()
+        compiler.find()
     assert "\n" not in str(info.value)
 
 

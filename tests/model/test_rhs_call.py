@@ -6,8 +6,7 @@ import numpy as np
 import pytest
 
 import whipple_kick as wk
-from whipple_kick.model import rhs_call, slip
-from whipple_kick.model.slip import compiled
+from whipple_kick.model import compiler, rhs_call, slip
 from whipple_kick.simulate import lsoda
 
 
@@ -37,7 +36,7 @@ def _ctypes_path(rhs, monkeypatch):
 
 def test_the_extension_is_built_here(steady):
     """Python.h is on this machine, so the integrators use the extension (else the timings mean nothing)."""
-    assert rhs_call.module(compiled._compiler()) is not None
+    assert rhs_call.module(compiler.find()) is not None
     assert hasattr(slip.CompiledRHS(steady.params).fast, "repeat")
 
 

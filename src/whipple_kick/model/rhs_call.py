@@ -22,7 +22,6 @@ import hashlib
 import importlib.machinery
 import importlib.util
 import platform
-import subprocess
 import sys
 import sysconfig
 import warnings
@@ -32,6 +31,7 @@ import numpy as np
 from whipple_kick.errors import CacheError, PerformanceWarning
 
 from . import cache
+from . import compiler as compilers
 
 _NAME = "whipple_kick_rhs_call"
 
@@ -216,7 +216,7 @@ PyMODINIT_FUNC PyInit_whipple_kick_rhs_call(void)
 
 def _flags():
     """Compiler flags of the extension (include folders of this Python and NumPy)."""
-    flags = ["-O2", "-fPIC", "-shared", "-std=c99", f"-I{sysconfig.get_paths()['include']}", f"-I{np.get_include()}"]
+    flags = [*compilers.EXTENSION_FLAGS, f"-I{sysconfig.get_paths()['include']}", f"-I{np.get_include()}"]
     if sys.platform == "darwin":   # Python's symbols come from the interpreter at load time
         flags += ["-undefined", "dynamic_lookup"]
     return flags
@@ -236,7 +236,7 @@ def module(compiler):
     Parameters
     ----------
     compiler : str
-        Path of the C compiler (:func:`whipple_kick.model.slip.compiled._compiler`).
+        Path of the C compiler (:func:`whipple_kick.model.compiler.find`).
 
     Returns
     -------
@@ -254,11 +254,10 @@ def module(compiler):
     def build(path):
         src = folder / f"rhs_call_{_key(compiler)}.c"
         src.write_text(_SOURCE)
-        proc = subprocess.run([compiler, *_flags(), "-o", str(path), str(src)], capture_output=True, text=True,
-                              check=False)
-        src.unlink(missing_ok=True)
-        if proc.returncode != 0:
-            raise RuntimeError(proc.stderr[-2000:])
+        try:
+            compilers.compile_shared(compiler, _flags(), src, path)
+        finally:
+            src.unlink(missing_ok=True)
 
     try:
         path = cache.build_once(f"rhs_call_{_key(compiler)}.so", build)

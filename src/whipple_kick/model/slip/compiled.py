@@ -1,4 +1,4 @@
-"""The compiled libraries: the C compiler, the cache entries (built on a miss), loading each once per process.
+"""The compiled libraries: the cache entries (built on a miss), loading each once per process.
 
 One library per model: the base model (the rigid rider) and each combination of declared parts a run
 asks for (:class:`whipple_kick.model.slip.layout.Layout`), each built on its first use.
@@ -7,43 +7,17 @@ import ctypes
 import functools
 import json
 import os
-import shutil
 
-from whipple_kick.errors import CompilerNotFoundError
-from whipple_kick.model import cache, rhs_call
+from whipple_kick.model import cache, compiler, rhs_call
 import whipple_kick.model.slip.layout as layouts  # the module by its full name, not through the package
 
 from .layout import _SOURCES
 
 
-def _compiler():
-    """Path of the C compiler: $CC if set (must exist), else cc, gcc or clang on PATH (else CompilerNotFoundError)."""
-    requested = os.environ.get("CC")
-    if requested:
-        cc = shutil.which(requested)
-        if not cc:
-            raise CompilerNotFoundError(f"CC={requested!r} is not an executable C compiler: install a C compiler "
-                                        "(e.g. gcc) or set CC to one")
-        return cc
-    cc = shutil.which("cc") or shutil.which("gcc") or shutil.which("clang")
-    if not cc:
-        raise CompilerNotFoundError("no C compiler found (looked for cc, gcc, clang on PATH): install a C compiler "
-                                    "(e.g. gcc) or set CC to one")
-    return cc
-
-
-#: -O3 (issue 41 item 3, ``scripts/bench_sweep.py flags``): 0.83x the integration's instructions of -O2 and
-#: 0.94x its wall time, trajectories bit-identical (-std=c99, not gnu99, keeps GCC from contracting a*b+c
-#: into an FMA). -march=native (0.75x with AVX2, -O3 -march=x86-64-v3; 0.86x wall) is not used: the code
-#: would be CPU-specific (the CPU in the cache key, SIGILL on another CPU sharing the cache, a compiler
-#: that may refuse it) and valgrind cannot run its AVX-512, which the instruction counts rely on.
-_CFLAGS = ("-O3", "-fPIC", "-shared", "-std=c99")
-
-
 @functools.cache
 def _native_call():
     """The compiled call extension (:func:`whipple_kick.model.rhs_call.module`), or None; looked up once per process."""
-    return rhs_call.module(_compiler())
+    return rhs_call.module(compiler.find())
 
 
 def metadata_layout(L=layouts.BASE):
@@ -72,13 +46,13 @@ def library_path(L=layouts.BASE):
     20-60 s, announced by a :class:`~whipple_kick.errors.PerformanceWarning`). An entry whose metadata is missing or
     records other layouts (states, parameters, outputs) is built again.
     """
-    cc = _compiler()
-    key = L.key + "_" + cache.source_hash(_SOURCES, extra=f"{os.path.basename(cc)} {' '.join(_CFLAGS)} "
+    cc = compiler.find()
+    key = L.key + "_" + cache.source_hash(_SOURCES, extra=f"{os.path.basename(cc)} {' '.join(compiler.MODEL_FLAGS)} "
                                                           f"{L.fingerprint()}")
     name = f"slip_{key}.so"
     def build(tmp):
         from whipple_kick.model.symbolic import slip_build  # SymPy and the derivation: only on a cache miss
-        slip_build.build_library(tmp, key, cc, _CFLAGS, L.part_names, L.delayed_reflex)
+        slip_build.build_library(tmp, key, cc, compiler.MODEL_FLAGS, L.part_names, L.delayed_reflex)
 
     lib_path = cache.build_once(name, build)
     if not _metadata_matches(lib_path.with_suffix(".json"), L):

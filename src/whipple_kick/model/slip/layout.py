@@ -85,7 +85,7 @@ OUT = {n: i for i, n in enumerate(OUTPUT_NAMES)}
 P = {n: i for i, n in enumerate(PARAMETER_NAMES)}
 
 #: Package modules the compiled library is generated from (its cache key hashes them).
-_SOURCES = ("symbols", "parts", "symbolic/derivation", "symbolic/codegen", "magic_formula", "transient", "carcass", "energy",
+_SOURCES = ("compiler", "symbols", "parts", "symbolic/derivation", "symbolic/codegen", "magic_formula", "transient", "carcass", "energy",
             "reflex",
             "slip/__init__", "slip/layout", "slip/compiled", "slip/call", "slip/parameters", "slip/jumps",
             "slip/linear", "symbolic/slip_build")

@@ -21,7 +21,6 @@ skip a pressure-blend set of weight 0; the named outputs
 """
 import functools
 import json
-import subprocess
 import sys
 import warnings
 
@@ -30,8 +29,9 @@ import sympy as sm
 from sympy.printing.c import C99CodePrinter
 
 from whipple_kick import fileio
-from whipple_kick.errors import BuildError, PerformanceWarning
+from whipple_kick.errors import PerformanceWarning
 from whipple_kick.model import cache, carcass, energy, kane, magic_formula, reflex, transient
+from whipple_kick.model import compiler as compilers
 from whipple_kick.model import symbols as S
 import whipple_kick.model.slip.layout as layouts  # the module by its full name, not through the package
 from whipple_kick.model.slip.layout import (
@@ -916,13 +916,6 @@ def build_library(path, key, compiler, flags, part_names=(), delayed_reflex=Fals
     folder = cache.cache_dir()
     src_path = folder / f"slip_{key}.c"
     fileio.write_atomic(src_path, c_source(part_names, delayed_reflex), private=True)   # kept next to the library for inspection
-    proc = subprocess.run([compiler, *flags, "-o", str(path), str(src_path), "-lm"],
-                          capture_output=True, text=True, check=False)
-    if proc.returncode != 0:
-        log = folder / f"slip_{key}.build.log"
-        fileio.write_atomic(log, proc.stdout + proc.stderr, private=True)
-        last = (proc.stderr.strip().splitlines() or ["no output"])[-1]
-        raise BuildError(f"the C compiler {compiler} failed (exit status {proc.returncode}: {last[:200]}); "
-                         f"its output is in {log}; install a working gcc or set CC")
+    compilers.compile_shared(compiler, flags, src_path, path, libraries=("-lm",), log=folder / f"slip_{key}.build.log")
     fileio.write_atomic(folder / f"slip_{key}.json", json.dumps(metadata(key, compiler, flags, layouts.for_parts(part_names, delayed_reflex)), indent=1) + "\n",
                         private=True)
