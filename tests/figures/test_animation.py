@@ -1,4 +1,5 @@
 """The animation: its timeline, what the scene puts where, and the files it writes (read back)."""
+import copy
 import math
 
 import imageio_ffmpeg  # the test extra installs it: the mp4 path is tested, not skipped
@@ -117,30 +118,109 @@ def test_force_arrows_are_the_tyre_forces_at_one_scale(short):
         np.testing.assert_allclose(load[:, 0, 2] - load[:, 1, 2], scene.samples[f"fz_{wheel}"] * scale, atol=1e-12)
 
 
-def test_rider_is_drawn_on_the_bicycle(short):
-    """The Yeadon rider sits where riders.place seats it: hands at the grips, feet at the crank axle.
+def _placed(scene, params, point, k=0):
+    """A benchmark-frame point of the nominal bicycle carried with the rear frame to the scene's frame ``k``."""
+    steady = wk.geometry.evaluate({q: scene.samples[q] for q in wk.geometry.COORDINATES}, params)
+    body = wk.geometry.benchmark_to_body(point, params)
+    return steady.points["rear_wheel_centre"][k] + steady.frames["C"][k] @ body
 
-    At the steady state the mesh point nearest each seating point is within
-    6 cm of it (the solids' radii: measured 3.5 cm hand, 4.7 cm foot) and
-    the seated rider's mass centre lies inside the mesh's bounding box.
+
+def test_rider_is_drawn_on_the_bicycle(short):
+    """The Yeadon rider sits where the run seated it: hands at the grips, feet at the crank axle.
+
+    The summary's posture is riders.place's (the seating points to 1e-12 m). At the steady state the mesh
+    point nearest each seating point is within 6 cm of it (the solids' radii: measured 3.5 cm hand, 4.7 cm
+    foot) and the seated rider's mass centre lies inside the mesh's bounding box.
     """
     bike = wk.bicycles.load("balanceassist_v1")
     rider = wk.riders.yeadon_rider("jason", mass_kg=short.summary["bicycle"]["rider_mass_kg"])
     seated = wk.riders.place(bike, rider)
+    posture = short.summary["bicycle"]["rider_posture"]
+    for name in ("seat", "bottom_bracket", "left_grip"):
+        np.testing.assert_allclose(posture[f"{name}_m"], getattr(seated, name), rtol=0, atol=1e-12)
     scene = animation.build_scene(short, short.trajectory["time"].to_numpy()[:1])
     params = animation._model_parameters(short, None)
-    # Seating points (benchmark frame) carried with the rear frame to the steady state.
-    steady = wk.geometry.evaluate({q: scene.samples[q] for q in wk.geometry.COORDINATES}, params)
-
-    def placed(point):
-        body = wk.geometry.benchmark_to_body(point, params)
-        return steady.points["rear_wheel_centre"][0] + steady.frames["C"][0] @ body
-
     rider_points = np.concatenate([item.points[0] for item in scene.items if item.kind == "hull"])
     for target in (seated.left_grip, seated.left_grip * [1, -1, 1], seated.bottom_bracket):
-        assert np.min(np.linalg.norm(rider_points - placed(target), axis=1)) < 0.06
-    com = placed(seated.com)
+        assert np.min(np.linalg.norm(rider_points - _placed(scene, params, target), axis=1)) < 0.06
+    com = _placed(scene, params, seated.com)
     assert np.all(rider_points.min(axis=0) < com) and np.all(com < rider_points.max(axis=0))
+
+
+def test_the_rider_drawn_is_the_runs_not_seated_again(monkeypatch):
+    """A rider shifted for a rear load share (0.70: about -0.1 m) is drawn where the run had it, from the summary.
+
+    Before, the animation seated the rider again with riders.place, without the shift: the hands were drawn
+    a shift away from the grips the model's rider held. Seating is refused here, and the drawn hands are
+    within 6 cm of the shifted grip (a hand's radius, as above); every point of the rider is drawn the shift
+    ahead of the same posture unshifted (1e-12 m: round-off).
+    """
+    result = simulation.run(simulation.Scenario(fz_n=635.0, rear_load_share=0.70, duration=0.3))
+    shift = result.summary["bicycle"]["rider_shift_m"]
+    assert shift < -0.08
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("the animation seated the rider again")
+    monkeypatch.setattr(wk.riders, "place", refuse)
+    monkeypatch.setattr(wk.riders, "for_load_share", refuse)
+    scene = animation.build_scene(result, result.trajectory["time"].to_numpy()[:1])
+    params = animation._model_parameters(result, None)
+    hands = np.concatenate([item.points[0] for item in scene.items if item.name.endswith("left hand")])
+    grip = np.array(result.summary["bicycle"]["rider_posture"]["left_grip_m"])
+    assert np.min(np.linalg.norm(hands - _placed(scene, params, grip), axis=1)) < 0.06
+    # The same posture without the shift: every point of the rider is drawn the shift further forward.
+    unshifted = copy.deepcopy(result)
+    posture = unshifted.summary["bicycle"]["rider_posture"]
+    for name in ("seat_m", "bottom_bracket_m", "left_grip_m"):
+        posture[name][0] -= shift
+    before = {item.name: item.points[0] for item in animation.build_scene(unshifted, scene.times).items}
+    forward = _placed(scene, params, [1.0, 0.0, 0.0]) - _placed(scene, params, [0.0, 0.0, 0.0])
+    for item in scene.items:
+        if item.kind == "hull":
+            np.testing.assert_allclose(item.points[0] - before[item.name], np.tile(shift * forward, (len(before[item.name]), 1)), atol=1e-12)
+
+
+def test_a_leaning_rider_is_drawn_leaning_with_the_hands_on_the_bar():
+    """rider_body "leaning", arms "on": the upper body turns with the run's lean about the hip axis, the
+    forearms and hands turn with the bar, the legs stay in the rear frame.
+
+    In the rear frame's axes, each upper-body point moves on a circle about the hip axis: its distance from
+    the axis is kept and its chord is 2 r sin(|lean|/2) (to 1e-9 m: round-off), and the head moves to the
+    side the lean is positive to (q11 > 0: lean right, C.y right). The hands keep their place in the front
+    frame (1e-9 m); the legs theirs in the rear frame.
+    """
+    result = simulation.run(simulation.Scenario(rider_body="leaning", arms="on", lqr_model="simulated", duration=1.0))
+    lean = result.trajectory["upper_body_lean"].to_numpy()
+    k = int(np.argmax(np.abs(lean)))
+    assert abs(lean[k]) > math.radians(0.5)
+    times = result.trajectory["time"].to_numpy()[[k, k]]
+    scene = animation.build_scene(result, times)
+    items = {item.name: item.points for item in scene.items}
+    assert {"G chest", "G head", "E left hand", "E right forearm", "C left shank"} <= set(items)
+    assert not any(name.startswith("C chest") for name in items)
+    params = animation._model_parameters(result, None)
+    pose = wk.geometry.evaluate({q: scene.samples[q] for q in wk.geometry.COORDINATES}, params)
+    rot_c, origin_c = pose.frames["C"][0], pose.points["rear_wheel_centre"][0]
+    bodies = {body.frame: body for body in animation._bicycle_bodies(result.scenario, result.summary, params)}
+    body = result.summary["bicycle"]["body"]
+    axis = np.array([math.cos(body["hip_tilt"]), 0.0, -math.sin(body["hip_tilt"])])
+    hinge = np.array([body["lh1"], 0.0, body["lh3"]])
+    for name in ("chest", "head"):
+        drawn = (items[f"G {name}"][0] - origin_c) @ rot_c            # in C's axes
+        rest = bodies["G"].solids[name]
+        radial = lambda p: (p - hinge) - np.outer((p - hinge) @ axis, axis)
+        r = np.linalg.norm(radial(rest), axis=1)
+        np.testing.assert_allclose(np.linalg.norm(radial(drawn), axis=1), r, atol=1e-9)
+        np.testing.assert_allclose(np.linalg.norm(drawn - rest, axis=1), 2 * r * abs(math.sin(lean[k] / 2)),
+                                   atol=1e-9)
+    head_side = np.mean((items["G head"][0] - origin_c) @ rot_c, axis=0)[1] - np.mean(bodies["G"].solids["head"],
+                                                                                        axis=0)[1]
+    assert np.sign(head_side) == np.sign(lean[k])
+    np.testing.assert_allclose((items["C left shank"][0] - origin_c) @ rot_c, bodies["C"].solids["left shank"],
+                               atol=1e-9)
+    rot_e, origin_e = pose.frames["E"][0], pose.points["front_wheel_centre"][0]
+    np.testing.assert_allclose((items["E left hand"][0] - origin_e) @ rot_e, bodies["E"].solids["left hand"],
+                               atol=1e-9)
 
 
 def test_camera_looks_at_its_target():

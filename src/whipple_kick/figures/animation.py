@@ -8,9 +8,11 @@ is installed):
   kinematics (:mod:`whipple_kick.model.geometry`, generated from
   :func:`whipple_kick.model.symbolic.derivation.kinematics`), evaluated at the run's
   coordinates; the wheels are discs in their planes with spokes turning
-  with the wheel angles; the rider is drawn from the Yeadon segments seated
-  by :func:`whipple_kick.library.riders.place` (rigid in the rear frame, as in the
-  model), or, for a preset whose rider is already lumped into the rear
+  with the wheel angles; the rider is drawn from the Yeadon segments in the
+  posture the run seated it in (the summary's ``bicycle.rider_posture``), each
+  segment on the body that carries it in the model (rear frame; the bar for
+  forearms on it; the upper body leaning on the hip with ``rider_body =
+  "leaning"``), or, for a preset whose rider is already lumped into the rear
   frame, as the rear frame's equivalent ellipsoid of inertia;
 * the kick plate (500 x 500 mm, thesis Section 8.3) moves with the run's
   ``plate_y``; the lane follows the steady motion before the kick, so the
@@ -169,7 +171,7 @@ _RIDER_COLOURS = {"P": "#3b3b48", "J1": "#3b3b48", "K1": "#3b3b48", "T": "#2f7fb
 
 
 def _yeadon_segments(human, seat, to_bike):
-    """Mesh points of each Yeadon segment in the bicycle's benchmark frame: {label: (m, 3)}."""
+    """Mesh points of each Yeadon segment in the bicycle's benchmark frame: {segment label: {name: (m, 3)}}."""
     segments = {}
     for segment in human.segments:
         points = []
@@ -190,10 +192,29 @@ def _yeadon_segments(human, seat, to_bike):
         label = segment.label.split(":")[0]
         groups = _SEGMENT_GROUPS.get(label, {label: len(points)})
         start = 0
+        segments[label] = {}
         for name, count in groups.items():
-            segments[name] = seat + np.vstack(points[start:start + count]) @ to_bike.T
+            segments[label][name] = seat + np.vstack(points[start:start + count]) @ to_bike.T
             start += count
     return segments
+
+
+def _segment_frames(bicycle, scenario):
+    """The frame that carries each Yeadon segment in the run's model: {segment label: "C", "E" or "G"}.
+
+    As :func:`whipple_kick.library.riders.seat_with_body` splits the rider (``bicycle`` the summary's section:
+    its ``body`` is set when the rider was split): the legs in the rear frame C; the forearms and hands with
+    the bar E when the arms are on it, else with the upper body; the upper body in G, leaning on the hip,
+    with the trunk part, else in C. A rider not split is rigid in C.
+    """
+    from whipple_kick.library import riders
+
+    if not bicycle.get("body"):
+        return {}
+    spec = scenario.bicycle_spec
+    upper = "G" if spec.leaning else "C"
+    frames = dict.fromkeys(riders.LEG_SEGMENTS, "C") | dict.fromkeys(riders.UPPER_BODY_SEGMENTS, upper)
+    return frames | dict.fromkeys(riders.FOREARM_SEGMENTS, "E" if spec.arms_on_bar else upper)
 
 
 def _inertia_ellipsoid(mass, inertia, vertices=16):
@@ -218,10 +239,11 @@ class Body:
 
     Attributes
     ----------
-    frame : {"C", "E"}
-        Rear frame (with the rider) or front frame.
+    frame : {"C", "E", "G"}
+        Rear frame (with the rider), front frame, or the rider's upper body leaning on the hip (the trunk part).
     lines : dict of str -> ndarray (m, 3)
-        Polylines [m] in body axes from the body's wheel centre.
+        Polylines [m] in body axes from the body's wheel centre (the upper body: the rear frame's axes at
+        zero lean).
     solids : dict of str -> ndarray (m, 3)
         Point clouds [m] of convex bodies, drawn as the outline of their projection.
     """
@@ -232,34 +254,47 @@ class Body:
 
 
 def _bicycle_bodies(scenario, summary, params):
-    """The rear body (frame lines and rider) and the front body (fork and handlebar) in body axes."""
+    """The rear body (frame lines and rider), the front body (fork, handlebar, the forearms on the bar) and the
+    leaning upper body, in body axes.
+
+    The rider is the one the run seated (``summary["bicycle"]["rider_posture"]``: the seating points, its
+    fore-aft shift included, and the joint angles), not seated again here; the frame is the bicycle's own
+    (the posture less the shift, which stands for a fit change: the saddle is drawn at the rider's seat).
+    """
     from whipple_kick.library import bicycleparameters, riders
 
-    bike = bicycleparameters.load_bicycle(scenario.bicycle, scenario.rider)
+    bicycle = summary["bicycle"]
+    posture = bicycle.get("rider_posture")
     to_c = functools.partial(geometry.benchmark_to_body, parameters=params, body="C")
     to_e = functools.partial(geometry.benchmark_to_body, parameters=params, body="E")
     d1, d2, d3 = params["d1"], params["d2"], params["d3"]
     axis_foot_e = np.array([-d3, 0.0, 0.0])          # on the steer axis, from the front wheel centre
-    rear_lines, rear_solids, front_lines = {}, {}, {}
-    if bike.geometry is not None and not bike.includes_rider:
-        mass = summary["bicycle"]["rider_mass_kg"]
-        rider = riders.yeadon_rider(scenario.rider, mass_kg=mass)
-        seated = riders.place(bike, rider)
-        human = rider.human(seated.configuration)
-        for label, pts in _yeadon_segments(human, seated.seat, riders.YEADON_TO_BIKE).items():
-            rear_solids[label] = to_c(pts)
-        g = bike.geometry
-        grip_left = seated.left_grip
+    bodies = {frame: Body(frame, {}, {}) for frame in ("C", "E", "G")}
+    rear_lines, front_lines = bodies["C"].lines, bodies["E"].lines
+    if posture is not None:
+        rider = riders.yeadon_rider(scenario.rider, mass_kg=bicycle["rider_mass_kg"])
+        human = rider.human(dict(posture["configuration_rad"]))
+        seat_pt, grip_left = np.array(posture["seat_m"]), np.array(posture["left_grip_m"])
+        convert = {"C": to_c, "E": to_e, "G": to_c}
+        carriers = _segment_frames(bicycle, scenario)
+        for label, named in _yeadon_segments(human, seat_pt, riders.YEADON_TO_BIKE).items():
+            frame = carriers.get(label, "C")
+            for name, pts in named.items():
+                bodies[frame].solids[name] = convert[frame](pts)
+        g = bicycleparameters.load_bicycle(scenario.bicycle, scenario.rider).geometry
+        frame_shift = np.array([bicycle["rider_shift_m"], 0.0, 0.0])
+        bb, seat = np.array(posture["bottom_bracket_m"]) - frame_shift, seat_pt - frame_shift
         grip_right = grip_left * np.array([1.0, -1.0, 1.0])
         bars = to_e(np.array([grip_left, 0.5 * (grip_left + grip_right), grip_right]))
         # Head-tube top: the point of the steer axis (E.z through the axis foot) nearest the bar centre.
         head_top_e = axis_foot_e + np.dot(bars[1] - axis_foot_e, [0, 0, 1.0]) * np.array([0, 0, 1.0])
-        seat_tube_top = seated.bottom_bracket + g["lst"] * (seated.seat - seated.bottom_bracket) / (g["lst"] + g["lsp"])
-        bb, seat, top = (to_c(p) for p in (seated.bottom_bracket, seated.seat, seat_tube_top))
+        seat_tube_top = bb + g["lst"] * (seat - bb) / (g["lst"] + g["lsp"])
+        bb, seat, top, saddle = (to_c(p) for p in (bb, seat, seat_tube_top, seat_pt))
         # The head tube is rigid in the rear frame: express its top in C (steer 0 at the nominal pose).
         # (The axis foot is d2 along C.z from the steer-axis point, which is d1 along C.x.)
         head_top_c = np.array([d1, 0.0, d2 + head_top_e[2]])
-        rear_lines["frame"] = np.array([[0.0, 0.0, 0.0], bb, seat, top, head_top_c, [d1, 0.0, 0.0], bb])
+        rear_lines["frame"] = np.array([[0.0, 0.0, 0.0], bb, seat, saddle, seat, top, head_top_c, [d1, 0.0, 0.0],
+                                        bb])
         rear_lines["seat stay"] = np.array([[0.0, 0.0, 0.0], top])
         front_lines["fork"] = np.array([[0.0, 0.0, 0.0], axis_foot_e, head_top_e, bars[1]])
         front_lines["handlebar"] = bars[[0, 2]]
@@ -268,19 +303,49 @@ def _bicycle_bodies(scenario, summary, params):
         inertia = np.array([[params["ic11"], 0.0, params["ic31"]], [0.0, params["ic22"], 0.0],
                             [params["ic31"], 0.0, params["ic33"]]])
         centre = np.array([params["l1"], 0.0, params["l2"]])
-        rear_solids["rear frame and rider (lumped)"] = centre + _inertia_ellipsoid(params["mc"], inertia)
+        bodies["C"].solids["rear frame and rider (lumped)"] = centre + _inertia_ellipsoid(params["mc"], inertia)
         head_top_e = axis_foot_e + np.array([0.0, 0.0, -(d2 + 0.25)])
         rear_lines["frame"] = np.array([[0.0, 0.0, 0.0], [d1, 0.0, 0.0], [d1, 0.0, -0.25]])
         front_lines["fork"] = np.array([[0.0, 0.0, 0.0], axis_foot_e, head_top_e])
-    return Body("C", rear_lines, rear_solids), Body("E", front_lines, {})
+    return [body for body in bodies.values() if body.lines or body.solids]
+
+
+def _upper_body_pose(result, times, rear_rotation, rear_origin):
+    """Rotation and origin of the leaning upper body G at ``times``: (n, 3, 3), (n, 3).
+
+    The trunk part's hinge (:data:`whipple_kick.model.parts.TRUNK`): G is the rear frame C turned by the
+    lean q11 (trajectory column ``upper_body_lean``) about the hip axis H.x, which is C.x turned about C.y by
+    ``hip_tilt``, through the hip point (``lh1``, 0, ``lh3``) in C from the rear wheel centre. A point p
+    given in C's axes at zero lean is then at ``origin + rotation @ p``.
+    """
+    body = result.summary["bicycle"]["body"]
+    tilt = body["hip_tilt"]
+    axis = np.array([math.cos(tilt), 0.0, -math.sin(tilt)])    # H.x in C (sympy's orient_axis about C.y)
+    hinge = np.array([body["lh1"], 0.0, body["lh3"]])
+    lean = np.interp(times, result.trajectory["time"].to_numpy(), result.trajectory["upper_body_lean"].to_numpy())
+    cross = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+    turn = (np.eye(3) + np.sin(lean)[:, None, None] * cross
+            + (1.0 - np.cos(lean))[:, None, None] * (cross @ cross))          # Rodrigues: about H.x by q11
+    rotation = rear_rotation @ turn
+    origin = rear_origin + rear_rotation @ hinge - rotation @ hinge
+    return rotation, origin
 
 
 def _model_parameters(result, tyres):
-    """Moore's parameters of the run's bicycle+rider with the tyres' crown radii, by name."""
+    """Moore's parameters of the run's bicycle with the tyres' crown radii, by name.
+
+    With a seated rider the drawing takes only the bicycle's geometry from them (the rider is the summary's
+    posture), so the bicycle's own set serves, without seating the rider again; a preset (rider lumped in)
+    gives the rear frame's inertia the lumped drawing needs, low-inertia change included.
+    """
+    from whipple_kick.library import bicycleparameters
     from whipple_kick.simulate import assembly
 
     scenario = result.scenario
-    moore, _, _ = assembly.build_bicycle(scenario.bicycle_spec)
+    if result.summary["bicycle"].get("rider_posture") is not None:
+        moore = dict(bicycleparameters.load_bicycle(scenario.bicycle, scenario.rider).moore)
+    else:
+        moore, _, _ = assembly.build_bicycle(scenario.bicycle_spec)
     if tyres is None:
         if str(result.summary.get("tyres", {}).get("name", "")).startswith("custom"):
             raise InputError("this run used custom tyre objects: pass the same ones as tyres=(rear, front) "
@@ -441,9 +506,12 @@ def build_scene(result, times, tyres=None, moments=True):
         items.append(Item(f"{wheel} spokes", "tube", np.stack(ends, axis=1), _STYLE["spokes"], width=0.0025,
                           follows=f"{wheel} wheel"))
 
-    rear_body, front_body = _bicycle_bodies(result.scenario, result.summary, params)
-    for body, centre in ((rear_body, "rear_wheel_centre"), (front_body, "front_wheel_centre")):
-        rot, origin = pose.frames[body.frame], pose.points[centre]
+    placed = {"C": (pose.frames["C"], pose.points["rear_wheel_centre"]),
+              "E": (pose.frames["E"], pose.points["front_wheel_centre"])}
+    for body in _bicycle_bodies(result.scenario, result.summary, params):
+        if body.frame not in placed:   # "G": the leaning upper body
+            placed["G"] = _upper_body_pose(result, times, *placed["C"])
+        rot, origin = placed[body.frame]
         for name, pts in body.lines.items():
             world = origin[:, None, :] + np.einsum("nij,mj->nmi", rot, pts)
             colour = _STYLE["front frame"] if body.frame == "E" else _STYLE["rear frame"]

@@ -300,6 +300,18 @@ class SeatedRider:
                 "zB": float(self.com[2]), "IBxx": float(i[0, 0]), "IByy": float(i[1, 1]),
                 "IBzz": float(i[2, 2]), "IBxz": float(i[0, 2])}
 
+    def posture(self):
+        """The seated posture as plain data (what a drawing of the rider needs besides the rider's file and mass).
+
+        The seating points [m] in the benchmark frame (from the rear contact, x forward, y right, z down) and
+        the Yeadon configuration [rad] the seating solved: ``seat_m``, ``bottom_bracket_m``, ``left_grip_m``
+        (the right grip is its mirror in the mid-plane), ``configuration_rad`` ([name, angle] pairs: a list, so
+        that a sweep's table, which takes a summary's scalars, does not get 21 columns of a drawing's input).
+        """
+        return {"seat_m": [float(v) for v in self.seat], "bottom_bracket_m": [float(v) for v in self.bottom_bracket],
+                "left_grip_m": [float(v) for v in self.left_grip],
+                "configuration_rad": [[k, float(v)] for k, v in self.configuration.items()]}
+
 
 def _seating_points(bench, geometry, bike_name):
     """Seat, bottom bracket and left grip in the benchmark frame (x fwd, y right, z down)."""
@@ -521,7 +533,7 @@ def _with_rider(bike, rider, seated, bench, name, how):
                     f"({rider.mass_kg:g} kg, {rider.height_m:.3f} m){how}",
         uncertainties={}, geometry=bike.geometry, tyre_placeholders=bike.tyre_placeholders, defaults=bike.defaults,
         rider={"name": rider.name, "mass_kg": rider.mass_kg, "height_m": rider.height_m,
-               **{f"rider_{k}": v for k, v in seated.benchmark().items()}},
+               **{f"rider_{k}": v for k, v in seated.benchmark().items()}, "posture": seated.posture()},
     )
 
 

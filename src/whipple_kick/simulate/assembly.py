@@ -280,6 +280,9 @@ def _bicycle_setup(spec, _stamp):
             "rider_mass_kg": rider_mass, "static_load_rear_n": rear_n, "static_load_front_n": front_n,
             # The rider's fore-aft shift from the seated posture [m, forward positive]: 0 seated, None for a preset.
             "rider_shift_m": shift, "rear_load_share": rear_n / (rear_n + front_n),
+            # The seated posture the parameters come from (shift included; riders.SeatedRider.posture), so a
+            # drawing shows the rider the run had without seating it again; None for a preset.
+            "rider_posture": None if bike.includes_rider else dict(combined.rider["posture"]),
             "total_mass_kg": sum(float(combined.benchmark[k]) for k in ("mR", "mB", "mH", "mF"))
             + (body["mt"] if body else 0.0), "body": body}
     return moore, design, info
