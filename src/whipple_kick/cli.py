@@ -17,6 +17,7 @@ import sys
 
 import numpy as np
 
+from whipple_kick.simulate import criteria
 from whipple_kick.simulate.criteria import CRITERIA
 
 from . import fileio
@@ -807,9 +808,8 @@ def _recommend(argv):
     p.add_argument("--step", type=_number("kPa"), default=10.0, metavar="KPA",
                    help="step of the --fine grid in kPa (default 10)")
     p.add_argument("--criterion", choices=tuple(k.replace("_", "-") for k in recommend.CRITERIA), default="settling",
-                   help="settling (default): time from which yaw, roll and steer rates all stay within 5 %% "
-                        "of their first peaks; last-peak: the thesis' rule, time of the last yaw-rate peak "
-                        "above 8 %% of the largest")
+                   help="; ".join(f"{k.replace('_', '-')}{' (default)' * (k == 'settling')}: "
+                                  + c.text.replace("%", "%%") for k, c in recommend.CRITERIA.items()))
     p.add_argument("--duration", type=_number("s"), metavar="S",
                    help=f"simulated time after the kick in s (default {DEFAULTS['duration']:g}, at most "
                         f"{MAX_DURATION:g})")
@@ -904,8 +904,9 @@ def _recommend(argv):
 #: The figure ``recommend-pressure --out`` writes into its sweep folder.
 SWEEP_FIGURE = "recommendation.png"
 #: The figures ``recommend-pressure --uncertain --out DIR`` writes into DIR.
-UNCERTAINTY_FIGURES = ("p_best.png", *(f"recovery_{key}.png" for key in CRITERIA),
-                       *(f"paired_{key}.png" for key in CRITERIA), *(f"sobol_{key}.png" for key in CRITERIA))
+UNCERTAINTY_FIGURES = criteria.Listing(lambda: ("p_best.png", *(f"recovery_{key}.png" for key in CRITERIA),
+                                                 *(f"paired_{key}.png" for key in CRITERIA),
+                                                 *(f"sobol_{key}.png" for key in CRITERIA)))
 
 
 def _study_flags_given(args):

@@ -156,7 +156,7 @@ def test_a_failed_case_ranks_after_the_falls_and_the_verdict_says_how_many_faile
     rank = list(np.argsort(wk.recommend._rank(rows, "settling")) + 1)
     assert rank == [4, 3, 1, 2]                    # the failed 300 kPa after the fall at 400 kPa
     rows["rank"] = rank
-    for col in wk.recommend._RECOMMENDATION_COLUMNS:
+    for col in wk.recommend._recommendation_columns():
         rows[col] = rows[col] if col in rows else np.nan
     rows["error"] = ["InputError: a stand-in", None, None, None]
     best, margin, verdict = wk.recommend._verdict(rows, "settling")

@@ -17,7 +17,7 @@ import numpy as np
 
 from whipple_kick.errors import InputError, SimulationError
 from whipple_kick.model import energy, parts, slip
-from whipple_kick.simulate import lsoda, provenance
+from whipple_kick.simulate import criteria, lsoda, provenance
 
 #: Significant digits of trajectory.csv's floats: a relative round-off of at most 5e-13, far below the
 #: integration's own error (rtol 1e-10 by default) and the float32 regression references (~6e-8), and
@@ -364,13 +364,14 @@ _BALANCE_INPUTS = frozenset((*energy.STORED, *energy.SUPPLIED, *energy.DISSIPATE
 
 
 def summary_columns(tyre_transient="carcass"):
-    """The trajectory columns :func:`summarise` reads (the metrics, recovery, peaks, tyre ranges, energy, numerics)."""
+    """The trajectory columns :func:`summarise` reads (the metrics, recovery, peaks, tyre ranges, energy, numerics,
+    and those the declared criteria's functions read, :attr:`whipple_kick.simulate.criteria.Criterion.columns`)."""
     from . import analysis
 
     patch = [] if tyre_transient == "force_lag" else ["slip_patch_rear", "slip_patch_front"]
     return ("time", *analysis.COLUMNS, *RECOVERY_STATES, *PEAK_COLUMNS, *patch, "slip_rear", "slip_front",
             "fz_rear", "fz_front", *[c for c, _ in energy.COLUMNS.values()], *_BALANCE_INPUTS,
-            "holonomic_residual", BALANCE_COLUMN)
+            "holonomic_residual", BALANCE_COLUMN, *(c for k in criteria.CRITERIA.values() for c in k.columns_read))
 
 
 def column_names(tyre_transient="carcass", model=slip.layout.BASE):
@@ -702,6 +703,8 @@ def summarise(scenario, kick, assembly, solution, frame, *, custom_tyres=False) 
         "units": {column: UNITS[column] for column in column_names(scenario.tyre_transient, solution.model)},
         "provenance": provenance.record(provenance.input_files(scenario, custom_tyres)),
     }
+    # The declared criteria the sections above do not report (criteria.summary_section): their values [s].
+    summary["criteria"] = criteria.summary_section(summary, frame)
     return clean(summary)
 
 

@@ -37,7 +37,7 @@ CRITERIA = criteria.CRITERIA
 #: between the best and the second-best pressure below the spread is "no clear optimum". The probability of
 #: each pressure being best over the inputs nothing pins down is the uncertainty study's
 #: (``recommend-pressure --uncertain``, :mod:`whipple_kick.studies.uncertainty`), which uses no fixed spread.
-CRITERION_SPREAD_S = {key: c.spread_s for key, c in CRITERIA.items()}
+CRITERION_SPREAD_S = criteria.attribute("spread_s")
 
 
 def criterion_key(criterion):
@@ -184,11 +184,16 @@ def _verdict(rows, criterion):
     return best, margin, "clear" if margin >= CRITERION_SPREAD_S[criterion] else "no clear optimum"
 
 
-#: Columns of :attr:`Recommendation.table`.
-_RECOMMENDATION_COLUMNS = (
-    "pressure_kpa", "measured", "recovery.time_s", "last_peak_time_s", "recovery.signals.yaw_rate.time_s",
-    "recovery.signals.roll_rate.time_s", "recovery.signals.steer_rate.time_s", "n_peaks",
-    "damping_ratio_1_3", "period_s", "peaks.max_abs_roll_absolute_rad", "fell", "status", "error")
+#: Columns of :attr:`Recommendation.table` after the criteria's (:func:`_recommendation_columns`).
+_RESPONSE_COLUMNS = (
+    "recovery.signals.yaw_rate.time_s", "recovery.signals.roll_rate.time_s", "recovery.signals.steer_rate.time_s",
+    "n_peaks", "damping_ratio_1_3", "period_s", "peaks.max_abs_roll_absolute_rad", "fell", "status", "error")
+
+
+def _recommendation_columns():
+    """Columns of :attr:`Recommendation.table`: the pressure, whether measured, each declared criterion's, the
+    response's."""
+    return ("pressure_kpa", "measured", *dict.fromkeys(c.column for c in CRITERIA.values()), *_RESPONSE_COLUMNS)
 
 
 def recommend_pressures(loads, tyre="T03", pressures=None, fine=False, step_kpa=10.0, base=None,
@@ -219,10 +224,11 @@ def recommend_pressures(loads, tyre="T03", pressures=None, fine=False, step_kpa=
     for fz in loads:
         rows = table[table["fz_n"] == fz].copy()
         rows["measured"] = rows["pressure_kpa"].isin(measured)
-        for col in _RECOMMENDATION_COLUMNS:
+        columns = _recommendation_columns()
+        for col in columns:
             if col not in rows:   # every case failed: no result columns at all
                 rows[col] = np.nan
-        rows = rows[list(_RECOMMENDATION_COLUMNS)].sort_values("pressure_kpa").reset_index(drop=True)
+        rows = rows[list(columns)].sort_values("pressure_kpa").reset_index(drop=True)
         rows["rank"] = np.argsort(_rank(rows, criterion)) + 1
         best, margin, verdict = _verdict(rows, criterion)
         best_measured = _verdict(rows[rows["measured"]].reset_index(drop=True), criterion)[0]
