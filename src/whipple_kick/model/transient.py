@@ -48,20 +48,84 @@ tyre's lateral force on the bicycle (plate part excluded) splits as
 ``P_carcass = F (V' - vsy)``. docs/validation.md gives the argument and the
 measured sizes.
 """
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
 from . import symbols as S
 
-#: Transient forms, by name; the compiled model's ``tyre_transient`` parameter is the index.
-TRANSIENTS = ("contact_patch", "slip_lag", "force_lag", "carcass")
-DEFAULT_TRANSIENT = "carcass"
-#: Tyre states in their fixed slots (rear, front, rear, front), per form.
-STATES = {
-    "contact_patch": ("slip_patch_r", "slip_patch_f", "camber_patch_r", "camber_patch_f"),
-    "slip_lag": ("slip_patch_r", "slip_patch_f", "camber_patch_r", "camber_patch_f"),
-    "force_lag": ("fyr", "fyf", "mzr", "mzf"),
-    "carcass": ("carcass_y_r", "carcass_y_f", "camber_patch_r", "camber_patch_f"),
-}
-#: Forms whose tyre block is a SymPy expression (:func:`tyre_block`); the carcass is written in C and Python.
-SYMBOLIC = ("contact_patch", "slip_lag", "force_lag")
+
+@dataclass(frozen=True)
+class Form:
+    """One transient form, declared once (:func:`declare`): what the rest of the package reads of it.
+
+    Attributes
+    ----------
+    name : str
+        The ``tyre_transient`` value; the compiled model's parameter is its index in :data:`TRANSIENTS`.
+    description : str
+        What it is, in a phrase (the scenario's help and documentation).
+    states : tuple of str
+        Names of its four tyre states in the fixed slots (rear, front, rear, front).
+    wheel : callable or None
+        Its tyre block for one wheel as SymPy expressions (:func:`tyre_block` calls it; see
+        :func:`_force_lag` for the arguments and results); None for a form written in C and Python
+        (the carcass, :mod:`whipple_kick.model.carcass`).
+    scales : tuple of float
+        Typical size of each state (1 for an angle [rad]; 100 for a force [N]; 1e-2 for a carcass deflection
+        [m]): the compiled Jacobian's difference steps follow it, and the integrator's tolerances and the
+        linearisation's steps follow it where it is above an angle's.
+    steady_outputs : tuple of str or None
+        The model outputs each state equals in a steady motion (its relaxed value); None: the form sets its
+        own (the carcass, whose stiffness comes from the steady loads:
+        :func:`whipple_kick.simulate.steady.start_state`).
+    columns : tuple
+        Its trajectory columns ``(column, "state" or "output", name in the model, unit)``.
+    """
+
+    name: str
+    description: str
+    states: tuple
+    wheel: Callable | None = None
+    scales: tuple = (1.0, 1.0, 1.0, 1.0)
+    steady_outputs: tuple | None = None
+    columns: tuple = field(default=())
+
+
+#: Every declared form by name, in declaration order (:func:`declare`).
+FORMS: dict = {}
+
+
+def declare(form):
+    """Add ``form`` to :data:`FORMS` (its index is its place there) and return it."""
+    if len(form.states) != 4 or len(form.scales) != 4:
+        raise ValueError(f"transient form {form.name!r}: four states and four scales (rear, front, rear, front)")
+    if form.wheel is None and any(f.wheel is None for f in FORMS.values() if f.name != form.name):
+        # The generated C dispatches the SymPy forms by index and leaves the rest to the carcass' C block.
+        raise ValueError(f"transient form {form.name!r} has no SymPy block: there is one form written in C (the "
+                         "carcass), the rest need their wheel function")
+    FORMS[form.name] = form
+    return form
+
+
+def transients():
+    """Names of the declared forms, in the compiled model's order (its ``tyre_transient`` index)."""
+    return tuple(FORMS)
+
+
+def fingerprint():
+    """The declared forms and their functions' source, hashed (part of the generated code's cache key).
+
+    This module's own source is hashed with the others the model is generated from; this adds a form
+    declared elsewhere (its declaration and its own function's source, not of helpers it calls).
+    """
+    import hashlib
+    import inspect
+
+    text = repr([(f.name, f.states, f.scales, f.steady_outputs, f.columns) for f in FORMS.values()])
+    text += "".join(inspect.getsource(f.wheel) for f in FORMS.values() if f.wheel is not None)
+    return hashlib.sha256(text.encode()).hexdigest()[:12]
+
+
 #: Floor of the secant ratio in the relaxation length [-]. A numerical floor
 #: only: the ratio of a curve that keeps opposing the slip stays above it
 #: (T03 table7_9, 400 kPa, 635 N: 0.03 at 90 deg); it acts where an
@@ -79,9 +143,9 @@ FZ_SHAPE_FLOOR = 1.0
 def check(name):
     """Index of the transient form ``name``; ``InputError`` naming the choices otherwise."""
     from whipple_kick.errors import InputError
-    if name not in TRANSIENTS:
-        raise InputError(f"tyre transient {name!r} is unknown; choose one of {', '.join(TRANSIENTS)}")
-    return TRANSIENTS.index(name)
+    if name not in FORMS:
+        raise InputError(f"tyre transient {name!r} is unknown; choose one of {', '.join(FORMS)}")
+    return transients().index(name)
 
 
 def tyre_block(name, curves, sigma0):
@@ -117,38 +181,106 @@ def tyre_block(name, curves, sigma0):
     w0 = slide = 0
     for k, wheel in enumerate("rf"):
         vsy, vx, camber, fz = S.syms([f"vsy_{wheel}", f"vx_{wheel}", f"camber_{wheel}", f"fz_{wheel}"])
-        speed = sm.Abs(vx)
-        first, second = states[k], states[k + 2]
-        if name == "force_lag":
-            slip = sm.atan2(vsy, speed)
-            force, moment = first, second
-            rates[k] = speed / sigma0[wheel] * (curves["fy"](wheel, slip, camber, fz) - first)
-            rates[k + 2] = speed / sigma0[wheel] * (curves["mz"](wheel, slip, camber, fz) - second)
-            force0 = curves["fy"](wheel, 0, camber, fz)
-            patch_speed = vsy
-            sigma = sigma0[wheel]
-            out[f"P_carcass_{wheel}"] = sm.S.Zero
-            out[f"patch_slip_{wheel}"] = slip
-        else:
-            slip, patch_camber = first, second
-            force = curves["fy"](wheel, slip, patch_camber, fz)
-            moment = curves["mz"](wheel, slip, patch_camber, fz)
-            if name == "contact_patch":
-                ratio = curves["secant"](wheel, slip, sm.Max(fz, FZ_SHAPE_FLOOR))
-                sigma = sigma0[wheel] * sm.Max(ratio, G_MIN)
-            else:
-                sigma = sigma0[wheel]
-            rates[k] = (vsy * sm.cos(slip)**2 - speed * sm.sin(slip) * sm.cos(slip)) / sigma
-            rates[k + 2] = speed * (camber - patch_camber) / sigma
-            force0 = curves["fy"](wheel, 0, patch_camber, fz)
-            patch_speed = speed * sm.tan(slip)
-            out[f"P_carcass_{wheel}"] = force * (patch_speed - vsy)
-            out[f"patch_slip_{wheel}"] = slip
-        out[f"Fy_{wheel}"], out[f"Mz_{wheel}"] = force, moment
-        out[f"sigma_{wheel}"] = sigma
-        w0 += force0 * patch_speed
-        slide += -(force - force0) * patch_speed
+        b = FORMS[name].wheel(wheel, states[k], states[k + 2], vsy, sm.Abs(vx), camber, fz, curves, sigma0[wheel])
+        rates[k], rates[k + 2] = b["rates"]
+        out[f"P_carcass_{wheel}"] = b["P_carcass"]
+        out[f"patch_slip_{wheel}"] = b["patch_slip"]
+        out[f"Fy_{wheel}"], out[f"Mz_{wheel}"] = b["force"], b["moment"]
+        out[f"sigma_{wheel}"] = b["sigma"]
+        w0 += b["force0"] * b["patch_speed"]
+        slide += -(b["force"] - b["force0"]) * b["patch_speed"]
     out["rates"] = rates
     out["W0"], out["D_slide"] = w0, slide
     out["D_carcass"] = sm.S.Zero
     return out
+
+
+# ------------------------------------------------------------------ the forms
+
+def _force_lag(wheel, first, second, vsy, speed, camber, fz, curves, sigma0):
+    """The thesis' lagged force and moment of one wheel (its states are the applied loads).
+
+    Parameters
+    ----------
+    wheel : {"r", "f"}
+    first, second : sympy.Symbol
+        The wheel's two states (slots k and k + 2).
+    vsy, speed, camber, fz : sympy.Expr
+        Lateral sliding velocity [m/s], rolling speed ``|vx|`` [m/s], camber [rad], normal load [N].
+    curves : mapping
+        As :func:`tyre_block`'s.
+    sigma0 : sympy.Symbol
+        Relaxation length at small slip [m].
+
+    Returns
+    -------
+    dict
+        ``force``, ``moment`` (applied), ``rates`` (of ``first`` and ``second``), ``force0`` (zero-slip force),
+        ``patch_speed`` (the patch's sliding velocity), ``sigma`` (relaxation length in use), ``patch_slip``
+        (the slip the steady curves are evaluated at), ``P_carcass`` (power into the carcass).
+    """
+    import sympy as sm
+
+    slip = sm.atan2(vsy, speed)
+    return {"force": first, "moment": second,
+            "rates": (speed / sigma0 * (curves["fy"](wheel, slip, camber, fz) - first),
+                      speed / sigma0 * (curves["mz"](wheel, slip, camber, fz) - second)),
+            "force0": curves["fy"](wheel, 0, camber, fz), "patch_speed": vsy, "sigma": sigma0,
+            "patch_slip": slip, "P_carcass": sm.S.Zero}
+
+
+def _patch(wheel, first, second, vsy, speed, camber, fz, curves, sigma, slip_dependent):
+    """The contact patch's lagged slip and camber (the contact forms), with the relaxation length ``sigma``."""
+    import sympy as sm
+
+    slip, patch_camber = first, second
+    force = curves["fy"](wheel, slip, patch_camber, fz)
+    if slip_dependent:
+        ratio = curves["secant"](wheel, slip, sm.Max(fz, FZ_SHAPE_FLOOR))
+        sigma = sigma * sm.Max(ratio, G_MIN)
+    patch_speed = speed * sm.tan(slip)
+    return {"force": force, "moment": curves["mz"](wheel, slip, patch_camber, fz),
+            "rates": ((vsy * sm.cos(slip)**2 - speed * sm.sin(slip) * sm.cos(slip)) / sigma,
+                      speed * (camber - patch_camber) / sigma),
+            "force0": curves["fy"](wheel, 0, patch_camber, fz), "patch_speed": patch_speed, "sigma": sigma,
+            "patch_slip": slip, "P_carcass": force * (patch_speed - vsy)}
+
+
+def _contact_patch(wheel, first, second, vsy, speed, camber, fz, curves, sigma0):
+    """Lagged patch slip and camber, the relaxation length shortened by the secant ratio (as :func:`_force_lag`)."""
+    return _patch(wheel, first, second, vsy, speed, camber, fz, curves, sigma0, slip_dependent=True)
+
+
+def _slip_lag(wheel, first, second, vsy, speed, camber, fz, curves, sigma0):
+    """Lagged patch slip and camber with a constant relaxation length (as :func:`_force_lag`)."""
+    return _patch(wheel, first, second, vsy, speed, camber, fz, curves, sigma0, slip_dependent=False)
+
+
+#: Trajectory columns of a form with a contact patch: its slip (an output: the state itself) and camber.
+_PATCH_COLUMNS = (("slip_patch_rear", "output", "patch_slip_r", "rad"),
+                  ("slip_patch_front", "output", "patch_slip_f", "rad"),
+                  ("camber_patch_rear", "state", "camber_patch_r", "rad"),
+                  ("camber_patch_front", "state", "camber_patch_f", "rad"))
+_PATCH_STATES = ("slip_patch_r", "slip_patch_f", "camber_patch_r", "camber_patch_f")
+_KINEMATIC = ("slip_r", "slip_f", "camber_r", "camber_f")
+
+declare(Form("contact_patch", "lagged patch slip and camber with a slip-dependent relaxation length "
+                              "(friction-limited, not passive under load changes)",
+             _PATCH_STATES, _contact_patch, steady_outputs=_KINEMATIC, columns=_PATCH_COLUMNS))
+declare(Form("slip_lag", "the same with a constant relaxation length", _PATCH_STATES, _slip_lag,
+             steady_outputs=_KINEMATIC, columns=_PATCH_COLUMNS))
+declare(Form("force_lag", "the thesis' lagged force and moment", ("fyr", "fyf", "mzr", "mzf"), _force_lag,
+             scales=(1e2, 1e2, 1e2, 1e2), steady_outputs=("fy_ss_r", "fy_ss_f", "mz_ss_r", "mz_ss_f")))
+declare(Form("carcass", "a lateral carcass spring in series with a sliding contact patch (passive and "
+                        "friction-limited whatever the load does; the force lag at small slip)",
+             ("carcass_y_r", "carcass_y_f", "camber_patch_r", "camber_patch_f"), scales=(1e-2, 1e-2, 1.0, 1.0),
+             columns=(*_PATCH_COLUMNS, ("carcass_deflection_rear", "state", "carcass_y_r", "m"),
+                      ("carcass_deflection_front", "state", "carcass_y_f", "m"))))
+
+#: Transient forms, by name; the compiled model's ``tyre_transient`` parameter is the index.
+TRANSIENTS = transients()
+DEFAULT_TRANSIENT = "carcass"
+#: Tyre states in their fixed slots (rear, front, rear, front), per form.
+STATES = {name: form.states for name, form in FORMS.items()}
+#: Forms whose tyre block is a SymPy expression (:func:`tyre_block`); the carcass is written in C and Python.
+SYMBOLIC = tuple(name for name, form in FORMS.items() if form.wheel is not None)

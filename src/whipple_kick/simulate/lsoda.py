@@ -29,7 +29,7 @@ import numpy as np
 from scipy.integrate import LSODA, odeint
 
 from whipple_kick.model import slip
-from whipple_kick.model.transient import DEFAULT_TRANSIENT
+from whipple_kick.model.transient import DEFAULT_TRANSIENT, FORMS
 
 
 @dataclass
@@ -97,17 +97,18 @@ def default_atol(rtol, transient=DEFAULT_TRANSIENT, n_states=len(slip.STATE_NAME
     """Absolute tolerances per state, scaled to each state's typical size.
 
     Angles and displacements (~1e-2..1) and speeds (~1) get ``rtol`` x 1e-2
-    of their scale, the compressions x 1e-4; the tyre slots are angles too
-    except in the ``force_lag`` form, whose force states (~100 N) get
+    of their scale, the compressions x 1e-4; the tyre slots by their form's
+    declared sizes (:attr:`whipple_kick.model.transient.Form.scales`), never
+    finer than an angle's: the ``force_lag`` form's forces (~100 N) get
     ``rtol``; the energy quadratures :data:`QUADRATURE_ATOL`. ``n_states``:
     the model's state count (the parts' states, angles and rates, follow the base model's).
     """
     atol = np.full(n_states, rtol * 1e-2)
     for name in ("q9", "q10", "u9", "u10"):
         atol[slip.X[name]] = rtol * 1e-4   # compressions are millimetres
-    if transient == "force_lag":
-        for name in slip.TYRE_STATES:
-            atol[slip.X[name]] = rtol
+    # The tyre slots by their form's declared sizes, never finer than an angle's (a force ~100 N gets rtol).
+    for name, scale in zip(slip.PATCH_STATES, FORMS[transient].scales, strict=True):
+        atol[slip.X[name]] = rtol * (1e-2 * max(scale, 1.0))
     for name in slip.QUADRATURE_STATES:
         atol[slip.X[name]] = QUADRATURE_ATOL
     return atol

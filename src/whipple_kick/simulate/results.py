@@ -16,7 +16,7 @@ import math
 import numpy as np
 
 from whipple_kick.errors import InputError, SimulationError
-from whipple_kick.model import energy, parts, slip
+from whipple_kick.model import energy, parts, slip, transient
 from whipple_kick.simulate import criteria, lsoda, provenance
 
 #: Significant digits of trajectory.csv's floats: a relative round-off of at most 5e-13, far below the
@@ -62,15 +62,19 @@ OUTPUT_COLUMNS = {
 #: and its patch slip as the output ``patch_slip_*``): state -> column.
 PATCH_STATE_COLUMNS = {"slip_patch_r": "slip_patch_rear", "slip_patch_f": "slip_patch_front",
                        "camber_patch_r": "camber_patch_rear", "camber_patch_f": "camber_patch_front"}
-#: The slip the steady curves are evaluated at (contact-patch and carcass forms): output -> column.
-PATCH_OUTPUT_COLUMNS = {"patch_slip_r": "slip_patch_rear", "patch_slip_f": "slip_patch_front"}
+#: The slip the steady curves are evaluated at (contact-patch and carcass forms): output -> column (as the forms
+#: declare their columns, :attr:`whipple_kick.model.transient.Form.columns`).
+PATCH_OUTPUT_COLUMNS = {name: col for col, source, name, _ in transient.FORMS["contact_patch"].columns
+                        if source == "output"}
 #: The carcass tyre's deflection states (transient carcass only): state -> column.
-CARCASS_STATE_COLUMNS = {"carcass_y_r": "carcass_deflection_rear", "carcass_y_f": "carcass_deflection_front"}
+CARCASS_STATE_COLUMNS = {name: col for col, source, name, _ in transient.FORMS["carcass"].columns
+                         if name.startswith("carcass_y")}
 #: Energy balance residual column [J] (:func:`whipple_kick.model.energy.balance_residual`).
 BALANCE_COLUMN = "energy_balance_residual"
 #: Unit of every trajectory column (from the symbol registry and :data:`whipple_kick.model.slip.OUTPUTS`).
 UNITS = {"time": "s", **dict(COORDINATE_COLUMNS.values()), **dict(SPEED_COLUMNS.values()), **HEADING_COLUMNS,
-         **dict.fromkeys(PATCH_STATE_COLUMNS.values(), "rad"), **dict.fromkeys(CARCASS_STATE_COLUMNS.values(), "m"),
+         **dict.fromkeys(PATCH_STATE_COLUMNS.values(), "rad"),
+         **{col: unit for form in transient.FORMS.values() for col, _, _, unit in form.columns},
          **{c: slip.OUTPUTS[o][0] for o, c in {**APPLIED_COLUMNS, **OUTPUT_COLUMNS}.items()},
          **dict(PART_COLUMNS.values()),
          **{o: unit for part in parts.REGISTRY.values() for o, (unit, _) in part.outputs.items()},
@@ -368,7 +372,9 @@ def summary_columns(tyre_transient="carcass"):
     and those the declared criteria's functions read, :attr:`whipple_kick.simulate.criteria.Criterion.columns`)."""
     from . import analysis
 
-    patch = [] if tyre_transient == "force_lag" else ["slip_patch_rear", "slip_patch_front"]
+    # The patch slip (the tyre extrapolation's), where the form has it among its declared columns.
+    declared = {col for col, _, _, _ in transient.FORMS[tyre_transient].columns}
+    patch = [c for c in ("slip_patch_rear", "slip_patch_front") if c in declared]
     return ("time", *analysis.COLUMNS, *RECOVERY_STATES, *PEAK_COLUMNS, *patch, "slip_rear", "slip_front",
             "fz_rear", "fz_front", *[c for c, _ in energy.COLUMNS.values()], *_BALANCE_INPUTS,
             "holonomic_residual", BALANCE_COLUMN, *(c for k in criteria.CRITERIA.values() for c in k.columns_read))
@@ -396,12 +402,9 @@ def frame_layout(tyre_transient="carcass", model=slip.layout.BASE):
     layout += [(model.COLUMNS[u][0], "state", model.X[u]) for p in model.parts for u in p.speeds]
     layout += [(name, "derived", None) for name in HEADING_COLUMNS]
     layout += [(name, "output", slip.OUT[o]) for o, name in APPLIED_COLUMNS.items()]
-    if tyre_transient != "force_lag":
-        layout += [(name, "output", slip.OUT[o]) for o, name in PATCH_OUTPUT_COLUMNS.items()]   # the state itself in the contact forms
-        layout += [("camber_patch_rear", "state", slip.X["camber_patch_r"]),
-                   ("camber_patch_front", "state", slip.X["camber_patch_f"])]
-    if tyre_transient == "carcass":
-        layout += [(name, "state", slip.X[state]) for state, name in CARCASS_STATE_COLUMNS.items()]
+    # The tyre form's own columns (the patch slip is an output: the state itself in the contact forms).
+    layout += [(col, source, (slip.X if source == "state" else slip.OUT)[name])
+               for col, source, name, _ in transient.FORMS[tyre_transient].columns]
     layout += [(name, "output", slip.OUT[o]) for o, name in OUTPUT_COLUMNS.items()]
     layout += [(o, "output", model.OUT[o]) for o in model.PART_OUTPUTS]
     layout += [(name, "state", slip.X[state]) for state, (name, _) in energy.COLUMNS.items()]

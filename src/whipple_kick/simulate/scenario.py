@@ -366,17 +366,14 @@ class Scenario:
         group="numerics")
     tyre_transient: str = setting(
         transient.DEFAULT_TRANSIENT,
-        "How the tyre forces build up (:mod:`whipple_kick.model.transient`): a lateral carcass spring in series "
-        "with a sliding contact patch (default: passive and friction-limited whatever the load does; the force "
-        "lag at small slip, :mod:`whipple_kick.model.carcass`); lagged contact-patch slip and camber with a "
-        "slip-dependent relaxation length (friction-limited, not passive under load changes); the same with a "
-        "constant relaxation length; or the thesis' lagged force.",
+        "How the tyre forces build up (:mod:`whipple_kick.model.transient`, each form as declared there): "
+        + "; ".join(f"{name}{' (default)' * (name == transient.DEFAULT_TRANSIENT)}: {form.description}"
+                    for name, form in transient.FORMS.items()) + ".",
         choices=TYRE_TRANSIENTS, label="tyre transient", views=("model", "design"), commands=EVERY_COMMAND,
         section=_TYRES,
-        help="how the tyre forces build up: carcass (default: a lateral carcass spring in series with a sliding "
-             "contact patch; passive, friction-limited, the force lag at small slip), contact_patch (lagged patch "
-             "slip and camber), slip_lag (the same with a constant relaxation length) or force_lag (the thesis' "
-             "lagged force)")
+        help="how the tyre forces build up: " + "; ".join(
+            f"{name}{' (default)' * (name == transient.DEFAULT_TRANSIENT)}: {form.description}"
+            for name, form in transient.FORMS.items()))
     carcass_sliding: str = setting(
         carcass.DEFAULT_SLIDING,
         "The carcass tyre's friction limit once the patch slides past the curve's peak: the peak itself "

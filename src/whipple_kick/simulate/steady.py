@@ -55,7 +55,7 @@ import math
 import numpy as np
 
 from whipple_kick.errors import InputError
-from whipple_kick.model import reflex, slip
+from whipple_kick.model import reflex, slip, transient
 from whipple_kick.model import symbols as S
 
 #: Leans [deg] of the steady turns tried when the direct solve fails, smallest first.
@@ -514,7 +514,8 @@ def _steady_tyre_states(rhs, x):
     if rhs.layout.REFLEX_STATES:
         x[[rhs.layout.X[n] for n in rhs.layout.REFLEX_STATES]] = reflex.steady_state(
             out[slip.OUT["reflex_input"]], rhs.p[slip.P["reflex_delay"]])
-    if form == "carcass":
+    outputs = transient.FORMS[form].steady_outputs
+    if outputs is None:   # the form sets its own: the carcass (the only one), its stiffness from the loads
         stiffness = (carcass_stiffness(rhs, out[slip.OUT["fz_r"]], out[slip.OUT["fz_f"]])
                      * rhs.p[slip.P["carcass_stiffness_scale"]])
         rhs.p[slip.P["ccr"]], rhs.p[slip.P["ccf"]] = stiffness
@@ -525,9 +526,7 @@ def _steady_tyre_states(rhs, x):
             x[slip.X[f"camber_patch_{wheel}"]] = out[slip.OUT[f"camber_{wheel}"]]
             x[slip.X[f"E_carcass_{wheel}"]] = 0.5 * c * y * y
         return x
-    names = (("fy_ss_r", "fy_ss_f", "mz_ss_r", "mz_ss_f") if form == "force_lag"
-             else ("slip_r", "slip_f", "camber_r", "camber_f"))
-    for slot, out_name in zip(slip.PATCH_STATES, names, strict=True):
+    for slot, out_name in zip(slip.PATCH_STATES, outputs, strict=True):
         x[slip.X[slot]] = out[slip.OUT[out_name]]
     return x
 

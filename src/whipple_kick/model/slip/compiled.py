@@ -8,7 +8,7 @@ import functools
 import json
 import os
 
-from whipple_kick.model import cache, compiler, rhs_call
+from whipple_kick.model import cache, compiler, rhs_call, transient
 import whipple_kick.model.slip.layout as layouts  # the module by its full name, not through the package
 
 from .layout import _SOURCES
@@ -48,7 +48,7 @@ def library_path(L=layouts.BASE):
     """
     cc = compiler.find()
     key = L.key + "_" + cache.source_hash(_SOURCES, extra=f"{os.path.basename(cc)} {' '.join(compiler.MODEL_FLAGS)} "
-                                                          f"{L.fingerprint()}")
+                                                          f"{L.fingerprint()} forms {transient.fingerprint()}")
     name = f"slip_{key}.so"
     def build(tmp):
         from whipple_kick.model.symbolic import slip_build  # SymPy and the derivation: only on a cache miss

@@ -79,8 +79,9 @@ OUTPUTS = {
 OUTPUT_NAMES = SPEEDS + tuple(OUTPUTS)
 PARAMETER_NAMES = S.SLIP_CONSTANTS
 X = {n: i for i, n in enumerate(STATE_NAMES)}
-X.update({n: X[m] for n, m in zip(TYRE_STATES, PATCH_STATES, strict=True)})
-X.update({n: X[m] for n, m in zip(transient.STATES["carcass"], PATCH_STATES, strict=True)})
+# Every declared form's state names are aliases of the slots (the thesis' force states, the carcass deflections).
+for _form in transient.FORMS.values():
+    X.update({n: X[m] for n, m in zip(_form.states, PATCH_STATES, strict=True)})
 OUT = {n: i for i, n in enumerate(OUTPUT_NAMES)}
 P = {n: i for i, n in enumerate(PARAMETER_NAMES)}
 

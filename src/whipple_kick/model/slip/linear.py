@@ -13,7 +13,6 @@ from .layout import (
     PATCH_STATES,
     SPEEDS,
     STATE_NAMES,
-    TYRE_STATES,
     P,
     X,
     tyre_state_names,
@@ -130,11 +129,12 @@ def linearize(rhs, x, step=1e-7, t=0.0, columns=None):
     x = solve_pitch(rhs, x)   # once for the reference; again only when a coordinate is perturbed
     columns = range(z0.size) if columns is None else list(columns)
     J = np.empty((z0.size, len(columns)))
-    # Tyre force states (force_lag) are ~100 N: a step 100 times larger.
-    force_scale = 1e2 if rhs.transient == "force_lag" else 1.0
+    # The tyre slots by their form's declared sizes, never below an angle's (force_lag's ~100 N: 100 times larger).
+    slot_scale = {n: max(scale, 1.0) for n, scale in zip(PATCH_STATES, transient.FORMS[rhs.transient].scales,
+                                                           strict=True)}
     for col, j in enumerate(columns):
         name = LINEAR_STATES[j]
-        h = step * max(1.0, abs(z0[j])) * (force_scale if name in PATCH_STATES else 1.0)
+        h = step * max(1.0, abs(z0[j])) * slot_scale.get(name, 1.0)
         zp, zm = z0.copy(), z0.copy()
         zp[j] += h
         zm[j] -= h
@@ -153,8 +153,8 @@ HOLONOMIC_ROW = 2
 def _difference_scales(form, n_states=len(STATE_NAMES)):
     """Typical size of each state for the C Jacobian's steps ``1.5e-8 max(|x_j|, scale_j)``.
 
-    Angles [rad] and speeds [m/s, rad/s] 1, compressions 1e-3 m, the
-    force-lag states 100 (N, N m). Steps about 1.5e-8 of these keep forward
+    Angles [rad] and speeds [m/s, rad/s] 1, compressions 1e-3 m, the tyre
+    slots their form's declared sizes (the force-lag states 100 N, N m). Steps about 1.5e-8 of these keep forward
     differences at ~1e-7 relative (round-off ~eps/step times the terms'
     size, truncation ~step/2 times the curvature), and the compression's
     step stays far below a tyre's static compression even at 1e10 N/m
@@ -165,10 +165,9 @@ def _difference_scales(form, n_states=len(STATE_NAMES)):
     scale = np.ones(n_states)
     for name in ("q9", "q10"):
         scale[X[name]] = 1e-3
-    if form == "force_lag":
-        scale[[X[s] for s in TYRE_STATES]] = 1e2
-    if form == "carcass":   # deflections ~1e-2 m at the friction limit
-        scale[[X["carcass_y_r"], X["carcass_y_f"]]] = 1e-2
+    # The tyre slots by their form's declared sizes (force_lag 100 N; the carcass' deflections ~1e-2 m at the
+    # friction limit).
+    scale[[X[s] for s in PATCH_STATES]] = transient.FORMS[form].scales
     scale.flags.writeable = False
     return scale
 

@@ -727,7 +727,7 @@ def numpy_source(part_names=()):
 def numpy_module(part_names=()):
     """The generated NumPy oracle module of the model with ``part_names`` (cached like the C library)."""
     L = layouts.for_parts(part_names)
-    key = cache.source_hash(_SOURCES, extra=f"numpy {L.fingerprint()}")
+    key = cache.source_hash(_SOURCES, extra=f"numpy {L.fingerprint()} forms {transient.fingerprint()}")
     path = cache.build_once(f"slip_numpy_{L.key}_{key}.py", lambda tmp: tmp.write_text(numpy_source(part_names)))
     return cache.load_module(path, f"whipple_kick_generated_slip_{L.key.replace('+', '_')}_{key}")
 
@@ -756,7 +756,7 @@ def numpy_rhs(t, x, p, with_outputs=False, part_names=()):
         t_reflex = reflex.output(z, r_in, tau)
         M, f0, G, b, kin = mod.stage2([t], q, u, [t_reflex], p)
         branches = {"r": {}, "f": {}}   # each wheel's curve scanned once per camber (block and limit share it)
-        block = (_carcass_block(kin, s, p, branches) if name == "carcass"
+        block = (_carcass_block(kin, s, p, branches) if transient.FORMS[name].wheel is None
                  else getattr(mod, f"tyre_{name}")([t], kin, s, p)[0])
         applied = block[:4]
         f = f0 + G @ applied
