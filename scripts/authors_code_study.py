@@ -187,8 +187,9 @@ def _parameters(scenario):
     moore, design, _ = wk.assembly.build_bicycle(scenario.bicycle_spec)
     rear, front, _ = wk.assembly.build_tyres(scenario.tyre_spec)
     gains, _ = wk.assembly.controller_gains(scenario.gains_spec, design)
-    return slip.model_parameters(moore, rear, front, gains=gains, tyre_transient=scenario.tyre_transient,
-                                 reverse_camber=scenario.camber_sign == "reversed", slip_speed=scenario.slip_speed)
+    return slip.model_parameters(moore, rear, front, slip.ModelOptions(tyre_transient=scenario.tyre_transient,
+                                                                   camber_sign=scenario.camber_sign,
+                                                                   slip_speed=scenario.slip_speed), gains=gains)
 
 
 def poles():

@@ -179,7 +179,8 @@ def bench_transient(repeats):
     fast = {}
     base = _base_case()
     for form in forms:
-        params = dict(base.params, tyre_transient=float(wk.transient.TRANSIENTS.index(form)))
+        params = slip.Parameters(slip.Model(base.params.model.parts, base.params.model.delayed_reflex, form),
+                                 base.params.replace(tyre_transient=float(wk.transient.TRANSIENTS.index(form))))
         ss = steady.steady_state(params, 3.0)
         x = ss.x.copy()
         x[slip.X["u4"]] = 0.1
@@ -314,7 +315,7 @@ combined, _ = wk.riders.for_rear_load(bike, fz_n=635.0)
 K, _ = wk.control.lqr_gains(combined, 3.0)
 tyre = wk.tyres.load("T03", pressure_kpa=400)
 par = slip.model_parameters(combined, tyre, tyre, gains=wk.control.gains_dict(K),
-                            kick=dict(t0=0.0, duration=0.15, displacement=0.15))
+                                kick=dict(t0=0.0, duration=0.15, displacement=0.15))
 ss = steady.steady_state(par, 3.0)
 x = ss.x.copy(); x[slip.X["u4"]] = 0.1
 np.save(sys.argv[1] + "_x.npy", x); np.save(sys.argv[1] + "_p.npy", slip.parameter_vector(ss.params))

@@ -31,7 +31,7 @@ def _steady(symmetric, speed=4.0):
     moore, design, _ = wk.assembly.build_bicycle(sc.bicycle_spec)
     rear, front, _ = wk.assembly.build_tyres(sc.tyre_spec)
     gains, _ = wk.assembly.controller_gains(sc.gains_spec, design)
-    params = slip.model_parameters(moore, rear, front, gains=gains, symmetric=symmetric)
+    params = slip.model_parameters(moore, rear, front, slip.ModelOptions(symmetric_tyres=symmetric), gains=gains)
     return steady.find_steady_state(params, speed).steady
 
 

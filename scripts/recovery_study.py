@@ -62,7 +62,8 @@ def linear_model(scenario, gains=None, tyre_pair=None):
     moore, design, _ = wk.assembly.build_bicycle(scenario.bicycle_spec)
     if gains is None:
         gains, _ = wk.assembly.controller_gains(scenario.gains_spec, design)
-    params = slip.model_parameters(moore, rear, front, gains=gains, symmetric=scenario.symmetric_tyres)
+    params = slip.model_parameters(moore, rear, front, slip.ModelOptions(symmetric_tyres=scenario.symmetric_tyres),
+                                   gains=gains)
     motion = steady.steady_state(params, scenario.speed)
     return slip.linear_state_space(motion.params, motion.x)
 

@@ -195,7 +195,7 @@ def steady():
     rear, front, _ = build_tyres(BASE.tyre_spec)
     ss = steady.steady_state(slip.model_parameters(moore, rear, front, gains=gains), 3.0)
     for torque in (0.0, 2 * ss.params["T6c"]):
-        params = dict(ss.params, T6c=torque)
+        params = ss.params.replace(T6c=torque)
         tr = lsoda.integrate(slip.CompiledRHS(params), ss.x, 20.0, output_rate=10)
         speed = np.hypot(tr.state("u1"), tr.state("u2"))
         print(f"T6c = {torque:+.4f} N m from the steady state: speed after 20 s {speed[-1]:.4f} m/s")

@@ -418,7 +418,8 @@ def test_their_leaning_rider_set_in_our_slip_model(bpk, k9, c9):
         ours = []
         for kappa in (1e3, 1e5):
             tyre = wk.tyres.linear_tyre(kappa, 1.0 / kappa, 1e5 * kappa)
-            ss = steady.steady_state(slip.model_parameters(dict(bike.moore), tyre, tyre, body=body), speed)
+            ss = steady.steady_state(slip.model_parameters(dict(bike.moore), tyre, tyre, model=slip.Model(("trunk",)),
+                                                           body=body), speed)
             ev = np.linalg.eigvals(slip.linear.heading_linearisation(slip.CompiledRHS(ss.params), ss.x)[0])
             ours.append(np.array([ev[np.argmin(np.abs(ev - r))] for r in ref]))
         limit = (100.0 * ours[1] - ours[0]) / 99.0

@@ -154,7 +154,7 @@ def test_steady_characteristic_of_the_block(rider_bike, t03, law):
     below the peak slip and, past it, to the peak ("peak") or to the curve itself ("curve", the fit's
     falling branch). Tolerance 1e-4 of the force: the plateau carries viscosity x (sliding speed - the
     peak's), at most 0.005 N s/m x 2 m/s = 0.01 N here."""
-    params = slip.model_parameters(rider_bike, t03, t03, symmetric=True, carcass_sliding=law)
+    params = slip.model_parameters(rider_bike, t03, t03, slip.ModelOptions(symmetric_tyres=True, carcass_sliding=law))
     ss = steady.steady_state(params, 3.0)
     for slip_deg in (-40.0, -20.0, -8.0, -3.0, 0.5, 5.0, 12.0, 40.0):
         rhs, x, j, f = _frozen_block(ss.params, slip_deg)
@@ -222,7 +222,8 @@ def test_small_slip_eigenvalues_equal_the_force_lag(rider_bike, gains, t03):
     (F = c y with c = C_a/sigma0; the moment's slip found at the lagged camber), so every eigenvalue
     agrees to 1e-6 relative. Measured 3e-8 (the finite-difference Jacobians' own error)."""
     def eigenvalues(form):
-        par = slip.model_parameters(rider_bike, t03, t03, gains=gains, symmetric=True, tyre_transient=form)
+        par = slip.model_parameters(rider_bike, t03, t03,
+                                    slip.ModelOptions(symmetric_tyres=True, tyre_transient=form), gains=gains)
         ss = steady.steady_state(par, 3.0)
         return np.linalg.eigvals(slip.linearize(slip.CompiledRHS(ss.params), ss.x))
 
@@ -263,8 +264,8 @@ def test_options_agree_with_the_python_block(rider_bike, gains, t03, law, dampin
     """C against the independent Python block (:func:`whipple_kick.model.carcass.reference_block`) for the
     sliding laws and the damper, at 60 random states on and past the limit. Tolerance 1e-8 relative: two
     exact inversions of the curve near its peak agree to ~eps F / (dF/da)."""
-    par = slip.model_parameters(rider_bike, t03, t03, gains=gains, carcass_sliding=law, carcass_damping=damping,
-                                kick=dict(t0=0.0, duration=0.15, displacement=0.15))
+    par = slip.model_parameters(rider_bike, t03, t03, slip.ModelOptions(carcass_sliding=law, carcass_damping=damping),
+                                gains=gains, kick=dict(t0=0.0, duration=0.15, displacement=0.15))
     ss = steady.steady_state(par, 3.0)
     rhs = slip.CompiledRHS(ss.params)
     p = slip.parameter_vector(ss.params)
@@ -285,7 +286,7 @@ def test_options_agree_with_the_python_block(rider_bike, gains, t03, law, dampin
 def test_block_stays_finite_as_the_rolling_speed_vanishes(rider_bike, t03):
     """A wheel turned sideways (|vx| = 0) while sliding: finite rates, the camber lag stops, the force
     relaxes toward the limit on its side."""
-    par = slip.model_parameters(rider_bike, t03, t03, symmetric=True)
+    par = slip.model_parameters(rider_bike, t03, t03, slip.ModelOptions(symmetric_tyres=True))
     ss = steady.steady_state(par, 3.0)
     rhs = slip.CompiledRHS(ss.params)
     x = ss.x.copy()
@@ -340,7 +341,8 @@ def test_blended_pressure_rhs_is_unchanged_at_every_sample():
     assert sorted(ref["state_names"][dropped]) == sorted(("q11", "u11", *slip.REFLEX_STATES))
     assert not np.any(ref["x"][:, dropped]) and not np.any(ref["dx"][:, dropped])
     output = [list(ref["output_names"]).index(n) for n in slip.OUTPUT_NAMES]
-    rhs = slip.CompiledRHS({n: p_old[n] for n in slip.PARAMETER_NAMES})
+    model = slip.Model(transient=wk.transient.TRANSIENTS[int(p_old["tyre_transient"])])
+    rhs = slip.CompiledRHS(slip.Parameters(model, {n: p_old[n] for n in slip.PARAMETER_NAMES}))
     assert rhs.p[slip.P["wr"]] == 0.5 and rhs.p[slip.P["wf"]] == 0.5   # the blend: 300 and 400 kPa, 1:1
     pairs = [rhs.outputs(t, x) for t, x in zip(ref["t"], ref["x"][:, state], strict=True)]
     for got, want in ((np.array([d for d, _ in pairs]), ref["dx"][:, state]),

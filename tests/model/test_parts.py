@@ -32,11 +32,24 @@ def test_the_trunk_is_a_declared_part_with_units_and_sources():
     assert slip.for_parts((), True).REFLEX_STATES == slip.REFLEX_STATES and not rigid.REFLEX_STATES
 
 
-def test_partial_part_parameters_are_refused():
-    """A parameter set with some of a part's parameters and not all: one line naming what is missing."""
-    params = {"kh": 1.0, "ch": 2.0}
-    with pytest.raises(wk.InputError, match="trunk part's parameters are incomplete: missing hip_tilt"):
-        slip.for_parameters(params)
+def test_the_model_is_declared_not_read_from_the_parameter_names():
+    """The model's parameters carry their model: a body with some of a part's parameters is refused for the
+    model with the part (one line naming what is missing), and a part's parameters for a model without it are
+    refused rather than choosing the part; a nonzero delay needs the delay filter; a plain mapping is no
+    model's parameters."""
+    moore = wk.assembly.build_bicycle(wk.Scenario().bicycle_spec)[0]
+    tyre = wk.tyres.load("T03", pressure_kpa=400)
+    leaning = slip.Model(("trunk",))
+    with pytest.raises(wk.InputError, match=r"the leaning upper body needs all of .*; missing hip_tilt"):
+        slip.model_parameters(moore, tyre, tyre, model=leaning, body={"kh": 1.0, "ch": 2.0})
+    with pytest.raises(wk.InputError, match=r"\['ch', 'kh'\] are not the rigid model's \(they are the trunk part's"):
+        slip.model_parameters(moore, tyre, tyre, body={"kh": 1.0, "ch": 2.0})
+    with pytest.raises(wk.InputError, match="a delay needs the model with the delay filter"):
+        slip.model_parameters(moore, tyre, tyre, body={"reflex_delay": 0.05})
+    params = slip.model_parameters(moore, tyre, tyre, model=slip.Model((), True), body={"reflex_delay": 0.05})
+    assert params.model.layout is slip.for_parts((), True) and params.copy().model is params.model
+    with pytest.raises(TypeError, match="not a plain mapping"):
+        slip.CompiledRHS(dict(params))
 
 
 def test_merged_upper_body_conserves_mass_and_mass_centre():
@@ -136,11 +149,12 @@ def test_a_part_declared_here_is_built_run_and_energy_checked(shift):
     """
     sc = wk.Scenario(duration=1.0, output_rate=200.0)
     base = assembly.assemble(sc, inputs.kick_of(sc.validate())).params
-    assert slip.for_parameters(base) is slip.layout.BASE
+    assert base.model.layout is slip.layout.BASE
     # No kick (the plate's stop is an impulse the run's pipeline carries across; the push here is enough).
-    params = dict(base, ms=5.0, ls1=0.1, ls3=-0.6, is11=0.02, is22=0.02, is33=0.02, ks=2000.0, cs=20.0, kq12=0.0,
+    params = slip.Parameters(slip.Model(("shift",), transient=base.model.transient), base)
+    params.update(ms=5.0, ls1=0.1, ls3=-0.6, is11=0.02, is22=0.02, is33=0.02, ks=2000.0, cs=20.0, kq12=0.0,
                   kick_D=0.0)
-    layout = slip.for_parameters(params)
+    layout = params.model.layout
     assert layout.part_names == ("shift",) and layout.GAIN_STATES["kq12"] == "q12"
     ss = steady.steady_state(params, 3.0)
     assert "q12" in ss.unknowns and abs(ss.unknowns["q12"]) < 1e-3

@@ -80,7 +80,7 @@ def test_parameters_changed_in_place_are_seen(steady):
     rhs.p[slip.P["ku7"]] += 1.0
     after = rhs.fast(0.0, x)
     assert not np.array_equal(before, after)
-    np.testing.assert_array_equal(after, slip.CompiledRHS({**steady.params, "ku7": steady.params["ku7"] + 1.0})(0.0, x))
+    np.testing.assert_array_equal(after, slip.CompiledRHS(steady.params.replace(ku7=steady.params["ku7"] + 1.0))(0.0, x))
 
 
 class _Past(Exception):

@@ -73,7 +73,7 @@ def test_steer_torque_input_matrix_matches_the_classic_model():
         # Measured 9e-5 for both: the finite tyre stiffness, as in the stiff-tyre test above.
         assert np.max(np.abs(matched - expected) / np.abs(expected)) < 1e-3
     # The input is linear in T7: bumping another gain gives the same B.
-    bumped = dict(ss.params, kq4=ss.params["kq4"] + 1.0)
+    bumped = ss.params.replace(kq4=ss.params["kq4"] + 1.0)
     A_b = slip.linearize(slip.CompiledRHS(bumped), ss.x)
     j = slip.LINEAR_STATES.index("q4")
     np.testing.assert_allclose(A_b[:, j], (A - B @ Kfull)[:, j] - B[:, 0], atol=1e-6 * np.abs(B).max())
@@ -90,13 +90,13 @@ def test_linearisation_columns_are_the_whole_jacobians_bit_for_bit(rider_bike, g
     assert np.array_equal(slip.linearize(rhs, ss.x, columns=picked), whole[:, picked])
     A, B, K = slip.linear_state_space(ss.params, ss.x)
     j = slip.LINEAR_STATES.index("u7")
-    bumped = slip.linearize(slip.CompiledRHS(dict(ss.params, ku7=ss.params["ku7"] + 1.0)), ss.x)
+    bumped = slip.linearize(slip.CompiledRHS(ss.params.replace(ku7=ss.params["ku7"] + 1.0)), ss.x)
     B_before = (whole[:, j] - bumped[:, j]).reshape(-1, 1)
     assert np.array_equal(B, B_before) and np.array_equal(A, whole + B_before @ K)
 
 
 def test_energy_never_increases_with_slip_and_damping(rider_bike, t03):
-    par = slip.model_parameters(rider_bike, t03, t03, symmetric=True)
+    par = slip.model_parameters(rider_bike, t03, t03, slip.ModelOptions(symmetric_tyres=True))
     ss = steady.steady_state(par, 4.5)
     x0 = ss.x.copy()
     x0[slip.X["u4"]], x0[slip.X["u7"]], x0[slip.X["u10"]] = 0.3, 0.2, 0.05
@@ -112,7 +112,7 @@ def test_energy_never_increases_with_slip_and_damping(rider_bike, t03):
 
 
 def test_energy_conserved_without_damping_and_slip(rider_bike, t03):
-    par = slip.model_parameters(rider_bike, t03, t03, symmetric=True, lateral=False)
+    par = slip.model_parameters(rider_bike, t03, t03, slip.ModelOptions(symmetric_tyres=True), lateral=False)
     par["czr"] = par["czf"] = 0.0
     ss = steady.steady_state(par, 4.5)
     x0 = ss.x.copy()
@@ -129,7 +129,7 @@ def test_energy_conserved_without_damping_and_slip(rider_bike, t03):
 
 @pytest.mark.parametrize("symmetric", [True, False])
 def test_steady_start_does_not_drift(rider_bike, gains, t03, symmetric):
-    par = slip.model_parameters(rider_bike, t03, t03, gains=gains, symmetric=symmetric)
+    par = slip.model_parameters(rider_bike, t03, t03, slip.ModelOptions(symmetric_tyres=symmetric), gains=gains)
     ss = steady.steady_state(par, 3.0)
     rhs = slip.CompiledRHS(ss.params)
     tr = lsoda.integrate(rhs, ss.x, 10.0, rtol=1e-10, output_rate=100)
@@ -149,7 +149,7 @@ def test_steady_start_does_not_drift(rider_bike, gains, t03, symmetric):
 
 
 def test_tyre_physics_in_the_model(rider_bike, t03):
-    par = slip.model_parameters(rider_bike, t03, t03, symmetric=True)
+    par = slip.model_parameters(rider_bike, t03, t03, slip.ModelOptions(symmetric_tyres=True))
     ss = steady.steady_state(par, 3.0)
     rhs = slip.CompiledRHS(ss.params)
     rng = np.random.default_rng(7)
@@ -221,7 +221,7 @@ def test_a_lifted_wheel_closing_on_the_ground_carries_no_force(rider_bike, t03, 
 def test_mirror_symmetric_kicks(rider_bike, gains, t03):
     responses = []
     for sign in (1.0, -1.0):
-        par = slip.model_parameters(rider_bike, t03, t03, gains=gains, symmetric=True,
+        par = slip.model_parameters(rider_bike, t03, t03, slip.ModelOptions(symmetric_tyres=True), gains=gains,
                                     kick=dict(t0=0.0, duration=0.15, displacement=0.15 * sign))
         ss = steady.steady_state(par, 3.0)
         rhs = slip.CompiledRHS(ss.params)
@@ -248,7 +248,8 @@ def test_bad_parameters_are_reported(rider_bike, t03):
 # ------------------------------------------------------- the tyre transient forms
 
 def _eigenvalues(rider_bike, gains, rear, front, transient, symmetric):
-    par = slip.model_parameters(rider_bike, rear, front, gains=gains, symmetric=symmetric, tyre_transient=transient)
+    par = slip.model_parameters(rider_bike, rear, front,
+                                slip.ModelOptions(symmetric_tyres=symmetric, tyre_transient=transient), gains=gains)
     ss = steady.steady_state(par, 3.0)
     rhs = slip.CompiledRHS(ss.params)
     return np.linalg.eigvals(slip.linearize(rhs, ss.x)), rhs, ss
@@ -349,7 +350,8 @@ def test_patch_states_stay_finite_as_the_rolling_speed_vanishes(rider_bike, t03)
     """A wheel turned sideways (|vx| -> 0) while its contact slides: the patch slip turns toward
     +-90 deg at a finite rate, the camber lag stops, force and moment follow the steady curve; unloaded,
     they are exactly zero (the contact-patch form; the carcass' own case is in test_carcass.py)."""
-    par = slip.model_parameters(rider_bike, t03, t03, symmetric=True, tyre_transient="contact_patch")
+    par = slip.model_parameters(rider_bike, t03, t03,
+                                slip.ModelOptions(symmetric_tyres=True, tyre_transient="contact_patch"))
     ss = steady.steady_state(par, 3.0)
     rhs = slip.CompiledRHS(ss.params)
     x = ss.x.copy()
@@ -414,7 +416,7 @@ def test_plate_stop_impulse_is_the_limit_of_a_short_stop(rider_bike, gains, t03)
     errors, changes = [], []
     v = 2 * D / T
     for delta in (1e-5, 1e-6):
-        short = slip.CompiledRHS(dict(ss.params, kick_profile=2.0, kick_t0=T, kick_c0=D, kick_c1=v,
+        short = slip.CompiledRHS(ss.params.replace(kick_profile=2.0, kick_t0=T, kick_c0=D, kick_c1=v,
                                       kick_c2=-v / (2 * delta), kick_c3=0.0))
         x = lsoda.integrate(short, x_stop, T + delta, t_start=T, rtol=1e-12, samples=np.array([T])).end_state
         errors.append(np.max(np.abs(x[ind] - x_impulse[ind])))
@@ -446,7 +448,7 @@ def test_upright_start_is_upright_and_balanced_vertically_but_not_steady(rider_b
     both tyres in vertical equilibrium (residual < 1e-8); the tyre states at their zero-slip values.
     With T03's offsets the lateral accelerations are not zero (measured 0.3-2.5 m/s^2 or rad/s^2); with
     symmetric tyres it is the steady motion (same pitch and compressions to 1e-12)."""
-    par = slip.model_parameters(rider_bike, t03, t03, gains=gains, tyre_transient="force_lag")
+    par = slip.model_parameters(rider_bike, t03, t03, slip.ModelOptions(tyre_transient="force_lag"), gains=gains)
     start = steady.upright_state(par, 3.0)
     x = start.x
     assert start.params["T6c"] == 0.0 and start.residual < 1e-8
@@ -459,7 +461,7 @@ def test_upright_start_is_upright_and_balanced_vertically_but_not_steady(rider_b
     for slot, name in zip(slip.TYRE_STATES, ("fy_ss_r", "fy_ss_f", "mz_ss_r", "mz_ss_f"), strict=True):
         assert x[slip.X[slot]] == out[slip.OUT[name]] != 0.0
     assert start.unknowns["largest_rate"] > 0.05
-    symmetric = slip.model_parameters(rider_bike, t03, t03, gains=gains, symmetric=True)
+    symmetric = slip.model_parameters(rider_bike, t03, t03, slip.ModelOptions(symmetric_tyres=True), gains=gains)
     up, motion = steady.upright_state(symmetric, 3.0), steady.steady_state(symmetric, 3.0)
     for name in ("q5", "q9", "q10"):
         assert up.x[slip.X[name]] == pytest.approx(motion.x[slip.X[name]], abs=1e-12)
@@ -477,7 +479,7 @@ def test_kept_speeds_leave_the_rear_sliding_at_the_plate_velocity_times_sin_yaw(
     slide = slip.kept_speeds_slide(rhs, T, x_stop)
     assert slide == pytest.approx(2 * D / T * np.sin(x_stop[slip.X["q3"]]), rel=1e-9)
     assert abs(slide) > 0.05
-    after = slip.CompiledRHS(dict(ss.params, vsx_r=slide))
+    after = slip.CompiledRHS(ss.params.replace(vsx_r=slide))
     before = rhs.outputs(np.nextafter(T, 0.0), x_stop)[1][:len(slip.SPEEDS)]
     np.testing.assert_allclose(after.outputs(T, x_stop)[1][:len(slip.SPEEDS)], before, rtol=0, atol=1e-12)
     tr = lsoda.integrate(after, x_stop, T + 1.0, t_start=T, rtol=1e-12, output_rate=100)

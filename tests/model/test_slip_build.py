@@ -24,10 +24,11 @@ def test_c_agrees_with_numpy_oracle(rider_bike, gains, t03, transient):
     constraint's power while the plate moves or a rear slide is imposed)
     and every named output.
     """
-    par = slip.model_parameters(rider_bike, t03, wk.tyres.load("T03", pressure_kpa=350), gains=gains,
-                                kick=dict(t0=0.0, duration=0.15, displacement=0.15), tyre_transient=transient)
+    par = slip.model_parameters(rider_bike, t03, wk.tyres.load("T03", pressure_kpa=350),
+                                slip.ModelOptions(tyre_transient=transient), gains=gains,
+                                kick=dict(t0=0.0, duration=0.15, displacement=0.15))
     ss = steady.steady_state(par, 3.0)
-    params = dict(ss.params, vsx_r=-0.2)   # a rear slide as the authors' plate stop leaves, in both printings
+    params = ss.params.replace(vsx_r=-0.2)   # a rear slide as the authors' plate stop leaves, in both printings
     rhs = slip.CompiledRHS(params)
     p = slip.parameter_vector(params)
     rng = np.random.default_rng(1)

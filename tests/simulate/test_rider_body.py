@@ -71,7 +71,7 @@ def test_upper_body_merged_into_the_rear_frame_is_the_lumped_rider(bike, rider, 
     gains = control.gains_dict(control.lqr_gains(lumped, 3.0)[0])
     pa = slip.model_parameters(dict(lumped.moore), t03, t03, gains=gains)
     pb = slip.model_parameters(merged, t03, t03, gains=gains)
-    assert slip.for_parameters(pb) is slip.layout.BASE   # no trunk part, nothing locked
+    assert pb.model.layout is slip.layout.BASE   # no trunk part, nothing locked
     sa, sb = steady.steady_state(pa, 3.0), steady.steady_state(pb, 3.0)
     assert "q11" not in sb.unknowns
     for name, value in sa.unknowns.items():
@@ -167,7 +167,7 @@ def test_a_leaning_rider_reports_the_static_loads_of_the_whole_rider():
 
 def _stage2(params, q, u):
     """Full mass matrix (n x n, n speeds of the model) and forcing without tyre loads (n,) from the NumPy oracle."""
-    layout = slip.for_parameters(params)
+    layout = params.model.layout
     p = slip.parameter_vector(params, layout)
     with np.errstate(invalid="ignore", divide="ignore"):
         M, f0, *_ = slip_build.numpy_module(layout.part_names).stage2([0.0], q, u, [0.0], p)
@@ -178,7 +178,7 @@ def _frame_fixed_sdof(params, speed_name, h=1e-6):
     """(inertia, stiffness, damping) of one speed's row with every other coordinate and speed held at the
     upright, uncompressed configuration (q5 the steer-axis tilt, all else 0): M[i, i], -df_i/dq_i and
     -df_i/du_i by central differences."""
-    speeds = slip.for_parameters(params).SPEEDS
+    speeds = params.model.layout.SPEEDS
     i = speeds.index(speed_name)
     q, u = np.zeros(len(speeds)), np.zeros(len(speeds))
     q[speeds.index("u5")] = steer_axis_tilt(params)
@@ -205,7 +205,7 @@ def test_hip_is_the_upper_body_on_a_spring_damper_with_the_frame_held(bike, ride
     """
     split, body = riders.seat_with_body(bike, rider, arms_on_bar=False)
     body = dict(body, kh=128.0, ch=50.0)
-    params = slip.model_parameters(dict(split.moore), t03, t03, body=body)
+    params = slip.model_parameters(dict(split.moore), t03, t03, model=slip.Model(("trunk",)), body=body)
     inertia, k, c = _frame_fixed_sdof(params, "u11")
     i_ref = body["it11"] + body["mt"] * body["lt3"] ** 2
     k_ref = body["kh"] + body["mt"] * params["g"] * body["lt3"]
@@ -231,7 +231,8 @@ def test_arms_are_a_spring_damper_on_the_bar_with_the_frame_held(bike, rider, t0
     """
     split, body = riders.seat_with_body(bike, rider, arms_on_bar=True)
     ka, ca = 10.0, 1.5
-    params = slip.model_parameters(dict(split.moore), t03, t03, body=dict(body, ka=ka, ca=ca, kh=0.0, ch=0.0))
+    params = slip.model_parameters(dict(split.moore), t03, t03, model=slip.Model(("trunk", "arms")),
+                                    body=dict(body, ka=ka, ca=ca, kh=0.0, ch=0.0))
     params["g"] = 0.0
     inertia, k, c = _frame_fixed_sdof(params, "u7")
     bench = split.benchmark
@@ -254,7 +255,8 @@ def test_arms_are_a_spring_damper_on_the_bar_with_the_frame_held(bike, rider, t0
     assert c / (2 * math.sqrt(k * inertia)) == pytest.approx(ca / (2 * math.sqrt(ka * i_ref)), rel=1e-9)
     # The forearms on the bar more than triple the steer inertia (measured 0.159 -> 0.554 kg m^2).
     without, body_without = riders.seat_with_body(bike, rider, arms_on_bar=False)
-    bare = slip.model_parameters(dict(without.moore), t03, t03, body=dict(body_without, ka=ka, ca=ca, kh=0.0, ch=0.0))
+    bare = slip.model_parameters(dict(without.moore), t03, t03, model=slip.Model(("trunk", "arms")),
+                                  body=dict(body_without, ka=ka, ca=ca, kh=0.0, ch=0.0))
     bare["g"] = 0.0
     assert _frame_fixed_sdof(bare, "u7")[0] < inertia / 3
 
@@ -326,7 +328,8 @@ def test_hip_and_arm_springs_and_dampers_are_in_the_energy(bike, rider, t03):
     Measured ~1e-16 relative. Bound 1e-12."""
     split, body = riders.seat_with_body(bike, rider, arms_on_bar=True)
     body = dict(body, kh=128.0, ch=50.0, ka=10.0, ca=1.5)
-    ss = steady.steady_state(slip.model_parameters(dict(split.moore), t03, t03, body=body), 3.0)
+    ss = steady.steady_state(slip.model_parameters(dict(split.moore), t03, t03, model=slip.Model(("trunk", "arms")),
+                                                   body=body), 3.0)
     rhs = slip.CompiledRHS(ss.params)
     X = rhs.layout.X
     x = ss.x.copy()
@@ -562,7 +565,7 @@ def test_leaning_body_is_moore_rider_lean_2012_with_stiff_tyres(bike, rider, k9,
         ours = []
         for kappa in (1e3, 1e5):
             tyre = wk.tyres.linear_tyre(kappa, 1.0 / kappa, 1e5 * kappa)
-            params = slip.model_parameters(dict(split.moore), tyre, tyre,
+            params = slip.model_parameters(dict(split.moore), tyre, tyre, model=slip.Model(("trunk",)),
                                            body=dict(body, kh=k9, ch=c9))
             ss = steady.steady_state(params, speed)
             A_ours, _ = slip.linear.heading_linearisation(slip.CompiledRHS(ss.params), ss.x)

@@ -243,7 +243,9 @@ def test_table_8_4_rider_in_the_no_slip_limit():
     K = [gains[k] for k in wk.control.GAIN_ORDER]
     classic_poles = np.linalg.eigvals(wk.control.closed_loop_matrix(moore, 3.0, K))
     slow_classic = classic_poles[np.argmax(classic_poles.real)]
-    steady = wk.steady.steady_state(wk.slip.model_parameters(moore, rigid, rigid, gains=gains, symmetric=True), 3.0)
+    steady = wk.steady.steady_state(wk.slip.model_parameters(moore, rigid, rigid,
+                                                             wk.slip.ModelOptions(symmetric_tyres=True),
+                                                             gains=gains), 3.0)
     A, B, Kfull = wk.slip.linear_state_space(steady.params, steady.x)
     poles = np.linalg.eigvals(A - B @ Kfull)
     poles = poles[np.abs(poles) > 1e-2]          # leave out the forward-speed mode (0)
@@ -729,7 +731,7 @@ def test_steady_rear_wheel_torque_is_a_brake_fed_by_the_tyres():
     gains, _ = wk.assembly.controller_gains(sc.gains_spec, design)
     rear, front, _ = wk.assembly.build_tyres(sc.tyre_spec)
     ss = steady.steady_state(slip.model_parameters(moore, rear, front, gains=gains), 3.0)
-    tr = lsoda.integrate(slip.CompiledRHS(dict(ss.params, T6c=0.0)), ss.x, 5.0, output_rate=10)
+    tr = lsoda.integrate(slip.CompiledRHS(ss.params.replace(T6c=0.0)), ss.x, 5.0, output_rate=10)
     assert np.hypot(tr.state("u1"), tr.state("u2"))[-1] > 3.001     # measured 3.004 m/s after 5 s
 
 

@@ -15,7 +15,7 @@ def _params(pressure=400.0, fz=635.0, design_speed=3.0, symmetric=False):
     moore, design, _ = wk.assembly.build_bicycle(sc.bicycle_spec)
     rear, front, _ = wk.assembly.build_tyres(sc.tyre_spec)
     gains = control.gains_dict(control.lqr_gains(design, design_speed)[0])
-    return slip.model_parameters(moore, rear, front, gains=gains, symmetric=symmetric)
+    return slip.model_parameters(moore, rear, front, slip.ModelOptions(symmetric_tyres=symmetric), gains=gains)
 
 
 def _heading_rates(found, speed):
@@ -129,7 +129,7 @@ def test_start_problem_checks_each_bound_on_its_own():
     assert "front tyre's slip" in steady.start_problem(changed(angles={"slip_f": 1.01 * slip_limit}))
     assert "rear tyre's slip" in steady.start_problem(changed(angles={"slip_r": -1.01 * slip_limit}))
     # The rider's gains reversed in roll: the same motion, no longer held (only asked for with hold=True).
-    reversed_roll = {**good.params, "kq4": -good.params["kq4"], "ku4": -good.params["ku4"]}
+    reversed_roll = good.params.replace(kq4=-good.params["kq4"], ku4=-good.params["ku4"])
     assert steady.start_problem(changed(params_=reversed_roll)) is None
     assert "unstable" in steady.start_problem(changed(params_=reversed_roll), hold=True)
 

@@ -80,15 +80,17 @@ def fingerprint(sc):
     rear, front, _ = assembly.build_tyres(sc.tyre_spec)
     moore, design, info = assembly.build_bicycle(sc.bicycle_spec)
     body = assembly.rider_body(sc.body_spec, info)
+    model = assembly.model_of(sc.body_spec, sc.tyre_transient)
     if sc.controller == "lqr" and sc.lqr_model == "simulated":
         spec = sc.design_spec
         felt, K = control.simulated_design_start(spec, design)
-        A, b, C = control._linear_design_model(spec, moore, rear, front, body, felt, 1.0, control.SCALED_BODY_GAINS)
+        A, b, C = control._linear_design_model(spec, moore, rear, front, body, felt, 1.0, control.SCALED_BODY_GAINS,
+                                               model)
         gains = {"design": (A, b, C, K, sc.gain_scale, sc.lqr_design_speed)}
-        params = assembly.model_parameters(sc.model_spec, kick, moore, body, rear, front, None)
+        params = assembly.model_parameters(sc.model_spec, kick, moore, body, rear, front, None, model)
     else:
         gains, _ = assembly.controller_gains(sc.gains_spec, design)
-        params = assembly.model_parameters(sc.model_spec, kick, moore, body, rear, front, gains)
+        params = assembly.model_parameters(sc.model_spec, kick, moore, body, rear, front, gains, model)
     return (slip.parameter_vector(params), gains, kick, integration_reads(sc),
             assembly.no_slip_plant(moore, design, info), float(sc.speed))
 
@@ -206,7 +208,8 @@ def test_item5_lean_gains_given_are_used():
     moore, _, info = assembly.build_bicycle(sc.bicycle_spec)
     rear, front, _ = assembly.build_tyres(sc.tyre_spec)
     body = assembly.rider_body(sc.body_spec, info)
-    params = assembly.model_parameters(sc.model_spec, inputs.kick_of(sc), moore, body, rear, front, gains)
+    params = assembly.model_parameters(sc.model_spec, inputs.kick_of(sc), moore, body, rear, front, gains,
+                                       assembly.model_of(sc.body_spec, sc.tyre_transient))
     assert params["kq11"] == 3.0 and params["ku11"] == 0.5
 
 

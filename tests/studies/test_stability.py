@@ -61,7 +61,7 @@ def test_heading_linearisation_equals_the_central_difference_one(symmetric, spee
     moore, design, _ = wk.assembly.build_bicycle(sc.bicycle_spec)
     rear, front, _ = wk.assembly.build_tyres(sc.tyre_spec)
     gains, _ = wk.assembly.controller_gains(sc.gains_spec, design)
-    params = slip.model_parameters(moore, rear, front, gains=gains, symmetric=symmetric)
+    params = slip.model_parameters(moore, rear, front, slip.ModelOptions(symmetric_tyres=symmetric), gains=gains)
     steady = wk.steady.find_steady_state(params, speed).steady
     rhs = slip.CompiledRHS(steady.params)
     A_ref = slip.linearize(rhs, steady.x)

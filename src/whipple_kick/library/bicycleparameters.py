@@ -503,7 +503,7 @@ def leaning_rider(obj):
     body : dict
         :func:`whipple_kick.library.riders.seat_with_body`'s body (hinge horizontal, ``hip_tilt = -lam``; the
         hinge point taken above the rear wheel centre, any point of the line will do), with ``kh = k9``,
-        ``ch = c9``: pass it to ``slip.model_parameters(..., body=body)`` (the model with the trunk part).
+        ``ch = c9``: pass it to ``slip.model_parameters(..., model=slip.Model(("trunk",)), body=body)``.
     """
     params = {k: _nominal(v)[0] for k, v in obj.parameters.items()}
     missing = [n for n in (*_benchmark.MOORE_NAMES, *LEAN_NAMES) if n not in params]

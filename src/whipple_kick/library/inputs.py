@@ -390,7 +390,7 @@ class KickTable:
 
 def segment_parameters(params, t0, coefficients):
     """``params`` with the plate following one cubic from ``t0`` (everything else, e.g. T6c, kept)."""
-    out = dict(params)
+    out = params.copy()   # the model's parameters keep their model (a plain mapping stays one)
     out["kick_profile"] = float(SEGMENT_PROFILE)
     out["kick_t0"] = float(t0)
     out.update({f"kick_c{i}": float(c) for i, c in enumerate(coefficients)})

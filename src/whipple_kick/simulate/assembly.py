@@ -64,8 +64,8 @@ class Assembly:
         The LQR design's closed-loop poles at its design speed [1/s].
     controller : str
         ``lqr``, ``thesis``, ``off`` or ``custom gains``.
-    params : dict
-        The compiled model's parameters (the steady drive torque T6c included).
+    params : whipple_kick.model.slip.Parameters
+        The compiled model's parameters (the steady drive torque T6c included) with their model (:attr:`model`).
     found : whipple_kick.simulate.steady.Found
         The steady motion stability is judged about, and how it was found.
     start : whipple_kick.simulate.steady.SteadyState
@@ -86,6 +86,11 @@ class Assembly:
     found: object
     start: object
     stability: dict
+
+    @property
+    def model(self):
+        """The compiled model's description (parts, delay filter, tyre form) its parameters are for."""
+        return self.params.model
 
     @property
     def reference(self):
@@ -130,17 +135,18 @@ def assemble(scenario, kick, *, tyres=None, gains=None) -> Assembly:
                  f"rear {rear!r}, front {front!r}"]
     moore, design, info = build_bicycle(scenario.bicycle_spec)
     body = rider_body(scenario.body_spec, info)
+    model = model_of(scenario.body_spec, scenario.tyre_transient)
     if custom is None and scenario.controller == "lqr" and scenario.lqr_model == "simulated":
         gains, poles = (simulated_design(scenario.design_spec, scenario.tyre_spec, scenario.bicycle_spec,
                                          scenario.body_spec) if tyres is None
-                        else control.lqr_on_simulated_model(scenario.design_spec, moore, design, body, rear, front))
+                        else control.lqr_on_simulated_model(scenario.design_spec, moore, design, body, rear, front, model))
         controller = scenario.controller
     elif custom is None:
         gains, poles = controller_gains(scenario.gains_spec, design)
         controller = scenario.controller
     else:
         gains, poles, controller = custom, None, "custom gains"
-    params = model_parameters(scenario.model_spec, kick, moore, body, rear, front, gains)
+    params = model_parameters(scenario.model_spec, kick, moore, body, rear, front, gains, model)
     found, start = steady.start_state(params, float(scenario.speed), start=scenario.start,
                                       start_pitch=scenario.start_pitch, advice=_steady_advice(scenario, controller))
     stability = linear_stability(scenario, no_slip_plant(moore, design, info), gains, found, controller)
@@ -180,8 +186,19 @@ def _refuse_tyre_fields(scenario):
 
 # ------------------------------------------------------------------ the parts
 
-def model_parameters(spec, kick, moore, body, rear, front, gains):
-    """The compiled model's parameters by name (before the steady motion's drive torque is found).
+def model_of(body_spec, tyre_transient):
+    """The compiled model a scenario asks for (:class:`whipple_kick.model.slip.Model`), from its settings.
+
+    The declared parts its fields select (:func:`whipple_kick.model.parts.selected`: the leaning upper body,
+    the arms on the bar), the reflex's delay filter when its ``reflex_delay`` is not 0 (the field's "0: none"),
+    and its tyre transient form. ``body_spec`` is ``scenario.body_spec``.
+    """
+    return slip.Model(tuple(p.name for p in parts.selected(body_spec)), body_spec.reflex_delay != 0.0,
+                      tyre_transient)
+
+
+def model_parameters(spec, kick, moore, body, rear, front, gains, model):
+    """The compiled model's parameters by name, with their model (before the steady drive torque is found).
 
     Parameters
     ----------
@@ -197,13 +214,11 @@ def model_parameters(spec, kick, moore, body, rear, front, gains):
     rear, front : whipple_kick.library.tyres.Tyre
     gains : dict or None
         Steer-torque gains by name.
+    model : whipple_kick.model.slip.Model
+        The model (:func:`model_of`).
     """
-    return slip.model_parameters(moore, rear, front, gains=gains, symmetric=spec.symmetric_tyres,
-                                 kick=None if kick is None else kick.model_kick(), tyre_transient=spec.tyre_transient,
-                                 reverse_camber=spec.camber_sign == "reversed",
-                                 carcass_sliding=spec.carcass_sliding, carcass_damping=spec.carcass_damping,
-                                 carcass_viscosity=spec.carcass_viscosity, slip_speed=spec.slip_speed,
-                                 body=body, carcass_stiffness_scale=spec.carcass_stiffness_scale)
+    return slip.model_parameters(moore, rear, front, spec, model=model, gains=gains, body=body,
+                                 kick=None if kick is None else kick.model_kick())
 
 
 def build_bicycle(spec):
@@ -376,7 +391,9 @@ def simulated_design(design, tyres, bicycle, body):
 def _simulated_design(design_spec, tyre_spec, bicycle_spec, body_spec, _stamp):
     rear, front, _ = build_tyres(tyre_spec)
     moore, design, info = build_bicycle(bicycle_spec)
-    gains, poles = control.lqr_on_simulated_model(design_spec, moore, design, rider_body(body_spec, info), rear, front)
+    model = model_of(body_spec, dict(design_spec.model_options)["tyre_transient"])
+    gains, poles = control.lqr_on_simulated_model(design_spec, moore, design, rider_body(body_spec, info), rear, front,
+                                                  model)
     return tuple(gains.items()), tuple(poles)
 
 

@@ -380,7 +380,7 @@ def classic_closed_loop_poles(moore, speed, gains):
     return np.asarray(_classic_poles(tuple(sorted(moore.items())), float(speed), tuple(sorted(gains.items()))))
 
 
-def lqr_on_simulated_model(spec, moore, design, body, rear, front):
+def lqr_on_simulated_model(spec, moore, design, body, rear, front, model):
     """The LQR rider designed on the model the run simulates (``lqr_model="simulated"``).
 
     The model of the run (its tyres, carcass, body, arms and reflex) with
@@ -404,6 +404,8 @@ def lqr_on_simulated_model(spec, moore, design, body, rear, front):
         The rider's body parameters (:func:`whipple_kick.simulate.assembly.rider_body`).
     rear, front : Tyre
         The run's tyres.
+    model : whipple_kick.model.slip.Model
+        The run's model (:func:`whipple_kick.simulate.assembly.model_of`).
 
     Returns
     -------
@@ -417,35 +419,35 @@ def lqr_on_simulated_model(spec, moore, design, body, rear, front):
     scaled = SCALED_BODY_GAINS
     models = {}
 
-    def model(share):
+    def design_model(share):
         """(A, b, C) of the design model with ``share`` of the ``scaled`` gains, built once per share."""
         if share not in models:
-            models[share] = _linear_design_model(spec, moore, rear, front, body, felt, share, scaled)
+            models[share] = _linear_design_model(spec, moore, rear, front, body, felt, share, scaled, model)
         return models[share]
 
     def stabilises(gains, share):
-        A, b, C = model(share)
+        A, b, C = design_model(share)
         return bool(np.max(np.linalg.eigvals(A - b @ gains[None, :] @ C).real) < 0.0)
 
     # Continuation: the share of the arms' and reflex's gains grows while the gains still stabilise the
     # next model; where they do not, they are re-optimised at the last share they did (a larger margin).
     done, step = (1.0, 1.0) if stabilises(K, 1.0) else (0.0, 0.25)
     if not stabilises(K, done):   # the body alone (forearms on the bar, a leaning trunk) defeats the Whipple design
-        K = stabilising_gains(*model(done), K)
+        K = stabilising_gains(*design_model(done), K)
     optimised_at = None
     while done < 1.0:
         share = min(1.0, done + step)
         if stabilises(K, share):
             done, step = share, step * 2.0
         elif optimised_at != done:
-            K, _ = output_feedback_lqr(*model(done), K0=K)
+            K, _ = output_feedback_lqr(*design_model(done), K0=K)
             optimised_at = done
         elif step < 1e-3:
             raise InputError(f"no stabilising LQR rider was found on the model simulated at {speed:g} m/s "
                              f"(the design lost stability at {share:.1%} of the arms' and reflex's gains)")
         else:
             step /= 2.0
-    K, poles = output_feedback_lqr(*model(1.0), K0=K)
+    K, poles = output_feedback_lqr(*design_model(1.0), K0=K)
     gains = dict.fromkeys(slip.GAIN_NAMES, 0.0)
     gains.update({name: float(spec.gain_scale * k) for name, k in zip(felt, K, strict=True)})
     return gains, poles
@@ -467,12 +469,13 @@ def simulated_design_start(spec, design):
     return felt, K
 
 
-def _linear_design_model(spec, moore, rear, front, body, felt, share, scaled):
+def _linear_design_model(spec, moore, rear, front, body, felt, share, scaled, model):
     """(A, b, C) of the design model with ``share`` of the ``scaled`` body gains (C picks the ``felt`` states)."""
     part = {k: (v * share if k in scaled else v) for k, v in body.items()}
     from . import steady
 
-    params = slip.model_parameters(moore, rear, front, symmetric=True, body=part, **dict(spec.model_options))
+    options = slip.ModelOptions(**dict(spec.model_options), symmetric_tyres=True)
+    params = slip.model_parameters(moore, rear, front, options, model=model, body=part)
     up = steady.upright_state(params, spec.speed)
     rhs = slip.CompiledRHS(up.params)
     A, b = slip.heading_linearisation(rhs, up.x)

@@ -240,7 +240,7 @@ def _integrate_kept_speeds(rhs, params, x, span, rows, stop, scenario, chunk, ju
         return first, [rhs], np.zeros(first.t.size, dtype=int)
     x_stop = first.end_state
     slide = slip.kept_speeds_slide(rhs, stop, x_stop)
-    after = slip.CompiledRHS({**params, "vsx_r": slide})
+    after = slip.CompiledRHS(params.replace(vsx_r=slide))
     ke = [r.outputs(t, x_stop)[1][slip.OUT["kinetic_energy"]]
           for r, t in ((rhs, np.nextafter(stop, -np.inf)), (after, stop))]
     jumps.append({"time_s": float(stop), "kinetic_energy_change_j": float(ke[1] - ke[0]), "impulse_work_j": None,

@@ -125,7 +125,7 @@ def offset_scaled(params, fraction):
     :data:`whipple_kick.model.slip.MZ_OFFSET_INDICES`), in both coefficient slots
     of both wheels; ``fraction`` 0 gives symmetric tyres.
     """
-    out = dict(params)
+    out = params.copy()
     for name in params:
         for prefix, indices in (("a", slip.FY_OFFSET_INDICES), ("c", slip.MZ_OFFSET_INDICES)):
             head, _, index = name.partition("_")
@@ -489,7 +489,7 @@ def steady_state(params, speed, tol=1e-13, guess=None):
         raise FloatingPointError(f"steady state not found at {speed} m/s: {sol.message} (residual {res:.3g})")
     xs = state(z)
     out = rhs.outputs(0.0, xs)[1]
-    out_params = dict(params)
+    out_params = params.copy()
     out_params["T6c"] = float(z[-1])
     out_params["ccr"], out_params["ccf"] = float(rhs.p[slip.P["ccr"]]), float(rhs.p[slip.P["ccf"]])
     return SteadyState(xs, out_params, res, dict(zip(names, z, strict=True)),
@@ -588,8 +588,7 @@ def upright_state(params, speed, tol=1e-13, pitch_without_compression=False):
 
     from whipple_kick.model.benchmark import steer_axis_tilt
 
-    out_params = dict(params)
-    out_params["T6c"] = 0.0
+    out_params = params.replace(T6c=0.0)
     rhs = slip.CompiledRHS(out_params)
     weight = params["g"] * (params["mc"] + params["md"] + params["me"] + params["mf"] + params.get("mt", 0.0))
     x = np.zeros(len(rhs.layout.STATE_NAMES))

@@ -16,7 +16,8 @@ independent speeds u1 u2 u3 u4 u7 u9 u10, four tyre states in fixed slots
 the thesis' relaxed forces fyr fyf mzr mzf, which :data:`X` also names),
 the reflex delay filter's four states, and the quadratures of :data:`whipple_kick.model.energy.QUADRATURE_STATES`;
 a model with declared parts (:mod:`whipple_kick.model.parts`: the leaning upper body) appends their
-coordinates and speeds (:class:`Layout`, :func:`for_parameters`).
+coordinates and speeds (:class:`Layout`); :class:`Model` says which model a parameter set is for
+(:class:`Parameters`).
 
 The package, one module per concern: :mod:`.layout` (names and indices),
 :mod:`.compiled` (the compiler, the cache entry, loading), :mod:`.call`
@@ -34,6 +35,10 @@ from .compiled import (  # noqa: F401 -- the package's names, as before the spli
     library_path,
     metadata_layout,
     model_hash,
+)
+from .description import (  # noqa: F401 -- the package's names
+    Model,
+    Parameters,
 )
 from .jumps import (  # noqa: F401 -- the package's names, as before the split
     kept_speeds_slide,
@@ -59,7 +64,6 @@ from .layout import (  # noqa: F401 -- the package's names, as before the split
     Layout,
     P,
     X,
-    for_parameters,
     for_parts,
     tyre_state_names,
 )
@@ -79,6 +83,7 @@ from .parameters import (  # noqa: F401 -- the package's names, as before the sp
     GAIN_STATES,
     MZ_OFFSET_INDICES,
     SLIP_SPEEDS,
+    ModelOptions,
     model_parameters,
     tyre_parameters,
 )

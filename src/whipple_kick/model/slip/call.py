@@ -5,11 +5,16 @@ import math
 import numpy as np
 
 from whipple_kick.errors import InputError
-from whipple_kick.model import transient
 import whipple_kick.model.slip.compiled as compiled  # noqa: PLR0402 -- the module, not the package that imports this one; tests patch its names
-import whipple_kick.model.slip.layout as layouts  # the module by its full name, not through the package
 
-from .layout import P
+
+def _model_of(params):
+    """The model ``params`` are for (``params.model``); a plain mapping has none and is refused."""
+    model = getattr(params, "model", None)
+    if model is None:
+        raise TypeError("the compiled model needs the model's parameters with their model (slip.model_parameters "
+                        "gives them; .copy() and .replace() keep it), not a plain mapping")
+    return model
 
 
 def parameter_vector(params, L=None):
@@ -20,15 +25,15 @@ def parameter_vector(params, L=None):
     params : mapping
         Every parameter of the model by name.
     L : Layout, optional
-        The model's layout; default the one ``params`` chooses
-        (:func:`whipple_kick.model.slip.layout.for_parameters`: the parts whose parameters it holds).
+        The model's layout; default ``params.model.layout``
+        (:class:`~whipple_kick.model.slip.description.Parameters`).
 
     Raises
     ------
     InputError
         If a name is missing or unknown.
     """
-    L = layouts.for_parameters(params) if L is None else L
+    L = _model_of(params).layout if L is None else L
     missing = [n for n in L.PARAMETER_NAMES if n not in params]
     if missing:
         raise InputError(f"slip-model parameters are missing: {', '.join(missing[:8])}"
@@ -44,11 +49,10 @@ class CompiledRHS:
 
     Parameters
     ----------
-    params : mapping
-        Every parameter of the model by name: the base model's
-        (:data:`whipple_kick.model.slip.layout.PARAMETER_NAMES`) and those of the
-        declared parts it has; the parts whose parameters it holds choose the
-        model (``layout``, :func:`whipple_kick.model.slip.layout.for_parameters`).
+    params : whipple_kick.model.slip.description.Parameters
+        Every parameter of the model by name, with the model they are for (``params.model``: its parts,
+        delay filter and tyre form, :func:`whipple_kick.model.slip.parameters.model_parameters`); the model
+        is not inferred from the names or values.
 
     Example
     -------
@@ -57,7 +61,9 @@ class CompiledRHS:
     """
 
     def __init__(self, params):
-        self.layout = layouts.for_parameters(params)
+        model = _model_of(params)
+        self.model = model
+        self.layout = model.layout
         self.lib = compiled.library(self.layout)
         self.p = np.ascontiguousarray(parameter_vector(params, self.layout))
         self._p_ptr = self.p.ctypes.data
@@ -69,8 +75,8 @@ class CompiledRHS:
 
     @property
     def transient(self):
-        """Name of the tyre transient form of these parameters."""
-        return transient.TRANSIENTS[int(self.p[P["tyre_transient"]])]
+        """Name of the model's tyre transient form."""
+        return self.model.transient
 
     def __call__(self, t, x):
         return self.fast(t, x)

@@ -9,7 +9,6 @@ bicycle's states by :data:`X` reads them from any model's state.
 """
 import functools
 
-from whipple_kick.errors import InputError
 from whipple_kick.model import energy, kane, parts, reflex, transient
 from whipple_kick.model import symbols as S
 
@@ -88,7 +87,7 @@ P = {n: i for i, n in enumerate(PARAMETER_NAMES)}
 #: Package modules the compiled library is generated from (its cache key hashes them).
 _SOURCES = ("compiler", "symbols", "parts", "symbolic/derivation", "symbolic/codegen", "magic_formula", "transient", "carcass", "energy",
             "reflex",
-            "slip/__init__", "slip/layout", "slip/compiled", "slip/call", "slip/parameters", "slip/jumps",
+            "slip/__init__", "slip/description", "slip/layout", "slip/compiled", "slip/call", "slip/parameters", "slip/jumps",
             "slip/linear", "symbolic/slip_build")
 
 
@@ -181,28 +180,3 @@ def _layout(part_names, delayed_reflex):
 
 
 BASE = for_parts(())
-
-
-def parts_of(params):
-    """Names of the parts whose parameters ``params`` (a mapping by name) holds: a model is chosen by them.
-
-    Raises
-    ------
-    InputError
-        Some, but not all, of a part's parameters are given.
-    """
-    names = []
-    for part in parts.REGISTRY.values():
-        given = [n for n in part.parameters if n in params]
-        if given and len(given) < len(part.parameters):
-            missing = [n for n in part.parameters if n not in params]
-            raise InputError(f"the {part.name} part's parameters are incomplete: missing {', '.join(missing[:8])}")
-        if given:
-            names.append(part.name)
-    return tuple(names)
-
-
-def for_parameters(params):
-    """The :class:`Layout` of the model whose parameters are ``params``: the parts of :func:`parts_of`,
-    and the reflex's delay filter where ``reflex_delay`` is not 0."""
-    return for_parts(parts_of(params), params.get("reflex_delay", 0.0) != 0.0)

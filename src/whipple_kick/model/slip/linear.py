@@ -45,10 +45,10 @@ def body_states(model):
 
     Parameters
     ----------
-    model : CompiledRHS or mapping
-        The compiled model, or its parameters by name.
+    model : CompiledRHS or whipple_kick.model.slip.description.Parameters
+        The compiled model, or its parameters (with their model).
     """
-    L = model.layout if isinstance(model, CompiledRHS) else layouts.for_parameters(model)
+    L = model.layout if isinstance(model, CompiledRHS) else model.model.layout
     return L.PART_STATES + L.REFLEX_STATES
 
 
@@ -280,8 +280,7 @@ def linear_state_space(params, x, step=1e-7):
     if params.get("kq3", 0.0):
         raise InputError("linear_state_space: a yaw-angle gain kq3 breaks the heading invariance")
     A_cl = linearize(CompiledRHS(params), x, step)
-    bumped = dict(params)
-    bumped["ku7"] = params["ku7"] + 1.0
+    bumped = params.replace(ku7=params["ku7"] + 1.0)
     j = LINEAR_STATES.index("u7")
     # Only the steer-rate column moves with ku7: the bumped model's other 14 columns are not computed.
     B = (A_cl[:, j] - linearize(CompiledRHS(bumped), x, step, columns=[j])[:, 0]).reshape(-1, 1)

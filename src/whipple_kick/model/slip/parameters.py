@@ -1,4 +1,5 @@
 """The model's parameters by name: the tyres', the bicycle's, the rider's gains, the kick's, the options'."""
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -85,13 +86,46 @@ def tyre_parameters(tyre, wheel, symmetric=False, lateral=True, reverse_camber=F
 SLIP_SPEEDS = ("wheel_centre", "contact_point")
 
 
-def model_parameters(moore, rear_tyre, front_tyre, gains=None, kick=None,
-                     symmetric=False, lateral=True, drive_torque=0.0,
-                     tyre_transient=transient.DEFAULT_TRANSIENT, reverse_camber=False,
-                     carcass_sliding=carcass.DEFAULT_SLIDING, carcass_damping=0.0,
-                     carcass_viscosity=carcass.SLIDING_VISCOSITY, slip_speed="wheel_centre", body=None,
-                     carcass_stiffness_scale=1.0):
-    """Assemble the slip model's parameters by name.
+@dataclass(frozen=True)
+class ModelOptions:
+    """The model's options (the fields of the scenario's model view, ``scenario.model_spec``, by the same names).
+
+    Attributes
+    ----------
+    tyre_transient : str
+        One of :data:`whipple_kick.model.transient.TRANSIENTS` (default ``carcass``).
+    symmetric_tyres : bool
+        Zero the zero-slip offsets (:func:`tyre_parameters`).
+    camber_sign : {"physical", "reversed"}
+        "reversed": the curves at the opposite camber (:func:`tyre_parameters`' ``reverse_camber``).
+    carcass_sliding : {"peak", "curve"}
+        The carcass tyre's friction limit past the peak (:mod:`whipple_kick.model.carcass`).
+    carcass_damping : float
+        Lateral damping of both carcasses [N s/m], parallel to their stiffness.
+    carcass_viscosity : float
+        :data:`whipple_kick.model.carcass.SLIDING_VISCOSITY` [N s/m]: the regularisation of an undamped
+        carcass' Coulomb plateau.
+    slip_speed : {"wheel_centre", "contact_point"}
+        Whose forward speed along the wheel's heading the slip angle ``atan(vsy / |vx|)`` and the
+        relaxation ``sigma / |vx|`` use: the wheel centre's (default) or the geometric contact point's, as
+        the thesis authors' published code takes it (parameter ``slip_speed_point``).
+    carcass_stiffness_scale : float
+        Factor on the carcass stiffnesses the steady state sets.
+    """
+
+    tyre_transient: str = transient.DEFAULT_TRANSIENT
+    symmetric_tyres: bool = False
+    camber_sign: str = "physical"
+    carcass_sliding: str = carcass.DEFAULT_SLIDING
+    carcass_damping: float = 0.0
+    carcass_viscosity: float = carcass.SLIDING_VISCOSITY
+    slip_speed: str = "wheel_centre"
+    carcass_stiffness_scale: float = 1.0
+
+
+def model_parameters(moore, rear_tyre, front_tyre, options=None, *, model=None, gains=None, kick=None, body=None,
+                     drive_torque=0.0, lateral=True):
+    """Assemble the slip model's parameters by name, with the model they are for.
 
     Parameters
     ----------
@@ -99,6 +133,11 @@ def model_parameters(moore, rear_tyre, front_tyre, gains=None, kick=None,
         Moore parameters of the bicycle (with rider).
     rear_tyre, front_tyre : whipple_kick.library.tyres.Tyre
         Loaded tyres.
+    options : ModelOptions or the scenario's model view, optional
+        The model's options (read by the names of :class:`ModelOptions`' fields; default its defaults).
+    model : whipple_kick.model.slip.description.Model, optional
+        The model: its parts, the reflex's delay filter and its tyre form, which must be ``options``'; default
+        the rigid rider without the delay filter.
     gains : mapping, optional
         Steer-torque gains by name (:data:`GAIN_NAMES`); missing ones are 0.
         ``T7 = -(kq4 q4 + kq7 q7 + ku4 u4 + ku7 u7 + kq3 q3 + ku3 u3)``.
@@ -108,61 +147,57 @@ def model_parameters(moore, rear_tyre, front_tyre, gains=None, kick=None,
         segment ``c0 + c1 tau + c2 tau^2 + c3 tau^3`` with ``tau = t - t0``,
         given as ``coefficients`` = (c0, c1, c2, c3) in m, m/s, m/s^2, m/s^3;
         see :func:`whipple_kick.library.inputs.cubic_segments`). Default: no kick.
-    symmetric, lateral, reverse_camber : bool
-        See :func:`tyre_parameters`.
+    body : mapping, optional
+        The rider's body by parameter name: the reflex (:data:`RIGID_BODY`, missing ones 0; a nonzero
+        ``reflex_delay`` needs the model's delay filter) and every parameter of each of the model's parts
+        that is not a gain (for the trunk :data:`TRUNK_BODY`: :func:`whipple_kick.library.riders.seat_with_body`
+        makes them; for the arms :data:`ARMS_BODY`), and no other part's.
     drive_torque : float
         Constant rear-wheel torque T6c [N m] about the rear frame's C.y axis
         (+ opposes forward rolling); the steady-state solver sets it.
-    tyre_transient : str
-        One of :data:`whipple_kick.model.transient.TRANSIENTS` (default ``carcass``).
-    carcass_sliding : {"peak", "curve"}
-        The carcass tyre's friction limit past the peak (:mod:`whipple_kick.model.carcass`).
-    carcass_damping : float
-        Lateral damping of both carcasses [N s/m], parallel to their stiffness
-        (default 0).
-    carcass_viscosity : float
-        :data:`whipple_kick.model.carcass.SLIDING_VISCOSITY` [N s/m]: the
-        regularisation of an undamped carcass' Coulomb plateau. The stiffnesses ``ccr``/``ccf`` are set by
-        :func:`steady_state` (or :func:`upright_state`) from the loads of the
-        state found: ``C_Fa(F_z0) / sigma0``.
-    slip_speed : {"wheel_centre", "contact_point"}
-        Whose forward speed along the wheel's heading the slip angle
-        ``atan(vsy / |vx|)`` and the relaxation ``sigma / |vx|`` use: the
-        wheel centre's (default) or the geometric contact point's, as the
-        thesis authors' published code takes it (parameter ``slip_speed_point``).
-    carcass_stiffness_scale : float
-        Factor on the carcass stiffnesses the steady state sets (default 1).
-    body : mapping, optional
-        The rider's body by parameter name (:data:`BODY_NAMES`): the reflex
-        (:data:`RIGID_BODY`, missing ones 0) and each part's parameters, all
-        or none: for the trunk part :data:`TRUNK_BODY` (the leaning upper
-        body's placement and inertia and the hip's spring-damper:
-        :func:`whipple_kick.library.riders.seat_with_body` makes them; its
-        gains ``kq11 ku11`` then apply), for the arms part :data:`ARMS_BODY`
-        (their spring-damper about the steer axis). The model has the parts
-        whose parameters are given. Default: the rigid rider, the model without parts.
+    lateral : bool
+        False switches the tyres' lateral forces and moments off (:func:`tyre_parameters`).
+
+    Returns
+    -------
+    whipple_kick.model.slip.description.Parameters
     """
+    from .description import Model, Parameters
+
+    options = ModelOptions() if options is None else options
+    opt = {name: getattr(options, name, default.default)
+           for name, default in ModelOptions.__dataclass_fields__.items()}
+    model = Model(transient=opt["tyre_transient"]) if model is None else model
+    if model.transient != opt["tyre_transient"]:
+        raise ValueError(f"the model's tyre form {model.transient!r} is not the options' {opt['tyre_transient']!r}")
+    slip_speed = opt["slip_speed"]
     if slip_speed not in SLIP_SPEEDS:
         raise InputError(f"slip speed {slip_speed!r} is unknown; choose one of {', '.join(SLIP_SPEEDS)}")
     params = {n: float(moore[n]) for n in S.CLASSIC_CONSTANTS}
-    params.update(tyre_parameters(rear_tyre, "r", symmetric, lateral, reverse_camber))
-    params.update(tyre_parameters(front_tyre, "f", symmetric, lateral, reverse_camber))
+    reverse = opt["camber_sign"] == "reversed"
+    params.update(tyre_parameters(rear_tyre, "r", opt["symmetric_tyres"], lateral, reverse))
+    params.update(tyre_parameters(front_tyre, "f", opt["symmetric_tyres"], lateral, reverse))
     body = dict(body or {})
     part_body = _part_body()
-    known = tuple(RIGID_BODY) + tuple(n for names in part_body.values() for n in names)
+    chosen = model.parts
+    known = tuple(RIGID_BODY) + tuple(n for name in chosen for n in part_body[name])
     unknown = set(body) - set(known)
     if unknown:
-        raise InputError(f"unknown rider-body parameters {sorted(unknown)}; known: {', '.join(known)}")
-    chosen = []   # the parts whose parameters the body holds: all of them, or none
-    for name, names in part_body.items():
-        given = [n for n in names if n in body]
-        if given and len(given) < len(names):
+        owners = sorted({name for name, names in part_body.items() if set(names) & unknown})
+        raise InputError(f"rider-body parameters {sorted(unknown)} are not the {model.layout.key} model's"
+                         + (f" (they are the {', '.join(owners)} part's: a model with it takes them)" if owners else "")
+                         + f"; known: {', '.join(known)}")
+    for name in chosen:   # a part's parameters: all of them
+        names = part_body[name]
+        if any(n not in body for n in names):
             part = parts.REGISTRY[name]
             raise InputError(f"{part.title or part.name} needs all of {', '.join(names)}; missing "
                              f"{', '.join(n for n in names if n not in body)}")
-        if given:
-            chosen.append(name)
-    layout = layouts.for_parts(tuple(chosen))
+    delay = float(body.get("reflex_delay", 0.0))
+    if (delay != 0.0) != model.delayed_reflex:
+        raise InputError(f"reflex delay = {delay:g} s: " + ("a delay needs the model with the delay filter"
+                                                            if delay else "the delay filter needs a delay > 0 s"))
+    layout = model.layout
     gains = dict(gains or {})
     # A zero gain on a state the model does not have changes nothing; a nonzero one is refused.
     unknown = {n for n in set(gains) - set(layout.GAIN_NAMES) if n not in GAIN_STATES or gains[n] != 0.0}
@@ -178,15 +213,15 @@ def model_parameters(moore, rear_tyre, front_tyre, gains=None, kick=None,
         "kick_profile": float(kick.get("profile", 0)),
         **{f"kick_c{i}": float(c) for i, c in enumerate(kick.get("coefficients", (0.0, 0.0, 0.0, 0.0)))},
         "T6c": float(drive_torque),
-        "tyre_transient": float(transient.check(tyre_transient)),
+        "tyre_transient": float(transient.check(model.transient)),
         "vsx_r": 0.0,
         "slip_speed_point": float(SLIP_SPEEDS.index(slip_speed)),
         "ccr": 0.0, "ccf": 0.0,   # set from the steady loads (_steady_tyre_states)
-        "dcr": float(carcass_damping), "dcf": float(carcass_damping),
-        "carcass_sliding": float(carcass.check_sliding(carcass_sliding)),
-        "carcass_viscosity": float(carcass_viscosity),
-        "carcass_stiffness_scale": float(carcass_stiffness_scale),
+        "dcr": float(opt["carcass_damping"]), "dcf": float(opt["carcass_damping"]),
+        "carcass_sliding": float(carcass.check_sliding(opt["carcass_sliding"])),
+        "carcass_viscosity": float(opt["carcass_viscosity"]),
+        "carcass_stiffness_scale": float(opt["carcass_stiffness_scale"]),
     })
     params.update({n: float(body.get(n, RIGID_BODY[n])) for n in RIGID_BODY})
     params.update({n: float(body[n]) for name in chosen for n in part_body[name]})
-    return params
+    return Parameters(model, params)

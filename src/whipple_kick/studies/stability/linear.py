@@ -245,7 +245,7 @@ def _base_params(setup):
     """
     sc = setup.scenario
     return assembly.model_parameters(sc.model_spec, None, setup.moore, assembly.rider_body(sc.body_spec, setup.info),
-                                     *setup.tyres, None)
+                                     *setup.tyres, None, assembly.model_of(sc.body_spec, sc.tyre_transient))
 
 
 def _loop_params(setup, speed, loop, base=None):
@@ -255,7 +255,7 @@ def _loop_params(setup, speed, loop, base=None):
     simulated (:func:`whipple_kick.simulate.control.lqr_on_simulated_model`), once
     per design speed.
     """
-    params = dict(_base_params(setup) if base is None else base)
+    params = (_base_params(setup) if base is None else base).copy()
     if loop == "closed":
         params.update(_rider_gains(setup, speed))
     return params
@@ -271,7 +271,7 @@ def _rider_gains(setup, speed):
         try:
             setup.designs[key] = control.lqr_on_simulated_model(
                 sc.design_spec, setup.moore, setup.design, assembly.rider_body(sc.body_spec, setup.info),
-                *setup.tyres)[0]
+                *setup.tyres, assembly.model_of(sc.body_spec, sc.tyre_transient))[0]
         except InputError as exc:
             setup.designs[key] = NoRiderDesign(f"no LQR rider designed on the model simulated at {key:g} m/s: "
                                                f"{exc}")

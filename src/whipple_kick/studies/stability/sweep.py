@@ -55,7 +55,7 @@ class _Loop:
         """
         params = _loop_params(self.setup, speed, self.loop, self.base)
         if other is not None:
-            shared = steady.SteadyState(other.x, {**params, **{n: other.params[n] for n in steady.STEADY_PARAMETERS}},
+            shared = steady.SteadyState(other.x, params.replace(**{n: other.params[n] for n in steady.STEADY_PARAMETERS}),
                                       other.residual, other.unknowns)
             rhs = slip.CompiledRHS(shared.params)
             if abs(rhs.outputs(0.0, shared.x)[1][slip.OUT["T7"]]) < ZERO_TORQUE_N_M:
