@@ -59,7 +59,7 @@ def bench_rhs(repeats):
     x[slip.X["u4"]] = 0.1
     n_c, n_np = 20000, 200
     c_times, alone_times, np_times = [], [], []
-    slip_build.numpy_rhs(0.05, x, p)  # import and warm up
+    slip_build.numpy_rhs(0.05, x, p, ss.params.model)  # import and warm up
     f = rhs.fast   # what the integrators call
     native = hasattr(f, "repeat")
     for _ in range(repeats):
@@ -73,7 +73,7 @@ def bench_rhs(repeats):
             alone_times.append((time.perf_counter() - t0) / n_c)
         t0 = time.perf_counter()
         for _ in range(n_np):
-            slip_build.numpy_rhs(0.05, x, p)
+            slip_build.numpy_rhs(0.05, x, p, ss.params.model)
         np_times.append((time.perf_counter() - t0) / n_np)
     c, n = statistics.median(c_times), statistics.median(np_times)
     print(f"RHS call from Python ({'rhs_call extension' if native else 'ctypes fallback'}): median "
@@ -158,7 +158,7 @@ def bench_run(repeats):
               f"({traj.nfev} RHS calls)  runs {[round(v, 3) for v in times]}")
         c_med = statistics.median(times)
         t0 = time.perf_counter()
-        lsoda.integrate(lambda t, x: slip_build.numpy_rhs(t, x, p), ss.x, 6.0, t_start=0.0,
+        lsoda.integrate(lambda t, x: slip_build.numpy_rhs(t, x, p, ss.params.model), ss.x, 6.0, t_start=0.0,
                             breakpoints=(0.15,), rtol=rtol)
         n = time.perf_counter() - t0
         print(f"6 s base case, NumPy RHS, rtol {rtol:g}: {n:.2f} s (one run); C is {n / c_med:.0f}x faster")

@@ -278,7 +278,7 @@ def test_options_agree_with_the_python_block(rider_bike, gains, t03, law, dampin
             x[slip.X[name]] += rng.uniform(-spread, spread)
         t = rng.uniform(-0.05, 0.2)
         dx_c, out_c = rhs.outputs(t, x)
-        dx_n, out_n = slip_build.numpy_rhs(t, x, p, with_outputs=True)
+        dx_n, out_n = slip_build.numpy_rhs(t, x, p, ss.params.model, with_outputs=True)
         np.testing.assert_allclose(dx_c, dx_n, rtol=1e-8, atol=1e-8 * np.abs(dx_n).max())
         np.testing.assert_allclose(out_c, out_n, rtol=1e-8, atol=1e-8 * np.abs(out_n).max())
 

@@ -36,7 +36,7 @@ def test_the_model_is_declared_not_read_from_the_parameter_names():
     """The model's parameters carry their model: a body with some of a part's parameters is refused for the
     model with the part (one line naming what is missing), and a part's parameters for a model without it are
     refused rather than choosing the part; a nonzero delay needs the delay filter; a plain mapping is no
-    model's parameters."""
+    model's parameters, and values that contradict their model are refused."""
     moore = wk.assembly.build_bicycle(wk.Scenario().bicycle_spec)[0]
     tyre = wk.tyres.load("T03", pressure_kpa=400)
     leaning = slip.Model(("trunk",))
@@ -50,6 +50,11 @@ def test_the_model_is_declared_not_read_from_the_parameter_names():
     assert params.model.layout is slip.for_parts((), True) and params.copy().model is params.model
     with pytest.raises(TypeError, match="not a plain mapping"):
         slip.CompiledRHS(dict(params))
+    # Values that contradict their model are refused, not read as another model.
+    with pytest.raises(wk.InputError, match=r"reflex_delay = 0\.05 s does not fit the rigid model"):
+        slip.CompiledRHS(slip.Parameters(slip.Model(), params))
+    with pytest.raises(wk.InputError, match="tyre_transient = 3 is not the force_lag model's index 2"):
+        slip.CompiledRHS(slip.Parameters(slip.Model((), True, "force_lag"), params))
 
 
 def test_merged_upper_body_conserves_mass_and_mass_centre():

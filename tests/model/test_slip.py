@@ -209,7 +209,8 @@ def test_a_lifted_wheel_closing_on_the_ground_carries_no_force(rider_bike, t03, 
         -ss.params[f"cc{wheel}"] * force / ss.params["carcass_viscosity"], rel=1e-9)
     assert np.all(np.isfinite(dx))
     assert dx[slip.X["D_damper"]] == pytest.approx(0.0, abs=1e-9)   # the other tyre is at rest vertically
-    oracle, oracle_out = slip_build.numpy_rhs(0.0, x, slip.parameter_vector(ss.params), with_outputs=True)
+    oracle, oracle_out = slip_build.numpy_rhs(0.0, x, slip.parameter_vector(ss.params), ss.params.model,
+                                                 with_outputs=True)
     assert oracle_out[slip.OUT[f"fz_{wheel}"]] == 0.0
     np.testing.assert_allclose(dx, oracle, rtol=0, atol=1e-10 * np.abs(dx).max())
     # Touching the ground again (q > 0), the same rate pushes: the contact is back.

@@ -47,7 +47,7 @@ def test_c_agrees_with_numpy_oracle(rider_bike, gains, t03, transient):
         x[slip.X["q10"]] = rng.uniform(0.0, 0.01)
         t = rng.uniform(-0.05, 0.2)
         dx_c, out_c = rhs.outputs(t, x)
-        dx_n, out_n = slip_build.numpy_rhs(t, x, p, with_outputs=True)
+        dx_n, out_n = slip_build.numpy_rhs(t, x, p, ss.params.model, with_outputs=True)
         # Same expressions, different evaluation order: agreement is limited
         # by the conditioning of the two small linear solves, ~1e-14 here.
         np.testing.assert_allclose(dx_c, dx_n, rtol=tol, atol=tol * np.abs(dx_n).max())

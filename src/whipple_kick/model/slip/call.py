@@ -5,6 +5,7 @@ import math
 import numpy as np
 
 from whipple_kick.errors import InputError
+from whipple_kick.model import transient
 import whipple_kick.model.slip.compiled as compiled  # noqa: PLR0402 -- the module, not the package that imports this one; tests patch its names
 
 
@@ -66,6 +67,14 @@ class CompiledRHS:
         self.layout = model.layout
         self.lib = compiled.library(self.layout)
         self.p = np.ascontiguousarray(parameter_vector(params, self.layout))
+        # The values agree with the model they come with (the C reads the form's index and the delay).
+        form, delay = self.p[self.layout.P["tyre_transient"]], self.p[self.layout.P["reflex_delay"]]
+        if form != transient.check(model.transient):
+            raise InputError(f"tyre_transient = {form:g} is not the {model.transient} model's index "
+                             f"{transient.check(model.transient)}")
+        if (delay != 0.0) != model.delayed_reflex:
+            raise InputError(f"reflex_delay = {delay:g} s does not fit the {model.layout.key} model (a delay needs "
+                             "the delay filter, the filter a delay > 0 s)")
         self._p_ptr = self.p.ctypes.data
         self._dx = np.empty(len(self.layout.STATE_NAMES))
         self._dx_ptr = self._dx.ctypes.data

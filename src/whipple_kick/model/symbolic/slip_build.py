@@ -732,12 +732,14 @@ def numpy_module(part_names=()):
     return cache.load_module(path, f"whipple_kick_generated_slip_{L.key.replace('+', '_')}_{key}")
 
 
-def numpy_rhs(t, x, p, with_outputs=False, part_names=()):
-    """Right-hand side of the model with ``part_names`` evaluated with NumPy (slow; the oracle for the C code).
+def numpy_rhs(t, x, p, model, with_outputs=False):
+    """Right-hand side of ``model`` evaluated with NumPy (slow; the oracle for the C code).
 
-    The reflex's delay filter is in the model where ``p``'s ``reflex_delay`` is not 0.
+    ``p`` is its parameter vector (:func:`whipple_kick.model.slip.parameter_vector`) and ``model`` the
+    :class:`whipple_kick.model.slip.Model` it is for (``params.model``): its parts, delay filter and tyre form.
     """
-    L = layouts.for_parts(part_names, p[P["reflex_delay"]] != 0.0)
+    part_names = model.parts
+    L = model.layout
     if len(x) != len(L.STATE_NAMES) or len(p) != len(L.PARAMETER_NAMES):
         raise ValueError(f"numpy_rhs: {len(x)} states and {len(p)} parameters are not the layout {L.key!r}'s")
     mod = numpy_module(part_names)
@@ -745,7 +747,7 @@ def numpy_rhs(t, x, p, with_outputs=False, part_names=()):
     u_ind = x[[L.X[n] for n in L.INDEPENDENT]]
     s = x[[X[n] for n in PATCH_STATES]]
     z = x[[L.X[n] for n in L.REFLEX_STATES]] if L.delayed_reflex else np.zeros(len(REFLEX_STATES))
-    name = transient.TRANSIENTS[int(p[P["tyre_transient"]])]
+    name = model.transient
     tau = p[P["reflex_delay"]]
     # numpy.select evaluates every branch of a Piecewise, including the
     # unloaded-tyre branch's 0/0 that C never takes; the selected values are finite.
