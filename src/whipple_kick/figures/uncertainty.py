@@ -15,8 +15,12 @@ from .plotting import _written
 
 #: Colours of the two criteria.
 _COLOURS = {"settling": "tab:blue", "last_peak": "tab:orange"}
-#: Each criterion's short name (:data:`whipple_kick.simulate.criteria.CRITERIA`).
-_CRITERION_TEXT = {key: c.short for key, c in CRITERIA.items()}
+
+
+def _criterion_text(criterion):
+    """A criterion's short name, read when drawn: a criterion declared after this module's import has one too
+    (:data:`whipple_kick.simulate.criteria.CRITERIA`)."""
+    return CRITERIA[criterion].short if criterion in CRITERIA else criterion
 
 
 def _figure(n_panels, height=3.6, rows=1):
@@ -53,7 +57,7 @@ def p_best_figure(p_best, path=None, title=None, dpi=120):
             low, high = rows["low"].to_numpy(dtype=float), rows["high"].to_numpy(dtype=float)
             err = np.vstack([p - low, high - p])
             bars = ax.bar(x + (k - (len(criteria) - 1) / 2) * width, p, width, yerr=np.clip(err, 0, None), capsize=3,
-                          color=_COLOURS.get(criterion), label=_CRITERION_TEXT.get(criterion, criterion))
+                          color=_COLOURS.get(criterion), label=_criterion_text(criterion))
             bars[-1].set_hatch("//")
             bars[-1].set_alpha(0.6)
             top = np.maximum(top, np.where(np.isfinite(high), high, p))
@@ -104,7 +108,7 @@ def distribution_figure(outcomes, criterion="settling", path=None, title=None, d
         ax.set_xticks(positions, [f"{p:g}" for p in pressures])
         ax.set_xlabel("pressure [kPa]")
         ax.set_title(f"rear load {fz:g} N")
-    axes[0].set_ylabel(f"{_CRITERION_TEXT[criterion]} [s]")
+    axes[0].set_ylabel(f"{_criterion_text(criterion)} [s]")
     if title:
         fig.suptitle(title, fontsize=10)
     fig.tight_layout()
@@ -155,7 +159,7 @@ def sobol_figure(sobol, criterion="settling", pair=None, path=None, title=None, 
                          f"{100 * rows['rows_neither_recovered'].iloc[0] / n:.0f} %")
             ax.set_title(head, fontsize=9)
     if title is None:
-        title = f"what decides which pressure recovers first by the {_CRITERION_TEXT[criterion]}"
+        title = f"what decides which pressure recovers first by the {_criterion_text(criterion)}"
     return _finish(fig, axes, title, path, dpi)
 
 
@@ -204,11 +208,11 @@ def paired_figure(outcomes, criterion="settling", path=None, title=None, dpi=120
             ax.text(0.03, 0.9, f"{a:g} first {first_a:.2f}\n{b:g} first {first_b:.2f}\nneither {neither:.2f}",
                     transform=ax.transAxes, va="top", fontsize=8)
             ax.text(edge, (low + edge) / 2, "not recovered", rotation=90, fontsize=7, va="center", ha="center")
-            ax.set_xlabel(f"{_CRITERION_TEXT[criterion]} at {a:g} kPa [s]")
+            ax.set_xlabel(f"{_criterion_text(criterion)} at {a:g} kPa [s]")
             ax.set_ylabel(f"at {b:g} kPa [s]")
             ax.set_title(f"rear load {fz:g} N ({n} paired rows)", fontsize=9)
     if title is None:
-        title = f"paired rows: {_CRITERION_TEXT[criterion]} at two pressures on the same inputs"
+        title = f"paired rows: {_criterion_text(criterion)} at two pressures on the same inputs"
     return _finish(fig, axes, title, path, dpi)
 
 
