@@ -162,3 +162,31 @@ def test_the_models_compiler_flags_give_the_bits_of_the_reference_flags(tmp_path
     (_, x_ref, t_ref), (_, x, t) = (bench_sweep._integrate_with(lib, scenario) for lib in libraries.values())
     assert len(libraries) == 2 and t.size > 1000
     assert np.array_equal(t, t_ref) and np.array_equal(x, x_ref)
+
+
+def test_calibration_options_tables_each_option_and_counts_where_the_measured_best_leads(tmp_path, capsys):
+    """scripts/calibration_options.py on a synthetic calibrate folder: the option in words, the credible
+    interval, the simulator's count within +-3, the measured best in bold and counted only where it leads."""
+    import calibration_options
+
+    folder = tmp_path / "cal"
+    folder.mkdir()
+    (folder / "settings.json").write_text(json.dumps({"choices": {"rider_body": "rigid", "lqr_model": "whipple",
+                                                                  "kick_direction": "left"}}))
+    (folder / "posterior.csv").write_text("gain_scale\n" + "\n".join(f"{0.6 + k / 1000:.3f}" for k in range(101)))
+    (folder / "features.csv").write_text("implausibility_at_posterior_mean,simulator_runs,simulator_standardised_error\n"
+                                         "1.5,8,0.5\n-2.5,8,-3.5\n0.2,0,\n")
+    (folder / "checks.csv").write_text("check,name,value,detail\nnon_implausible_fraction,wave 1,0.25,x\n"
+                                       "non_implausible_fraction,wave 2,0.125,x\n")
+    rows = ["fz_n,criterion,pressure_kpa,p,low,high,rows,rows_failed,measured_best"]
+    for criterion, shares in (("last_peak", (0.5, 0.3, 0.2)), ("settling", (0.1, 0.6, 0.3))):
+        rows += [f"570.0,{criterion},{p:.1f},{s},0.0,1.0,32,0,{p == 300.0}" for p, s in zip((300.0, 400.0, 500.0),
+                                                                                             shares, strict=True)]
+        rows.append(f"570.0,{criterion},,0.0,0.0,0.1,32,0,False")
+    (folder / "p_best.csv").write_text("\n".join(rows) + "\n")
+    assert calibration_options.main([str(folder)]) == 0
+    out = capsys.readouterr().out
+    assert "| rigid rider, whipple LQR, kicked left | 0.125 | gain_scale 0.605-0.695 | 2.50 | 1 of 2 |" in out
+    assert "| 570 N | last_peak | **0.50 (0.00-1.00)** | 0.30 (0.00-1.00) |" in out
+    assert "the measured best is the most probable in 1 of 2 (load, criterion)" in out
+    assert calibration_options.main([str(tmp_path)]) == 2
