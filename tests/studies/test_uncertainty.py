@@ -622,7 +622,14 @@ def test_sobol_caution_names_implausible_sums_and_wide_intervals():
     assert any("first-order indices sum to 1.20 +- 0.17 (between 0 and 1)" in r for r in reasons)
     assert any("1 of 3 inputs with an index negative" in r for r in reasons)
     assert any("largest total index (a 0.40 +- 0.50) is not resolved from 0" in r for r in reasons)
-    assert any("3 of the 3 inputs with a total index >= 0.05 have total intervals wider" in r for r in reasons)
+    assert any("3 of the 3 inputs with a total index >= 0.05 have intervals wider" in r for r in reasons)
+    # Interactions only: first-order indices near 0 with intervals wider than them are not a caution by
+    # themselves (they are at any N); resolved totals are resolved.
+    interacting = pd.DataFrame({"input": ["a", "b", "c"], "S1": [0.02, 0.01, 0.0], "S1_conf": [0.06, 0.05, 0.04],
+                                "ST": [0.85, 0.5, 0.3], "ST_conf": [0.08, 0.08, 0.06]})
+    assert uncertainty.sobol_caution(interacting) == []
+    assert any("2 of the 2 inputs with a first-order index >= 0.05 have intervals wider" in r for r in
+               uncertainty.sobol_caution(interacting.assign(S1=[0.1, 0.08, 0.0], S1_conf=[0.2, 0.1, 0.04])))
     good = pd.DataFrame({"input": ["a", "b"], "S1": [0.7, 0.2], "S1_conf": [0.05, 0.05], "ST": [0.8, 0.25],
                          "ST_conf": [0.05, 0.05]})
     assert uncertainty.sobol_caution(good) == []
