@@ -71,11 +71,20 @@ class Mechanics:
         return q, u
 
     def body(self, name, point, frame, mass, inertia):
-        """Add a rigid body with its weight (``inertia`` a dyadic about ``point``, its mass centre)."""
+        """Add a rigid body with its weight (``inertia`` a dyadic about ``point``, its mass centre); return it."""
         import sympy.physics.mechanics as me
 
-        self.kin.bodies.append(me.RigidBody(name, point, frame, mass, (inertia, point)))
+        body = me.RigidBody(name, point, frame, mass, (inertia, point))
+        self.kin.bodies.append(body)
         self.kin.gravity_loads.append((point, mass * self.par["g"] * self.kin.frames["N"].z))
+        return body
+
+    def rigid_body(self, name):
+        """The system's rigid body called ``name`` (``"rear_frame"``, ``"front_frame"``, a part's), to join to."""
+        found = [b for b in self.kin.bodies if b.name == name]
+        if not found:
+            raise KeyError(f"no body {name!r}; bodies: {', '.join(b.name for b in self.kin.bodies)}")
+        return found[0]
 
 
 @dataclass(frozen=True)
@@ -274,7 +283,8 @@ _TRUNK_BODY = ("hip_tilt", "lh1", "lh3", "mt", "lt1", "lt3", "it11", "it22", "it
 
 
 def _build_trunk(m):
-    """The upper body G on a revolute hip joint about H.x, with its spring-damper; the hands on G."""
+    """The upper body G on the hip, a revolute joint about H.x (SymPy's ``PinJoint``), with its spring-damper
+    (a ``TorqueActuator`` at the joint); the hands on G."""
     import sympy.physics.mechanics as me
 
     kin, b = m.kin, m.par
@@ -284,18 +294,21 @@ def _build_trunk(m):
     H = me.ReferenceFrame("H")
     H.orient_axis(C, C.y, b["hip_tilt"])
     G = me.ReferenceFrame("G")
-    G.orient_axis(H, H.x, q11)
-    G.set_ang_vel(H, u11 * H.x)
     do = kin.points["do"]
     ho = do.locatenew("ho", b["lh1"] * C.x + b["lh3"] * C.z)
     ho.v2pt_theory(do, N, C)
-    go = ho.locatenew("go", b["lt1"] * G.x + b["lt3"] * G.z)
-    go.v2pt_theory(ho, N, G)
-    m.body("upper_body", go, G, b["mt"], me.inertia(G, b["it11"], b["it22"], b["it33"], 0, 0, b["it31"]))
+    go = me.Point("go")
+    upper_body = m.body("upper_body", go, G, b["mt"],
+                        me.inertia(G, b["it11"], b["it22"], b["it33"], 0, 0, b["it31"]))
+    # The joint turns G about H.x by q11 at rate u11 and puts the hip point of G (lt1, lt3 from go) on ho.
+    hip = me.PinJoint("hip", m.rigid_body("rear_frame"), upper_body, coordinates=q11, speeds=u11,
+                      parent_point=ho, child_point=-(b["lt1"] * G.x + b["lt3"] * G.z), parent_interframe=H,
+                      joint_axis=H.x)
+    go.v2pt_theory(ho, N, G)   # the joint gives go's velocity in the rear frame; Kane's method reads it in N
     kin.frames.update(H=H, G=G)
     kin.points.update(ho=ho, go=go)
-    hip_torque = -(b["kh"] * q11 + b["ch"] * u11)
-    m.loads += [(C, -hip_torque * H.x), (G, hip_torque * H.x)]
+    hip_torque = -(b["kh"] * q11 + b["ch"] * u11)   # on G about H.x, reacted on the rear frame
+    m.loads += me.TorqueActuator.at_pin_joint(hip_torque, hip).to_loads()
     # The hands hold the bar from G: the bar turns relative to G about C.z by q7 - (H.x . C.z) q11
     # (H.x . C.z is constant), so the arms' spring is exact.
     axis_share = H.x.dot(C.z)
@@ -358,13 +371,15 @@ def _build_arms(m):
     Built after the trunk when the model has it (``after=("trunk",)``), so the hands' frame is the upper
     body's when it leans.
     """
+    import sympy.physics.mechanics as me
+
     kin, b = m.kin, m.par
     C, E = kin.frames["C"], kin.frames["E"]
     # The bar turns relative to the hands' frame by q7 less that frame's own turn about C.z (exact).
     arm_angle = S.dyn("q7") - m.hands_angle
     arm_rate = S.dyn("u7") - m.hands_rate
-    arm_torque = -(b["ka"] * arm_angle + b["ca"] * arm_rate)
-    m.loads += [(m.hands_frame, -arm_torque * C.z), (E, arm_torque * C.z)]
+    arm_torque = -(b["ka"] * arm_angle + b["ca"] * arm_rate)   # on the bar E about C.z, reacted on the hands
+    m.loads += me.TorqueActuator(arm_torque, C.z, E, m.hands_frame).to_loads()
     m.spring_energy.append(b["ka"] * arm_angle**2 / 2)
     m.damper_dissipation.append(b["ca"] * arm_rate**2)
     m.outputs["arm_steer_torque"] = arm_torque
