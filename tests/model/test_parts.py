@@ -274,6 +274,30 @@ def test_a_parts_scenario_fields_come_from_its_declaration():
     assert "; the leaning upper body (hip stiffness 300 N m/rad, hip damping 7 N m s/rad)" in report.describe(sc)
 
 
+def test_a_parts_gains_values_and_rider_parameters_come_from_its_declaration(shift):
+    """The rest of a part's footprint in a run, from its declaration: its gains are known to the custom-gains
+    check and refused (one line naming the part and how to select it) while the scenario does not select it;
+    its declared values and fields are its parameters in the rider's body; the trunk takes its placement and
+    inertia from the rider's segments because it declares them (``from_rider``), and a declaration that sets
+    one parameter twice is refused."""
+    from whipple_kick.simulate import scenario as scenario_module
+
+    cls = scenario_module.with_parts(shift)
+    with pytest.raises(wk.InputError) as refused:
+        assembly.custom_gains({"kq12": 1.0}, cls())
+    assert str(refused.value) == ("gain(s) ['kq12'] feed back the sliding mass's states (q12), which only shift 'on' "
+                                  "has (here 'off'); allowed: 0 or the sliding mass")
+    assert assembly.custom_gains({"kq12": 1.0}, cls(shift="on"))["kq12"] == 1.0
+    body = assembly.rider_body(cls(shift="on", shift_damping=40.0).body_spec, {})
+    assert {n: body[n] for n in ("ms", "ls3", "ks", "cs")} == {"ms": 5.0, "ls3": -0.6, "ks": 2000.0, "cs": 40.0}
+    assert parts.TRUNK.from_rider == slip.parameters.TRUNK_BODY[:10]
+    segments = dict.fromkeys(parts.TRUNK.from_rider, 0.25)
+    leaning = assembly.rider_body(wk.Scenario(rider_body="leaning").body_spec, {"body": segments})
+    assert all(leaning[n] == 0.25 for n in segments) and leaning["kh"] == 128.0
+    with pytest.raises(ValueError, match=r"values \['ms'\] are not among its parameters that nothing else"):
+        dataclasses.replace(shift, from_rider=("ms",))
+
+
 @pytest.mark.slow   # derives and compiles the shift model when no other test has (about 40 s), then runs it
 def test_a_part_declared_here_runs_through_scenario_assemble_and_run_from_its_field_and_flag(shift):
     """The acceptance of issue 42: the sliding-mass part, declared in this module alone, is selected and set

@@ -164,7 +164,11 @@ class Part:
     values : dict
         Values of its parameters that neither its fields nor its gains set (name -> value, in the units of its
         symbols; their sources cited where the part is declared): a run whose scenario selects it takes them.
-        The trunk's come from the rider's segments instead (``whipple_kick.simulate.assembly.rider_body``).
+        The trunk's come from the rider's segments instead (:attr:`from_rider`).
+    from_rider : tuple of str
+        Its parameters a run takes from the rider's segments (the upper body that
+        :func:`whipple_kick.library.riders.seat_with_body` splits off, by the same names), where the bicycle's
+        rider has them (``whipple_kick.simulate.assembly.rider_body``).
     """
 
     name: str
@@ -184,6 +188,7 @@ class Part:
     needs: tuple = ()
     after: tuple = ()
     values: dict = field(default_factory=dict)
+    from_rider: tuple = ()
 
     def __post_init__(self):
         if self.name in self.needs + self.after:
@@ -198,11 +203,12 @@ class Part:
         unknown = [f.parameter for f in self.fields if f.parameter not in self.parameters]
         if unknown:
             raise ValueError(f"part {self.name!r}: fields set {unknown}, which are not among its parameters")
-        unknown = [n for n in self.values if n not in self.parameters or n in self.gains
-                   or n in {f.parameter for f in self.fields}]
-        if unknown:
-            raise ValueError(f"part {self.name!r}: values {unknown} are not among its parameters that neither a "
-                             "gain nor a field sets")
+        for what, names in (("values", tuple(self.values)), ("from_rider", self.from_rider)):
+            others = set(self.gains) | {f.parameter for f in self.fields} | (set(self.values) & set(self.from_rider))
+            unknown = [n for n in names if n not in self.parameters or n in others]
+            if unknown:
+                raise ValueError(f"part {self.name!r}: {what} {unknown} are not among its parameters that nothing "
+                                 "else (a gain, a field, the other of values and from_rider) sets")
         if self.fields and not self.selected_by:
             raise ValueError(f"part {self.name!r} has scenario fields but no selected_by that selects it")
 
@@ -360,6 +366,7 @@ TRUNK = declare(Part(
               "Moore (2012, ch. 4, 'Leaning rider extension', from de Lorenzo and Hubbard)"),
     ),
     title="the leaning upper body",
+    from_rider=_TRUNK_BODY,   # the rider's own upper body: its placement on the hip and its inertia
 ))
 
 
