@@ -298,6 +298,15 @@ def test_a_parts_gains_values_and_rider_parameters_come_from_its_declaration(shi
         dataclasses.replace(shift, from_rider=("ms",))
 
 
+def test_a_part_declared_here_has_its_columns_in_the_stability_study(shift):
+    """The linear stability study names a part's states by its declared columns and counts them as the
+    rider's body, for a part declared after the study's modules were imported."""
+    from whipple_kick.studies.stability import linear, modes
+
+    assert linear.state_labels(body=("q12", "u12"))[-2:] == [("mass_shift", "m"), ("mass_shift_rate", "m/s")]
+    assert {"q12", "u12", "q11"} <= modes._body_states() and "q4" not in modes._body_states()
+
+
 @pytest.mark.slow   # derives and compiles the shift model when no other test has (about 40 s), then runs it
 def test_a_part_declared_here_runs_through_scenario_assemble_and_run_from_its_field_and_flag(shift):
     """The acceptance of issue 42: the sliding-mass part, declared in this module alone, is selected and set
