@@ -133,12 +133,18 @@ def _build_shift(m):
     do = kin.points["do"]
     rest = do.locatenew("shift_rest", b["ls1"] * C.x + b["ls3"] * C.z)   # fixed in the rear frame
     rest.v2pt_theory(do, N, C)
-    so = rest.locatenew("shift_mass", q12 * C.y)
-    so.set_vel(C, u12 * C.y)
-    so.v1pt_theory(rest, N, C)
-    m.body("shifting_mass", so, C, b["ms"], me.inertia(C, b["is11"], b["is22"], b["is33"]))
+    # The mass slides on SymPy's PrismaticJoint along C.y; its own frame S (a joint's child has one) stays
+    # parallel to C.
+    S = me.ReferenceFrame("S")
+    so = me.Point("shift_mass")
+    mass = m.body("shifting_mass", so, S, b["ms"], me.inertia(S, b["is11"], b["is22"], b["is33"]))
+    me.PrismaticJoint("shift", m.rigid_body("rear_frame"), mass, coordinates=q12, speeds=u12, parent_point=rest,
+                      joint_axis=C.y)
+    so.v1pt_theory(rest, N, C)   # the joint gives its velocity in the rear frame; Kane's method reads it in N
+    # The spring-damper between the mass and the frame, by hand: SymPy's LinearSpring and LinearDamper act
+    # along a pathway's length, |q12| here, whose direction is undefined at the rest point q12 = 0.
     force = -(b["ks"] * q12 + b["cs"] * u12)
-    m.loads += [(so, force * C.y), (rest, -force * C.y)]   # the spring-damper between the mass and the frame
+    m.loads += [(so, force * C.y), (rest, -force * C.y)]
     m.spring_energy.append(b["ks"] * q12**2 / 2)
     m.damper_dissipation.append(b["cs"] * u12**2)
     m.outputs["shift_force"] = force
