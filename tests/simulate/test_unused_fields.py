@@ -214,7 +214,7 @@ def test_item5_lean_gains_given_are_used():
 
 
 def test_item5_lean_gains_need_a_leaning_body_and_gains_replace_the_controller():
-    with pytest.raises(InputError, match=r"\['kq11'\] feed back the upper body's lean"):
+    with pytest.raises(InputError, match=r"\['kq11'\] feed back the leaning upper body's states \(q11\), which only rider_body 'leaning' has"):
         assembly.custom_gains({"kq11": 3.0}, Scenario())
     with pytest.raises(InputError, match=r"gain_scale = 0\.5 is replaced by the given gains"):
         assembly.custom_gains({"kq4": -10.0}, Scenario(gain_scale=0.5))

@@ -20,8 +20,8 @@ for this model's single Kane derivation.
 :data:`TRUNK` is the rider's upper body leaning on the hip (Moore 2012, ch. 4,
 "Leaning rider extension"); :data:`ARMS` the arms' spring-damper about the
 steer axis between the bar and the frame the hands hold (the upper body's
-when it leans: it is declared after the trunk, and parts are built in
-declaration order). :func:`merge_into_rear_frame` lumps an upper
+when it leans: it declares that it is built after the trunk, :attr:`Part.after`;
+a part that cannot work without another declares it in :attr:`Part.needs`). :func:`merge_into_rear_frame` lumps an upper
 body into the rear frame, exactly, for the rigid rider whose arms hold the bar.
 """
 from collections.abc import Callable
@@ -31,6 +31,7 @@ import inspect
 
 import numpy as np
 
+from whipple_kick.errors import InputError
 from whipple_kick.model import symbols as S
 
 
@@ -70,11 +71,20 @@ class Mechanics:
         return q, u
 
     def body(self, name, point, frame, mass, inertia):
-        """Add a rigid body with its weight (``inertia`` a dyadic about ``point``, its mass centre)."""
+        """Add a rigid body with its weight (``inertia`` a dyadic about ``point``, its mass centre); return it."""
         import sympy.physics.mechanics as me
 
-        self.kin.bodies.append(me.RigidBody(name, point, frame, mass, (inertia, point)))
+        body = me.RigidBody(name, point, frame, mass, (inertia, point))
+        self.kin.bodies.append(body)
         self.kin.gravity_loads.append((point, mass * self.par["g"] * self.kin.frames["N"].z))
+        return body
+
+    def rigid_body(self, name):
+        """The system's rigid body called ``name`` (``"rear_frame"``, ``"front_frame"``, a part's), to join to."""
+        found = [b for b in self.kin.bodies if b.name == name]
+        if not found:
+            raise KeyError(f"no body {name!r}; bodies: {', '.join(b.name for b in self.kin.bodies)}")
+        return found[0]
 
 
 @dataclass(frozen=True)
@@ -146,6 +156,19 @@ class Part:
         is not selected, all from this declaration).
     title : str
         Its name in messages ("the leaning upper body").
+    needs : tuple of str
+        Parts it requires: a model with it and without one of them is refused (:func:`named`).
+    after : tuple of str
+        Parts it reads what they build from when the model has them (the arms read the hands' frame the trunk
+        sets): they are built before it, whatever the order of declaration (:func:`named`).
+    values : dict
+        Values of its parameters that neither its fields nor its gains set (name -> value, in the units of its
+        symbols; their sources cited where the part is declared): a run whose scenario selects it takes them.
+        The trunk's come from the rider's segments instead (:attr:`from_rider`).
+    from_rider : tuple of str
+        Its parameters a run takes from the rider's segments (the upper body that
+        :func:`whipple_kick.library.riders.seat_with_body` splits off, by the same names), where the bicycle's
+        rider has them (``whipple_kick.simulate.assembly.rider_body``).
     """
 
     name: str
@@ -162,8 +185,14 @@ class Part:
     selected_by: tuple = ()
     fields: tuple = ()
     title: str = ""
+    needs: tuple = ()
+    after: tuple = ()
+    values: dict = field(default_factory=dict)
+    from_rider: tuple = ()
 
     def __post_init__(self):
+        if self.name in self.needs + self.after:
+            raise ValueError(f"part {self.name!r} names itself among the parts it needs or is built after")
         S.register(self.symbols)
         missing = [n for n in self.coordinates + self.speeds + self.parameters if n not in S.REGISTRY]
         if missing:
@@ -174,23 +203,37 @@ class Part:
         unknown = [f.parameter for f in self.fields if f.parameter not in self.parameters]
         if unknown:
             raise ValueError(f"part {self.name!r}: fields set {unknown}, which are not among its parameters")
+        for what, names in (("values", tuple(self.values)), ("from_rider", self.from_rider)):
+            others = set(self.gains) | {f.parameter for f in self.fields} | (set(self.values) & set(self.from_rider))
+            unknown = [n for n in names if n not in self.parameters or n in others]
+            if unknown:
+                raise ValueError(f"part {self.name!r}: {what} {unknown} are not among its parameters that nothing "
+                                 "else (a gain, a field, the other of values and from_rider) sets")
+        if self.fields and not self.selected_by:
+            raise ValueError(f"part {self.name!r} has scenario fields but no selected_by that selects it")
 
     def selected(self, scenario):
-        """Whether ``scenario`` puts this part into its run's model (:attr:`selected_by`)."""
-        return bool(self.selected_by) and getattr(scenario, self.selected_by[0]) == self.selected_by[1]
+        """Whether ``scenario`` puts this part into its run's model (:attr:`selected_by`; a scenario without
+        that field, one not made by ``whipple_kick.simulate.scenario.with_parts``, does not)."""
+        return bool(self.selected_by) and getattr(scenario, self.selected_by[0], None) == self.selected_by[1]
 
     def field_parameters(self, scenario):
-        """The part's parameters that ``scenario``'s fields set, by name."""
-        return {f.parameter: float(getattr(scenario, f.name)) for f in self.fields}
+        """The part's parameters that ``scenario``'s fields set, by name, with its :attr:`values`."""
+        return {**{n: float(v) for n, v in self.values.items()},
+                **{f.parameter: float(getattr(scenario, f.name)) for f in self.fields}}
 
     def fingerprint(self):
-        """Hash of the declaration and the source of ``build`` (part of the generated code's cache key)."""
+        """Hash of the declaration and the source of ``build`` (part of the generated code's cache key).
+
+        ``needs`` and ``after`` change no equation: the build order they set is in the key as the order of
+        the parts (:meth:`whipple_kick.model.slip.layout.Layout.fingerprint`).
+        """
         text = repr((self.name, self.symbols, self.coordinates, self.speeds, self.parameters, self.gains,
                      self.outputs)) + inspect.getsource(self.build)
         return hashlib.sha256(text.encode()).hexdigest()[:12]
 
 
-#: Every declared part by name, in declaration order (the order parts take in a model).
+#: Every declared part by name, in declaration order (a model's parts take :func:`named`'s order, not this).
 REGISTRY: dict = {}
 
 
@@ -201,11 +244,43 @@ def declare(part):
 
 
 def named(names):
-    """The parts called ``names``, in :data:`REGISTRY` order (refusing unknown names)."""
+    """The parts called ``names`` in the order they are built and laid out.
+
+    Each part comes after the parts it needs or is built after (:attr:`Part.needs`, :attr:`Part.after`),
+    and otherwise in the order of their names, so the order of declaration (and of ``names``) changes
+    nothing. Unknown names are refused (KeyError), and so is a part whose needed part is not among
+    ``names`` (:class:`~whipple_kick.errors.InputError`, one line naming both and how to select it).
+    """
     unknown = [n for n in names if n not in REGISTRY]
     if unknown:
         raise KeyError(f"no declared part {unknown[0]!r}; known: {', '.join(REGISTRY) or 'none'}")
-    return tuple(p for p in REGISTRY.values() if p.name in names)
+    chosen = {n: REGISTRY[n] for n in sorted(set(names))}
+    for part in chosen.values():
+        for need in part.needs:
+            if need not in chosen:
+                raise InputError(f"{_words(part)} needs {_words(need)}, which the model lacks"
+                                 + (f"; select it with {_selection(need)}" if _selection(need) else ""))
+    order, placed = [], set()
+    while len(order) < len(chosen):
+        ready = [p for n, p in chosen.items() if n not in placed
+                 and all(b in placed for b in p.needs + p.after if b in chosen)]
+        if not ready:
+            raise ValueError(f"parts {sorted(set(chosen) - placed)} need or follow each other in a circle")
+        order.append(ready[0])   # the first by name among those whose predecessors are placed
+        placed.add(ready[0].name)
+    return tuple(order)
+
+
+def _words(part):
+    """A part (or a part's name) in messages: its title and name."""
+    part = REGISTRY.get(part) if isinstance(part, str) else part
+    return f"{part.title or part.name} (part {part.name!r})" if part is not None else "an undeclared part"
+
+
+def _selection(name):
+    """How a scenario selects part ``name`` ("rider_body 'leaning'"), or "" for a part used from Python only."""
+    part = REGISTRY.get(name)
+    return f"{part.selected_by[0]} {part.selected_by[1]!r}" if part is not None and part.selected_by else ""
 
 
 # ------------------------------------------------------------------ the trunk
@@ -214,7 +289,8 @@ _TRUNK_BODY = ("hip_tilt", "lh1", "lh3", "mt", "lt1", "lt3", "it11", "it22", "it
 
 
 def _build_trunk(m):
-    """The upper body G on a revolute hip joint about H.x, with its spring-damper; the hands on G."""
+    """The upper body G on the hip, a revolute joint about H.x (SymPy's ``PinJoint``), with its spring-damper
+    (a ``TorqueActuator`` at the joint); the hands on G."""
     import sympy.physics.mechanics as me
 
     kin, b = m.kin, m.par
@@ -224,18 +300,21 @@ def _build_trunk(m):
     H = me.ReferenceFrame("H")
     H.orient_axis(C, C.y, b["hip_tilt"])
     G = me.ReferenceFrame("G")
-    G.orient_axis(H, H.x, q11)
-    G.set_ang_vel(H, u11 * H.x)
     do = kin.points["do"]
     ho = do.locatenew("ho", b["lh1"] * C.x + b["lh3"] * C.z)
     ho.v2pt_theory(do, N, C)
-    go = ho.locatenew("go", b["lt1"] * G.x + b["lt3"] * G.z)
-    go.v2pt_theory(ho, N, G)
-    m.body("upper_body", go, G, b["mt"], me.inertia(G, b["it11"], b["it22"], b["it33"], 0, 0, b["it31"]))
+    go = me.Point("go")
+    upper_body = m.body("upper_body", go, G, b["mt"],
+                        me.inertia(G, b["it11"], b["it22"], b["it33"], 0, 0, b["it31"]))
+    # The joint turns G about H.x by q11 at rate u11 and puts the hip point of G (lt1, lt3 from go) on ho.
+    hip = me.PinJoint("hip", m.rigid_body("rear_frame"), upper_body, coordinates=q11, speeds=u11,
+                      parent_point=ho, child_point=-(b["lt1"] * G.x + b["lt3"] * G.z), parent_interframe=H,
+                      joint_axis=H.x)
+    go.v2pt_theory(ho, N, G)   # the joint gives go's velocity in the rear frame; Kane's method reads it in N
     kin.frames.update(H=H, G=G)
     kin.points.update(ho=ho, go=go)
-    hip_torque = -(b["kh"] * q11 + b["ch"] * u11)
-    m.loads += [(C, -hip_torque * H.x), (G, hip_torque * H.x)]
+    hip_torque = -(b["kh"] * q11 + b["ch"] * u11)   # on G about H.x, reacted on the rear frame
+    m.loads += me.TorqueActuator.at_pin_joint(hip_torque, hip).to_loads()
     # The hands hold the bar from G: the bar turns relative to G about C.z by q7 - (H.x . C.z) q11
     # (H.x . C.z is constant), so the arms' spring is exact.
     axis_share = H.x.dot(C.z)
@@ -287,6 +366,7 @@ TRUNK = declare(Part(
               "Moore (2012, ch. 4, 'Leaning rider extension', from de Lorenzo and Hubbard)"),
     ),
     title="the leaning upper body",
+    from_rider=_TRUNK_BODY,   # the rider's own upper body: its placement on the hip and its inertia
 ))
 
 
@@ -295,15 +375,18 @@ TRUNK = declare(Part(
 def _build_arms(m):
     """The arms' spring-damper about the steer axis, between the bar E and the frame the hands hold.
 
-    Built after the trunk (declaration order), so the hands' frame is the upper body's when it leans.
+    Built after the trunk when the model has it (``after=("trunk",)``), so the hands' frame is the upper
+    body's when it leans.
     """
+    import sympy.physics.mechanics as me
+
     kin, b = m.kin, m.par
     C, E = kin.frames["C"], kin.frames["E"]
     # The bar turns relative to the hands' frame by q7 less that frame's own turn about C.z (exact).
     arm_angle = S.dyn("q7") - m.hands_angle
     arm_rate = S.dyn("u7") - m.hands_rate
-    arm_torque = -(b["ka"] * arm_angle + b["ca"] * arm_rate)
-    m.loads += [(m.hands_frame, -arm_torque * C.z), (E, arm_torque * C.z)]
+    arm_torque = -(b["ka"] * arm_angle + b["ca"] * arm_rate)   # on the bar E about C.z, reacted on the hands
+    m.loads += me.TorqueActuator(arm_torque, C.z, E, m.hands_frame).to_loads()
     m.spring_energy.append(b["ka"] * arm_angle**2 / 2)
     m.damper_dissipation.append(b["ca"] * arm_rate**2)
     m.outputs["arm_steer_torque"] = arm_torque
@@ -336,6 +419,7 @@ ARMS = declare(Part(
               "no published value was at hand (docs/experiments.md, the identification of the rider's body)"),
     ),
     title="the arms on the bar",
+    after=("trunk",),   # the hands hold the upper body when it leans: the trunk sets the hands' frame first
 ))
 
 

@@ -353,16 +353,16 @@ def rider_body(spec, info):
 
     ``spec`` is ``scenario.body_spec``, ``info`` :func:`build_bicycle`'s.
     The reflex (:data:`~whipple_kick.model.slip.parameters.RIGID_BODY`) in every model; each declared part
-    the scenario selects adds its fields' parameters: the leaning upper body (the trunk part) also its
-    placement and inertia from :func:`build_bicycle`, the arms on the bar (the arms part) their
-    spring-damper. (The rigid rider with arms on the bar has its upper body in :func:`build_bicycle`'s
+    the scenario selects adds its fields' parameters and its declared values, and those it takes from the
+    rider's segments (:attr:`whipple_kick.model.parts.Part.from_rider`: the leaning upper body's placement
+    and inertia from :func:`build_bicycle`); the arms on the bar (the arms part) their spring-damper. (The rigid rider with arms on the bar has its upper body in :func:`build_bicycle`'s
     rear frame.)
     """
     body = dict(slip.parameters.RIGID_BODY)
-    for part in parts.selected(spec):   # the model with the selected parts
+    rider = info.get("body") or {}
+    for part in parts.selected(spec):   # the model with the selected parts, each as its declaration says
         body.update(part.field_parameters(spec))
-    if parts.TRUNK.selected(spec) and info.get("body"):
-        body.update({n: info["body"][n] for n in slip.parameters.TRUNK_BODY if n in info["body"]})
+        body.update({n: rider[n] for n in part.from_rider if n in rider})
     body.update(rq4=spec.reflex_roll, ru4=spec.reflex_roll_rate, rq7=spec.reflex_steer,
                 ru7=spec.reflex_steer_rate, reflex_delay=spec.reflex_delay)
     return body
@@ -608,27 +608,34 @@ CONTROLLER_FIELDS = ("controller", "design_speed", "gain_scale", "thesis_load_n"
 def custom_gains(gains, scenario=None):
     """Check user-given steer-torque gains (by name) and fill the missing ones with 0.
 
-    Every gain given is used (none is dropped): the upper body's lean gains
-    ``kq11``/``ku11`` need ``scenario.rider_body="leaning"`` (a rigid rider has
-    no lean to feed back). With ``scenario``, its fields that the given gains
+    Every gain given is used (none is dropped): a declared part's gains need a
+    scenario that selects it (the upper body's lean gains ``kq11``/``ku11``
+    need ``scenario.rider_body="leaning"``: a rigid rider has no lean to feed back). With ``scenario``, its fields that the given gains
     replace (:data:`CONTROLLER_FIELDS`) must be at their defaults.
     """
     from whipple_kick.model import symbols
 
-    unknown = sorted(set(gains) - set(slip.GAIN_NAMES))
+    # Every declared part's gains, read now: a part declared after the import counts too.
+    known = tuple(dict.fromkeys((*slip.GAIN_NAMES, *(g for part in parts.REGISTRY.values() for g in part.gains))))
+    unknown = sorted(set(gains) - set(known))
     if unknown:
-        raise InputError(f"unknown steer-torque gain(s) {unknown}; known: {list(slip.GAIN_NAMES)}")
+        raise InputError(f"unknown steer-torque gain(s) {unknown}; known: {list(known)}")
     if scenario is not None:
         for name in CONTROLLER_FIELDS:
             if getattr(scenario, name) != DEFAULTS[name]:
                 raise InputError(f"{name} = {getattr(scenario, name)!r} is replaced by the given gains (it would be "
                                  f"ignored): leave it at its default {DEFAULTS[name]!r} with gains=")
-        lean = [n for n in ("kq11", "ku11") if gains.get(n, 0.0) != 0.0]
-        if lean and scenario.rider_body != "leaning":
-            raise InputError(f"gain(s) {lean} feed back the upper body's lean, which only rider_body 'leaning' "
-                             f"has (here {scenario.rider_body!r}); allowed: 0 or a leaning rider")
+        for part in parts.REGISTRY.values():   # a part's gains feed back its states: a model without it has none
+            given = [n for n in part.gains if gains.get(n, 0.0) != 0.0]
+            if given and not part.selected(scenario):
+                field, value = part.selected_by or ("", "")
+                title = part.title or part.name
+                states = ", ".join(dict.fromkeys(part.gains[n] for n in given))
+                raise InputError(f"gain(s) {given} feed back {title}'s states ({states}), which only "
+                                 + (f"{field} {value!r} has (here {getattr(scenario, field, 'off')!r})"
+                                    if field else "a model with it has") + f"; allowed: 0 or {title}")
     # The four of the thesis' law always; the others (yaw, the upper body's lean) when given.
-    names = control.GAIN_ORDER + tuple(n for n in slip.GAIN_NAMES if n in gains and n not in control.GAIN_ORDER)
+    names = control.GAIN_ORDER + tuple(n for n in known if n in gains and n not in control.GAIN_ORDER)
     return {name: check_range(f"gain {name}", gains.get(name, 0.0), None, None, symbols.info(name).unit)
             for name in names}
 

@@ -79,6 +79,20 @@ UNITS = {"time": "s", **dict(COORDINATE_COLUMNS.values()), **dict(SPEED_COLUMNS.
          **dict(PART_COLUMNS.values()),
          **{o: unit for part in parts.REGISTRY.values() for o, (unit, _) in part.outputs.items()},
          **dict(energy.COLUMNS.values()), BALANCE_COLUMN: "J"}
+
+
+def unit_of(column):
+    """The unit of trajectory column ``column``: :data:`UNITS`, or a declared part's state column or output
+    (read when called, so a part declared after this module was imported counts too)."""
+    if column in UNITS:
+        return UNITS[column]
+    for part in parts.REGISTRY.values():
+        units = {**dict(part.columns.values()), **{o: unit for o, (unit, _) in part.outputs.items()}}
+        if column in units:
+            return units[column]
+    raise KeyError(f"no trajectory column {column!r}")
+
+
 #: Columns whose largest absolute values after the kick the summary lists (``max_abs_<column>_absolute_<unit>``).
 PEAK_COLUMNS = ("yaw_rate", "roll_rate", "steer_rate", "roll", "steer", "slip_rear", "fy_rear", "fy_front",
                 "steer_torque")
@@ -420,7 +434,7 @@ def with_units(frame):
     >>> list(with_units(pd.DataFrame({"time": [0.0], "roll": [0.1]})).columns)
     ['time [s]', 'roll [rad]']
     """
-    return frame.rename(columns={c: f"{c} [{UNITS[c]}]" for c in frame.columns})
+    return frame.rename(columns={c: f"{c} [{unit_of(c)}]" for c in frame.columns})
 
 
 def check_trajectory(frame, summary, scenario, path):
@@ -703,7 +717,7 @@ def summarise(scenario, kick, assembly, solution, frame, *, custom_tyres=False) 
         "metrics_unavailable": unavailable,
         "numerics": _numerics_section(scenario, solution, frame),
         "scenario": scenario.to_dict(),
-        "units": {column: UNITS[column] for column in column_names(scenario.tyre_transient, solution.model)},
+        "units": {column: unit_of(column) for column in column_names(scenario.tyre_transient, solution.model)},
         "provenance": provenance.record(provenance.input_files(scenario, custom_tyres)),
     }
     # The declared criteria the sections above do not report (criteria.summary_section): their values [s].

@@ -21,7 +21,7 @@ Example
 >>> sc.pressures, sc.with_changes(speed=4.0).lqr_design_speed
 ((300.0, 300.0), 4.0)
 """
-from dataclasses import asdict, dataclass, fields, replace
+from dataclasses import asdict, dataclass, fields, make_dataclass, replace
 
 from whipple_kick.errors import InputError, check_range
 from whipple_kick.library import inputs, thesis, tyres
@@ -865,6 +865,47 @@ class Scenario:
         return replace(self, **changes)
 
 
+
+
+def with_parts(*declared, base=None):
+    """A Scenario class whose fields select and set the declared parts ``declared`` (:class:`~whipple_kick.model.parts.Part`).
+
+    For each part, the field that selects it (:attr:`~whipple_kick.model.parts.Part.selected_by`: "off" by
+    default, or the part's value), unless ``base`` (default :class:`Scenario`) has it, then its fields
+    (:func:`~whipple_kick.simulate.settings.part_setting`), all derived from its declaration: validated,
+    refused while the part is not selected, held by the body's view (so the run's model has the part) and
+    given command-line flags (``whipple_kick.cli._simulate_parser(cls)``). The parts must be declared
+    (:func:`whipple_kick.model.parts.declare`) before the class is made and while it is used.
+
+    Example
+    -------
+    ``ShiftScenario = with_parts(SHIFT)``; ``ShiftScenario(shift="on", shift_stiffness=2000.0)``.
+    """
+    base = Scenario if base is None else base
+    have = {f.name for f in fields(base)}
+    members = []
+    for part in declared:
+        if parts.REGISTRY.get(part.name) is not part:
+            raise ValueError(f"part {part.name!r} is not the declared one (declare it first: parts.declare)")
+        if not part.selected_by:
+            raise ValueError(f"part {part.name!r} has no selected_by: no scenario field selects it")
+        name, value = part.selected_by
+        if name not in have:
+            if value == "off":
+                raise ValueError(f"part {part.name!r}: the value that selects it may not be 'off' (the default)")
+            title = part.title or part.name
+            members.append((name, str, setting(
+                "off", f'"{value}": {title}, {part.description}; "off" (default): a model without it '
+                f"(the part {part.name!r}, :mod:`{part.build.__module__}`).", choices=("off", value),
+                label=name.replace("_", " "), views=("body",), commands=EVERY_COMMAND, section=_BODY,
+                help=f"{value}: {title}; off (default): without it")))
+            have.add(name)
+        members += [(f.name, float, part_setting(part.name, f.name)) for f in part.fields if f.name not in have]
+        have.update(f.name for f in part.fields)
+    names = "".join(p.name.title().replace("_", "") for p in declared)
+    return make_dataclass(f"{base.__name__}With{names}", members, bases=(base,), frozen=True, namespace={
+        "__doc__": f"{base.__name__} with the fields of the part(s) {', '.join(p.name for p in declared)} "
+                   "(:func:`whipple_kick.simulate.scenario.with_parts`).", "__module__": base.__module__})
 
 
 #: Every field's default, by name.

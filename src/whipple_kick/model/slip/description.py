@@ -18,7 +18,7 @@ class Model:
     Attributes
     ----------
     parts : tuple of str
-        The declared parts it has (:mod:`whipple_kick.model.parts`), in declaration order; () the rigid rider.
+        The declared parts it has (:mod:`whipple_kick.model.parts`), in build order (:func:`whipple_kick.model.parts.named`); () the rigid rider.
     delayed_reflex : bool
         Whether it has the reflex's delay filter (:mod:`whipple_kick.model.reflex`): a nonzero delay needs it.
     transient : str

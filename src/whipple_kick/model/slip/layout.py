@@ -169,7 +169,7 @@ class Layout:
 
 
 def for_parts(part_names=(), delayed_reflex=False):
-    """The (shared) :class:`Layout` of the base model with the parts ``part_names`` (in declaration order) and,
+    """The (shared) :class:`Layout` of the base model with the parts ``part_names`` (in build order, :func:`whipple_kick.model.parts.named`) and,
     with ``delayed_reflex``, the reflex's delay filter: one object per model in a process."""
     return _layout(tuple(p.name for p in parts.named(part_names)), bool(delayed_reflex))
 

@@ -4,7 +4,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from whipple_kick.errors import InputError, check_range
-from whipple_kick.model import slip
+from whipple_kick.model import parts, slip
 from whipple_kick.model.transient import DEFAULT_TRANSIENT
 from whipple_kick.simulate import assembly, control, results
 
@@ -16,7 +16,6 @@ STATES = tuple(n for n in slip.LINEAR_STATES if n != "v_fwd")
 _LABELS = {
     **{q: col for q, col in results.COORDINATE_COLUMNS.items()},
     **{u: col for u, col in results.SPEED_COLUMNS.items()},
-    **results.PART_COLUMNS,   # the declared parts' states (the leaning upper body's lean and its rate)
     **{state: (col, "rad") for state, col in results.PATCH_STATE_COLUMNS.items()},
     **{state: (col, "m") for state, col in results.CARCASS_STATE_COLUMNS.items()},
     "v_fwd": ("forward_velocity", "m/s"), "v_lat": ("lateral_velocity", "m/s"),
@@ -71,7 +70,10 @@ def state_labels(transient=DEFAULT_TRANSIENT, constant_speed=True, body=()):
     >>> state_labels()[:2]
     [('roll', 'rad'), ('steer', 'rad')]
     """
-    return [_LABELS[n] for n in active_states(transient, body, constant_speed)]
+    # The declared parts' states (the leaning upper body's lean and its rate) read now: a part declared after
+    # this module was imported counts too.
+    labels = {**{q: c for part in parts.REGISTRY.values() for q, c in part.columns.items()}, **_LABELS}
+    return [labels[n] for n in active_states(transient, body, constant_speed)]
 
 
 # ----------------------------------------------------------------- linear model

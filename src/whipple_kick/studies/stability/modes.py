@@ -74,7 +74,8 @@ def mode_content(model, eigenvalue, vector, wheelbase):
     speed = model.speed
     tau = 1.0 / np.maximum(np.abs(lam), speed / wheelbase)
     lag = []
-    bicycle = [n for n in model.states if n not in _BODY_STATES]
+    body = _body_states()
+    bicycle = [n for n in model.states if n not in body]
     for name in bicycle[-4:]:   # tyre slots: rear, front, rear, front
         i = idx[name]
         gain = 1.0
@@ -105,9 +106,11 @@ def mode_content(model, eigenvalue, vector, wheelbase):
     return (shares[0], scaled[:, 0]) if single else (shares, scaled)
 
 
-#: States of the rider's body (after the bicycle's in a :class:`LinearModel`).
-_BODY_STATES = frozenset(tuple(n for part in parts.REGISTRY.values() for n in part.coordinates + part.speeds)
-                         + slip.REFLEX_STATES)
+def _body_states():
+    """States of the rider's body (after the bicycle's in a :class:`LinearModel`): every declared part's, read
+    when called (a part declared after this module was imported counts too), and the reflex filter's."""
+    return frozenset(tuple(n for part in parts.REGISTRY.values() for n in part.coordinates + part.speeds)
+                     + slip.REFLEX_STATES)
 
 
 def groups_of(model):
@@ -120,7 +123,7 @@ def groups_of(model):
     >>> groups_of(linear_model(Scenario(symmetric_tyres=True), 4.0))
     ('roll', 'steer', 'heading', 'vertical', 'rear_tyre', 'front_tyre')
     """
-    return GROUPS + (BODY_GROUPS if any(n in _BODY_STATES for n in model.states) else ())
+    return GROUPS + (BODY_GROUPS if any(n in _body_states() for n in model.states) else ())
 
 
 def _body_content(model, lam, vec, idx):
