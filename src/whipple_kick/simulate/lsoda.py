@@ -8,9 +8,11 @@ through a jump map where the caller gives one (the plate stop's impulse).
 A fall (``|roll|`` beyond a limit) ends the run as an event, not an error.
 LSODA's stiff steps use the compiled model's Jacobian (forward differences
 in C over the dynamic states, one foreign call; the energy quadratures feed
-nothing back). LSODA calls the compiled model through
-``CompiledRHS.fast`` (:mod:`whipple_kick.model.rhs_call`: one foreign call per
-evaluation, the roll and steer limits checked in C on the fast path).
+nothing back). On the fast path LSODA runs in C with
+the compiled model (:mod:`whipple_kick.simulate.lsoda_c`: one call per piece, the
+roll and steer limits checked in C); elsewhere it calls the compiled model
+through ``CompiledRHS.fast`` (:mod:`whipple_kick.model.rhs_call`: one foreign
+call per evaluation).
 
 No integration runs for ever: a :class:`Budget` bounds the right-hand-side
 evaluations per simulated second (those LSODA makes and those inside each
@@ -317,8 +319,9 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
     """Integrate ``rhs`` from ``x0`` piecewise between breakpoints with LSODA.
 
     Each smooth piece is integrated in chunks of about ``chunk`` seconds
-    with ODEPACK's LSODA through :func:`scipy.integrate.odeint`, whose step
-    loop runs in Fortran. A chunk in which the roll limit is crossed (or in
+    with LSODA as :func:`scipy.integrate.odeint` runs it: for a compiled
+    model all the chunks of a piece in one C call (:mod:`whipple_kick.simulate.lsoda_c`,
+    the same numbers), otherwise through ``odeint``. A chunk in which the roll limit is crossed (or in
     which LSODA reports trouble) is integrated again from its start with
     the same LSODA stepped from Python (:class:`scipy.integrate.LSODA`,
     as ``solve_ivp`` does) and a fall event, which gives the exact fall
