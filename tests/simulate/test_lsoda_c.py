@@ -66,3 +66,29 @@ def test_a_chunk_over_the_budget_goes_to_the_careful_path_as_before(monkeypatch)
     a, b = _both(simulation.Scenario(duration=3.0), monkeypatch)
     assert a.failed and "budget" in a.message
     _assert_identical(a, b)
+
+
+def test_the_c_loop_resumes_after_a_chunk_the_careful_path_did(monkeypatch):
+    """A chunk LSODA gives up on in C (here: more than 25 steps between two samples, a small stall window)
+    goes to the careful path, and the C loop takes the piece's next chunks from the state it reached.
+
+    ``stall_progress`` is tiny so that the careful path completes the chunk rather than failing the run.
+    """
+    monkeypatch.setattr(lsoda, "DEFAULT_BUDGET", lsoda.Budget(stall_window=100, stall_progress=1e-12))
+    careful, resumed = [], []
+    original_careful, original_call = lsoda._careful_chunk, lsoda_c.FastChunks.__call__
+
+    def counting_careful(*args, **kwargs):
+        careful.append(1)
+        return original_careful(*args, **kwargs)
+
+    def counting_call(self, grid, cuts, x, counts):
+        done, states, x = original_call(self, grid, cuts, x, counts)
+        resumed.append(done > 0 and cuts[0] > 0)   # chunks done in C after a careful one in the same piece
+        return done, states, x
+    monkeypatch.setattr(lsoda, "_careful_chunk", counting_careful)
+    monkeypatch.setattr(lsoda_c.FastChunks, "__call__", counting_call)
+    a, b = _both(simulation.Scenario(duration=2.0), monkeypatch)
+    assert careful and any(resumed)
+    assert not a.failed
+    _assert_identical(a, b)
