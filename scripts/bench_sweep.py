@@ -42,7 +42,9 @@ load on a shared machine falls on all variants alike.
   (the ratio shrugs off a neighbour's load). Instructions per case: the same paths counted by valgrind's
   callgrind (``--callgrind``; ``perf stat`` has no counters on a virtual machine), instrumented only
   while the cases run (client requests around each path, :func:`_callgrind_helper`), so the count is
-  the case's own, not the imports', and does not depend on the machine's load. Running this script with
+  the case's own, not the imports', and does not depend on the machine's load. The integration alone is
+  counted too, with its C floor (LSODA with the right-hand side, the Jacobian and LAPACK, less the C chunk
+  loop's glue, :func:`_integration_floor`; issue 41 item 1) and each path's ratio to it. Running this script with
   ``PYTHONPATH=<another checkout>/src`` measures that checkout's code with the same bench: a before/after.
 * ``tolerance``: the uncertainty study (shipped file, N samples, one load) at the default rtol and at
   ``--rtol``, on the same sampled rows (:func:`bench_tolerance`): P(best) per pressure and criterion, the
@@ -447,6 +449,8 @@ def _count_inner(duration, n_cases, helper_folder):
     """Under callgrind: warm every path, then count each path's cases between client requests."""
     import gc
 
+    from whipple_kick.library import inputs
+    from whipple_kick.simulate import assembly, integration
     from whipple_kick.studies import sweep_engine
     lib = _callgrind_helper(helper_folder)
     sweep_engine._keep_freed_memory()
@@ -454,6 +458,16 @@ def _count_inner(duration, n_cases, helper_folder):
         case_list, spec, store = _cost_setup(n_cases, duration, os.path.join(tmp, "sweep"))
         try:
             _cost_warm_up(case_list, spec, store)
+            # The integration alone (what its C floor is taken from, _integration_floor), the model assembled first.
+            prepared = []
+            for _, sc, _ in case_list:
+                kick = inputs.kick_of(sc.validate())
+                prepared.append((assembly.assemble(sc, kick), sc, kick))
+            gc.collect()
+            lib.wk_cg_start()
+            for model, sc, kick in prepared:
+                integration.integrate_run(model, sc, kick)
+            lib.wk_cg_stop(b"integration")
             for path in COST_PATHS:
                 # Each path starts from an empty young generation: a full collection falling into one path's
                 # cases and not another's (some 1e8 instructions with the package's objects) is not its cost.
@@ -469,12 +483,40 @@ def _count_inner(duration, n_cases, helper_folder):
 def bench_instructions(duration, n_cases):
     """Print the instructions per case of each path, counted by callgrind in a child process."""
     t0 = time.perf_counter()
-    counts = _callgrind_counts("_count", duration, n_cases, COST_PATHS)
+    floor = {}
+    counts = _callgrind_counts("_count", duration, n_cases, (*COST_PATHS, "integration"), floor)
     print(f"instructions per case (callgrind, {n_cases} thesis cases, {duration:g} s; {time.perf_counter() - t0:.0f} s "
           "under valgrind):")
-    for path in COST_PATHS:
-        print(f"  {path:6s} {counts[path] / 1e6:8.1f} M; / run: {counts[path] / counts['run']:.3f}")
+    for path in (*COST_PATHS, "integration"):
+        per_floor = f"; / integration's C floor: {counts[path] / floor['floor']:.3f}" if "floor" in floor else ""
+        print(f"  {path:11s} {counts[path] / 1e6:8.1f} M; / run: {counts[path] / counts['run']:.3f}{per_floor}")
+    if "floor" in floor:
+        print(f"  the integration's C floor (LSODA with the right-hand side, Jacobian and LAPACK, less the C loop's "
+              f"glue): {floor['floor'] / 1e6:.1f} M")
+    else:
+        print("  the integration's C floor: not separable here (the odeint path: LSODA calls the model through Python)")
     return counts
+
+
+def _integration_floor(dump, n_cases):
+    """Instructions per case of LSODA with everything it calls, less the C loop's calls into the model (glue).
+
+    From the ``integration`` dump: ``lsoda`` inclusive, less ``f_thunk`` and ``jac_thunk`` exclusive (the
+    limit test and the Jacobian's transpose); None where the run did not go through the C loop
+    (:mod:`whipple_kick.simulate.lsoda_c`), since ``odeint``'s LSODA calls the model through Python.
+    """
+    import re
+    import subprocess
+
+    def cost(inclusive, name):
+        text = subprocess.run(["callgrind_annotate", f"--inclusive={inclusive}", "--threshold=100", dump],
+                              capture_output=True, text=True, check=True).stdout
+        found = re.search(rf"^\s*([\d,]+) \([^)]*\)\s+\S*:{name}(?:\.\S*)? \[", text, re.MULTILINE)
+        return int(found.group(1).replace(",", "")) if found else None
+    total, thunks = cost("yes", "lsoda"), [cost("no", "f_thunk"), cost("no", "jac_thunk")]
+    if total is None or None in thunks:
+        return None
+    return (total - sum(thunks)) / n_cases
 
 
 def bench_tolerance(samples, fz, rtol, workers):
@@ -635,8 +677,12 @@ def _count_flags_inner(duration, n_cases, helper_folder):
         lib.wk_cg_stop(name.encode())
 
 
-def _callgrind_counts(mode, duration, n_cases, labels):
-    """Run this script's ``mode`` under callgrind; {label: instructions per case} of its client-request dumps."""
+def _callgrind_counts(mode, duration, n_cases, labels, floor=None):
+    """Run this script's ``mode`` under callgrind; {label: instructions per case} of its client-request dumps.
+
+    With a dict ``floor``, its ``"floor"`` gets the integration's C floor per case (:func:`_integration_floor`)
+    where the ``integration`` dump allows it.
+    """
     import glob
     import re
     import subprocess
@@ -656,6 +702,10 @@ def _callgrind_counts(mode, duration, n_cases, labels):
             total = re.search(r"^(?:totals|summary): (\d+)", text, re.MULTILINE)
             if label and total and label.group(1) in labels:
                 counts[label.group(1)] = int(total.group(1)) / n_cases
+                if floor is not None and label.group(1) == "integration":
+                    value = _integration_floor(name, n_cases)
+                    if value is not None:
+                        floor["floor"] = value
     return counts
 
 

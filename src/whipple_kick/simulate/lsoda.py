@@ -8,9 +8,11 @@ through a jump map where the caller gives one (the plate stop's impulse).
 A fall (``|roll|`` beyond a limit) ends the run as an event, not an error.
 LSODA's stiff steps use the compiled model's Jacobian (forward differences
 in C over the dynamic states, one foreign call; the energy quadratures feed
-nothing back). LSODA calls the compiled model through
-``CompiledRHS.fast`` (:mod:`whipple_kick.model.rhs_call`: one foreign call per
-evaluation, the roll and steer limits checked in C on the fast path).
+nothing back). On the fast path LSODA runs in C with
+the compiled model (:mod:`whipple_kick.simulate.lsoda_c`: one call per piece, the
+roll and steer limits checked in C); elsewhere it calls the compiled model
+through ``CompiledRHS.fast`` (:mod:`whipple_kick.model.rhs_call`: one foreign
+call per evaluation).
 
 No integration runs for ever: a :class:`Budget` bounds the right-hand-side
 evaluations per simulated second (those LSODA makes and those inside each
@@ -30,6 +32,7 @@ from scipy.integrate import LSODA, odeint
 
 from whipple_kick.model import slip
 from whipple_kick.model.transient import DEFAULT_TRANSIENT, FORMS
+from whipple_kick.simulate import lsoda_c
 
 
 @dataclass
@@ -296,14 +299,29 @@ def _fast_chunk(guarded, x, times, rtol, atol, mxstep, jac=None):
     return y, (nfev, njev, _evaluations(jac, nfev, njev))
 
 
+def _chunks_in_c(rhs, jac, rtol, atol, mxstep, limits, budget, t_start):
+    """The fast path's chunk loop in C (:class:`whipple_kick.simulate.lsoda_c.FastChunks`) for a compiled model, else None.
+
+    None for any other ``f(t, x)`` (the NumPy oracle, a test's function) or where the driver cannot be built: the
+    chunks then run through ``odeint`` (:func:`_fast_chunk`), the same numbers.
+    """
+    if jac is None or not hasattr(getattr(rhs, "lib", None), "wk_slip_jacobian"):
+        return None
+    lib = lsoda_c.driver()
+    if lib is None:
+        return None
+    return lsoda_c.FastChunks(lib, rhs, jac, rtol, atol, mxstep, limits, budget, t_start)
+
+
 def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None,
               output_rate=1000.0, fall_angle=np.deg2rad(45.0), chunk=None, samples=None,
               budget=None, jumps=None, steer_limit=None):
     """Integrate ``rhs`` from ``x0`` piecewise between breakpoints with LSODA.
 
     Each smooth piece is integrated in chunks of about ``chunk`` seconds
-    with ODEPACK's LSODA through :func:`scipy.integrate.odeint`, whose step
-    loop runs in Fortran. A chunk in which the roll limit is crossed (or in
+    with LSODA as :func:`scipy.integrate.odeint` runs it: for a compiled
+    model all the chunks of a piece in one C call (:mod:`whipple_kick.simulate.lsoda_c`,
+    the same numbers), otherwise through ``odeint``. A chunk in which the roll limit is crossed (or in
     which LSODA reports trouble) is integrated again from its start with
     the same LSODA stepped from Python (:class:`scipy.integrate.LSODA`,
     as ``solve_ivp`` does) and a fall event, which gives the exact fall
@@ -397,6 +415,12 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
     fall.terminal = True
     fall.direction = -1
     guarded = _guarded(rhs, roll, fall_angle, steer, steer_limit)   # once per integration, not per chunk
+    # The fast path gives up (and the careful path takes over, with the budget) after more steps
+    # between two samples than a quarter of the stall window's evaluations (a step costs 1 to ~25
+    # evaluations, a stiff one with a new Jacobian the most), so a stall wastes about one window
+    # here; a legitimate interval needs far fewer steps (docs/simulate.md).
+    mxstep = max(1, budget.stall_window // 4)
+    chunks_in_c = _chunks_in_c(rhs, jac, rtol, atol, mxstep, (roll, fall_angle, steer, steer_limit), budget, t_start)
 
     ts, xs = [], []
     nfev = njev = spent = 0   # LSODA's evaluations, Jacobians, all evaluations (the budget's count)
@@ -415,11 +439,6 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
     x = np.asarray(x0, dtype=float)
     fell, fall_time, message, failed, fall_reason = False, None, "completed", False, None
     done = False
-    # The fast path gives up (and the careful path takes over, with the budget) after more steps
-    # between two samples than a quarter of the stall window's evaluations (a step costs 1 to ~25
-    # evaluations, a stiff one with a new Jacobian the most), so a stall wastes about one window
-    # here; a legitimate interval needs far fewer steps (docs/simulate.md).
-    mxstep = max(1, budget.stall_window // 4)
     for a, b in itertools.pairwise(edges):
         at_a = samples[np.abs(samples - a) <= eps]
         at_b = samples[(np.abs(samples - b) <= eps) & (samples > a + eps)]
@@ -433,11 +452,26 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
         else:
             marks = np.searchsorted(grid, a + chunk * np.arange(1, int(np.ceil((b - a) / chunk))))
             cuts = sorted({0, len(grid) - 1, *(int(m) for m in marks if 0 < m < len(grid) - 1)})
-        for i0, i1 in itertools.pairwise(cuts):
+        k = 0
+        while k < len(cuts) - 1:
+            if chunks_in_c is not None:
+                # The chunks of the piece in one C call, up to the first that the careful path must redo.
+                counts = np.array([nfev, njev, spent], dtype=np.int64)
+                ran, states, x = chunks_in_c(grid, cuts[k:], x, counts)
+                nfev, njev, spent = (int(v) for v in counts)
+                if ran:
+                    j = cuts[k + ran]
+                    last = -1 if j == len(grid) - 1 else None   # the piece's end: after the jump map (below)
+                    emit(grid[cuts[k]:j + 1][:last], states[:last])
+                    k += ran
+                    if k == len(cuts) - 1:
+                        break
+            i0, i1 = cuts[k], cuts[k + 1]
+            k += 1
             times = grid[i0:i1 + 1]
             # A sample at the piece's end is emitted after the jump map (below).
             last = -1 if i1 == len(grid) - 1 else None
-            fast = _fast_chunk(guarded, x, times, rtol, atol, mxstep, jac)
+            fast = None if chunks_in_c is not None else _fast_chunk(guarded, x, times, rtol, atol, mxstep, jac)
             # The guard sees only the states LSODA evaluates; a sample (the chunk's end above all)
             # interpolated past a limit must still go to the careful path, or the fall is missed.
             if fast is not None and spent + fast[1][2] <= budget.limit(times[-1] - t_start) \

@@ -1,0 +1,149 @@
+"""The fast path's chunk loop in C: SciPy's LSODA driven from C with the compiled model (issue 41 item 1).
+
+:func:`whipple_kick.simulate.lsoda.integrate` integrates each smooth piece in
+chunks of about half a second with ``odeint``'s LSODA, redoing a chunk in
+which a limit is passed with the careful path (LSODA stepped from Python,
+the fall event). Through ``odeint`` each right-hand side and Jacobian crosses
+into Python and back, and each chunk sets LSODA up from Python. Here the
+chunks of one piece run in one C call (``lsoda_src/driver.c``): SciPy's own
+LSODA, ``lsoda_src/lsoda.c`` of SciPy 1.17.1 (its C translation of ODEPACK,
+``scipy/integrate/src/lsoda.c`` at tag v1.17.1, commit 527eb7fd; BSD licence,
+``lsoda_src/LICENSE-scipy.txt``), called with the options ``odeint`` gives it,
+the model's ``wk_slip_rhs`` and ``wk_slip_jacobian`` by function pointer, and
+the LAPACK routines SciPy's LSODA uses (``scipy.linalg.cython_lapack``'s
+``dgetrf``/``dgetrs``): the same steps, evaluations and states, bit for bit
+(``tests/simulate/test_lsoda_c.py``). The call stops before the first chunk
+that the careful path must redo, which stays in Python.
+
+Where no C compiler is found, or the build fails, or the installed SciPy is not
+the release the source comes from (:data:`SCIPY_RELEASE`: another release's
+odeint may step differently, and a run must give the same numbers whichever
+path it takes), :func:`driver` returns None and the Python path runs (the
+same numbers, slower).
+"""
+import ctypes
+import functools
+import hashlib
+import pathlib
+
+import numpy as np
+
+from whipple_kick.errors import BuildError, CompilerNotFoundError
+from whipple_kick.model import cache, compiler
+
+#: SciPy release (major.minor) whose LSODA source is vendored; with another release odeint's path is used.
+SCIPY_RELEASE = (1, 17)
+_FOLDER = pathlib.Path(__file__).with_name("lsoda_src")
+_SOURCES = ("driver.c", "lsoda.c", "lsoda.h", "blaslapack_declarations.h")
+_FLAGS = (*compiler.EXTENSION_FLAGS, "-fvisibility=hidden")
+
+
+def _capsule_pointer(capsule):
+    """Address of the C function in a Cython ``__pyx_capi__`` capsule."""
+    get_name = ctypes.pythonapi.PyCapsule_GetName
+    get_name.restype, get_name.argtypes = ctypes.c_char_p, [ctypes.py_object]
+    get_pointer = ctypes.pythonapi.PyCapsule_GetPointer
+    get_pointer.restype, get_pointer.argtypes = ctypes.c_void_p, [ctypes.py_object, ctypes.c_char_p]
+    return get_pointer(capsule, get_name(capsule))
+
+
+@functools.cache
+def driver():
+    """The compiled driver (ctypes library, built into the cache on a miss), or None where it cannot be used."""
+    import scipy
+    if tuple(int(v) for v in scipy.__version__.split(".")[:2]) != SCIPY_RELEASE:
+        return None
+    try:
+        cc = compiler.find()
+    except CompilerNotFoundError:
+        return None
+    digest = hashlib.sha256(f"{cc} {' '.join(_FLAGS)}".encode())
+    for name in _SOURCES:
+        digest.update((_FOLDER / name).read_bytes())
+    name = f"lsoda_driver_{digest.hexdigest()[:20]}.so"
+
+    def build(path):
+        compiler.compile_shared(cc, (*_FLAGS, f"-I{_FOLDER}"), _FOLDER / "driver.c", path, ("-lm",))
+
+    try:
+        lib = ctypes.CDLL(str(cache.build_once(name, build)))
+    except (BuildError, OSError):
+        return None
+    from scipy.linalg import cython_lapack
+    lib.wk_lsoda_set_lapack.argtypes = [ctypes.c_void_p] * 4
+    lib.wk_lsoda_set_lapack(*(_capsule_pointer(cython_lapack.__pyx_capi__[f])
+                              for f in ("dgetrf", "dgetrs", "dgbtrf", "dgbtrs")))
+    pointer, c_int, c_double = ctypes.c_void_p, ctypes.c_int, ctypes.c_double
+    lib.wk_lsoda_fast_chunks.restype = c_int
+    lib.wk_lsoda_fast_chunks.argtypes = [pointer, pointer, pointer, pointer, c_int, pointer, pointer, c_int, pointer,
+                                         c_double, pointer, c_int, c_int, c_double, c_int, c_double, c_int,
+                                         c_double, c_double, c_double, pointer, pointer]
+    return lib
+
+
+class FastChunks:
+    """The C chunk loop bound to one compiled model, its Jacobian's scale and the run's limits and tolerances.
+
+    Parameters
+    ----------
+    rhs : whipple_kick.model.slip.CompiledRHS
+        The compiled model with its parameters.
+    jac : callable
+        Its Jacobian (``rhs.jacobian_function(scale)``): the scale and the evaluation count are read from it.
+    rtol, atol : float, ndarray
+        LSODA's tolerances.
+    mxstep : int
+        Most steps between two samples (odeint's ``mxstep``).
+    limits : (int, float, int, float)
+        Roll index, fall angle [rad], steer index, steer limit [rad].
+    budget : Budget
+        The run's evaluation budget; ``t_start`` [s] its start.
+    """
+
+    def __init__(self, lib, rhs, jac, rtol, atol, mxstep, limits, budget, t_start):
+        self.lib = lib
+        self.rhs_address = ctypes.cast(rhs.lib.wk_slip_rhs, ctypes.c_void_p).value
+        self.jac_address = ctypes.cast(rhs.lib.wk_slip_jacobian, ctypes.c_void_p).value
+        self.p = rhs.p   # kept alive: C reads it
+        self.scale = np.ascontiguousarray(jac.scale, dtype=float)
+        self.jac_evaluations = int(jac.evaluations)
+        self.atol = np.ascontiguousarray(atol, dtype=float)
+        self.rtol, self.mxstep, self.limits = float(rtol), int(mxstep), limits
+        self.budget = (float(budget.allowance), float(budget.per_second), float(t_start))
+
+    def __call__(self, grid, cuts, x, counts):
+        """Integrate the chunks ``grid[cuts[k]:cuts[k + 1] + 1]`` from ``x`` until one needs the careful path.
+
+        Parameters
+        ----------
+        grid : ndarray
+            The piece's chunk edges and sample times [s].
+        cuts : sequence of int
+            Indices of the chunk edges in ``grid``.
+        x : ndarray
+            State at ``grid[cuts[0]]``.
+        counts : ndarray of int64, shape (3,)
+            ``nfev, njev, evaluations`` so far; the chunks done are added to it.
+
+        Returns
+        -------
+        done : int
+            Chunks done.
+        states : ndarray
+            States at ``grid[cuts[0]:cuts[done] + 1]``.
+        x : ndarray
+            State at ``grid[cuts[done]]``.
+        """
+        grid = np.ascontiguousarray(grid, dtype=float)
+        c = np.ascontiguousarray(cuts, dtype=np.intc)
+        x = np.array(x, dtype=float)
+        n = x.size
+        out = np.empty((grid.size, n))
+        roll, fall_angle, steer, steer_limit = self.limits
+        done = self.lib.wk_lsoda_fast_chunks(
+            self.rhs_address, self.jac_address, self.p.ctypes.data, self.scale.ctypes.data, n, grid.ctypes.data,
+            c.ctypes.data, c.size, x.ctypes.data, self.rtol, self.atol.ctypes.data, self.mxstep, roll, fall_angle,
+            steer, steer_limit, self.jac_evaluations, *self.budget, counts.ctypes.data, out.ctypes.data)
+        if done < 0:
+            raise MemoryError("the C chunk loop ran out of memory")
+        return done, out[c[0]:c[done] + 1], x
