@@ -167,9 +167,10 @@ def _interval(row):
 
 
 def group_uncertainty():
-    """docs/uncertainty.md: the stored study's P(best), rates, Sobol ranges and cost (the tables in
-    :data:`UNCERTAINTY`; a rerun of the study is ``python scripts/uncertainty_study.py`` with study.json's N and
-    seed). The shipped uncertainty file's inputs must be the study's: a changed file makes the doc stale."""
+    """docs/uncertainty.md: the stored study's P(best) (pooled and per option), the check against the measurement,
+    rates, Sobol ranges and cost (the tables in :data:`UNCERTAINTY`; a rerun of the study is
+    ``python scripts/uncertainty_study.py`` with study.json's N and seed). The shipped uncertainty file's inputs
+    must be the study's: a changed file makes the doc stale."""
     import pandas as pd
 
     from whipple_kick.library import uncertain
@@ -181,25 +182,33 @@ def group_uncertainty():
                          f"{shipped}: rerun the study (docs/uncertainty.md says how) and copy its tables")
     n, d = meta["samples"], len(meta["inputs"])
     p_best = pd.read_csv(UNCERTAINTY / "p_best.csv")
+    by_option = pd.read_csv(UNCERTAINTY / "p_best_by_option.csv")
     measured = pd.read_csv(UNCERTAINTY / "measured.csv")
     rates = pd.read_csv(UNCERTAINTY / "rates.csv")
     sobol = pd.read_csv(UNCERTAINTY / "sobol.csv")
     cost = json.loads((UNCERTAINTY / "cost.json").read_text())
+    loads = sorted(p_best["fz_n"].unique())
     out = {"uncertainty.samples": f"{n}", "uncertainty.inputs": f"{d}", "uncertainty.rows": f"{n * (d + 2)}",
            "uncertainty.base_rows": f"{2 * n}", "uncertainty.runs": f"{cost['runs']}",
-           "uncertainty.seed": f"{meta['seed']}", "uncertainty.commit": meta["commit"]}
+           "uncertainty.seed": f"{meta['seed']}", "uncertainty.commit": meta["commit"],
+           "uncertainty.analysed": meta["analysed"], "uncertainty.loads": " and ".join(f"{f:g}" for f in loads)}
     for (fz, criterion), rows in p_best.groupby(["fz_n", "criterion"], sort=True):
         cells = []
         for _, row in rows.sort_values("pressure_kpa", na_position="last").iterrows():
             text = _interval(row) if row["pressure_kpa"] == row["pressure_kpa"] else f"{row['p']:.2f}"
             cells.append(f"**{text}**" if row["measured_best"] else text)
         out[f"uncertainty.p_best.{criterion}.{fz:g}"] = " / ".join(cells)
-    for criterion, rows in measured.groupby("criterion"):
-        whole = rows[rows["fz_n"].isna()].iloc[0]
-        out[f"uncertainty.measured.{criterion}"] = (f"{_interval(whole)}: "
-                                                    + ("admitted" if whole["admitted"] else "not admitted"))
-        for _, row in rows[rows["fz_n"].notna()].iterrows():
-            out[f"uncertainty.measured.{criterion}.{row['fz_n']:g}"] = _interval(row)
+    for criterion in ("settling", "last_peak"):
+        out[f"uncertainty.options.{criterion}"] = _options_table(by_option[by_option["criterion"] == criterion], loads)
+    lp = measured[measured["criterion"] == "last_peak"]
+    for fz, rows in lp[lp["fz_n"].notna()].groupby("fz_n"):
+        diffs = ", ".join(f"{r['pressure_kpa']:g} kPa {r['measured_diff_s']:+.2f} s" for _, r in rows.iterrows())
+        first = rows.iloc[0]
+        out[f"uncertainty.measured.{fz:g}"] = (f"{first['measured_best_kpa']:g} kPa best ({diffs}; sd of a "
+                                               f"difference {first['measured_sd_s']:.3f} s): {first['verdict']}")
+    whole = lp[lp["fz_n"].isna()].iloc[0]
+    out["uncertainty.measured.whole"] = (f"{whole['verdict']}; P = {whole['p_best']:.2f} [{whole['p_best_low']:.2f}, "
+                                         f"{whole['p_best_high']:.2f}]")
     out["uncertainty.fell"] = f"{int(rates['fell'].sum())}"
     out["uncertainty.failed"] = f"{int(rates['failed'].sum())}"
     for criterion in ("settling", "last_peak"):
@@ -208,23 +217,14 @@ def group_uncertainty():
         none = p_best[(p_best["criterion"] == criterion) & p_best["pressure_kpa"].isna()]["p"]
         low, high = f"{100 * none.min():.0f}", f"{100 * none.max():.0f}"
         out[f"uncertainty.none.{criterion}"] = f"{low} %" if low == high else f"{low}-{high} %"
-        for name, rows in sobol[sobol["criterion"] == criterion].groupby("input", sort=False):
-            out[f"uncertainty.st.{criterion}.{name}"] = f"{rows['ST'].min():.2f}-{rows['ST'].max():.2f}"
-    # By the last peak the pressures are about equally likely at every load: the range of their P(best).
-    shown = p_best[(p_best["criterion"] == "last_peak") & p_best["pressure_kpa"].notna()]["p"]
-    out["uncertainty.p_range.last_peak"] = f"{shown.min():.2f}-{shown.max():.2f}"
-    share = sobol[(sobol["criterion"] == "settling") & (sobol["input"] == "rear_load_share")]
-    top = share.loc[share["ST"].idxmax()]
-    out["uncertainty.share_st"] = (f"{top['ST']:.2f} +- {top['ST_conf']:.2f}, for {top['pressure_a_kpa']:g} vs "
-                                   f"{top['pressure_b_kpa']:g} kPa at {top['fz_n']:g} N")
-    out["uncertainty.st_conf_max"] = f"{sobol['ST_conf'].max():.1f}"
-    # The rider's shift at the top of the file's share range, at each study load (riders.for_load_share).
-    from whipple_kick.library import bicycles, riders
-    entry = uncertain.load(uncertain.DEFAULT).inputs[meta["inputs"].index("rear_load_share")]
-    bike = bicycles.load("balanceassist_v1")
-    shifts = [-riders.for_load_share(bike, entry.high, fz_n=fz).shift_m for fz in LOADS]
-    out["uncertainty.share_high"] = f"{entry.high:.2f}"
-    out["uncertainty.share_shift"] = f"{min(shifts):.2f}-{max(shifts):.2f}"
+        rows = sobol[sobol["criterion"] == criterion]
+        for name, group in rows.groupby("input", sort=False):
+            out[f"uncertainty.st.{criterion}.{name}"] = f"{group['ST'].min():.2f}-{group['ST'].max():.2f}"
+        one = 100 * rows["rows_one_not_recovered"] / rows["rows"]
+        neither = 100 * rows["rows_neither_recovered"] / rows["rows"]
+        out[f"uncertainty.censored.{criterion}"] = (f"{one.min():.0f}-{one.max():.0f} % / "
+                                                     f"{neither.min():.0f}-{neither.max():.0f} %")
+    out["uncertainty.st_conf_max"] = f"{sobol['ST_conf'].max():.2f}"
     out["uncertainty.verdict"] = "\n".join(f"* {line}" for line in
                                             (UNCERTAINTY / "verdict.txt").read_text().split("\n\n")[0].splitlines())
     for key in ("run_cpu_mean_s", "run_wall_mean_s", "integration_wall_mean_s"):
@@ -232,11 +232,23 @@ def group_uncertainty():
     out["uncertainty.cost.integration_share"] = f"{100 * cost['integration_share']:.0f} %"
     out["uncertainty.cost.distinct"] = f"{cost['distinct']}"
     out["uncertainty.cost.wall_s"] = f"{cost['wall_s']:.0f}"
-    out["uncertainty.cost.extrapolate"] = (f"{cost['extrapolate_rows']} rows, {cost['extrapolate_runs']} runs, about "
-                                           f"{cost['extrapolate_distinct']:.0f} distinct")
-    out["uncertainty.cost.extrapolate_idle_h"] = f"{cost['extrapolate_idle_h']:.1f}"
-    out["uncertainty.cost.extrapolate_contended_h"] = f"{cost['extrapolate_contended_h']:.1f}"
     return out
+
+
+def _options_table(rows, loads):
+    """P(best) per option (p_best_by_option.csv rows of one criterion) as a Markdown table: an input's option per
+    row, per load the pressures' P(best) (the most probable in bold) and the option's rows."""
+    header = "| input = option | " + " | ".join(f"{fz:g} N: 300 / 400 / 500 kPa (rows)" for fz in loads) + " |"
+    lines = [header, "| --- |" + " --- |" * len(loads)]
+    for (name, option), group in rows.groupby(["input", "option"], sort=False):
+        cells = []
+        for fz in loads:
+            at = group[(group["fz_n"] == fz) & group["pressure_kpa"].notna()].sort_values("pressure_kpa")
+            top = at["p"].max()
+            shares = [f"**{p:.2f}**" if p == top else f"{p:.2f}" for p in at["p"]]
+            cells.append(" / ".join(shares) + f" ({int(at['rows'].iloc[0])})")
+        lines.append(f"| {name} = {option} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
 
 
 GROUPS = {"nine": group_nine, "force_lag": group_force_lag, "fine": group_fine, "spread": group_spread,
