@@ -1340,7 +1340,8 @@ def calibrate_main(argv=None):
         progress = sys.stderr.isatty()
         options = dict(waves=args.waves, steps=1000 if args.quick else 5000, seed=args.seed)
         result = calibration.calibrate(spec=args.spec, inputs=inputs, cells=cells, base=base, workers=args.workers,
-                                       progress=progress, check_runs=4 if args.quick else 8, **options)
+                                       progress=progress, check_runs=4 if args.quick else 8,
+                                       runs=pathlib.Path(args.out) / calibration.RUNS, **options)
         if args.held_out:
             result.held_out = _held_out(args, result, base, inputs, cells, progress, options)
         out = pathlib.Path(args.out)

@@ -272,3 +272,18 @@ def test_surely_unstable_inputs_are_ruled_out():
         share_below[limit] = float(np.mean(u1 < 0.3))
     assert share_below[None] > 0.05 and share_below[0.35] < 0.01, share_below
     assert "unstable_runs" in set(result.checks["check"])
+
+
+def test_the_model_simulator_keeps_its_runs_in_a_folder_and_a_rerun_runs_none(tmp_path):
+    """calibrate --out DIR keeps the simulator's runs in DIR/calibration_runs: calling again with the same rows
+    (a stopped calibration rerun) reads them back (the folder's log gains no line) and gives the same features;
+    new rows extend the same folder."""
+    folder = tmp_path / cal.RUNS
+    sim = cal.ModelSimulator(["gain_scale"], [(635.0, 400.0)], ["frequency_hz"], workers=1, folder=folder)
+    first = sim(np.array([[0.7]]))
+    lines = (folder / "cases.jsonl").read_text().count("\n")
+    assert lines == 1 and np.isfinite(first).all()
+    np.testing.assert_array_equal(sim(np.array([[0.7]])), first)
+    assert (folder / "cases.jsonl").read_text().count("\n") == lines
+    sim(np.array([[0.7], [0.9]]))
+    assert (folder / "cases.jsonl").read_text().count("\n") == 2

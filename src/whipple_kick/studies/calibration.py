@@ -253,6 +253,10 @@ def model_features(t, yaw_rate, steady=0.0, t_kick=0.0, processing=None):
 
 # ------------------------------------------------------------------------------------------------ simulators
 
+#: The folder of a ``calibrate --out DIR`` that keeps the simulator's runs (a rerun resumes from it).
+RUNS = "calibration_runs"
+
+
 class ModelSimulator:
     """The kick model as a calibration simulator: ``sim(X) -> Y``.
 
@@ -269,7 +273,7 @@ class ModelSimulator:
     :func:`history_match` emulates to rule out surely unstable riders.
     """
 
-    def __init__(self, fields, cells, features, base=None, workers=None, progress=False):
+    def __init__(self, fields, cells, features, base=None, workers=None, progress=False, folder=None):
         from . import validation
 
         self.fields = list(fields)
@@ -277,9 +281,13 @@ class ModelSimulator:
         self.features = _check_features(features)
         self.base = validation.base_scenario(duration=FEATURE_DURATION) if base is None else base
         self.workers, self.progress = workers, progress
+        # A sweep folder that keeps every run (one folder for every call: extended, never refused), so a
+        # stopped calibration resumes without rerunning them; None: a temporary folder per call.
+        self.folder = folder
         self.runs = 0
 
     def __call__(self, X):
+        import contextlib
         import tempfile
 
         from .sweep_engine import make_cases, sweep
@@ -293,9 +301,12 @@ class ModelSimulator:
         Y = np.full((len(X), len(self.cells) * len(self.features)), np.nan)
         self.last_unstable = np.zeros(len(X), bool)
         self.last_margin = np.full(len(X), -np.inf)
-        with tempfile.TemporaryDirectory(prefix="whipple_kick_calibrate_") as folder:
+        with contextlib.ExitStack() as stack:
+            folder = self.folder if self.folder is not None else stack.enter_context(
+                tempfile.TemporaryDirectory(prefix="whipple_kick_calibrate_"))
             table = sweep(cases=cases, base=self.base, folder=folder, workers=self.workers, progress=self.progress,
-                          trajectory_columns=("time", "yaw_rate"), trajectory_dtype="float64", trajectory_rate=None)
+                          trajectory_columns=("time", "yaw_rate"), trajectory_dtype="float64", trajectory_rate=None,
+                          extend=True)
             ok = {row["case_id"]: row["status"] == "ok" for _, row in table.iterrows()}
             for k, cid in enumerate(ids):
                 if not ok.get(cid):
@@ -770,7 +781,8 @@ def choose_priors(spec, inputs=None, bounds=None):
 
 def calibrate(simulator=None, spec=priors.DEFAULT, inputs=None, bounds=None, features=None, cells=None,
               discrepancy=None, measured=None, base=None, waves=2, first=None, per_wave=None, rank=None,
-              walkers=32, steps=2000, candidates=20000, seed=0, workers=None, progress=False, check_runs=0):
+              walkers=32, steps=2000, candidates=20000, seed=0, workers=None, progress=False, check_runs=0,
+              runs=None):
     """History-match and calibrate (module docstring).
 
     Parameters
@@ -792,6 +804,9 @@ def calibrate(simulator=None, spec=priors.DEFAULT, inputs=None, bounds=None, fea
     walkers, steps : see :func:`posterior`.
     check_runs : int
         Posterior draws run on the simulator itself (``posterior_runs_*`` rows of the checks).
+    runs : path, optional
+        A sweep folder that keeps the default simulator's runs: a stopped calibration run again with the
+        same arguments reruns none of them (calibrate --out DIR keeps them in DIR/calibration_runs).
 
     Returns
     -------
@@ -805,11 +820,12 @@ def calibrate(simulator=None, spec=priors.DEFAULT, inputs=None, bounds=None, fea
     # threads made each Cholesky solve 2-3 ms instead of well under 1 ms (the sweep engine limits its runs alike).
     with threadpool_limits(limits=1):
         return _calibrate(simulator, spec, inputs, bounds, features, cells, discrepancy, measured, base, waves,
-                          first, per_wave, rank, walkers, steps, candidates, seed, workers, progress, check_runs)
+                          first, per_wave, rank, walkers, steps, candidates, seed, workers, progress, check_runs,
+                          runs)
 
 
 def _calibrate(simulator, spec, inputs, bounds, features, cells, discrepancy, measured, base, waves, first,
-               per_wave, rank, walkers, steps, candidates, seed, workers, progress, check_runs):
+               per_wave, rank, walkers, steps, candidates, seed, workers, progress, check_runs, runs=None):
     import pandas as pd
 
     spec = spec if isinstance(spec, priors.CalibrationSpec) else priors.load(spec)
@@ -823,7 +839,7 @@ def _calibrate(simulator, spec, inputs, bounds, features, cells, discrepancy, me
             raise InputError(f"measured values: {measured.size} given, {len(table)} features expected")
         table = table.assign(measured=measured)
     if simulator is None:
-        simulator = ModelSimulator([p.field for p in prior_list], cells, features, base, workers, progress)
+        simulator = ModelSimulator([p.field for p in prior_list], cells, features, base, workers, progress, runs)
     z = table["measured"].to_numpy()
     var_obs = table["sd_measurement"].to_numpy() ** 2 + table["sd_discrepancy"].to_numpy() ** 2
     wave_list, matcher, U_all, Y_all, survivors = history_match(
