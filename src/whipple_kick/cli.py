@@ -1255,6 +1255,37 @@ def _held_out(args, result, base, inputs, cells, progress, options):
     return frame
 
 
+def _screen(args, inputs, cells, base, progress):
+    """``calibrate --screen``: Morris screening of every prior the rider reads, into DIR/screening.csv."""
+    import pathlib
+
+    from whipple_kick import fileio
+    from whipple_kick.library import priors
+    from whipple_kick.studies import calibration
+    spec = priors.load(args.spec)
+    candidates = [n for n in spec.priors if n != "hip_stiffness" or args.rider_body == "leaning"]
+    frame = calibration.screen_inputs(spec, candidates, cells=cells, base=base, workers=args.workers,
+                                      progress=progress, trajectories=4 if args.quick else 8, seed=args.seed,
+                                      runs=pathlib.Path(args.out) / calibration.RUNS)
+    out = pathlib.Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    fileio.write_atomic(out / SCREENING_FILE, frame.to_csv(index=False))
+    print(f"screening ({int(frame['rows'].iloc[0])} rows of Morris trajectories; active: mu* >= "
+          f"{calibration.SCREEN_THRESHOLD:g} sd of some feature over the prior's range):")
+    for _, r in frame.iterrows():
+        print(f"  {r['input']}: mu* {r['mu_star_sd']:.2f} sd ({r['feature']}), sigma {r['sigma_sd']:.2f} sd: "
+              + ("active" if r["active"] else "not seen by the features"))
+    active = dict(zip(frame["input"], frame["active"], strict=True))
+    unseen = [n for n in inputs if not active.get(n, True)]
+    if unseen:
+        print(f"  calibrated but not seen by the features: {', '.join(unseen)} (their posterior stays near the prior)")
+    return frame
+
+
+#: What ``calibrate --screen`` writes.
+SCREENING_FILE = "screening.csv"
+
+
 #: The figure of the answer under a posterior (P(best) per pressure and load), beside p_best.csv.
 ANSWER_FIGURE = "p_best.png"
 
@@ -1317,6 +1348,10 @@ def calibrate_main(argv=None):
                        help="held-out checks, rows in checks.csv and held_out.csv: load (calibrate without each "
                             "rear load in turn and predict it; one calibration per load) and/or direction "
                             "(predict the measurements with the model kicked the other way)")
+        p.add_argument("--screen", action="store_true",
+                       help="first screen every prior the rider reads (Morris elementary effects, 4 trajectories "
+                            "with --quick, else 8): screening.csv, and which calibrated inputs the features do "
+                            "not see")
         p.add_argument("--samples", type=int, metavar="M",
                        help="posterior rows for the answer (P(best) per pressure and load, p_best.csv; each row "
                             "run at every pressure and load): default 24 with --quick, else 32; 0: no answer")
@@ -1339,6 +1374,8 @@ def calibrate_main(argv=None):
                                  + (["hip_stiffness"] if args.rider_body == "leaning" else []))
         progress = sys.stderr.isatty()
         options = dict(waves=args.waves, steps=1000 if args.quick else 5000, seed=args.seed)
+        if args.screen:
+            _screen(args, inputs, cells, base, progress)
         result = calibration.calibrate(spec=args.spec, inputs=inputs, cells=cells, base=base, workers=args.workers,
                                        progress=progress, check_runs=4 if args.quick else 8,
                                        runs=pathlib.Path(args.out) / calibration.RUNS, **options)

@@ -233,8 +233,13 @@ def test_calibrate_command_quick_writes_its_tables(tmp_path, capsys):
     posterior (4 rows here; shares summing to 1 per load and criterion) (~2 min)."""
     import pandas as pd
 
-    code, out, err = _console(["--out", str(tmp_path), "--quick", "--workers", "2", "--samples", "4"], capsys)
+    code, out, err = _console(["--out", str(tmp_path), "--quick", "--workers", "2", "--samples", "4", "--screen"],
+                              capsys)
     assert code == 0, err
+    screening = pd.read_csv(tmp_path / "screening.csv").set_index("input")
+    # the speed's 1.92-2 m/s moves no feature by half its sd (0.06 sd measured): the calibration holds it at 2 m/s
+    assert not screening.loc["speed", "active"] and screening.loc["carcass_stiffness_scale", "active"]
+    assert "speed: mu*" in out and "not seen by the features" in out
     checks = pd.read_csv(tmp_path / "checks.csv")
     assert {"emulator_held_out", "non_implausible_fraction", "unsourced"} <= set(checks["check"])
     features = pd.read_csv(tmp_path / "features.csv")
@@ -287,3 +292,20 @@ def test_the_model_simulator_keeps_its_runs_in_a_folder_and_a_rerun_runs_none(tm
     assert (folder / "cases.jsonl").read_text().count("\n") == lines
     sim(np.array([[0.7], [0.9]]))
     assert (folder / "cases.jsonl").read_text().count("\n") == 2
+
+
+def test_screening_finds_the_inputs_the_features_see_and_an_inert_one():
+    """Morris screening on the toy (which reads its first three inputs only): the fourth input moves no
+    feature (mu* 0 exactly) and is inactive; the first two move them by several of their sd."""
+    spec = priors.load()
+    names = ["gain_scale", "carcass_stiffness_scale", "carcass_damping", "kick_accel"]
+    pl = cal.choose_priors(spec, names)
+    cells = [(635.0, 400.0), (701.0, 500.0)]
+    table = cal.measured_features(spec, cells=cells)
+    toy = cal.ToySimulator(pl, cells, list(dict.fromkeys(table["feature"])))
+    result = cal.screen_inputs(spec, names, cells=cells, simulator=toy, trajectories=6)
+    by = result.set_index("input")
+    assert list(by["active"]) == [True, True, True, False]
+    assert by.loc["kick_accel", "mu_star_sd"] == 0.0
+    assert by.loc["gain_scale", "mu_star_sd"] > 3 and by.loc["gain_scale", "feature"].endswith("frequency_hz")
+    assert (by["rows"] == 6 * 5).all() and (by["rows_without_value"] == 0).all()

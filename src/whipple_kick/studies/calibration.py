@@ -760,6 +760,80 @@ class Calibration:
         return paths + [path]
 
 
+#: Screening: an input is active when changing it over its whole prior range moves some feature, on average
+#: over the Morris trajectories (mu*), by at least this many of that feature's standard deviations (measurement
+#: and discrepancy): below, the measurements cannot tell its values apart, and calibrating it adds a dimension
+#: the data do not inform.
+SCREEN_THRESHOLD = 0.5
+
+
+def screen(simulator, prior_list, sd, keys, trajectories=4, levels=4, seed=0):
+    """Morris elementary-effects screening of the inputs on the features (SALib), before history matching.
+
+    Parameters
+    ----------
+    simulator : callable
+        ``simulator(X) -> Y`` as for :func:`calibrate`, its columns ``keys``.
+    prior_list : list of Prior
+        The candidate inputs and their ranges (the design is on their unit cube).
+    sd : array
+        Each feature's standard deviation (measurement and discrepancy), in ``keys`` order.
+    trajectories, levels, seed : int
+        Morris' trajectories ``r`` (``r (D + 1)`` simulator rows), grid levels and seed.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Per input: ``input``, ``mu_star_sd`` (the largest over the features of mu* / sd: the mean absolute
+        change of a feature across the input's whole range, in that feature's sd), ``feature`` (where it is
+        largest), ``sigma_sd`` (that feature's spread of the effects, in sd: interactions or nonlinearity),
+        ``active`` (``mu_star_sd >= SCREEN_THRESHOLD``), ``rows`` (simulator rows), ``rows_without_value`` (rows where some
+        feature had no value; their cells take the feature's mean over the design so the effects stay defined).
+    """
+    import pandas as pd
+    from SALib.analyze import morris as morris_analyze
+    from SALib.sample import morris as morris_sample
+
+    names = [p.name for p in prior_list]
+    problem = {"num_vars": len(names), "names": names, "bounds": [[0.0, 1.0]] * len(names)}
+    U = morris_sample.sample(problem, int(trajectories), num_levels=int(levels), seed=int(seed))
+    low = np.array([p.low for p in prior_list])
+    width = np.array([p.width for p in prior_list])
+    Y = np.asarray(simulator(low + U * width), float)
+    missing = ~np.isfinite(Y)
+    best = dict.fromkeys(names, (0.0, None, 0.0))
+    for j, key in enumerate(keys):
+        y = Y[:, j]
+        if missing[:, j].all():
+            continue
+        y = np.where(missing[:, j], np.nanmean(y), y)
+        res = morris_analyze.analyze(problem, U, y, num_levels=int(levels), seed=int(seed))
+        for n, mu_star, sigma in zip(names, res["mu_star"], res["sigma"], strict=True):
+            value = float(mu_star) / float(sd[j])
+            if value > best[n][0]:
+                best[n] = (value, key, float(sigma) / float(sd[j]))
+    return pd.DataFrame([{"input": n, "mu_star_sd": v, "feature": k, "sigma_sd": sig,
+                          "active": bool(v >= SCREEN_THRESHOLD), "rows": int(len(U)),
+                          "rows_without_value": int(missing.any(axis=1).sum())}
+                         for n, (v, k, sig) in best.items()])
+
+
+def screen_inputs(spec=priors.DEFAULT, inputs=None, cells=None, features=None, base=None, workers=None,
+                  progress=False, trajectories=4, seed=0, runs=None, simulator=None):
+    """:func:`screen` on the kick model (or ``simulator``) for the file's priors ``inputs`` (default every
+    prior the rigid rider reads: all but ``hip_stiffness``); the features' sd from the file."""
+    spec = spec if isinstance(spec, priors.CalibrationSpec) else priors.load(spec)
+    names = [n for n in spec.priors if n != "hip_stiffness"] if inputs is None else list(inputs)
+    prior_list = choose_priors(spec, names)
+    table = measured_features(spec, features=features, cells=cells)
+    feats = list(dict.fromkeys(table["feature"]))
+    cell_list = list(dict.fromkeys(zip(table["fz_n"], table["pressure_kpa"], strict=True)))
+    if simulator is None:
+        simulator = ModelSimulator([p.field for p in prior_list], cell_list, feats, base, workers, progress, runs)
+    sd = np.sqrt(table["sd_measurement"].to_numpy() ** 2 + table["sd_discrepancy"].to_numpy() ** 2)
+    return screen(simulator, prior_list, sd, list(table["key"]), trajectories=trajectories, seed=seed)
+
+
 def choose_priors(spec, inputs=None, bounds=None):
     """The priors of ``inputs`` (names in the file; default all but ``hip_stiffness`` and ``speed``), with
     ``bounds = {name: (low, high)}`` overriding (checked; an override is marked unsourced)."""
