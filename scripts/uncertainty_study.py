@@ -63,6 +63,8 @@ def main(argv=None):
         return
     with tempfile.TemporaryDirectory() as tmp:
         out = args.out or tmp
+        # Resumed: the folder held finished runs before this session (a wall-time rule misread a quick study).
+        resumed = os.path.exists(os.path.join(out, "runs", "cases.jsonl"))
         t0 = time.perf_counter()
         study = uncertainty.run_study(spec, samples=args.samples, seed=args.seed, workers=args.workers,
                                       folder=os.path.join(out, "runs"), progress=sys.stderr.isatty(),
@@ -71,7 +73,7 @@ def main(argv=None):
         study.write(out)
     print(uncertainty.format_study(study))
     record = cost(study.outcomes, wall, args.workers, len(spec.inputs), args.extrapolate,
-                  resumed=bool(args.out) and wall < 0.05 * len(study.outcomes))
+                  resumed=resumed)
     print_cost(record)
     if args.out:
         fileio.write_atomic(os.path.join(args.out, "cost.json"), json.dumps(record, indent=1) + "\n")
