@@ -22,6 +22,7 @@ path it takes), :func:`driver` returns None and the Python path runs (the
 same numbers, slower).
 """
 import ctypes
+from dataclasses import dataclass
 import functools
 import hashlib
 import pathlib
@@ -78,7 +79,55 @@ def driver():
     lib.wk_lsoda_fast_chunks.argtypes = [pointer, pointer, pointer, pointer, c_int, pointer, pointer, c_int, pointer,
                                          c_double, pointer, c_int, c_int, c_double, c_int, c_double, c_int,
                                          c_double, c_double, c_double, pointer, pointer]
+    lib.wk_lsoda_careful_chunk.restype = c_int
+    lib.wk_lsoda_careful_chunk.argtypes = [pointer, pointer, pointer, pointer, c_int, pointer, c_int, pointer,
+                                           c_double, pointer, c_int, c_double, c_int, c_double, c_int, c_double,
+                                           c_double, c_double, ctypes.c_longlong, ctypes.c_longlong, c_double,
+                                           pointer, pointer, pointer, pointer, pointer]
     return lib
+
+
+#: How a careful chunk ended: ``wk_lsoda_careful_chunk``'s codes (driver.c's CAREFUL_* enumeration).
+CAREFUL_STATUS = {0: "completed", 1: "fell", 2: "lsoda", 3: "model", 4: "budget", 5: "stall", 6: "root_nan",
+                  7: "root_signs", 8: "root_iterations"}
+
+
+@dataclass(frozen=True)
+class CarefulChunk:
+    """What one careful chunk in C produced (:meth:`FastChunks.careful`); the caller words the messages.
+
+    Attributes
+    ----------
+    samples : ndarray
+        States at the chunk's first ``len(samples)`` times.
+    end : (float, ndarray)
+        Last time and state reached (the fall's; the last accepted step's where it failed).
+    status : str
+        A value of :data:`CAREFUL_STATUS`.
+    counts : (int, int, int)
+        LSODA's evaluations, its Jacobians, all evaluations (the budget's count).
+    step : float
+        Last accepted step's time [s] (where LSODA or the model failed, or the budget or stall was judged).
+    step_size : float
+        That step's size [s].
+    window : (int, float)
+        Evaluations and time at the stall window's start (budget and stall).
+    failed : tuple or None
+        For ``model``: the time, the state and the function (``"rhs"`` or ``"jacobian"``) at which the model
+        failed; for ``root_nan``: ``(t, None)``, the time at which the fall margin was NaN.
+    istate : int
+        LSODA's ``istate`` where it failed.
+    """
+
+    samples: np.ndarray
+    end: tuple
+    status: str
+    counts: tuple
+    step: float
+    step_size: float
+    window: tuple
+    failed: tuple | None
+    istate: int
 
 
 class FastChunks:
@@ -110,6 +159,9 @@ class FastChunks:
         self.atol = np.ascontiguousarray(atol, dtype=float)
         self.rtol, self.mxstep, self.limits = float(rtol), int(mxstep), limits
         self.budget = (float(budget.allowance), float(budget.per_second), float(t_start))
+        self.stall = (int(budget.stall_window), float(budget.stall_progress))
+        # scipy's LSODA solver object raises its rtol to 100 eps (scipy.integrate._ivp.common.validate_tol).
+        self.careful_rtol = float(np.maximum(rtol, 100 * np.finfo(float).eps))
 
     def __call__(self, grid, cuts, x, counts):
         """Integrate the chunks ``grid[cuts[k]:cuts[k + 1] + 1]`` from ``x`` until one needs the careful path.
@@ -147,3 +199,45 @@ class FastChunks:
         if done < 0:
             raise MemoryError("the C chunk loop ran out of memory")
         return done, out[c[0]:c[done] + 1], x
+
+    def careful(self, times, x, spent):
+        """One chunk of the careful path in C: LSODA stepped one step at a time, the fall event, the budget.
+
+        As :func:`whipple_kick.simulate.lsoda._careful_chunk` with ``scipy.integrate.LSODA`` (the same steps,
+        evaluations and ending; the samples and the fall time from the same interpolant, to round-off).
+
+        Parameters
+        ----------
+        times : ndarray
+            The chunk's sample times [s], its start and end included.
+        x : ndarray
+            State at ``times[0]``.
+        spent : int
+            Evaluations the run spent before the chunk (the budget's count).
+
+        Returns
+        -------
+        CarefulChunk
+        """
+        times = np.ascontiguousarray(times, dtype=float)
+        x = np.ascontiguousarray(x, dtype=float)
+        n, m = x.size, times.size
+        samples, end, failed_x = np.empty((m, n)), np.empty(n + 1), np.empty(n)
+        counts, report = np.zeros(8, dtype=np.int64), np.zeros(4)
+        roll, fall_angle, steer, steer_limit = self.limits
+        code = self.lib.wk_lsoda_careful_chunk(
+            self.rhs_address, self.jac_address, self.p.ctypes.data, self.scale.ctypes.data, n, times.ctypes.data, m,
+            x.ctypes.data, self.careful_rtol, self.atol.ctypes.data, roll, fall_angle, steer, steer_limit,
+            self.jac_evaluations, *self.budget, int(spent), *self.stall, samples.ctypes.data, end.ctypes.data,
+            failed_x.ctypes.data, counts.ctypes.data, report.ctypes.data)
+        if code < 0:
+            raise MemoryError("the C careful chunk ran out of memory")
+        status = CAREFUL_STATUS[code]
+        failed = None
+        if status == "model":
+            failed = (float(report[3]), failed_x, "jacobian" if counts[6] == 2 else "rhs")
+        elif status == "root_nan":
+            failed = (float(report[3]), None)
+        return CarefulChunk(samples[:int(counts[3])], (float(end[0]), end[1:]), status,
+                            (int(counts[0]), int(counts[1]), int(counts[2])), float(report[0]), float(report[1]),
+                            (int(counts[5]), float(report[2])), failed, int(counts[4]))
