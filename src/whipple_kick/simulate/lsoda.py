@@ -8,11 +8,13 @@ through a jump map where the caller gives one (the plate stop's impulse).
 A fall (``|roll|`` beyond a limit) ends the run as an event, not an error.
 LSODA's stiff steps use the compiled model's Jacobian (forward differences
 in C over the dynamic states, one foreign call; the energy quadratures feed
-nothing back). On the fast path LSODA runs in C with
-the compiled model (:mod:`whipple_kick.simulate.lsoda_c`: one call per piece, the
-roll and steer limits checked in C); elsewhere it calls the compiled model
-through ``CompiledRHS.fast`` (:mod:`whipple_kick.model.rhs_call`: one foreign
-call per evaluation).
+nothing back). For the compiled model LSODA runs in C
+(:mod:`whipple_kick.simulate.lsoda_c`): the fast path one call per piece, the
+roll and steer limits checked in C, and the careful path (a fall, LSODA's
+trouble, the budget) one call per chunk, stepped, sampled and its fall found
+in C; elsewhere (another SciPy release, no C compiler, any other ``f(t, x)``)
+it calls the compiled model through ``CompiledRHS.fast``
+(:mod:`whipple_kick.model.rhs_call`: one foreign call per evaluation).
 
 No integration runs for ever: a :class:`Budget` bounds the right-hand-side
 evaluations per simulated second (those LSODA makes and those inside each
@@ -165,7 +167,10 @@ DEFAULT_BUDGET = Budget()
 
 
 def _careful_chunk(rhs, x, times, rtol, atol, fall, spent, budget, t_start, jac=None):
-    """Integrate one chunk with LSODA stepped from Python, the fall event and the budget.
+    """Integrate one chunk with LSODA stepped from Python, the fall event and the budget (the careful path).
+
+    For a compiled model where the driver builds, :func:`_careful_chunk_in_c` does the same in C; this is
+    the path for any other ``f(t, x)``, and the fallback.
 
     The same solver, step by step, as ``solve_ivp(method="LSODA", t_eval=times,
     events=fall)`` (samples from each step's dense output, the fall time by
@@ -379,8 +384,9 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
     model all the chunks of a piece in one C call (:mod:`whipple_kick.simulate.lsoda_c`,
     the same numbers), otherwise through ``odeint``. A chunk in which the roll limit is crossed (or in
     which LSODA reports trouble) is integrated again from its start with
-    the same LSODA stepped from Python (:class:`scipy.integrate.LSODA`,
-    as ``solve_ivp`` does) and a fall event, which gives the exact fall
+    the same LSODA stepped one step at a time (:class:`scipy.integrate.LSODA`,
+    as ``solve_ivp`` does; for a compiled model the same steps in C, the
+    samples and the fall time equal to round-off) and a fall event, which gives the exact fall
     time. Numerical
     trouble there (LSODA giving up, a non-finite derivative, or more
     evaluations than ``budget`` allows) ends the integration as a failure:

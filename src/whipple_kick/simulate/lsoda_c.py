@@ -1,4 +1,4 @@
-"""The fast path's chunk loop in C: SciPy's LSODA driven from C with the compiled model (issue 41 item 1).
+"""LSODA driven from C with the compiled model: the fast path's chunk loop and the careful path (issue 41 item 1).
 
 :func:`whipple_kick.simulate.lsoda.integrate` integrates each smooth piece in
 chunks of about half a second with ``odeint``'s LSODA, redoing a chunk in
@@ -13,13 +13,27 @@ the model's ``wk_slip_rhs`` and ``wk_slip_jacobian`` by function pointer, and
 the LAPACK routines SciPy's LSODA uses (``scipy.linalg.cython_lapack``'s
 ``dgetrf``/``dgetrs``): the same steps, evaluations and states, bit for bit
 (``tests/simulate/test_lsoda_c.py``). The call stops before the first chunk
-that the careful path must redo, which stays in Python.
+that the careful path must redo.
+
+The careful path runs in C too (:meth:`FastChunks.careful`, one call per
+chunk): the same LSODA stepped one step at a time as SciPy's
+``scipy.integrate.LSODA`` steps it (its work arrays and options, ``itask`` 5),
+the samples and the fall event from each step's interpolant (the polynomial
+SciPy's ``LsodaDenseOutput`` builds from LSODA's Nordsieck history, evaluated
+by Horner's rule as LSODA's own ``intdy``), the fall time by a port of SciPy's
+``brentq`` (same tolerances), the budget and the stall window after every
+step. So the same steps, evaluation counts, ending and messages as the
+Python path; the samples, the fall time and the state at the fall agree
+with it to round-off (``np.dot`` sums the interpolant's terms in another
+order): measured at most 3.9e-16 of a state's peak and no fall time
+changed on the falling regression references and runs, tested within
+1e-13 and 1e-12 s.
 
 Where no C compiler is found, or the build fails, or the installed SciPy is not
 the release the source comes from (:data:`SCIPY_RELEASE`: another release's
 odeint may step differently, and a run must give the same numbers whichever
-path it takes), :func:`driver` returns None and the Python path runs (the
-same numbers, slower).
+path it takes: the same steps, to round-off in a careful chunk's samples),
+:func:`driver` returns None and the Python path runs (slower).
 """
 import ctypes
 from dataclasses import dataclass
