@@ -822,33 +822,70 @@ def bench_fall(repeats, duration):
     return walls, careful, facts
 
 
+def _careful_calls(case):
+    """The careful chunks of the case's run: [(the C chunk loop, _careful_chunk's arguments)], ``x`` copied."""
+    from whipple_kick.simulate import lsoda
+    calls, in_c = [], lsoda._careful_chunk_in_c
+
+    def recording(chunks_in_c, rhs, x, *rest):
+        calls.append((chunks_in_c, (rhs, x.copy(), *rest)))
+        return in_c(chunks_in_c, rhs, x, *rest)
+    lsoda._careful_chunk_in_c = recording
+    try:
+        _integrate_careful("c", case)
+    finally:
+        lsoda._careful_chunk_in_c = in_c
+    return calls
+
+
+def _careful_alone(path, calls):
+    """The recorded careful chunks again on ``path`` ("python": scipy's LSODA from Python, "c")."""
+    import numpy as np
+
+    from whipple_kick.simulate import lsoda
+    for chunks_in_c, arguments in calls:
+        if path == "python":
+            lsoda._careful_chunk(*(a.copy() if isinstance(a, np.ndarray) else a for a in arguments))
+        else:
+            lsoda._careful_chunk_in_c(chunks_in_c, *arguments)
+
+
 def _count_fall_inner(duration, helper_folder):
-    """Under callgrind: every falling case on both careful paths warm, then each counted between client requests."""
+    """Under callgrind: every falling case on both careful paths warm, then each counted between client
+    requests: the whole integration, and its careful chunks alone (rerun from their recorded arguments)."""
     import gc
     lib = _callgrind_helper(helper_folder)
     cases = _falling_cases(duration)
+    calls = {case[0]: _careful_calls(case) for case in cases}
     for case in cases:
         for path in CAREFUL_PATHS:
             _integrate_careful(path, case)
+            _careful_alone(path, calls[case[0]])
     for case in cases:
         for path in CAREFUL_PATHS:
             gc.collect()
             lib.wk_cg_start()
             _integrate_careful(path, case)
             lib.wk_cg_stop(f"{path}:{case[0]}".encode())
+            gc.collect()
+            lib.wk_cg_start()
+            _careful_alone(path, calls[case[0]])
+            lib.wk_cg_stop(f"{path}-careful:{case[0]}".encode())
 
 
 def bench_fall_instructions(duration):
     """Print each falling case's integration instructions on both careful paths (callgrind, a child process)."""
     t0 = time.perf_counter()
-    labels = [f"{p}:{label}" for label, _ in FALLING for p in CAREFUL_PATHS]
+    labels = [f"{p}{part}:{label}" for label, _ in FALLING for p in CAREFUL_PATHS for part in ("", "-careful")]
     counts = _callgrind_counts("_count_fall", duration, 1, labels)
-    print(f"integration instructions per falling case (callgrind, {duration:g} s; {time.perf_counter() - t0:.0f} s "
-          "under valgrind):")
+    print(f"instructions per falling case (callgrind, {duration:g} s; {time.perf_counter() - t0:.0f} s under "
+          "valgrind): the integration, and its careful chunks alone")
     for label, _ in FALLING:
         python, c = counts[f"python:{label}"], counts[f"c:{label}"]
+        careful_python, careful_c = counts[f"python-careful:{label}"], counts[f"c-careful:{label}"]
         print(f"  {label:19s} Python {python / 1e6:8.1f} M, C {c / 1e6:8.1f} M; C / Python {c / python:.3f}; "
-              f"saved {(python - c) / 1e6:.1f} M")
+              f"careful chunks: Python {careful_python / 1e6:7.1f} M, C {careful_c / 1e6:6.1f} M, C / Python "
+              f"{careful_c / careful_python:.3f}")
     return counts
 
 
