@@ -195,18 +195,18 @@ def test_the_careful_path_in_c_ends_falling_runs_as_python_does(name, monkeypatc
     _assert_same_to_round_off(a, b)
 
 
-def test_a_run_over_the_budget_fails_in_the_careful_path_in_c_as_in_python(monkeypatch):
-    monkeypatch.setattr(lsoda, "DEFAULT_BUDGET", lsoda.Budget(allowance=3000, per_second=1000.0))
-    a, b = _careful_both(simulation.Scenario(duration=3.0), monkeypatch)
-    assert a.failed and "more than the budget 3000 + 1000/s" in a.message
-    _assert_same_to_round_off(a, b)
+#: Budgets that stop the default run in a careful chunk, and the words of each stop: 3000 evaluations and
+#: 1000 per second run out; a window of 100 evaluations that must advance 1 ms stalls the first one.
+STOPPING_BUDGETS = {"budget": (lsoda.Budget(allowance=3000, per_second=1000.0), "more than the budget 3000 + 1000/s"),
+                    "stall": (lsoda.Budget(stall_window=100, stall_progress=1e-3), "advanced it only")}
 
 
-def test_a_stall_in_the_careful_path_in_c_is_judged_as_in_python(monkeypatch):
-    """A stall window of 100 evaluations that must advance 1 ms: the first careful chunk stalls."""
-    monkeypatch.setattr(lsoda, "DEFAULT_BUDGET", lsoda.Budget(stall_window=100, stall_progress=1e-3))
-    a, b = _careful_both(simulation.Scenario(duration=2.0), monkeypatch)
-    assert a.failed and "advanced it only" in a.message
+@pytest.mark.parametrize("stop", STOPPING_BUDGETS)
+def test_the_budget_stops_the_careful_path_in_c_as_in_python(stop, monkeypatch):
+    budget, words = STOPPING_BUDGETS[stop]
+    monkeypatch.setattr(lsoda, "DEFAULT_BUDGET", budget)
+    a, b, ended = _careful_both_counted(simulation.Scenario(duration=2.0), monkeypatch)
+    assert a.failed and words in a.message and ended[-1] == stop
     _assert_same_to_round_off(a, b)
 
 
