@@ -267,6 +267,16 @@ def test_lsoda_refusing_in_the_careful_path_in_c_is_reported_as_in_python():
     assert warned_c == warned_python == ["lsoda: Illegal input detected (internal error)."]
 
 
+def test_a_careful_chunk_in_c_starting_past_the_limit_falls_at_its_start():
+    """|roll| = 1 rad > 45 deg at the chunk's start: a fall there, no step taken, on both paths."""
+    x = np.full(len(slip.STATE_NAMES), np.nan)
+    x[slip.X["q4"]] = 1.0
+    (a, _), (b, _) = _one_chunk_both(x, lsoda.default_atol(1e-10))
+    assert a[3:] == b[3:] == ("fell", None, (0, 0, 0))
+    assert a[0].tolist() == b[0].tolist() == [0.0] and a[2][0] == b[2][0] == 0.0
+    assert np.array_equal(a[1], b[1]) and np.array_equal(a[2][1], b[2][1]) and a[2][1][slip.X["q4"]] == 1.0
+
+
 def test_a_non_finite_start_is_refused_by_both_careful_paths():
     x = np.full(len(slip.STATE_NAMES), np.nan)
     x[slip.X["u9"]] = np.inf
