@@ -124,7 +124,8 @@ def test_merged_upper_body_conserves_mass_and_mass_centre():
 # ------------------------------------------------------------------ one more degree of freedom
 
 def _build_shift(m):
-    """A mass on the saddle sliding sideways along the rear frame's C.y on a spring-damper (q12 [m])."""
+    """A mass on the saddle sliding sideways along the rear frame's C.y (q12 [m]) on SymPy's PrismaticJoint,
+    held by a LinearSpring and a LinearDamper along a LinearPathway."""
     import sympy.physics.mechanics as me
 
     kin, b = m.kin, m.par
@@ -138,16 +139,20 @@ def _build_shift(m):
     S = me.ReferenceFrame("S")
     so = me.Point("shift_mass")
     mass = m.body("shifting_mass", so, S, b["ms"], me.inertia(S, b["is11"], b["is22"], b["is33"]))
-    me.PrismaticJoint("shift", m.rigid_body("rear_frame"), mass, coordinates=q12, speeds=u12, parent_point=rest,
-                      joint_axis=C.y)
+    joint = me.PrismaticJoint("shift", m.rigid_body("rear_frame"), mass, coordinates=q12, speeds=u12,
+                              parent_point=rest, joint_axis=C.y)
     so.v1pt_theory(rest, N, C)   # the joint gives its velocity in the rear frame; Kane's method reads it in N
-    # The spring-damper between the mass and the frame, by hand: SymPy's LinearSpring and LinearDamper act
-    # along a pathway's length, |q12| here, whose direction is undefined at the rest point q12 = 0.
-    force = -(b["ks"] * q12 + b["cs"] * u12)
-    m.loads += [(so, force * C.y), (rest, -force * C.y)]
-    m.spring_energy.append(b["ks"] * q12**2 / 2)
-    m.damper_dissipation.append(b["cs"] * u12**2)
-    m.outputs["shift_force"] = force
+    m.system.add_joints(joint)
+    # The spring and the damper pull along a straight pathway from an anchor in the rear frame 1 m to the
+    # left of the rest point: its length 1 + q12 keeps its direction (C.y) for any shift under 1 m, where a
+    # pathway from the rest point itself, of length |q12|, would have none at q12 = 0. The derivation takes
+    # the spring's store and the damper's dissipation from them.
+    anchor = rest.locatenew("shift_anchor", -C.y)
+    anchor.v2pt_theory(do, N, C)
+    pathway = me.LinearPathway(anchor, so)
+    m.system.add_actuators(me.LinearSpring(b["ks"], pathway, equilibrium_length=1),
+                           me.LinearDamper(b["cs"], pathway))
+    m.outputs["shift_force"] = -(b["ks"] * q12 + b["cs"] * u12)
 
 
 def _shift_part():
@@ -365,6 +370,10 @@ def _hand_written_trunk(m):
     kin, b = m.kin, m.par
     N, C = kin.frames["N"], kin.frames["C"]
     q11, u11 = m.coordinate("q11", "u11")
+    # No joint: the coordinate, its speed and dq11/dt = u11 by hand.
+    m.system.add_coordinates(q11)
+    m.system.add_speeds(u11)
+    m.system.add_kdes(q11.diff(me.dynamicsymbols._t) - u11)
     H = me.ReferenceFrame("H")
     H.orient_axis(C, C.y, b["hip_tilt"])
     G = me.ReferenceFrame("G")
@@ -379,7 +388,7 @@ def _hand_written_trunk(m):
     kin.frames.update(H=H, G=G)
     kin.points.update(ho=ho, go=go)
     hip_torque = -(b["kh"] * q11 + b["ch"] * u11)
-    m.loads += [(C, -hip_torque * H.x), (G, hip_torque * H.x)]
+    m.system.add_loads(me.Torque(C, -hip_torque * H.x), me.Torque(G, hip_torque * H.x))
     axis_share = H.x.dot(C.z)
     m.hands_frame, m.hands_angle, m.hands_rate = G, axis_share * q11, axis_share * u11
     m.spring_energy.append(b["kh"] * q11**2 / 2)
@@ -389,6 +398,8 @@ def _hand_written_trunk(m):
 
 def _hand_written_arms(m):
     """The arms' loads as written by hand before the TorqueActuator: the reference."""
+    import sympy.physics.mechanics as me
+
     from whipple_kick.model import symbols
 
     kin, b = m.kin, m.par
@@ -396,7 +407,7 @@ def _hand_written_arms(m):
     arm_angle = symbols.dyn("q7") - m.hands_angle
     arm_rate = symbols.dyn("u7") - m.hands_rate
     arm_torque = -(b["ka"] * arm_angle + b["ca"] * arm_rate)
-    m.loads += [(m.hands_frame, -arm_torque * C.z), (E, arm_torque * C.z)]
+    m.system.add_loads(me.Torque(m.hands_frame, -arm_torque * C.z), me.Torque(E, arm_torque * C.z))
     m.spring_energy.append(b["ka"] * arm_angle**2 / 2)
     m.damper_dissipation.append(b["ca"] * arm_rate**2)
     m.outputs["arm_steer_torque"] = arm_torque

@@ -37,54 +37,100 @@ from whipple_kick.model import symbols as S
 
 @dataclass
 class Mechanics:
-    """What the parts of one derivation add to the bicycle, as SymPy objects (the build side only).
+    """What the parts of one derivation add to the bicycle: a SymPy :class:`~sympy.physics.mechanics.System`.
 
-    A part's ``build`` receives this and appends to it. ``hands_frame`` is the
-    frame the rider's hands react the steer torque and the arms on (the rear
-    frame C unless a part carries the upper body), and ``hands_angle`` /
-    ``hands_rate`` its rotation [rad] and rate [rad/s] about the steer axis
-    C.z relative to the rear frame (the arms' spring stretches by the bar's
-    rotation relative to the hands).
+    A part's ``build`` receives this and adds to :attr:`system` what SymPy's
+    mechanics API holds: its bodies (``system.add_bodies``, or :meth:`body`),
+    joints (``system.add_joints``: a joint brings its coordinates, speeds and
+    kinematic differential equations), actuators (``system.add_actuators``:
+    a ``TorqueActuator``, a ``LinearSpring`` or ``LinearDamper`` along a
+    pathway) and other loads (``system.add_loads``). The system starts with
+    the bicycle's four bodies (a joint's parent, :meth:`rigid_body`); the
+    derivation reads the parts' bodies, coordinates, speeds, kinematic
+    equations and loads back from it, weighs every body the parts added, and
+    takes the store of each ``LinearSpring`` and the dissipation of each
+    ``LinearDamper`` into the energy balance. What SymPy's system does not
+    hold is here: the energy of a spring-damper written as a torque
+    (:attr:`spring_energy`, :attr:`damper_dissipation`), the part's declared
+    outputs, and the frame the hands hold.
+
+    ``hands_frame`` is the frame the rider's hands react the steer torque and
+    the arms on (the rear frame C unless a part carries the upper body), and
+    ``hands_angle`` / ``hands_rate`` its rotation [rad] and rate [rad/s] about
+    the steer axis C.z relative to the rear frame (the arms' spring stretches
+    by the bar's rotation relative to the hands).
     """
 
-    kin: object                 # derivation.Kinematics (frames, points, q, u, bodies, gravity loads)
+    kin: object                 # derivation.Kinematics (frames, points, q, u, the bicycle's bodies, its weights)
     par: dict                   # parameter symbols by name (the base model's and every part's)
-    coordinates: dict = field(default_factory=dict)   # name -> dynamicsymbol, the parts' coordinates
-    speeds: dict = field(default_factory=dict)        # name -> dynamicsymbol, the parts' speeds
-    loads: list = field(default_factory=list)         # (point or frame, vector) as KanesMethod takes them
-    spring_energy: list = field(default_factory=list)        # terms [J]
-    damper_dissipation: list = field(default_factory=list)   # terms [W], each >= 0
+    system: object = None       # sympy.physics.mechanics.System in the ground frame N about O (set when None)
+    spring_energy: list = field(default_factory=list)        # terms [J] of springs that are not LinearSprings
+    damper_dissipation: list = field(default_factory=list)   # terms [W], each >= 0, of dampers that are not
+    #                                                          LinearDampers
     outputs: dict = field(default_factory=dict)       # name -> expression (the part's declared outputs)
     hands_frame: object = None
     hands_angle: object = 0
     hands_rate: object = 0
 
-    def coordinate(self, q_name, u_name):
-        """A new coordinate and its speed (``u = dq/dt``), appended to the system's: (q, u) dynamicsymbols."""
-        import sympy.physics.mechanics as me
+    def __post_init__(self):
+        if self.system is None:
+            import sympy.physics.mechanics as me
 
-        q, u = S.dyn(q_name), S.dyn(u_name)
-        self.kin.q = (*self.kin.q, q)
-        self.kin.u = (*self.kin.u, u)
-        self.kin.qd_to_u[q.diff(me.dynamicsymbols._t)] = u
-        self.coordinates[q_name], self.speeds[u_name] = q, u
-        return q, u
+            self.system = me.System(self.kin.frames["N"], self.kin.points["O"])
+            self.system.add_bodies(*self.kin.bodies)
+        self._bicycle = tuple(self.kin.bodies)
+
+    def coordinate(self, q_name, u_name):
+        """A part's coordinate and its speed (``u = dq/dt``) by name: (q, u) dynamicsymbols, for its joint.
+
+        The joint brings them into :attr:`system` (``system.add_joints``); a coordinate no joint carries is
+        added with ``system.add_coordinates``, ``add_speeds`` and ``add_kdes`` (``dq/dt - u``).
+        """
+        return S.dyn(q_name), S.dyn(u_name)
 
     def body(self, name, point, frame, mass, inertia):
-        """Add a rigid body with its weight (``inertia`` a dyadic about ``point``, its mass centre); return it."""
+        """Add a rigid body (``inertia`` a dyadic about ``point``, its mass centre) to :attr:`system`; return it.
+
+        The derivation weighs it (every body a part adds).
+        """
         import sympy.physics.mechanics as me
 
         body = me.RigidBody(name, point, frame, mass, (inertia, point))
-        self.kin.bodies.append(body)
-        self.kin.gravity_loads.append((point, mass * self.par["g"] * self.kin.frames["N"].z))
+        self.system.add_bodies(body)
         return body
 
     def rigid_body(self, name):
-        """The system's rigid body called ``name`` (``"rear_frame"``, ``"front_frame"``, a part's), to join to."""
-        found = [b for b in self.kin.bodies if b.name == name]
+        """The system's body called ``name`` (``"rear_frame"``, ``"front_frame"``, a part's), to join to."""
+        found = [b for b in self.system.bodies if b.name == name]
         if not found:
-            raise KeyError(f"no body {name!r}; bodies: {', '.join(b.name for b in self.kin.bodies)}")
+            raise KeyError(f"no body {name!r}; bodies: {', '.join(b.name for b in self.system.bodies)}")
         return found[0]
+
+    def added_bodies(self):
+        """The bodies the parts added, in the order they were added (the bicycle's four excluded)."""
+        return [b for b in self.system.bodies if not any(b is own for own in self._bicycle)]
+
+    def loads(self):
+        """The parts' loads as Kane's method takes them: each actuator's (in the order added), then the rest."""
+        return [*(load for act in self.system.actuators for load in act.to_loads()), *self.system.loads]
+
+    def actuator_energy(self):
+        """(store [J], dissipation rate [W]) of the system's ``LinearSpring`` and ``LinearDamper`` actuators.
+
+        A linear spring of stiffness k and equilibrium length l0 along a pathway of length l stores
+        k (l - l0)^2 / 2; a linear damper of damping c dissipates c (dl/dt)^2 >= 0.
+        """
+        import sympy.physics.mechanics as me
+
+        store, dissipation = [], []
+        for act in self.system.actuators:
+            if isinstance(act, me.LinearSpring):
+                store.append(act.stiffness * (act.pathway.length - act.equilibrium_length) ** 2 / 2)
+            elif isinstance(act, me.LinearDamper):
+                dissipation.append(act.damping * act.pathway.extension_velocity ** 2)
+        # A pathway's extension velocity is d(length)/dt: in the speeds by dq/dt = u.
+        return ([e.xreplace(self.kin.qd_to_u) for e in store],
+                [e.xreplace(self.kin.qd_to_u) for e in dissipation])
 
 
 @dataclass(frozen=True)
@@ -311,10 +357,11 @@ def _build_trunk(m):
                       parent_point=ho, child_point=-(b["lt1"] * G.x + b["lt3"] * G.z), parent_interframe=H,
                       joint_axis=H.x)
     go.v2pt_theory(ho, N, G)   # the joint gives go's velocity in the rear frame; Kane's method reads it in N
+    m.system.add_joints(hip)   # brings q11, u11 and dq11/dt = u11
     kin.frames.update(H=H, G=G)
     kin.points.update(ho=ho, go=go)
     hip_torque = -(b["kh"] * q11 + b["ch"] * u11)   # on G about H.x, reacted on the rear frame
-    m.loads += me.TorqueActuator.at_pin_joint(hip_torque, hip).to_loads()
+    m.system.add_actuators(me.TorqueActuator.at_pin_joint(hip_torque, hip))
     # The hands hold the bar from G: the bar turns relative to G about C.z by q7 - (H.x . C.z) q11
     # (H.x . C.z is constant), so the arms' spring is exact.
     axis_share = H.x.dot(C.z)
@@ -386,7 +433,7 @@ def _build_arms(m):
     arm_angle = S.dyn("q7") - m.hands_angle
     arm_rate = S.dyn("u7") - m.hands_rate
     arm_torque = -(b["ka"] * arm_angle + b["ca"] * arm_rate)   # on the bar E about C.z, reacted on the hands
-    m.loads += me.TorqueActuator(arm_torque, C.z, E, m.hands_frame).to_loads()
+    m.system.add_actuators(me.TorqueActuator(arm_torque, C.z, E, m.hands_frame))
     m.spring_energy.append(b["ka"] * arm_angle**2 / 2)
     m.damper_dissipation.append(b["ca"] * arm_rate**2)
     m.outputs["arm_steer_torque"] = arm_torque
