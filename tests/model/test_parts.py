@@ -301,7 +301,7 @@ def test_a_parts_gains_values_and_rider_parameters_come_from_its_declaration(shi
     assert assembly.custom_gains({"kq12": 1.0}, cls(shift="on"))["kq12"] == 1.0
     body = assembly.rider_body(cls(shift="on", shift_damping=40.0).body_spec, {})
     assert {n: body[n] for n in ("ms", "ls3", "ks", "cs")} == {"ms": 5.0, "ls3": -0.6, "ks": 2000.0, "cs": 40.0}
-    assert parts.TRUNK.from_rider == slip.parameters.TRUNK_BODY[:10]
+    assert set(parts.TRUNK.from_rider) < set(slip.parameters.body_names()) - set(parts.TRUNK.gains)
     segments = dict.fromkeys(parts.TRUNK.from_rider, 0.25)
     leaning = assembly.rider_body(wk.Scenario(rider_body="leaning").body_spec, {"body": segments})
     assert all(leaning[n] == 0.25 for n in segments) and leaning["kh"] == 128.0

@@ -32,6 +32,7 @@ import inspect
 import numpy as np
 
 from whipple_kick.errors import InputError
+from whipple_kick.model import benchmark
 from whipple_kick.model import symbols as S
 
 
@@ -169,6 +170,45 @@ class Field:
 
 
 @dataclass(frozen=True)
+class Split:
+    """How a part takes its body from the rider's Yeadon segments (:func:`whipple_kick.library.riders.split_rider`).
+
+    The rider's segments go to the rear frame unless a part of the model carries them: the parts in their
+    build order (:func:`named`) each take the segments they name, a later part from an earlier one (the arms,
+    built after the trunk, take the forearms the trunk names).
+
+    Attributes
+    ----------
+    segments : tuple of str
+        The Yeadon segments it carries (``"P"`` pelvis, ``"A2"`` a forearm and hand ...).
+    frame : str
+        The benchmark body its segments are lumped into (``"H"``: the front frame, they turn with the bar), or
+        ``""`` for a body of its own (then :attr:`body`).
+    body : callable, optional
+        ``body(bench, seat, mass, com, inertia)``: its parameters by name from its segments' mass [kg], mass
+        centre (3,) [m] and inertia (3, 3) [kg m^2] about it, in the benchmark frame, ``seat`` (3,) [m] the
+        rider's seat point and ``bench`` the bicycle's benchmark parameters.
+    rigid : callable, optional
+        ``rigid(moore, body)``: the Moore parameters with :attr:`body`'s parameters held by the rear frame, for
+        a model without the part whose rider is split for another part (the rigid rider with the arms on the
+        bar); without it the segments are lumped into the rear frame.
+    moves_with : str
+        The model's frame its segments move with, for drawings (``"G"`` the leaning upper body, ``"E"`` the
+        front frame; the rest of the rider moves with the rear frame ``"C"``).
+    """
+
+    segments: tuple
+    frame: str = ""
+    body: Callable = None
+    rigid: Callable = None
+    moves_with: str = "C"
+
+    def __post_init__(self):
+        if bool(self.frame) == (self.body is not None):
+            raise ValueError("a part's split lumps its segments into a frame or makes a body of its own, one of them")
+
+
+@dataclass(frozen=True)
 class Part:
     """One declared part of the bicycle-rider system.
 
@@ -215,6 +255,8 @@ class Part:
         Its parameters a run takes from the rider's segments (the upper body that
         :func:`whipple_kick.library.riders.seat_with_body` splits off, by the same names), where the bicycle's
         rider has them (``whipple_kick.simulate.assembly.rider_body``).
+    split : Split, optional
+        How it takes its body from the rider's segments (:func:`whipple_kick.library.riders.split_rider`).
     """
 
     name: str
@@ -235,6 +277,7 @@ class Part:
     after: tuple = ()
     values: dict = field(default_factory=dict)
     from_rider: tuple = ()
+    split: Split = None
 
     def __post_init__(self):
         if self.name in self.needs + self.after:
@@ -329,9 +372,85 @@ def _selection(name):
     return f"{part.selected_by[0]} {part.selected_by[1]!r}" if part is not None and part.selected_by else ""
 
 
+def _hinge_rotation(hip_tilt):
+    """Rotation matrix whose columns are the hip frame H's axes in the rear frame C (H turned about C.y)."""
+    c, s = np.cos(hip_tilt), np.sin(hip_tilt)
+    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+
+
+def _parallel_axis(mass, offset):
+    """Inertia [kg m^2] a point mass at ``offset`` [m] adds about the origin."""
+    d = np.asarray(offset, dtype=float)
+    return mass * (d @ d * np.eye(3) - np.outer(d, d))
+
+
+def merge_into_rear_frame(moore, body):
+    """Moore parameters with the upper body of ``body`` (the trunk's placement and inertia) in the rear frame.
+
+    The upper body at zero lean is a rigid part of the rear frame: its mass,
+    mass centre and inertia are combined with the rear frame's (Moore's
+    ``mc l1 l2 ic11 ic22 ic33 ic31``, about the combined mass centre, in the
+    rear frame's axes), exactly as a locked hip would hold it. For the rigid
+    rider whose forearms turn with the bar (the rest of the rider is then
+    the rear frame plus this upper body).
+
+    Parameters
+    ----------
+    moore : mapping
+        Moore parameters of the bicycle whose rear frame lacks the upper body.
+    body : mapping
+        At least the trunk's placement and inertia (``hip_tilt lh1 lh3 mt lt1 lt3 it11 it22 it33 it31``).
+
+    Returns
+    -------
+    dict
+        ``moore`` with the rear frame's seven entries replaced.
+    """
+    out = dict(moore)
+    mc, mt = float(moore["mc"]), float(body["mt"])
+    R = _hinge_rotation(float(body["hip_tilt"]))   # G = H at zero lean
+    r_c = np.array([moore["l1"], 0.0, moore["l2"]], dtype=float)
+    r_g = np.array([body["lh1"], 0.0, body["lh3"]], dtype=float) + R @ np.array([body["lt1"], 0.0, body["lt3"]])
+    mass = mc + mt
+    r = (mc * r_c + mt * r_g) / mass
+    I_c = np.array([[moore["ic11"], 0.0, moore["ic31"]], [0.0, moore["ic22"], 0.0],
+                    [moore["ic31"], 0.0, moore["ic33"]]], dtype=float)
+    I_g = np.array([[body["it11"], 0.0, body["it31"]], [0.0, body["it22"], 0.0],
+                    [body["it31"], 0.0, body["it33"]]], dtype=float)
+    inertia = I_c + _parallel_axis(mc, r_c - r) + R @ I_g @ R.T + _parallel_axis(mt, r_g - r)
+    out.update(mc=mass, l1=float(r[0]), l2=float(r[2]), ic11=float(inertia[0, 0]), ic22=float(inertia[1, 1]),
+               ic33=float(inertia[2, 2]), ic31=float(inertia[0, 2]))
+    return out
+
+
 # ------------------------------------------------------------------ the trunk
 
 _TRUNK_BODY = ("hip_tilt", "lh1", "lh3", "mt", "lt1", "lt3", "it11", "it22", "it33", "it31")
+
+
+def trunk_body(lam, hinge, offset, mass, inertia):
+    """The trunk's placement and inertia (:data:`_TRUNK_BODY`) from an upper body hinged on a horizontal axis.
+
+    ``lam`` [rad] is the bicycle's steer axis tilt (Moore's rear frame C is the benchmark frame pitched by
+    it: turning C about C.y by ``-lam`` makes the hinge axis H.x horizontal), ``hinge`` (x, z) [m] the hinge
+    point from the rear wheel centre and ``offset`` (x, z) [m] the body's mass centre from the hinge, both in
+    benchmark axes, ``mass`` [kg] and ``inertia`` (3, 3) [kg m^2] about the mass centre in benchmark axes
+    (G is level with them at zero lean).
+    """
+    c_x, c_z = benchmark._pitch_matrix(lam)
+    hinge = np.asarray(hinge, dtype=float)
+    return {"hip_tilt": -lam, "lh1": float(hinge @ c_x), "lh3": float(hinge @ c_z),
+            "mt": mass, "lt1": float(offset[0]), "lt3": float(offset[1]),
+            "it11": float(inertia[0][0]), "it22": float(inertia[1][1]), "it33": float(inertia[2][2]),
+            "it31": float(inertia[0][2])}
+
+
+def _split_trunk(bench, seat, mass, com, inertia):
+    """The trunk from its Yeadon segments: hinged at the rider's seat point (the top of the seat post, where
+    yeadon's origin sits), Moore's (2012, ch. 4) upper-body hinge near the saddle."""
+    hinge = (seat - np.array([0.0, 0.0, -bench["rR"]]))[[0, 2]]
+    arm = com - seat
+    return trunk_body(bench["lam"], hinge, arm[[0, 2]], mass, inertia)
 
 
 def _build_trunk(m):
@@ -414,6 +533,11 @@ TRUNK = declare(Part(
     ),
     title="the leaning upper body",
     from_rider=_TRUNK_BODY,   # the rider's own upper body: its placement on the hip and its inertia
+    # Pelvis, thorax, chest-head, the upper arms and the forearms and hands (which a part the model has built
+    # after it takes: the arms on the bar); the legs stay in the rear frame. Without the trunk, a rider split
+    # for another part holds its upper body rigidly in the rear frame.
+    split=Split(segments=("P", "T", "C", "A1", "B1", "A2", "B2"), body=_split_trunk,
+                rigid=merge_into_rear_frame, moves_with="G"),
 ))
 
 
@@ -467,6 +591,9 @@ ARMS = declare(Part(
     ),
     title="the arms on the bar",
     after=("trunk",),   # the hands hold the upper body when it leans: the trunk sets the hands' frame first
+    # The forearms and hands turn with the bar (their inertia about the steer axis is the arms' inertia
+    # moving with it): lumped into the benchmark front frame H.
+    split=Split(segments=("A2", "B2"), frame="H", moves_with="E"),
 ))
 
 
@@ -478,54 +605,3 @@ def selected(scenario):
 def fields():
     """Every declared part's scenario fields, in declaration order."""
     return tuple(f for p in REGISTRY.values() for f in p.fields)
-
-
-def _hinge_rotation(hip_tilt):
-    """Rotation matrix whose columns are the hip frame H's axes in the rear frame C (H turned about C.y)."""
-    c, s = np.cos(hip_tilt), np.sin(hip_tilt)
-    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
-
-
-def _parallel_axis(mass, offset):
-    """Inertia [kg m^2] a point mass at ``offset`` [m] adds about the origin."""
-    d = np.asarray(offset, dtype=float)
-    return mass * (d @ d * np.eye(3) - np.outer(d, d))
-
-
-def merge_into_rear_frame(moore, body):
-    """Moore parameters with the upper body of ``body`` (the trunk's placement and inertia) in the rear frame.
-
-    The upper body at zero lean is a rigid part of the rear frame: its mass,
-    mass centre and inertia are combined with the rear frame's (Moore's
-    ``mc l1 l2 ic11 ic22 ic33 ic31``, about the combined mass centre, in the
-    rear frame's axes), exactly as a locked hip would hold it. For the rigid
-    rider whose forearms turn with the bar (the rest of the rider is then
-    the rear frame plus this upper body).
-
-    Parameters
-    ----------
-    moore : mapping
-        Moore parameters of the bicycle whose rear frame lacks the upper body.
-    body : mapping
-        At least the trunk's placement and inertia (``hip_tilt lh1 lh3 mt lt1 lt3 it11 it22 it33 it31``).
-
-    Returns
-    -------
-    dict
-        ``moore`` with the rear frame's seven entries replaced.
-    """
-    out = dict(moore)
-    mc, mt = float(moore["mc"]), float(body["mt"])
-    R = _hinge_rotation(float(body["hip_tilt"]))   # G = H at zero lean
-    r_c = np.array([moore["l1"], 0.0, moore["l2"]], dtype=float)
-    r_g = np.array([body["lh1"], 0.0, body["lh3"]], dtype=float) + R @ np.array([body["lt1"], 0.0, body["lt3"]])
-    mass = mc + mt
-    r = (mc * r_c + mt * r_g) / mass
-    I_c = np.array([[moore["ic11"], 0.0, moore["ic31"]], [0.0, moore["ic22"], 0.0],
-                    [moore["ic31"], 0.0, moore["ic33"]]], dtype=float)
-    I_g = np.array([[body["it11"], 0.0, body["it31"]], [0.0, body["it22"], 0.0],
-                    [body["it31"], 0.0, body["it33"]]], dtype=float)
-    inertia = I_c + _parallel_axis(mc, r_c - r) + R @ I_g @ R.T + _parallel_axis(mt, r_g - r)
-    out.update(mc=mass, l1=float(r[0]), l2=float(r[2]), ic11=float(inertia[0, 0]), ic22=float(inertia[1, 1]),
-               ic33=float(inertia[2, 2]), ic31=float(inertia[0, 2]))
-    return out
