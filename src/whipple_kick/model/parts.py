@@ -28,6 +28,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 import hashlib
 import inspect
+import math
 
 import numpy as np
 
@@ -257,6 +258,13 @@ class Part:
         rider has them (``whipple_kick.simulate.assembly.rider_body``).
     split : Split, optional
         How it takes its body from the rider's segments (:func:`whipple_kick.library.riders.split_rider`).
+    pose : callable, optional
+        For a part whose segments move with a frame of its own (``split.moves_with``, the upper body's G):
+        ``pose(body, states, rear_rotation, rear_origin)`` gives that frame's rotation (n, 3, 3) and origin
+        (n, 3) in the ground frame at n drawn instants, from the run's body parameters by name, the part's
+        states by name (n,) and the rear frame's rotation and wheel-centre origin; a point p given in the
+        rear frame's axes at the part's rest (from the rear wheel centre) is drawn at ``origin + rotation @ p``
+        (:func:`whipple_kick.figures.animation.build_scene`).
     """
 
     name: str
@@ -278,6 +286,7 @@ class Part:
     values: dict = field(default_factory=dict)
     from_rider: tuple = ()
     split: Split = None
+    pose: Callable = None
 
     def __post_init__(self):
         if self.name in self.needs + self.after:
@@ -453,6 +462,24 @@ def _split_trunk(bench, seat, mass, com, inertia):
     return trunk_body(bench["lam"], hinge, arm[[0, 2]], mass, inertia)
 
 
+def _trunk_pose(body, states, rear_rotation, rear_origin):
+    """The upper body G's rotation and origin at the drawn instants (:attr:`Part.pose`).
+
+    G is the rear frame C turned by the lean q11 about the hip axis H.x, which is C.x turned about C.y by
+    ``hip_tilt``, through the hip point (``lh1``, 0, ``lh3``) in C from the rear wheel centre.
+    """
+    tilt = body["hip_tilt"]
+    axis = np.array([math.cos(tilt), 0.0, -math.sin(tilt)])    # H.x in C (sympy's orient_axis about C.y)
+    hinge = np.array([body["lh1"], 0.0, body["lh3"]])
+    lean = np.asarray(states["q11"], dtype=float)
+    cross = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+    turn = (np.eye(3) + np.sin(lean)[:, None, None] * cross
+            + (1.0 - np.cos(lean))[:, None, None] * (cross @ cross))          # Rodrigues: about H.x by q11
+    rotation = rear_rotation @ turn
+    origin = rear_origin + rear_rotation @ hinge - rotation @ hinge
+    return rotation, origin
+
+
 def _build_trunk(m):
     """The upper body G on the hip, a revolute joint about H.x (SymPy's ``PinJoint``), with its spring-damper
     (a ``TorqueActuator`` at the joint); the hands on G."""
@@ -538,6 +565,7 @@ TRUNK = declare(Part(
     # for another part holds its upper body rigidly in the rear frame.
     split=Split(segments=("P", "T", "C", "A1", "B1", "A2", "B2"), body=_split_trunk,
                 rigid=merge_into_rear_frame, moves_with="G"),
+    pose=_trunk_pose,   # drawn leaning on the hip
 ))
 
 
