@@ -460,3 +460,90 @@ def test_the_hip_on_sympys_pin_joint_and_torque_actuator_gives_the_hand_written_
     for a, b in zip(at_joint, at_hand, strict=True):
         assert np.all(np.isfinite(a))
         assert np.abs(a - b).max() <= 1e-12 * np.abs(b).max()
+
+
+# ------------------------------------------------------------------ the rider's segments and the drawing
+
+_LEGS = ("J1", "J2", "K1", "K2")
+_LIFT_M = 0.1
+
+
+def _legs_body(bench, seat, mass, com, inertia):
+    """The legs as a body of their own (a test part's): their mass, mass centre and inertia by name."""
+    return {"legs_mass": mass, "legs_x": float(com[0]), "legs_z": float(com[2]), "legs_ixx": float(inertia[0, 0]),
+            "legs_iyy": float(inertia[1, 1]), "legs_izz": float(inertia[2, 2]), "legs_ixz": float(inertia[0, 2])}
+
+
+def _legs_pose(body, states, rear_rotation, rear_origin):
+    """The legs' frame in a drawing: the rear frame's, lifted by _LIFT_M (the ground's z points down)."""
+    return rear_rotation, rear_origin - _LIFT_M * np.array([0.0, 0.0, 1.0])
+
+
+@pytest.fixture
+def legs(monkeypatch):
+    """A part, declared here only, that carries the rider's legs as a body of its own, drawn in a frame of its
+    own (no equations: it is never built here)."""
+    part = parts.Part(name="legs", description="the rider's legs as a body of their own (a test part)",
+                      source="this test", symbols=(), coordinates=(), speeds=(), parameters=(), gains={},
+                      columns={}, outputs={}, build=lambda m: None, selected_by=("legs", "on"), title="the legs",
+                      split=parts.Split(segments=_LEGS, body=_legs_body, moves_with="L"), pose=_legs_pose)
+    monkeypatch.setitem(parts.REGISTRY, part.name, part)
+    return part
+
+
+def test_a_part_declared_here_splits_the_rider_and_is_drawn_in_its_frame(legs):
+    """A part's whole footprint on the rider from its declaration, no other file touched: its segments (the
+    legs) are split off the seated rider as its own body, the rest stays in the rear frame, the scenario field
+    that selects it splits the run's bicycle for it, and the animation draws its segments in its frame, posed
+    as it declares; the other parts' splits still hold (the arms take the forearms from the trunk).
+
+    Bounds: lumping the legs' body back into the rear frame gives the rider seated whole to rel 1e-12 (the
+    same sums in another order); the drawn legs are the rigid rider's lifted by the declared 0.1 m, to 1e-12 m.
+    """
+    import copy
+
+    from whipple_kick.figures import animation
+    from whipple_kick.library import riders
+    from whipple_kick.simulate import scenario as scenario_module
+    from whipple_kick.simulate import simulation
+
+    bike = wk.bicycles.load("balanceassist_v1")
+    rider = riders.yeadon_rider("jason", mass_kg=80.0)
+    split = riders.split_rider(bike, rider, ("legs",))
+    body = split.body
+    assert split.held == () and split.body_mass == body["legs_mass"] and 15.0 < body["legs_mass"] < 40.0
+    inertia = np.array([[body["legs_ixx"], 0.0, body["legs_ixz"]], [0.0, body["legs_iyy"], 0.0],
+                        [body["legs_ixz"], 0.0, body["legs_izz"]]])
+    back = riders.lump_into_frame(split.combined.benchmark, "B", body["legs_mass"],
+                                  np.array([body["legs_x"], 0.0, body["legs_z"]]), inertia)
+    whole = riders.seat(bike, rider).benchmark
+    for key in ("mB", "xB", "zB", "IBxx", "IByy", "IBzz", "IBxz", "mH", "IHxx"):
+        assert back[key] == pytest.approx(whole[key], rel=1e-12, abs=1e-12), key
+    carried = riders.segment_carriers(("legs",))
+    assert {s for s, p in carried.items() if p is legs} == set(_LEGS)
+    assert all(p is None for s, p in carried.items() if s not in _LEGS)
+    # With the trunk and the arms: the arms (built after the trunk) take the forearms, the legs theirs.
+    carried = riders.segment_carriers(("trunk", "arms", "legs"))
+    assert {s: p.name for s, p in carried.items()} == {**dict.fromkeys(("P", "T", "C", "A1", "B1"), "trunk"),
+                                                       **dict.fromkeys(("A2", "B2"), "arms"),
+                                                       **dict.fromkeys(_LEGS, "legs")}
+    # The run's bicycle is split for it when its field selects it (the bicycle's view holds the field).
+    cls = scenario_module.with_parts(legs)
+    _, _, info = assembly.build_bicycle(cls(legs="on").bicycle_spec)
+    _, _, plain = assembly.build_bicycle(cls().bicycle_spec)
+    assert set(info["body"]) == set(body) and plain["body"] is None
+    assert info["total_mass_kg"] == pytest.approx(plain["total_mass_kg"], rel=1e-12)
+    # The drawing: the legs in the part's frame "L", posed by its declaration; the rest where it was.
+    result = simulation.run(wk.Scenario(duration=0.2))
+    drawn = copy.copy(result)
+    drawn.scenario, drawn.summary = cls(legs="on"), copy.deepcopy(result.summary)
+    drawn.summary["bicycle"]["body"] = info["body"]
+    times = result.trajectory["time"].to_numpy()[:1]
+    rigid = {item.name: item.points for item in animation.build_scene(result, times).items}
+    items = {item.name: item.points for item in animation.build_scene(drawn, times).items}
+    legs_drawn = [name for name in items if name.startswith("L ")]
+    assert set(legs_drawn) == {"L J1", "L K1", "L left shank", "L right shank", "L left foot", "L right foot"}
+    assert not any(n.startswith("L ") for n in rigid) and "C left shank" not in items
+    for name in legs_drawn:
+        np.testing.assert_allclose(items[name], rigid["C" + name[1:]] + [0.0, 0.0, -_LIFT_M], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(items["C head"], rigid["C head"], rtol=0, atol=0)

@@ -813,17 +813,18 @@ def _segments(human, seat_pt, names):
 def carriers(part_names):
     """The declared parts that split the rider for a model with parts ``part_names``, in build order.
 
-    The model's parts that declare a :class:`~whipple_kick.model.parts.Split`, and, when there is one, every
-    declared part that holds its body rigidly without being in the model (``Split.rigid``: the upper body of
-    the rigid rider with the arms on the bar). Empty: the rider is not split.
+    The model's parts that declare a :class:`~whipple_kick.model.parts.Split`, and every declared part the
+    model lacks that holds its body rigidly (``Split.rigid``) and names segments one of them carries: its
+    body is the rest of its segments, held as it declares (the upper body of the rigid rider whose arms take
+    the forearms to the bar). Empty: the rider is not split.
     """
     from whipple_kick.model import parts
 
-    chosen = [p.name for p in parts.named(part_names) if p.split is not None]
-    if not chosen:
-        return ()
-    held = [n for n, p in parts.REGISTRY.items() if p.split is not None and p.split.rigid and n not in chosen]
-    return parts.named(chosen + held)
+    chosen = [p for p in parts.named(part_names) if p.split is not None]
+    taken = {s for p in chosen for s in p.split.segments}
+    held = [n for n, p in parts.REGISTRY.items() if p.split is not None and p.split.rigid
+            and p not in chosen and taken & set(p.split.segments)]
+    return parts.named([p.name for p in chosen] + held) if chosen else ()
 
 
 def segment_carriers(part_names):
@@ -874,9 +875,11 @@ def split_rider(bike, rider, part_names, shift_m=0.0):
     human = rider.human(seated.configuration)
     seat_pt = seated.seat
     owner = segment_carriers(part_names)
-    rest = _segments(human, seat_pt, [s for s in RIDER_SEGMENTS if owner[s] is None])
-    bench = lump_into_frame(bike.benchmark, "B", *rest)
-    total, body, body_mass, held, titles = rest[0], {}, 0.0, [], []
+    rest, bench, total = [s for s in RIDER_SEGMENTS if owner[s] is None], bike.benchmark, 0.0
+    if rest:   # the segments no part carries, in the rear frame
+        rest = _segments(human, seat_pt, rest)
+        bench, total = lump_into_frame(bench, "B", *rest), rest[0]
+    body, body_mass, held, titles = {}, 0.0, [], []
     for part in carriers(part_names):
         names = [s for s in part.split.segments if owner[s] is part]
         if not names:
