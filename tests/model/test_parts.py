@@ -547,3 +547,38 @@ def test_a_part_declared_here_splits_the_rider_and_is_drawn_in_its_frame(legs):
     for name in legs_drawn:
         np.testing.assert_allclose(items[name], rigid["C" + name[1:]] + [0.0, 0.0, -_LIFT_M], rtol=0, atol=1e-12)
     np.testing.assert_allclose(items["C head"], rigid["C head"], rtol=0, atol=0)
+
+
+def test_the_parts_build_into_a_sympy_system_the_derivation_reads_back():
+    """The trunk's build adds its body, its hip joint (which brings q11, u11 and dq11/dt = u11) and its
+    spring-damper actuator to SymPy's System, which starts with the bicycle's four bodies; the derivation
+    reads them back (the coordinates after the bicycle's, the upper body with its weight). A build whose
+    system holds coordinates the part does not declare is refused, naming both."""
+    import sympy.physics.mechanics as me
+
+    from whipple_kick.model import symbols
+    from whipple_kick.model.symbolic import derivation
+
+    kin = derivation.kinematics(tyre_model=True)
+    chosen = parts.named(("trunk",))
+    par = {n: symbols.sym(n) for n in symbols.SLIP_CONSTANTS + parts.TRUNK.parameters}
+    mech = parts.Mechanics(kin=kin, par=par, hands_frame=kin.frames["C"])
+    assert [b.name for b in mech.system.bodies] == ["rear_frame", "rear_wheel", "front_frame", "front_wheel"]
+    parts.TRUNK.build(mech)
+    q11, u11 = symbols.dyn("q11"), symbols.dyn("u11")
+    assert tuple(mech.system.q) == (q11,) and tuple(mech.system.u) == (u11,)
+    assert [type(j).__name__ for j in mech.system.joints] == ["PinJoint"]
+    assert [type(a).__name__ for a in mech.system.actuators] == ["TorqueActuator"] and len(mech.loads()) == 2
+    assert [b.name for b in mech.added_bodies()] == ["upper_body"]
+    derivation.take_parts(kin, mech, chosen)
+    assert kin.q[-1] == q11 and kin.u[-1] == u11 and kin.qd_to_u[q11.diff(me.dynamicsymbols._t)] == u11
+    point, weight = kin.gravity_loads[-1]
+    assert point is mech.rigid_body("upper_body").masscenter
+    assert weight == par["mt"] * par["g"] * kin.frames["N"].z
+    # A build that gives the system a coordinate its part does not declare is refused.
+    kin = derivation.kinematics(tyre_model=True)
+    mech = parts.Mechanics(kin=kin, par=par, hands_frame=kin.frames["C"])
+    parts.TRUNK.build(mech)
+    mech.system.add_coordinates(symbols.dyn("q9"))
+    with pytest.raises(ValueError, match=r"gave the system the coordinates \['q11', 'q9'\]; they declare \['q11'\]"):
+        derivation.take_parts(kin, mech, chosen)

@@ -5,12 +5,15 @@ is the bicycle with a rigid rider lumped into the rear frame and its
 reflex; each :class:`Part` adds
 to it what it declares: its symbols (with units and descriptions), its
 coordinates and speeds, its bodies, joint, springs, dampers and loads (its
-``build``), its parameters, the rider's feedback gains on its states, its
-trajectory columns and its outputs. A part is declared once, in its own
+``build``, which adds them to a SymPy ``System``: :class:`Mechanics`), its
+parameters, the rider's feedback gains on its states, its trajectory
+columns, its outputs, how it takes its body from the rider's segments
+(:class:`Split`) and how it is drawn. A part is declared once, in its own
 module, and the rest follows from the declaration: the derivation, the
 generated code and its cache key, the state, parameter and output layouts
-(:class:`whipple_kick.model.slip.layout.Layout`), the trajectory's columns
-and the gain table. A model without a part has none of its terms: the rigid
+(:class:`whipple_kick.model.slip.layout.Layout`), the trajectory's columns,
+the gain table, the rider's split (:func:`whipple_kick.library.riders.split_rider`)
+and the animation. A model without a part has none of its terms: the rigid
 rider is the model without the trunk part, not a locked one.
 
 This follows SymBRiM's split of a rider into models and connections that
