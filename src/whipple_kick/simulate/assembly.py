@@ -249,7 +249,10 @@ def _bicycle_setup(spec, _stamp):
     from whipple_kick.model import benchmark
 
     bike = bicycleparameters.load_bicycle(spec.bicycle, spec.rider)
-    if spec.split and bike.includes_rider:
+    # The model's parts that split the rider (riders.carriers: the leaning upper body, the arms on the bar).
+    model_parts = tuple(p.name for p in parts.selected(spec))
+    split = bool(riders.carriers(model_parts))
+    if split and bike.includes_rider:
         raise _lumped_rider_error(bike)
     _refuse_rider_file(bike, spec.rider)
     if bike.includes_rider:
@@ -275,8 +278,7 @@ def _bicycle_setup(spec, _stamp):
     rear_n, front_n = riders.static_loads(combined)
     design = dict(combined.moore)
     body, body_mass, held = None, 0.0, ()
-    model_parts = tuple(p.name for p in parts.selected(spec))
-    if riders.carriers(model_parts):
+    if split:
         # The same rider, split as the model's parts declare: the legs in the rear frame, the forearms in
         # the front frame (on the bar), the upper body on its hip.
         rider = riders.yeadon_rider(spec.rider, mass_kg=rider_mass)
