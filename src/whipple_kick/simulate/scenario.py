@@ -978,21 +978,6 @@ class _BicycleView:
 
     __slots__ = ()
 
-    @property
-    def split(self) -> bool:
-        """Whether the rider is split into legs, forearms and upper body (a leaning body or arms on the bar)."""
-        return self.rider_body != "rigid" or self.arms_on_bar
-
-    @property
-    def leaning(self) -> bool:
-        """Whether the upper body leans on the hip (otherwise it is merged into the rear frame)."""
-        return self.rider_body == "leaning"
-
-    @property
-    def arms_on_bar(self) -> bool:
-        """Whether the forearms and hands turn with the bar."""
-        return self.arms == "on"
-
 
 class _TyreView:
     """What :func:`~whipple_kick.simulate.assembly.build_tyres` reads: the tyres and their (rear, front) pressures."""
