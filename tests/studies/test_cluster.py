@@ -30,7 +30,9 @@ def test_a_sweep_on_a_command_line_cluster_is_the_pools_table():
         reports = cluster.prepare_workers(client, GRID, base=SHORT)
         on_dask = wk.sweep(GRID, base=SHORT, executor=client.get_executor(), progress=False)
     assert len(reports) == 2 and all(r["built"] == [] for r in reports)   # the test's cache is warm
-    assert all(r["memory_kept"] for r in reports) and all(r["warmup_status"] == ["ok"] for r in reports)
+    # The pool's worker settings: freed memory kept (glibc, as here), no sampling profiler.
+    assert all(r["memory_kept"] and r["profiler_stopped"] for r in reports)
+    assert all(r["warmup_status"] == ["ok"] for r in reports)
     worker_pids = {str(r["pid"]) for r in reports}
     assert {w.rsplit(":", 1)[1] for w in on_dask["run.worker"]} <= worker_pids
     assert str(os.getpid()) not in worker_pids

@@ -3,8 +3,8 @@
 :func:`whipple_kick.studies.sweep_engine.sweep` runs on any ``concurrent.futures`` executor, a Dask client's
 ``get_executor()`` among them. On a cluster, :func:`prepare_workers` readies the workers first: one worker of each
 host builds (or loads) every compiled model the sweep's cases ask for, then every worker loads them, keeps the
-memory it frees as the default pool's workers do and runs one short case per model, so the first real cases
-do not pay for imports and builds. The cache's own file lock (:func:`whipple_kick.model.cache.build_once`) keeps
+memory it frees as the default pool's workers do, stops Dask's sampling profiler (the pool's workers have none)
+and runs one short case per model, so the first real cases do not pay for imports and builds. The cache's own file lock (:func:`whipple_kick.model.cache.build_once`) keeps
 two workers of one host that ask for the same missing model at once from building it twice; preparing one worker
 per host first makes the build happen before any case is waiting on it, and a build that fails fails once, here.
 
@@ -53,6 +53,22 @@ def warmup_cases(scenarios):
     return list(chosen.items())
 
 
+def _stop_profiler(dask_worker):
+    """Stop a Dask worker's sampling profiler (run by ``client.run``, in the worker's event loop); whether it ran.
+
+    Dask's default takes the running task's stack every 10 ms (``distributed.worker.profile.interval``), the GIL
+    with it, for the dashboard's profile page; the pool's workers have no such thread (docs/sweeps.md measures
+    what it costs a case).
+    """
+    stopped = False
+    for name in ("profile", "profile-cycle"):
+        callback = dask_worker.periodic_callbacks.get(name)
+        if callback is not None and callback.is_running():
+            callback.stop()
+            stopped = True
+    return stopped
+
+
 def _ready_worker(address, warmups):
     """In one worker: keep freed memory, load (building on a miss) each model, run each warm-up case.
 
@@ -80,7 +96,7 @@ def _ready_worker(address, warmups):
             "seconds": time.perf_counter() - start}
 
 
-def prepare_workers(client, grid=None, cases=None, *, base=None):
+def prepare_workers(client, grid=None, cases=None, *, base=None, profiler=False):
     """Ready a Dask cluster's workers for a sweep: the compiled models built once per host, then loaded by all.
 
     Parameters
@@ -90,15 +106,20 @@ def prepare_workers(client, grid=None, cases=None, *, base=None):
     grid, cases, base
         The sweep's cases, as :func:`~whipple_kick.studies.sweep_engine.sweep` takes them: they name the
         compiled models to build (the rigid rider's always).
+    profiler : bool
+        Keep Dask's sampling profiler running in the workers (its dashboard page); by default it is stopped,
+        as it slows a case (:func:`_stop_profiler`).
 
     Returns
     -------
     list of dict
-        One per worker (:func:`_ready_worker`'s report), the first worker of each host first.
+        One per worker (:func:`_ready_worker`'s report, and ``profiler_stopped``), the first worker of each
+        host first.
 
     Each model is built on one worker per host (the scheduler's ``host`` of the worker) before the other
     workers of that host load it from the cache folder they share. Workers that join later (an adaptive
-    cluster) load or build on their first case, under the cache's lock.
+    cluster) load or build on their first case, under the cache's lock, and keep the profiler unless the
+    workers' Dask configuration turns it off (``distributed.worker.profile.enabled: false``).
     """
     warmups = warmup_cases(sc for _, sc, _ in make_cases(grid, cases, base))
     workers = client.scheduler_info(n_workers=-1)["workers"]
@@ -116,6 +137,9 @@ def prepare_workers(client, grid=None, cases=None, *, base=None):
         futures = [client.submit(_ready_worker, address, warmups, key=f"whipple-kick-ready-{tag}-{address}",
                                  workers=[address], allow_other_workers=False, pure=False) for address in group]
         reports += client.gather(futures)
+    stopped = {} if profiler else client.run(_stop_profiler, workers=[r["worker"] for r in reports])
+    for report in reports:
+        report["profiler_stopped"] = stopped.get(report["worker"], False)
     return reports
 
 
