@@ -72,10 +72,11 @@ def _stop_profiler(dask_worker):
 def _ready_worker(address, warmups):
     """In one worker: keep freed memory, load (building on a miss) each model, run each warm-up case.
 
-    Returns ``{"worker", "host", "pid", "built", "memory_kept", "warmup_status", "started", "seconds"}``;
+    Returns ``{"worker", "host", "pid", "built", "memory_kept", "warmup_status", "started", "loaded", "seconds"}``;
     ``built`` lists the builds this process did (each build announces itself with a
     :class:`~whipple_kick.errors.PerformanceWarning`, once per build), so the builds across a cluster add up;
-    ``started`` is the Unix time [s] it began, ``seconds`` how long it took.
+    ``started`` and ``loaded`` are the Unix times [s] it began and had every model loaded, ``seconds`` how long
+    it took in all.
     """
     started, start = time.time(), time.perf_counter()
     memory_kept = _memory_kept_once()
@@ -88,11 +89,13 @@ def _ready_worker(address, warmups):
             # The cache entry checked (built on a miss) even where this process has loaded the model before.
             compiled.library_path(layout)
             compiled.library(layout)
+        loaded = time.time()
+        for _, scenario in warmups:
             statuses.append(run_case(scenario, "warm-up")["status"])
     built = [str(w.message) for w in said
              if issubclass(w.category, PerformanceWarning) and str(w.message).startswith("building the slip model")]
     return {"worker": address, "host": socket.gethostname(), "pid": os.getpid(), "built": built,
-            "memory_kept": memory_kept, "warmup_status": statuses, "started": started,
+            "memory_kept": memory_kept, "warmup_status": statuses, "started": started, "loaded": loaded,
             "seconds": time.perf_counter() - start}
 
 
