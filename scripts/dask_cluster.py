@@ -117,13 +117,13 @@ def main(argv=None):
                     args.workers, env=env, timeout=120))
         clients = {label: stack.enter_context(Client(address, timeout=60)) for label, address in clusters.items()}
         for label, client in clients.items():
-            print(f"{label}: {clusters[label]}, {len(client.scheduler_info(n_workers=-1)['workers'])} workers")
+            print(f"{label}: {clusters[label]}, {len(cluster.scheduler_workers(client))} workers")
             start = time.perf_counter()
             reports = cluster.prepare_workers(client, grid, base=base, profiler=label.endswith("profiler on"))
             print(f"  ({time.perf_counter() - start:.1f} s)")
             _print_reports(label, reports)
         pool_size = args.workers if not args.scheduler else len(
-            clients["cluster"].scheduler_info(n_workers=-1)["workers"])
+            cluster.scheduler_workers(clients["cluster"]))
 
         runs = {"pool": functools.partial(wk.sweep, grid, base=base, workers=pool_size, progress=False)}
         for label, client in clients.items():

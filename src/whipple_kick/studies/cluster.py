@@ -4,9 +4,10 @@
 ``get_executor()`` among them. On a cluster, :func:`prepare_workers` readies the workers first: one worker of each
 host builds (or loads) every compiled model the sweep's cases ask for, then every worker loads them, keeps the
 memory it frees as the default pool's workers do, stops Dask's sampling profiler (the pool's workers have none)
-and runs one short case per model, so the first real cases do not pay for imports and builds. The cache's own file lock (:func:`whipple_kick.model.cache.build_once`) keeps
-two workers of one host that ask for the same missing model at once from building it twice; preparing one worker
-per host first makes the build happen before any case is waiting on it, and a build that fails fails once, here.
+and runs one short case per model, so the first real cases do not pay for imports and builds. The cache's own
+file lock (:func:`whipple_kick.model.cache.build_once`) keeps two workers of one host that ask for the same
+missing model at once from building it twice; preparing one worker per host first makes the build happen before
+any case is waiting on it, and a build that fails fails once, here.
 
 :func:`command_line_cluster` starts a cluster the way a real one is started, from the command line
 (``dask scheduler`` and ``dask worker`` processes talking over TCP), on this machine: for
@@ -32,7 +33,7 @@ from whipple_kick.simulate.assembly import model_of
 from .sweep_engine import _memory_kept_once, _preload, make_cases, run_case
 
 #: Length [s] of each worker's warm-up case (one per compiled model): past the kick's start, so the run goes
-#: through every step a case takes (steady state, rider, integration, summary), at a few percent of a 6 s case.
+#: through every step a case takes (steady state, rider, integration, summary), at about a tenth of a 6 s case.
 WARMUP_DURATION = 0.5
 
 
@@ -57,7 +58,7 @@ def _stop_profiler(dask_worker):
     """Stop a Dask worker's sampling profiler (run by ``client.run``, in the worker's event loop); whether it ran.
 
     Dask's default takes the running task's stack every 10 ms (``distributed.worker.profile.interval``), the GIL
-    with it, for the dashboard's profile page; the pool's workers have no such thread (docs/sweeps.md measures
+    with it, for the dashboard's profile page; the pool's workers have no such sampling (docs/sweeps.md measures
     what it costs a case).
     """
     stopped = False
@@ -99,6 +100,14 @@ def _ready_worker(address, warmups):
             "seconds": time.perf_counter() - start}
 
 
+def scheduler_workers(client):
+    """The scheduler's ``{address: info}`` of every worker (newer Dask lists 5 unless asked for all)."""
+    try:
+        return client.scheduler_info(n_workers=-1)["workers"]
+    except TypeError:   # an older distributed has no n_workers, and lists them all
+        return client.scheduler_info()["workers"]
+
+
 def prepare_workers(client, grid=None, cases=None, *, base=None, profiler=False):
     """Ready a Dask cluster's workers for a sweep: the compiled models built once per host, then loaded by all.
 
@@ -125,7 +134,7 @@ def prepare_workers(client, grid=None, cases=None, *, base=None, profiler=False)
     workers' Dask configuration turns it off (``distributed.worker.profile.enabled: false``).
     """
     warmups = warmup_cases(sc for _, sc, _ in make_cases(grid, cases, base))
-    workers = client.scheduler_info(n_workers=-1)["workers"]
+    workers = scheduler_workers(client)
     if not workers:
         raise InputError("the Dask cluster has no workers yet; wait for them first (client.wait_for_workers(n))")
     by_host = {}
