@@ -327,6 +327,12 @@ def test_the_lean_path_gives_the_tables_values_and_the_same_summary(changes):
     only = run(scenario, columns=("plate_y",))
     assert "plate_y" in only.trajectory and "camber_front" not in only.trajectory
     assert comparable(only.summary) == comparable(full.summary)
+    # A table-only case (a sweep's row): no optional output group evaluated (slip.layout.OPTIONAL_OUTPUTS),
+    # the same summary, JSON text included, and the same values of the columns it keeps.
+    row = run(scenario, columns=())
+    assert json.dumps(comparable(row.summary)) == json.dumps(comparable(full.summary))
+    assert row.trajectory and all(np.array_equal(values, full.trajectory[column].to_numpy())
+                                  for column, values in row.trajectory.items())
     with pytest.raises(wk.errors.InputError, match=r"trajectory column\(s\) \['rol'\] do not exist"):
         run(scenario, columns=("rol",))
 
@@ -349,7 +355,7 @@ def test_the_lean_path_refuses_a_non_finite_value_where_the_table_does():
     for column, fails in ((used[3], True), (unused[0], False)):
         bad = outputs.copy()
         bad[5, column] = np.nan
-        solution.outputs = lambda bad=bad: bad
+        solution.outputs = lambda bad=bad, **_: bad
         if fails:
             for build in (results.trajectory_frame, results.trajectory_columns):
                 with pytest.raises(SimulationError, match="non-finite"):
