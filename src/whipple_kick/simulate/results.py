@@ -615,6 +615,15 @@ def _recovery_section(recovery, baselines):
 
 def clean(value):
     """JSON-ready copy: numpy scalars/arrays to Python, NaN/inf refused."""
+    kind = type(value)
+    # The summary's most common leaves first, by exact type (a Python float or string is its own copy): the same
+    # values as the checks below give them, some 500 per case.
+    if kind is float:
+        if not math.isfinite(value):
+            raise SimulationError(f"non-finite value {value} in the summary")
+        return value
+    if kind is str or value is None:
+        return value
     if isinstance(value, dict):
         return {str(k): clean(v) for k, v in value.items()}
     if isinstance(value, (list, tuple, np.ndarray)):

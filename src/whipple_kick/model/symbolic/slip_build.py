@@ -473,20 +473,24 @@ def _c_prologue(ex, dynamics, L):
     lines.append(f"    double u[{n}];")
     for name, idx in zip(L.INDEPENDENT, ind, strict=True):
         lines.append(f"    u[{idx}] = x[{L.X[name]}];")
-    lines.append(f"    double Adep[{m * m}], rhs1[{m * (k + 1)}];")
+    # With the dynamics, one LU of A_dep serves both the speeds (last column) and T (the rest); without them
+    # only the speeds' column is solved for: lu_solve treats each column on its own, so the speeds are the
+    # same bit for bit (and the outputs some 3% cheaper per sample).
+    width = k + 1 if dynamics else 1
+    lines.append(f"    double Adep[{m * m}], rhs1[{m * width}];")
     lines.append(f"    for (int i = 0; i < {m}; i++) {{")
     lines.append("        double s = a0[i];")
     for jj, idx in enumerate(dep):
         lines.append(f"        Adep[i * {m} + {jj}] = A[i * {n} + {idx}];")
     for jj, idx in enumerate(ind):
         lines.append(f"        s += A[i * {n} + {idx}] * u[{idx}];")
-        lines.append(f"        rhs1[i * {k + 1} + {jj}] = A[i * {n} + {idx}];")
-    lines.append(f"        rhs1[i * {k + 1} + {k}] = -s;")
+        if dynamics:
+            lines.append(f"        rhs1[i * {k + 1} + {jj}] = A[i * {n} + {idx}];")
+    lines.append(f"        rhs1[i * {width} + {width - 1}] = -s;")
     lines.append("    }")
-    # One LU of A_dep serves both the speeds (last column) and T (the rest).
-    lines.append(f"    if (lu_solve({m}, Adep, {k + 1}, rhs1)) return 1;")
+    lines.append(f"    if (lu_solve({m}, Adep, {width}, rhs1)) return 1;")
     for jj, idx in enumerate(dep):
-        lines.append(f"    u[{idx}] = rhs1[{jj} * {k + 1} + {k}];")
+        lines.append(f"    u[{idx}] = rhs1[{jj} * {width} + {width - 1}];")
     for i, s in enumerate(sy["u"]):
         lines.append(f"    const double {s.name} = u[{i}];")
     # The rider's reflex: its undelayed torque through the delay filter (whipple_kick.model.reflex), in the
