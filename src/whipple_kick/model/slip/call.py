@@ -79,6 +79,8 @@ class CompiledRHS:
         self._p_ptr = self.p.ctypes.data
         self._dx = np.empty(len(self.layout.STATE_NAMES))
         self._dx_ptr = self._dx.ctypes.data
+        self._x = np.empty(len(self.layout.STATE_NAMES))
+        self._x_ptr = self._x.ctypes.data
         self._out = np.empty(len(self.layout.OUTPUT_NAMES))
         self._out_ptr = self._out.ctypes.data
         self.fast = self.guarded()   # f(t, x): one foreign call (what the integrators call)
@@ -251,8 +253,10 @@ class CompiledRHS:
 
     def outputs(self, t, x):
         """Derivatives and named outputs (the layout's ``OUTPUT_NAMES``) at one state."""
-        x = np.ascontiguousarray(x, dtype=float)
-        status = self.lib.wk_slip_rhs(t, x.ctypes.data, self._p_ptr, self._dx_ptr, self._out_ptr)
+        # Into a buffer of its own (no ctypes view of a new array per call: the steady search and the
+        # linearisation make some 100 of these calls per run).
+        self._x[:] = x
+        status = self.lib.wk_slip_rhs(t, self._x_ptr, self._p_ptr, self._dx_ptr, self._out_ptr)
         if status:
             _raise_status(status, t)
         return self._dx.copy(), self._out.copy()
