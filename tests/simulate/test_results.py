@@ -1,6 +1,7 @@
 """Results of a run: the trajectory table and its units, the summary, the recovery and the energy balance."""
 import json
 import math
+import pathlib
 import re
 
 import numpy as np
@@ -307,6 +308,8 @@ def test_a_fall_is_status_1_and_a_success():
     {"tyre_transient": "force_lag"},                                      # no patch columns
     {"rider_body": "leaning", "duration": 0.8},                           # a part's states and outputs
     {"controller": "off", "duration": 3.0, "fall_angle_deg": 20.0},       # ends in a fall
+    {"kick_profile": "table",                                             # a model per table piece
+     "kick_table": str(pathlib.Path(__file__).parents[1] / "data" / "regression" / "kick_table_smooth_10ms.csv")},
 ])
 def test_the_lean_path_gives_the_tables_values_and_the_same_summary(changes):
     # run(columns=...) builds no table: its columns must be the table's, bit for bit (the same sources and
@@ -327,6 +330,12 @@ def test_the_lean_path_gives_the_tables_values_and_the_same_summary(changes):
     only = run(scenario, columns=("plate_y",))
     assert "plate_y" in only.trajectory and "camber_front" not in only.trajectory
     assert comparable(only.summary) == comparable(full.summary)
+    # A table-only case (a sweep's row): no optional output group evaluated (slip.layout.OPTIONAL_OUTPUTS),
+    # the same summary, JSON text included, and the same values of the columns it keeps.
+    row = run(scenario, columns=())
+    assert json.dumps(comparable(row.summary)) == json.dumps(comparable(full.summary))
+    assert row.trajectory and all(np.array_equal(values, full.trajectory[column].to_numpy())
+                                  for column, values in row.trajectory.items())
     with pytest.raises(wk.errors.InputError, match=r"trajectory column\(s\) \['rol'\] do not exist"):
         run(scenario, columns=("rol",))
 
@@ -349,7 +358,7 @@ def test_the_lean_path_refuses_a_non_finite_value_where_the_table_does():
     for column, fails in ((used[3], True), (unused[0], False)):
         bad = outputs.copy()
         bad[5, column] = np.nan
-        solution.outputs = lambda bad=bad: bad
+        solution.outputs = lambda bad=bad, **_: bad
         if fails:
             for build in (results.trajectory_frame, results.trajectory_columns):
                 with pytest.raises(SimulationError, match="non-finite"):
@@ -358,3 +367,15 @@ def test_the_lean_path_refuses_a_non_finite_value_where_the_table_does():
             frame = results.trajectory_frame(solution, scenario.tyre_transient)
             columns = results.trajectory_columns(solution, scenario.tyre_transient, "all")
             assert all(np.array_equal(frame[c].to_numpy(), columns[c]) for c in frame.columns)
+
+
+@pytest.mark.parametrize("columns", [[0, 1, 2, 4, 7, 8], [3], [], [8, 0, 5, 6]])
+def test_the_finite_check_looks_at_exactly_its_columns(columns):
+    # Runs of consecutive columns are checked as views: a NaN anywhere in a listed column fails, elsewhere not.
+    values = np.ones((4, 9))
+    assert results._all_finite(values, columns)
+    for k in range(9):
+        for bad in (np.nan, np.inf):
+            changed = values.copy()
+            changed[2, k] = bad
+            assert results._all_finite(changed, columns) == (k not in columns), (k, bad)

@@ -60,21 +60,22 @@ class Solution:
         """The :class:`~whipple_kick.model.slip.layout.Layout` of the compiled model that produced the samples."""
         return (self.rhs[0] if isinstance(self.rhs, (list, tuple)) else self.rhs).layout
 
-    def outputs(self, via_rhs=False) -> np.ndarray:
+    def outputs(self, via_rhs=False, names=None) -> np.ndarray:
         """The compiled model's named outputs (:data:`whipple_kick.model.slip.OUTPUT_NAMES`) at every sample.
 
-        ``via_rhs``: from the whole right-hand side at each sample (the reference;
-        :meth:`whipple_kick.model.slip.CompiledRHS.outputs_at`).
+        ``via_rhs``: from the whole right-hand side at each sample (the reference); ``names``: the outputs
+        needed, the optional groups holding none of them left out, NaN
+        (:meth:`whipple_kick.model.slip.CompiledRHS.outputs_at`).
         """
         traj = self.states
         if self.owner is None:
-            return self.rhs.outputs_at(traj.t, traj.x, via_rhs)
+            return self.rhs.outputs_at(traj.t, traj.x, via_rhs, names)
         # Each piece's compiled model evaluates the samples it produced.
         owner = np.asarray(self.owner)
         outs = np.empty((traj.t.size, len(self.model.OUTPUT_NAMES)))
         for k in np.unique(owner):
             rows = owner == k
-            outs[rows] = self.rhs[k].outputs_at(traj.t[rows], traj.x[rows], via_rhs)
+            outs[rows] = self.rhs[k].outputs_at(traj.t[rows], traj.x[rows], via_rhs, names)
         return outs
 
 

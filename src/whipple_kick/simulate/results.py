@@ -310,7 +310,6 @@ def trajectory_columns(solution, tyre_transient="carcass", names=None):
         A value in one of the table's columns is not finite (as :func:`trajectory_frame`).
     """
     traj = solution.states
-    outs = solution.outputs()
     layout = frame_layout(tyre_transient, solution.model)
     every = column_names(tyre_transient, solution.model)
     asked = set(every) if names == "all" else set(names or ())
@@ -318,10 +317,18 @@ def trajectory_columns(solution, tyre_transient="carcass", names=None):
     if unknown:
         raise InputError(f"trajectory column(s) {sorted(unknown)} do not exist; available: {', '.join(every)}")
     wanted = asked | (set(summary_columns(tyre_transient)) & set(every))
+    # Only the optional output groups a wanted column is in are evaluated (the others are NaN, and not read):
+    # the summary reads none of them, and they are some 20% of the outputs' cost.
+    output_names = solution.model.OUTPUT_NAMES
+    needed = {output_names[index] for name, source, index in layout
+              if source == "output" and (name in wanted or name in _HEADING_SOURCES)}
+    outs = solution.outputs(names=needed)
+    left_out = {name for group in slip.layout.OPTIONAL_OUTPUTS if not needed & set(group) for name in group}
     # The finite check covers the table's columns, as trajectory_frame's does, not the outputs it leaves out
-    # (the whole arrays first: no copy of the columns when all is finite, as it nearly always is).
+    # (the whole arrays first: no copy of the columns when all is finite, as it nearly always is); of the
+    # optional groups, those evaluated.
     states = sorted({index for _, source, index in layout if source == "state"})
-    outputs = sorted({index for _, source, index in layout if source == "output"})
+    outputs = sorted({index for _, source, index in layout if source == "output" and output_names[index] not in left_out})
     if not (_all_finite(traj.x, states) and _all_finite(outs, outputs) and np.all(np.isfinite(traj.t))):
         raise SimulationError("non-finite values in the trajectory")
     source = {name: entry for name, *entry in layout}
@@ -330,13 +337,17 @@ def trajectory_columns(solution, tyre_transient="carcass", names=None):
         if kind != "derived" and name in wanted:
             columns[name] = _source((name, kind, index), traj, outs) + 0.0   # + 0.0: no -0.0, as in the table
     if wanted & set(HEADING_COLUMNS):
-        yaw, vx, vy = (_source((c, *source[c]), traj, outs) for c in ("yaw", "velocity_x_fixed", "velocity_y_fixed"))
+        yaw, vx, vy = (_source((c, *source[c]), traj, outs) for c in _HEADING_SOURCES)
         columns.update({name: value + 0.0 for name, value in heading_speeds(yaw, vx, vy).items()})
     residual = energy.balance_residual({name: _Column(columns[name]) for name in _BALANCE_INPUTS})
     if not np.all(np.isfinite(residual)):
         raise SimulationError("non-finite values in the trajectory")
     columns[BALANCE_COLUMN] = residual
     return {name: columns[name] for name in every if name in wanted}
+
+
+#: The columns :data:`HEADING_COLUMNS` are computed from (:func:`heading_speeds`).
+_HEADING_SOURCES = ("yaw", "velocity_x_fixed", "velocity_y_fixed")
 
 
 class _Column:
@@ -604,6 +615,15 @@ def _recovery_section(recovery, baselines):
 
 def clean(value):
     """JSON-ready copy: numpy scalars/arrays to Python, NaN/inf refused."""
+    kind = type(value)
+    # The summary's most common leaves first, by exact type (a Python float or string is its own copy): the same
+    # values as the checks below give them, some 500 per case.
+    if kind is float:
+        if not math.isfinite(value):
+            raise SimulationError(f"non-finite value {value} in the summary")
+        return value
+    if kind is str or value is None:
+        return value
     if isinstance(value, dict):
         return {str(k): clean(v) for k, v in value.items()}
     if isinstance(value, (list, tuple, np.ndarray)):

@@ -7,6 +7,7 @@ import numpy as np
 from whipple_kick.errors import InputError
 from whipple_kick.model import transient
 import whipple_kick.model.slip.compiled as compiled  # noqa: PLR0402 -- the module, not the package that imports this one; tests patch its names
+import whipple_kick.model.slip.layout as layouts  # the module by its full name, not through the package
 
 
 def _model_of(params):
@@ -78,6 +79,8 @@ class CompiledRHS:
         self._p_ptr = self.p.ctypes.data
         self._dx = np.empty(len(self.layout.STATE_NAMES))
         self._dx_ptr = self._dx.ctypes.data
+        self._x = np.empty(len(self.layout.STATE_NAMES))
+        self._x_ptr = self._x.ctypes.data
         self._out = np.empty(len(self.layout.OUTPUT_NAMES))
         self._out_ptr = self._out.ctypes.data
         self.fast = self.guarded()   # f(t, x): one foreign call (what the integrators call)
@@ -157,7 +160,7 @@ class CompiledRHS:
                                        a0.ctypes.data)
         return M, A, a0
 
-    def outputs_at(self, t, X, via_rhs=False):
+    def outputs_at(self, t, X, via_rhs=False, names=None):
         """Named outputs (the layout's ``OUTPUT_NAMES``) at many samples, in one C call.
 
         The outputs need no accelerations, so the C function evaluates the
@@ -175,6 +178,9 @@ class CompiledRHS:
             Evaluate the whole right-hand side at each sample instead (the
             reference the tests compare with; it also fails on a non-finite
             derivative).
+        names : iterable of str, optional
+            The outputs needed: the groups of :data:`~whipple_kick.model.slip.layout.OPTIONAL_OUTPUTS` that hold
+            none of them are left out (their columns NaN), the others are the same bit for bit. Default: all.
 
         Returns
         -------
@@ -185,9 +191,15 @@ class CompiledRHS:
         ns = len(self.layout.STATE_NAMES)
         if X.shape != (t.size, ns):
             raise ValueError(f"states must have shape ({t.size}, {ns}), got {X.shape}")
-        out = np.empty((t.size, len(self.layout.OUTPUT_NAMES)))
-        fn = self.lib.wk_slip_outputs if via_rhs else self.lib.wk_slip_outputs_only
-        status = fn(t.size, t.ctypes.data, X.ctypes.data, self._p_ptr, out.ctypes.data)
+        groups = optional_groups(names)
+        if via_rhs or groups == (1 << len(layouts.OPTIONAL_OUTPUTS)) - 1:
+            out = np.empty((t.size, len(self.layout.OUTPUT_NAMES)))
+            fn = self.lib.wk_slip_outputs if via_rhs else self.lib.wk_slip_outputs_only
+            status = fn(t.size, t.ctypes.data, X.ctypes.data, self._p_ptr, out.ctypes.data)
+        else:
+            out = np.full((t.size, len(self.layout.OUTPUT_NAMES)), np.nan)   # the groups left out: never read as values
+            status = self.lib.wk_slip_outputs_some(t.size, t.ctypes.data, X.ctypes.data, self._p_ptr, groups,
+                                                   out.ctypes.data)
         if status:
             raise FloatingPointError(_STATUS.get(status, f"status {status}") + " while evaluating outputs")
         return out
@@ -241,11 +253,22 @@ class CompiledRHS:
 
     def outputs(self, t, x):
         """Derivatives and named outputs (the layout's ``OUTPUT_NAMES``) at one state."""
-        x = np.ascontiguousarray(x, dtype=float)
-        status = self.lib.wk_slip_rhs(t, x.ctypes.data, self._p_ptr, self._dx_ptr, self._out_ptr)
+        # Into a buffer of its own (no ctypes view of a new array per call: the steady search and the
+        # linearisation make some 100 of these calls per run).
+        self._x[:] = x
+        status = self.lib.wk_slip_rhs(t, self._x_ptr, self._p_ptr, self._dx_ptr, self._out_ptr)
         if status:
             _raise_status(status, t)
         return self._dx.copy(), self._out.copy()
+
+
+def optional_groups(names=None):
+    """Bit mask of the :data:`~whipple_kick.model.slip.layout.OPTIONAL_OUTPUTS` groups that hold one of the outputs
+    ``names`` (None: every group)."""
+    if names is None:
+        return (1 << len(layouts.OPTIONAL_OUTPUTS)) - 1
+    names = set(names)
+    return sum(1 << k for k, group in enumerate(layouts.OPTIONAL_OUTPUTS) if names & set(group))
 
 
 _STATUS = {

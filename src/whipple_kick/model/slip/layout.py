@@ -76,6 +76,12 @@ OUTPUTS = {
 }
 #: Every output by position: the ten speeds (dependent ones included), then :data:`OUTPUTS`.
 OUTPUT_NAMES = SPEEDS + tuple(OUTPUTS)
+#: Outputs evaluated beside the dynamics rather than by them, in groups an outputs call may leave out
+#: (:meth:`~whipple_kick.model.slip.call.CompiledRHS.outputs_at`'s ``names``): the plate's prescribed motion
+#: (a polynomial of time), the tyres' steady-state curves at the kinematic slip, the friction limits (a search
+#: on the curves). They are some 20% of the outputs' instructions per sample (callgrind, the thesis cases);
+#: a study's summary reads none of them (``scripts/bench_sweep.py cost --callgrind``).
+OPTIONAL_OUTPUTS = (("yp", "vp", "ap"), ("fy_ss_r", "fy_ss_f", "mz_ss_r", "mz_ss_f"), ("fy_limit_r", "fy_limit_f"))
 PARAMETER_NAMES = S.SLIP_CONSTANTS
 X = {n: i for i, n in enumerate(STATE_NAMES)}
 # Every declared form's state names are aliases of the slots (the thesis' force states, the carcass deflections).
