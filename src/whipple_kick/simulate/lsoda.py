@@ -487,8 +487,10 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
     nfev = njev = spent = 0   # LSODA's evaluations, Jacobians, all evaluations (the budget's count)
     last_t = -np.inf   # time of the last emitted sample (chunks share end points)
     # The result's rows, written once each as they come (every sample, and a fall's time beyond them), instead
-    # of a list of pieces concatenated at the end: one copy of the states less.
-    t_out, x_out = np.empty(samples.size + 1), np.empty((samples.size + 1, len(x0)))
+    # of a list of pieces concatenated at the end; the C chunk loop writes its samples straight into them. Row 0
+    # of `x_rows` is spare: that loop writes a chunk's start state one row before the chunk's first sample.
+    t_out, x_rows = np.empty(samples.size + 2), np.empty((samples.size + 3, len(x0)))
+    x_out = x_rows[1:]
     filled = 0
 
     def put(times, states):
@@ -538,12 +540,25 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
             if chunks_in_c is not None:
                 # The chunks of the piece in one C call, up to the first that the careful path must redo.
                 counts = np.array([nfev, njev, spent], dtype=np.int64)
-                ran, states, x = chunks_in_c(grid, cuts[k:], x, counts)
+                # Grid row g goes to x_rows' row filled + g - cuts[k]: the chunks' first sample to the result's
+                # next row; the start state to the row before, the last row emitted (kept: put back below).
+                start, spare = x, x_rows[filled].copy()
+                into = x_rows.ctypes.data + (filled - cuts[k]) * x_rows.strides[0]
+                ran, _, x = chunks_in_c(grid, cuts[k:], x, counts, into=into)
+                x_rows[filled] = spare
                 nfev, njev, spent = (int(v) for v in counts)
                 if ran:
                     j = cuts[k + ran]
-                    last = -1 if j == len(grid) - 1 else None   # the piece's end: after the jump map (below)
-                    emit(grid[cuts[k]:j + 1][:last], states[:last], on_grid[cuts[k]:j + 1][:last])
+                    stop = j if j == len(grid) - 1 else j + 1   # the piece's end: after the jump map (below)
+                    if stop > cuts[k] + 1 and on_grid[cuts[k] + 1:stop].all() and grid[cuts[k] + 1] > last_t:
+                        # Every row after the start is a sample (the grid's inner times are): in place already.
+                        t_out[filled:filled + stop - cuts[k] - 1] = grid[cuts[k] + 1:stop]
+                        filled += stop - cuts[k] - 1
+                        last_t = grid[stop - 1]
+                    else:
+                        states = x_rows[filled:filled + j - cuts[k] + 1].copy()
+                        states[0] = start
+                        emit(grid[cuts[k]:stop], states[:stop - cuts[k]], on_grid[cuts[k]:stop])
                     k += ran
                     if k == len(cuts) - 1:
                         break
