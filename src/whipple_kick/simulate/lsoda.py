@@ -376,7 +376,7 @@ def _chunks_in_c(rhs, jac, rtol, atol, mxstep, limits, budget, t_start):
 
 def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None,
               output_rate=1000.0, fall_angle=np.deg2rad(45.0), chunk=None, samples=None,
-              budget=None, jumps=None, steer_limit=None):
+              budget=None, jumps=None, steer_limit=None, before=None):
     """Integrate ``rhs`` from ``x0`` piecewise between breakpoints with LSODA.
 
     Each smooth piece is integrated in chunks of about ``chunk`` seconds
@@ -432,6 +432,9 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
         ``{breakpoint: g(t, x) -> x}``: the state leaving the piece that
         ends at the breakpoint is mapped by ``g`` before the next piece
         starts (a sample at the breakpoint gets the mapped state).
+    before : StateHistory, optional
+        A run that ends before ``t_start`` and whose samples come first: the result is
+        ``join([before, this call's])``, without copying this call's samples again.
 
     Returns
     -------
@@ -489,9 +492,11 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
     # The result's rows, written once each as they come (every sample, and a fall's time beyond them), instead
     # of a list of pieces concatenated at the end; the C chunk loop writes its samples straight into them. Row 0
     # of `x_rows` is spare: that loop writes a chunk's start state one row before the chunk's first sample.
-    t_out, x_rows = np.empty(samples.size + 2), np.empty((samples.size + 3, len(x0)))
+    head = 0 if before is None else before.t.size
+    t_out, x_rows = np.empty(head + samples.size + 2), np.empty((head + samples.size + 3, len(x0)))
     x_out = x_rows[1:]
-    filled = 0
+    t_out[:head], x_out[:head] = (before.t, before.x) if head else (0.0, 0.0)
+    filled = head
 
     def put(times, states):
         nonlocal filled, last_t
@@ -609,5 +614,7 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
     t, X = t_out[:filled], x_out[:filled]
     if X.size and not np.all(np.isfinite(X)):
         raise FloatingPointError("non-finite state in the integration result")
+    if before is not None:   # as join() sums them
+        nfev, njev, spent = nfev + before.nfev, njev + before.njev, spent + before.evaluations
     return StateHistory(t, X, fell, fall_time, nfev, message, end_state=np.asarray(x, dtype=float), failed=failed,
                       njev=njev, evaluations=spent, fall_reason=fall_reason)
