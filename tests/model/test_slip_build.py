@@ -16,7 +16,7 @@ _TYRE_SPREAD = {"force_lag": (200.0, 200.0, 5.0, 5.0), "contact_patch": (0.6, 0.
                 "slip_lag": (0.6, 0.6, 0.3, 0.3), "carcass": (0.015, 0.015, 0.3, 0.3)}
 
 
-@pytest.mark.parametrize("transient", wk.transient.TRANSIENTS)
+@pytest.mark.parametrize("transient", wk.transient.transients())
 def test_c_agrees_with_numpy_oracle(rider_bike, gains, t03, transient):
     """100 random states, plate moving or not: C and the NumPy printing of the same expressions.
 

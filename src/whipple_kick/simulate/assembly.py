@@ -615,8 +615,7 @@ def custom_gains(gains, scenario=None):
     """
     from whipple_kick.model import symbols
 
-    # Every declared part's gains, read now: a part declared after the import counts too.
-    known = tuple(dict.fromkeys((*slip.GAIN_NAMES, *(g for part in parts.REGISTRY.values() for g in part.gains))))
+    known = slip.gain_names()   # every declared part's gains, read now: a part declared after the import too
     unknown = sorted(set(gains) - set(known))
     if unknown:
         raise InputError(f"unknown steer-torque gain(s) {unknown}; known: {list(known)}")

@@ -387,7 +387,7 @@ def lqr_on_simulated_model(spec, moore, design, body, rear, front, model):
     symmetric tyres, linearised about upright straight running at the design
     speed at constant speed (:func:`whipple_kick.model.slip.heading_linearisation`);
     the law feeds back roll, steer and their rates, and the upper body's lean
-    and its rate when it leans (:data:`whipple_kick.model.slip.parameters.GAIN_STATES`),
+    and its rate when it leans (:func:`whipple_kick.model.slip.parameters.gain_states`),
     with gains LQR-optimal for that law (identity weights on those states,
     1 on the torque, as the Whipple design), found from the Whipple design's
     gains by :func:`whipple_kick.simulate.control.output_feedback_lqr`. Where the
@@ -410,7 +410,7 @@ def lqr_on_simulated_model(spec, moore, design, body, rear, front, model):
     Returns
     -------
     gains : dict
-        By name (:data:`whipple_kick.model.slip.parameters.GAIN_NAMES`), times ``gain_scale``.
+        By name (:func:`whipple_kick.model.slip.parameters.gain_names`), times ``gain_scale``.
     poles : ndarray
         The design's closed-loop eigenvalues.
     """
@@ -448,7 +448,7 @@ def lqr_on_simulated_model(spec, moore, design, body, rear, front, model):
         else:
             step /= 2.0
     K, poles = output_feedback_lqr(*design_model(1.0), K0=K)
-    gains = dict.fromkeys(slip.GAIN_NAMES, 0.0)
+    gains = dict.fromkeys(slip.gain_names(), 0.0)
     gains.update({name: float(spec.gain_scale * k) for name, k in zip(felt, K, strict=True)})
     return gains, poles
 
@@ -490,5 +490,5 @@ def _linear_design_model(spec, moore, rear, front, body, felt, share, scaled, mo
         names.append("q3")
     C = np.zeros((len(felt), len(names)))
     for row, gain in enumerate(felt):
-        C[row, names.index(slip.GAIN_STATES[gain])] = 1.0
+        C[row, names.index(slip.gain_states()[gain])] = 1.0
     return A, b, C

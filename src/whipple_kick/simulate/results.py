@@ -8,6 +8,7 @@ columns and units in :data:`UNITS`) and a JSON-ready summary
 the recovery and the Section 8.3 metrics of :mod:`whipple_kick.simulate.analysis`,
 numerics. Nothing in a result is NaN (:func:`clean`).
 """
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 import functools
 import json
@@ -40,8 +41,6 @@ SPEED_COLUMNS = {
     "u8": ("front_wheel_rate", "rad/s"), "u9": ("compression_rate_rear", "m/s"),
     "u10": ("compression_rate_front", "m/s"),
 }
-#: The declared parts' states (:mod:`whipple_kick.model.parts`): state -> (column, unit), in a run that has them.
-PART_COLUMNS = {state: column for part in parts.REGISTRY.values() for state, column in part.columns.items()}
 #: The rear contact's velocity along the heading (yaw q3) [m/s]: forward and lateral (the drift).
 HEADING_COLUMNS = {"forward_speed": "m/s", "lateral_speed": "m/s"}
 #: The force and moment each tyre applies to the bicycle (in every transient form): output -> column.
@@ -71,26 +70,56 @@ CARCASS_STATE_COLUMNS = {name: col for col, source, name, _ in transient.FORMS["
                          if name.startswith("carcass_y")}
 #: Energy balance residual column [J] (:func:`whipple_kick.model.energy.balance_residual`).
 BALANCE_COLUMN = "energy_balance_residual"
-#: Unit of every trajectory column (from the symbol registry and :data:`whipple_kick.model.slip.OUTPUTS`).
-UNITS = {"time": "s", **dict(COORDINATE_COLUMNS.values()), **dict(SPEED_COLUMNS.values()), **HEADING_COLUMNS,
-         **dict.fromkeys(PATCH_STATE_COLUMNS.values(), "rad"),
-         **{col: unit for form in transient.FORMS.values() for col, _, _, unit in form.columns},
-         **{c: slip.OUTPUTS[o][0] for o, c in {**APPLIED_COLUMNS, **OUTPUT_COLUMNS}.items()},
-         **dict(PART_COLUMNS.values()),
-         **{o: unit for part in parts.REGISTRY.values() for o, (unit, _) in part.outputs.items()},
-         **dict(energy.COLUMNS.values()), BALANCE_COLUMN: "J"}
+#: Unit of each trajectory column of the bicycle (from :data:`whipple_kick.model.slip.OUTPUTS` and the energy
+#: columns); :data:`UNITS` adds the declared parts' and tyre forms' columns.
+_BICYCLE_UNITS = {"time": "s", **dict(COORDINATE_COLUMNS.values()), **dict(SPEED_COLUMNS.values()), **HEADING_COLUMNS,
+                  **dict.fromkeys(PATCH_STATE_COLUMNS.values(), "rad"),
+                  **{c: slip.OUTPUTS[o][0] for o, c in {**APPLIED_COLUMNS, **OUTPUT_COLUMNS}.items()},
+                  **dict(energy.COLUMNS.values()), BALANCE_COLUMN: "J"}
+
+
+def part_columns():
+    """The declared parts' states (:mod:`whipple_kick.model.parts`): state -> (column, unit), in a run that has
+    them; read when called, so a part declared after this module was imported counts too."""
+    return {state: column for part in parts.REGISTRY.values() for state, column in part.columns.items()}
+
+
+def _declared_units():
+    """Units of the declared parts' state columns and outputs and of the declared tyre forms' columns, now."""
+    return {**{col: unit for form in transient.FORMS.values() for col, _, _, unit in form.columns},
+            **dict(part_columns().values()),
+            **{o: unit for part in parts.REGISTRY.values() for o, (unit, _) in part.outputs.items()}}
+
+
+class _Units(Mapping):
+    """Unit of every trajectory column by name: the bicycle's, then the declared parts' and tyre forms' columns
+    read when asked (a part or form declared after this module was imported counts too)."""
+
+    def __getitem__(self, column):
+        if column in _BICYCLE_UNITS:
+            return _BICYCLE_UNITS[column]
+        return _declared_units()[column]
+
+    def __iter__(self):
+        return iter({**_BICYCLE_UNITS, **_declared_units()})
+
+    def __len__(self):
+        return len({**_BICYCLE_UNITS, **_declared_units()})
+
+    def __repr__(self):
+        return repr(dict(self))
+
+
+#: Unit of every trajectory column (a read-only mapping that follows the declarations).
+UNITS = _Units()
 
 
 def unit_of(column):
-    """The unit of trajectory column ``column``: :data:`UNITS`, or a declared part's state column or output
-    (read when called, so a part declared after this module was imported counts too)."""
-    if column in UNITS:
+    """The unit of trajectory column ``column`` (:data:`UNITS`); KeyError naming it if there is none."""
+    try:
         return UNITS[column]
-    for part in parts.REGISTRY.values():
-        units = {**dict(part.columns.values()), **{o: unit for o, (unit, _) in part.outputs.items()}}
-        if column in units:
-            return units[column]
-    raise KeyError(f"no trajectory column {column!r}")
+    except KeyError:
+        raise KeyError(f"no trajectory column {column!r}") from None
 
 
 #: Columns whose largest absolute values after the kick the summary lists (``max_abs_<column>_absolute_<unit>``).

@@ -28,6 +28,7 @@ from whipple_kick.library import inputs, thesis, tyres
 from whipple_kick.model import carcass, parts, transient
 from whipple_kick.model.slip import SLIP_SPEEDS
 
+from . import criteria
 from . import settings as _settings
 from .settings import CASE_COMMANDS, EVERY_COMMAND, SIMULATE, part_setting, setting
 
@@ -37,8 +38,9 @@ CONTROLLERS = ("lqr", "thesis", "off")
 LOW_INERTIA_KEYS = ("IBxx", "IByy", "IBzz", "IBxz", "zB")
 #: Table 8.4's gains were designed at this speed [m/s] (thesis Section 8.3).
 THESIS_DESIGN_SPEED = 3.0
-#: Tyre transient forms (:mod:`whipple_kick.model.transient`): the default and the others.
-TYRE_TRANSIENTS = transient.TRANSIENTS
+#: Tyre transient forms (:func:`whipple_kick.model.transient.transients`), read when listed: a form declared after
+#: the package was imported is a choice too.
+TYRE_TRANSIENTS = criteria.Listing(transient.transients)
 #: What happens to the speeds when the thesis' plate stops instantly (2 m/s to 0):
 #: ``impulse`` (the rear no-slip constraint's impulse, momentum-consistent),
 #: ``resolve`` (only the dependent speeds re-solved, as before the impulse existed)

@@ -461,7 +461,7 @@ def compare_transients(base=None, forms=None, experiment=None, directions=DIRECT
     Parameters
     ----------
     forms : sequence of str, optional
-        Tyre transient forms (default every one of :data:`whipple_kick.model.transient.TRANSIENTS`).
+        Tyre transient forms (default every one of :func:`whipple_kick.model.transient.transients`).
     base, experiment, directions, workers, progress, time_origin
         As for :func:`validate`.
 
@@ -478,7 +478,7 @@ def compare_transients(base=None, forms=None, experiment=None, directions=DIRECT
     from .recommend import dependence
 
     base = base_scenario() if base is None else base
-    forms = tuple(transient.TRANSIENTS if forms is None else forms)
+    forms = tuple(transient.transients() if forms is None else forms)
     results = {form: validate(base.with_changes(tyre_transient=form), experiment, directions, workers, progress,
                               time_origin) for form in forms}
     verdicts = {}

@@ -160,7 +160,7 @@ def _gains_vector(params, states):
     if params.get("kq3", 0.0):
         raise InputError("a yaw-angle gain kq3 breaks the heading invariance the linear model needs")
     K = np.zeros((1, len(states)))
-    for gain, state in slip.GAIN_STATES.items():   # q3 is not among the states (kq3 is refused above)
+    for gain, state in slip.gain_states().items():   # q3 is not among the states (kq3 is refused above)
         if state in states:
             K[0, states.index(state)] = params.get(gain, 0.0)
     return K
