@@ -9,6 +9,7 @@ from whipple_kick.model import slip, transient
 from whipple_kick.model.slip import compiled
 from whipple_kick.simulate import lsoda, results
 from whipple_kick.simulate.scenario import Scenario
+from whipple_kick.studies.stability import linear
 
 
 def test_the_lists_of_forms_are_the_declarations(capsys):
@@ -98,7 +99,8 @@ def lagged_again():
 
 def test_a_form_declared_here_is_a_choice_with_columns_states_and_its_own_cache_key(lagged_again, capsys):
     """The scenario's check and the command's choices take it, the trajectory has its declared columns with
-    their units, its state names are the tyre slots', and the compiled model's key changes with it (and back)."""
+    their units, its state names are the tyre slots' (the linear study names them by its columns), and the
+    compiled model's key changes with it (and back)."""
     from conftest import run_console
     from whipple_kick.simulate import settings
 
@@ -115,6 +117,8 @@ def test_a_form_declared_here_is_a_choice_with_columns_states_and_its_own_cache_
     assert [slip.X[n] for n in _AGAIN_STATES] == [slip.X[n] for n in slip.PATCH_STATES]
     assert "again_fy_r" in slip.X and slip.for_parts(("trunk",)).X["again_mz_f"] == slip.X["mzf"]
     assert slip.tyre_state_names("lagged_again") == _AGAIN_STATES
+    assert linear.state_labels("lagged_again")[-4:] == [("again_fy_rear", "N"), ("again_fy_f", ""),
+                                                        ("again_mz_r", ""), ("again_mz_front", "N m")]
     assert lsoda.default_atol(1e-8, "lagged_again")[slip.X["again_fy_r"]] == 1e-8   # its scale 1e2: rtol itself
     del transient.FORMS["lagged_again"]
     try:

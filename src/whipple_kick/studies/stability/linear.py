@@ -5,7 +5,7 @@ import numpy as np
 
 from whipple_kick.errors import InputError, check_range
 from whipple_kick.model import parts, slip
-from whipple_kick.model.transient import DEFAULT_TRANSIENT
+from whipple_kick.model.transient import DEFAULT_TRANSIENT, FORMS
 from whipple_kick.simulate import assembly, control, results
 
 from ._constants import LOOPS
@@ -70,10 +70,12 @@ def state_labels(transient=DEFAULT_TRANSIENT, constant_speed=True, body=()):
     >>> state_labels()[:2]
     [('roll', 'rad'), ('steer', 'rad')]
     """
-    # The declared parts' states (the leaning upper body's lean and its rate) read now: a part declared after
-    # this module was imported counts too.
-    labels = {**{q: c for part in parts.REGISTRY.values() for q, c in part.columns.items()}, **_LABELS}
-    return [labels[n] for n in active_states(transient, body, constant_speed)]
+    # The declared parts' states (the leaning upper body's lean and its rate) and the form's state columns read
+    # now: a part or form declared after this module was imported counts too; a form's state it gives no column
+    # is named as it is, without a unit.
+    labels = {**{q: c for part in parts.REGISTRY.values() for q, c in part.columns.items()},
+              **{n: (col, unit) for col, source, n, unit in FORMS[transient].columns if source == "state"}, **_LABELS}
+    return [labels.get(n, (n, "")) for n in active_states(transient, body, constant_speed)]
 
 
 # ----------------------------------------------------------------- linear model
