@@ -105,6 +105,6 @@ def test_library_without_matching_metadata_is_built_again(tmp_path, monkeypatch,
         (folder / f"slip_{key}.json").write_text(good.with_suffix(".json").read_text())
 
     monkeypatch.setattr(slip_build, "build_library", build_library)
-    lib_loaded = slip.library.__wrapped__()
+    lib_loaded = slip.compiled._library.__wrapped__(slip.layout.BASE, wk.transient.fingerprint())   # not the cached one
     assert len(builds) == 1 and json.loads(meta.read_text())["layout"] == slip.metadata_layout()
     assert lib_loaded.wk_slip_rhs is not None

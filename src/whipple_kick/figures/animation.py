@@ -38,9 +38,14 @@ import subprocess
 import time
 
 import numpy as np
+from scipy.ndimage import gaussian_filter1d
 
 from whipple_kick.errors import InputError, check_range
+from whipple_kick.library import bicycleparameters, riders
 from whipple_kick.model import geometry
+from whipple_kick.simulate import assembly
+
+from . import plotting
 
 #: Trajectory columns the animation reads, by what they hold: the ONE place
 #: to change when trajectory columns are renamed. q1..q10 are Moore's
@@ -207,8 +212,6 @@ def _segment_frames(bicycle, scenario):
     the bar E when the arms are on it, else with the upper body; the upper body in G, leaning on the hip,
     with the trunk part, else in C. A rider not split is rigid in C.
     """
-    from whipple_kick.library import riders
-
     if not bicycle.get("body"):
         return {}
     spec = scenario.bicycle_spec
@@ -261,8 +264,6 @@ def _bicycle_bodies(scenario, summary, params):
     fore-aft shift included, and the joint angles), not seated again here; the frame is the bicycle's own
     (the posture less the shift, which stands for a fit change: the saddle is drawn at the rider's seat).
     """
-    from whipple_kick.library import bicycleparameters, riders
-
     bicycle = summary["bicycle"]
     posture = bicycle.get("rider_posture")
     to_c = functools.partial(geometry.benchmark_to_body, parameters=params, body="C")
@@ -338,9 +339,6 @@ def _model_parameters(result, tyres):
     posture), so the bicycle's own set serves, without seating the rider again; a preset (rider lumped in)
     gives the rear frame's inertia the lumped drawing needs, low-inertia change included.
     """
-    from whipple_kick.library import bicycleparameters
-    from whipple_kick.simulate import assembly
-
     scenario = result.scenario
     if result.summary["bicycle"].get("rider_posture") is not None:
         moore = dict(bicycleparameters.load_bicycle(scenario.bicycle, scenario.rider).moore)
@@ -382,8 +380,6 @@ def _steady_path(first, arc_lengths):
 
 
 def _smooth(values, times, sigma_s):
-    from scipy.ndimage import gaussian_filter1d
-
     step = float(np.median(np.diff(times))) if times.size > 1 else 1.0
     return gaussian_filter1d(values, sigma_s / step, mode="nearest")
 
@@ -752,7 +748,6 @@ class _Frames:
         from matplotlib.figure import Figure
         from matplotlib.patches import Polygon
 
-        from . import plotting
 
         width, height = size
         self.fig = Figure(figsize=(width / dpi, height / dpi), dpi=dpi, facecolor="white")

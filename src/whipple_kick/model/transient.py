@@ -54,6 +54,8 @@ import functools
 import hashlib
 import inspect
 
+from whipple_kick.errors import InputError
+
 from . import symbols as S
 
 
@@ -173,7 +175,6 @@ FZ_SHAPE_FLOOR = 1.0
 
 def check(name):
     """Index of the transient form ``name``; ``InputError`` naming the choices otherwise."""
-    from whipple_kick.errors import InputError
     if name not in FORMS:
         raise InputError(f"tyre transient {name!r} is unknown; choose one of {', '.join(FORMS)}")
     return transients().index(name)

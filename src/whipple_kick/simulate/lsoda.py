@@ -29,6 +29,7 @@ import warnings
 
 import numpy as np
 from scipy.integrate import LSODA, odeint
+from scipy.optimize import brentq
 
 from whipple_kick.model import slip
 from whipple_kick.model.transient import DEFAULT_TRANSIENT, FORMS
@@ -185,8 +186,6 @@ def _careful_chunk(rhs, x, times, rtol, atol, fall, spent, budget, t_start, jac=
         LSODA's evaluations, its Jacobians, and all evaluations (the
         Jacobians' included: :func:`_evaluations`), as the budget counts them.
     """
-    from scipy.optimize import brentq
-
     solver = LSODA(rhs, times[0], x, times[-1], rtol=rtol, atol=atol, jac=jac)
 
     def counts():

@@ -13,12 +13,20 @@ from dataclasses import dataclass, field
 import functools
 import json
 import math
+import pathlib
 
 import numpy as np
+import pandas as pd
 
+from whipple_kick import fileio
 from whipple_kick.errors import InputError, SimulationError
-from whipple_kick.model import energy, parts, slip, transient
+from whipple_kick.model import carcass, energy, parts, slip, symbols, transient
 from whipple_kick.simulate import criteria, lsoda, provenance
+
+from . import analysis
+from . import assembly as assembly_module
+from .integration import sample_times
+from .scenario import THESIS_DESIGN_SPEED, Scenario
 
 #: Significant digits of trajectory.csv's floats: a relative round-off of at most 5e-13, far below the
 #: integration's own error (rtol 1e-10 by default) and the float32 regression references (~6e-8), and
@@ -198,10 +206,6 @@ class Result:
         >>> result.save("kick_run")
         ['trajectory.csv', 'summary.json', 'scenario.toml']
         """
-        import json
-        import pathlib
-
-        from whipple_kick import fileio
         out = pathlib.Path(folder)
         out.mkdir(parents=True, exist_ok=True)
         fileio.write_csv(with_units(self.trajectory), out / TRAJECTORY_FILE, significant_digits=TRAJECTORY_CSV_DIGITS)
@@ -232,10 +236,6 @@ class Result:
         >>> result.summary["recovered"], result.trajectory["yaw_rate"].iloc[-1]   # doctest: +SKIP
         (True, 0.0945...)
         """
-        import json
-        import pathlib
-
-        from .scenario import Scenario
         path = pathlib.Path(folder)
         if not path.is_dir():
             raise InputError(f"run folder {str(path)!r} {'is not a folder' if path.exists() else 'does not exist'}")
@@ -284,8 +284,6 @@ def trajectory_frame(solution, tyre_transient="carcass"):
     SimulationError
         A value is not finite (never NaN in a result).
     """
-    import pandas as pd
-
     traj = solution.states
     outs = solution.outputs()
     layout = frame_layout(tyre_transient, solution.model)
@@ -413,8 +411,6 @@ _BALANCE_INPUTS = frozenset((*energy.STORED, *energy.SUPPLIED, *energy.DISSIPATE
 def summary_columns(tyre_transient="carcass"):
     """The trajectory columns :func:`summarise` reads (the metrics, recovery, peaks, tyre ranges, energy, numerics,
     and those the declared criteria's functions read, :attr:`whipple_kick.simulate.criteria.Criterion.columns`)."""
-    from . import analysis
-
     # The patch slip (the tyre extrapolation's), where the form has it among its declared columns.
     declared = {col for col, _, _, _ in transient.FORMS[tyre_transient].columns}
     patch = [c for c in ("slip_patch_rear", "slip_patch_front") if c in declared]
@@ -477,8 +473,6 @@ def check_trajectory(frame, summary, scenario, path):
     an empty cell (a row cut in the middle) is refused, naming what is wrong.
     Times are compared to 1e-9 s: trajectory.csv keeps 13 significant digits.
     """
-    from .integration import sample_times
-
     where = f"{str(path)!r}"
     if "time" not in frame:
         raise InputError(f"{where} has no time column ('time [s]'): not a trajectory of simulate")
@@ -518,16 +512,12 @@ def read_trajectory(path):
 
     ``pandas.read_csv(path)`` reads the same file with the units in the names (``"roll [rad]"``).
     """
-    from whipple_kick import fileio
-
     frame = fileio.read_csv(path, "trajectory")
     return frame.rename(columns=lambda c: c.split(" [", 1)[0])
 
 
 def response_metrics(df, baseline, x0, scenario, traj):
     """Section 8.3 metrics (``metrics``, ``unavailable``) and the recovery of a (possibly partial) run."""
-    from . import analysis
-
     fall_roll = math.radians(scenario.fall_angle_deg)
     ended = None
     if traj.fell and traj.fall_time < 0.0:
@@ -561,8 +551,6 @@ def no_response_metrics(reason):
     The same keys as :func:`whipple_kick.simulate.analysis.kick_metrics` gives (no peaks, each
     peak metric None), so tables of runs keep their columns; ``unavailable`` names ``reason`` for each.
     """
-    from . import analysis
-
     keys = ["peak_times", "peak_values", "last_peak_time",
             *(f"{name}_{a}_{b}" for a, b in analysis.PEAK_PAIRS for name in ("log_decrement", "damping_ratio",
                                                                               "period")), "period"]
@@ -620,8 +608,6 @@ def _summary_metrics(metrics):
 
 def _recovery_section(recovery, baselines):
     """The recovery with each signal's first peak named "from steady", its steady value and its 5 % band."""
-    from . import analysis
-
     signals = {}
     for name, entry in recovery["signals"].items():
         peak = entry["first_peak_rad_s"]
@@ -791,7 +777,6 @@ def _carcass_section(scenario, assembly, start_outputs):
     if scenario.tyre_transient != "carcass":
         return None
     # The loads the stiffness was taken at: those of the state the run starts from (the kick start).
-    from whipple_kick.model import carcass
     _, out = start_outputs
     params = assembly.params
     return {
@@ -878,11 +863,6 @@ def extrapolation_line(summary):
 
 
 def _controller_section(scenario, assembly):
-    from whipple_kick.model import symbols
-
-    from . import assembly as assembly_module
-    from .scenario import THESIS_DESIGN_SPEED
-
     kind, gains = assembly.controller, assembly.gains
     poles = assembly.design_poles
     return {
@@ -1014,9 +994,6 @@ def compare_table(results, labels=None):
     >>> compare_table(runs).loc["outcome"].tolist()
     ['completed', 'fell']
     """
-    import pandas as pd
-
-
     labels = checked_labels(results, labels)
     columns = {}
     for label, result in zip(labels, results, strict=True):

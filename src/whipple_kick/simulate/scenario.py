@@ -22,9 +22,14 @@ Example
 ((300.0, 300.0), 4.0)
 """
 from dataclasses import asdict, dataclass, fields, make_dataclass, replace
+import json
+import math
+import pathlib
 
+from whipple_kick import fileio
 from whipple_kick.errors import InputError, check_range
 from whipple_kick.library import inputs, thesis, tyres
+from whipple_kick.library.parameters import tomllib
 from whipple_kick.model import carcass, parts, transient
 from whipple_kick.model.slip import SLIP_SPEEDS
 
@@ -780,10 +785,6 @@ class Scenario:
         ...     Scenario.from_file(path) == Scenario(pressure_kpa=300.0, design_speed=3.0)
         True
         """
-        import json
-        import pathlib
-
-        from whipple_kick import fileio
         lines = ["# whipple_kick scenario: one kick-plate run. Rerun it with `simulate --scenario FILE` (flags override",
                  "# its values) or wk.run(wk.Scenario.from_file(FILE)). Units: SI, pressures in kPa; \"none\": the",
                  "# field's rule for no value (see help(wk.Scenario)). Paths relative to this file's folder."]
@@ -816,10 +817,6 @@ class Scenario:
         >>> sc = Scenario.from_file("kick_run/scenario.toml")    # doctest: +SKIP
         >>> wk.run(sc.with_changes(pressure_kpa=300.0))          # doctest: +SKIP
         """
-        import math
-        import pathlib
-
-        from whipple_kick.library.parameters import tomllib
         file = pathlib.Path(path)
         label = f"scenario file {str(path)!r}"
         try:

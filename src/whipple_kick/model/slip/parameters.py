@@ -8,6 +8,8 @@ from whipple_kick.model import carcass, magic_formula, parts, transient
 from whipple_kick.model import symbols as S
 import whipple_kick.model.slip.layout as layouts  # the module by its full name, not through the package
 
+from .description import Model, Parameters
+
 # ------------------------------------------------------- parameters and steady state
 
 #: Magic-Formula coefficients that shift the curves at zero slip and camber
@@ -174,8 +176,6 @@ def model_parameters(moore, rear_tyre, front_tyre, options=None, *, model=None, 
     -------
     whipple_kick.model.slip.description.Parameters
     """
-    from .description import Model, Parameters
-
     options = ModelOptions() if options is None else options
     opt = {name: getattr(options, name, default.default)
            for name, default in ModelOptions.__dataclass_fields__.items()}

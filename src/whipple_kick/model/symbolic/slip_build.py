@@ -44,7 +44,7 @@ from whipple_kick.model.slip.layout import (
     P,
     X,
 )
-from whipple_kick.model.symbolic import codegen
+from whipple_kick.model.symbolic import codegen, derivation
 
 #: Status of the C functions when a reflex delay is set in a model without the delay filter.
 STATUS_NEEDS_DELAY = 3
@@ -219,7 +219,6 @@ def _expressions_of(part_names, forms):
         name, the block's copies excluded), ``mass`` (the mass matrix alone)
         and ``symbols``; of the model with the parts ``part_names``.
     """
-    from whipple_kick.model.symbolic import derivation
     L = layouts.for_parts(part_names)
     eom = derivation.slip_equations(part_names)
     dyn = list(eom.q) + list(eom.u)

@@ -6,7 +6,7 @@ import numpy as np
 from whipple_kick.errors import InputError, check_range
 from whipple_kick.model import parts, slip
 from whipple_kick.model.transient import DEFAULT_TRANSIENT, FORMS
-from whipple_kick.simulate import assembly, control, results
+from whipple_kick.simulate import assembly, control, results, steady
 
 from ._constants import LOOPS
 
@@ -296,7 +296,6 @@ def _steady(params, speed, guess):
     continued motion that has left them is searched for afresh, and a speed
     with none is left out as having no near-upright steady motion.
     """
-    from whipple_kick.simulate import steady
     if guess is not None:
         try:
             continued = steady.steady_state(params, speed, guess=guess)
