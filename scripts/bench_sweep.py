@@ -584,7 +584,7 @@ def _flag_libraries(folder, names=None):
     import pathlib
     import subprocess
 
-    from whipple_kick.model import compiler
+    from whipple_kick.model import compiler, transient
     from whipple_kick.model.slip import compiled, layout
     base = layout.BASE
     source = compiled.library_path(base).with_suffix(".c")
@@ -598,7 +598,7 @@ def _flag_libraries(folder, names=None):
         original = compiled.library_path
         compiled.library_path = lambda L, target=target: pathlib.Path(target)
         try:
-            libraries[name] = compiled.library.__wrapped__(base)   # the same argument types as the model's
+            libraries[name] = compiled._library.__wrapped__(base, transient.fingerprint())   # the model's argument types
         finally:
             compiled.library_path = original
     return libraries

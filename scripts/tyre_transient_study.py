@@ -105,14 +105,14 @@ def _secant_floor(value):
         return hash_function(sources, extra=f"{extra} G_MIN={value!r}")
     transient.G_MIN = value
     cache.source_hash = keyed
-    slip_build._expressions.cache_clear()
-    slip.library.cache_clear()
+    slip_build._expressions_of.cache_clear()
+    slip.compiled._library.cache_clear()
     try:
         yield
     finally:
         transient.G_MIN, cache.source_hash = original, hash_function
-        slip_build._expressions.cache_clear()
-        slip.library.cache_clear()
+        slip_build._expressions_of.cache_clear()
+        slip.compiled._library.cache_clear()
 
 
 def plate_stop():
