@@ -69,15 +69,8 @@ def test_a_second_form_written_in_c_is_refused():
 # ------------------------------------------------------- a form declared here, in this test module only
 
 def _lagged_again(wheel, first, second, vsy, speed, camber, fz, curves, sigma0):
-    """The thesis' force lag written again in this module (as :func:`whipple_kick.model.transient._force_lag`)."""
-    import sympy as sm
-
-    slip = sm.atan2(vsy, speed)
-    return {"force": first, "moment": second,
-            "rates": (speed / sigma0 * (curves["fy"](wheel, slip, camber, fz) - first),
-                      speed / sigma0 * (curves["mz"](wheel, slip, camber, fz) - second)),
-            "force0": curves["fy"](wheel, 0, camber, fz), "patch_speed": vsy, "sigma": sigma0,
-            "patch_slip": slip, "P_carcass": sm.S.Zero}
+    """The thesis' force lag as a form of this module's: its function, here, calls the shipped form's block."""
+    return transient._force_lag(wheel, first, second, vsy, speed, camber, fz, curves, sigma0)
 
 
 _AGAIN_STATES = ("again_fy_r", "again_fy_f", "again_mz_r", "again_mz_f")
