@@ -10,6 +10,7 @@ Usage:
     python scripts/bench_sweep.py cost --callgrind   # and its instructions (valgrind, ~2 min)
     python scripts/bench_sweep.py tolerance --samples 8 --fz 635 --rtol 1e-8   # a study at two rtols
     python scripts/bench_sweep.py flags [--callgrind]   # the model's compiler flags: wall, instructions, bits
+    python scripts/bench_sweep.py fall [--callgrind]    # falling runs: the careful path in Python against C
     python scripts/bench_sweep.py all
 
 "Warm" means the compiled model is already in the on-disk cache and this
@@ -55,6 +56,14 @@ load on a shared machine falls on all variants alike.
   case's integration wall time as a ratio to the current flags' beside it (interleaved repeats, medians),
   and its trajectory compared bit for bit with theirs; with ``--callgrind`` the integration's
   instructions per case (the sets valgrind can run: AVX-512 it cannot).
+* ``fall``: the falling runs of :data:`FALLING` (the controller off, a low speed, a big kick, the thesis'
+  set-up at 1.92 m/s), each integrated (:func:`whipple_kick.simulate.integration.integrate_run`, the model
+  assembled before) with the careful path (the chunk with the fall) in Python, scipy's LSODA stepped from
+  Python as before, and in C (:mod:`whipple_kick.simulate.lsoda_c`), the fast chunks in C in both
+  (:func:`bench_fall`). Wall time: medians of interleaved repeats of the whole integration and of its
+  careful chunks alone, and C's ratio to Python in the same repeat; the evaluations and fall times beside
+  (the same steps on both paths). With ``--callgrind`` each case's integration on each path counted by
+  callgrind between client requests (:func:`_count_fall_inner`), after a warm run of every case.
 * ``blend``: 350 kPa (T03's 300 and 400 kPa fits blended) against 400 kPa in
   this process: the integration's wall time per evaluation that LSODA counts
   (``numerics.evaluations``, Jacobian columns included), and the compiled
@@ -722,10 +731,169 @@ def bench_flag_instructions(duration, n_cases):
     return counts
 
 
+#: The falling runs of the ``fall`` bench: (label, Scenario keywords; ``thesis`` selects ``Scenario.thesis``).
+FALLING = (
+    ("off", {"controller": "off"}),                                    # the fork turns over at 1.54 s
+    ("speed_1.5", {"speed": 1.5, "design_speed": 3.0}),                # a rider designed for 3 m/s at 1.5 m/s
+    ("kick_200", {"kick_accel": 200.0, "speed": 1.5, "design_speed": 3.0}),
+    ("thesis_300kPa_1.92", {"thesis": True, "pressure_kpa": 300.0, "speed": 1.92}),   # |roll| reaches 45 deg
+    ("thesis_400kPa_1.92", {"thesis": True, "pressure_kpa": 400.0, "speed": 1.92}),   # the budget's largest
+)
+
+#: The careful path's two implementations the ``fall`` bench compares.
+CAREFUL_PATHS = ("python", "c")
+
+
+def _falling_cases(duration):
+    """[(label, assembled model, scenario, kick)] of :data:`FALLING`, each ``duration`` s after the kick."""
+    from whipple_kick.library import inputs
+    from whipple_kick.simulate import assembly, simulation
+    cases = []
+    for label, keywords in FALLING:
+        keywords = dict(keywords, duration=duration)
+        scenario = (simulation.Scenario.thesis(**{k: v for k, v in keywords.items() if k != "thesis"})
+                    if keywords.pop("thesis", False) else simulation.Scenario(**keywords))
+        kick = inputs.kick_of(scenario.validate())
+        cases.append((label, assembly.assemble(scenario, kick), scenario, kick))
+    return cases
+
+
+def _integrate_careful(path, case, careful_wall=None):
+    """The case's integration (``integrate_run``'s solution) with the careful path in ``path``; the careful
+    chunks' wall time [s] is added to ``careful_wall[0]`` where given."""
+    from whipple_kick.simulate import integration, lsoda
+    _, model, scenario, kick = case
+    in_c, in_python = lsoda._careful_chunk_in_c, lsoda._careful_chunk
+
+    def python(chunks_in_c, *arguments):
+        return timed(in_python, *arguments)
+
+    def timed(function, *arguments):
+        t0 = time.perf_counter()
+        try:
+            return function(*arguments)
+        finally:
+            if careful_wall is not None:
+                careful_wall[0] += time.perf_counter() - t0
+    lsoda._careful_chunk_in_c = python if path == "python" else (lambda *arguments: timed(in_c, *arguments))
+    try:
+        return integration.integrate_run(model, scenario, kick)
+    finally:
+        lsoda._careful_chunk_in_c = in_c
+
+
+def bench_fall(repeats, duration):
+    """Print each falling case's integration and careful-chunk wall times on both careful paths, and C's ratio.
+
+    Returns ``(walls, careful, facts)``: per (case, path) the integration's and the careful chunks' wall times
+    [s] of each repeat, and the evaluations, fall time [s] and message of the run.
+    """
+    from whipple_kick.studies import sweep_engine
+    cases = _falling_cases(duration)
+    walls = {(c[0], p): [] for c in cases for p in CAREFUL_PATHS}
+    careful = {(c[0], p): [] for c in cases for p in CAREFUL_PATHS}
+    facts = {}
+    sweep_engine._keep_freed_memory()
+    with sweep_engine._blas_controller().limit(limits=1):
+        for case in cases:   # warm, and what each path ends with
+            for path in CAREFUL_PATHS:
+                states = _integrate_careful(path, case).states
+                facts[case[0], path] = (states.evaluations, states.fall_time, states.message)
+        for r in range(repeats):
+            for case in cases:
+                for path in _rotated(list(CAREFUL_PATHS), r):
+                    spent = [0.0]
+                    t0 = time.perf_counter()
+                    _integrate_careful(path, case, spent)
+                    walls[case[0], path].append(time.perf_counter() - t0)
+                    careful[case[0], path].append(spent[0])
+    print(f"falling runs ({duration:g} s after the kick, {repeats} interleaved repeats; the fast chunks in C on "
+          "both paths): integration wall time, its careful chunks alone, C / Python in the same repeat")
+    for label, *_ in cases:
+        ratio = [c / p for c, p in zip(walls[label, "c"], walls[label, "python"], strict=True)]
+        careful_ratio = [c / p for c, p in zip(careful[label, "c"], careful[label, "python"], strict=True)]
+        evaluations, fall_time, message = facts[label, "c"]
+        same = "the same" if facts[label, "python"][:2] == (evaluations, fall_time) else "DIFFERENT"
+        print(f"  {label:19s} Python {statistics.median(walls[label, 'python']) * 1e3:7.1f} ms "
+              f"(careful {statistics.median(careful[label, 'python']) * 1e3:6.1f} ms), "
+              f"C {statistics.median(walls[label, 'c']) * 1e3:7.1f} ms "
+              f"(careful {statistics.median(careful[label, 'c']) * 1e3:6.2f} ms); C / Python "
+              f"{statistics.median(ratio):.3f} (careful {statistics.median(careful_ratio):.4f}); {evaluations} "
+              f"evaluations, fall at {fall_time} s ({same} on both paths): {message}")
+    return walls, careful, facts
+
+
+def _careful_calls(case):
+    """The careful chunks of the case's run: [(the C chunk loop, _careful_chunk's arguments)], ``x`` copied."""
+    from whipple_kick.simulate import lsoda
+    calls, in_c = [], lsoda._careful_chunk_in_c
+
+    def recording(chunks_in_c, rhs, x, *rest):
+        calls.append((chunks_in_c, (rhs, x.copy(), *rest)))
+        return in_c(chunks_in_c, rhs, x, *rest)
+    lsoda._careful_chunk_in_c = recording
+    try:
+        _integrate_careful("c", case)
+    finally:
+        lsoda._careful_chunk_in_c = in_c
+    return calls
+
+
+def _careful_alone(path, calls):
+    """The recorded careful chunks again on ``path`` ("python": scipy's LSODA from Python, "c")."""
+    import numpy as np
+
+    from whipple_kick.simulate import lsoda
+    for chunks_in_c, arguments in calls:
+        if path == "python":
+            lsoda._careful_chunk(*(a.copy() if isinstance(a, np.ndarray) else a for a in arguments))
+        else:
+            lsoda._careful_chunk_in_c(chunks_in_c, *arguments)
+
+
+def _count_fall_inner(duration, helper_folder):
+    """Under callgrind: every falling case on both careful paths warm, then each counted between client
+    requests: the whole integration, and its careful chunks alone (rerun from their recorded arguments)."""
+    import gc
+    lib = _callgrind_helper(helper_folder)
+    cases = _falling_cases(duration)
+    calls = {case[0]: _careful_calls(case) for case in cases}
+    for case in cases:
+        for path in CAREFUL_PATHS:
+            _integrate_careful(path, case)
+            _careful_alone(path, calls[case[0]])
+    for case in cases:
+        for path in CAREFUL_PATHS:
+            gc.collect()
+            lib.wk_cg_start()
+            _integrate_careful(path, case)
+            lib.wk_cg_stop(f"{path}:{case[0]}".encode())
+            gc.collect()
+            lib.wk_cg_start()
+            _careful_alone(path, calls[case[0]])
+            lib.wk_cg_stop(f"{path}-careful:{case[0]}".encode())
+
+
+def bench_fall_instructions(duration):
+    """Print each falling case's integration instructions on both careful paths (callgrind, a child process)."""
+    t0 = time.perf_counter()
+    labels = [f"{p}{part}:{label}" for label, _ in FALLING for p in CAREFUL_PATHS for part in ("", "-careful")]
+    counts = _callgrind_counts("_count_fall", duration, 1, labels)
+    print(f"instructions per falling case (callgrind, {duration:g} s; {time.perf_counter() - t0:.0f} s under "
+          "valgrind): the integration, and its careful chunks alone")
+    for label, _ in FALLING:
+        python, c = counts[f"python:{label}"], counts[f"c:{label}"]
+        careful_python, careful_c = counts[f"python-careful:{label}"], counts[f"c-careful:{label}"]
+        print(f"  {label:19s} Python {python / 1e6:8.1f} M, C {c / 1e6:8.1f} M; C / Python {c / python:.3f}; "
+              f"careful chunks: Python {careful_python / 1e6:7.1f} M, C {careful_c / 1e6:6.1f} M, C / Python "
+              f"{careful_c / careful_python:.3f}")
+    return counts
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("what", choices=("split", "nine", "parallel", "blend", "many", "cost", "tolerance", "flags",
-                                    "all", "_count", "_count_flags"))
+                                    "fall", "all", "_count", "_count_flags", "_count_fall"))
     p.add_argument("--repeats", type=int, default=3)
     p.add_argument("--n", type=int, default=1000, help="cases of the large sweep")
     p.add_argument("--duration", type=float, default=6.0, help="simulated time after the kick [s]")
@@ -742,6 +910,9 @@ def main(argv=None):
         return 0
     if args.what == "_count_flags":   # the child process bench_flag_instructions runs under valgrind
         _count_flags_inner(args.duration, args.cases, args.folder)
+        return 0
+    if args.what == "_count_fall":   # the child process bench_fall_instructions runs under valgrind
+        _count_fall_inner(args.duration, args.folder)
         return 0
     print(f"{os.cpu_count()} cores; load average {os.getloadavg()[0]:.2f} before the run")
     _warm_up()
@@ -761,6 +932,10 @@ def main(argv=None):
         bench_flags(args.repeats, args.duration, args.cases)
         if args.callgrind:
             bench_flag_instructions(args.duration, args.cases)
+    if args.what in ("fall", "all"):
+        bench_fall(args.repeats, args.duration)
+        if args.callgrind:
+            bench_fall_instructions(args.duration)
     if args.what == "tolerance":   # minutes: not part of "all"
         bench_tolerance(args.samples, args.fz, args.rtol, args.workers)
     if args.what in ("many", "all"):

@@ -146,6 +146,19 @@ def test_the_cost_bench_runs_each_path_and_its_counting_requests_are_inert_outsi
     assert "instructions" not in capsys.readouterr().out
 
 
+def test_the_fall_bench_runs_every_falling_case_on_both_careful_paths():
+    """scripts/bench_sweep.py fall: each case falls on both careful paths (Python and C) after the same
+    evaluations, and gets a wall time on each."""
+    import bench_sweep
+
+    walls, careful, facts = bench_sweep.bench_fall(1, 3.0)
+    for label, _ in bench_sweep.FALLING:
+        (evaluations, fall_time, _), (evaluations_c, fall_time_c, _) = (facts[label, p] for p in ("python", "c"))
+        assert evaluations == evaluations_c and fall_time is not None
+        assert abs(fall_time - fall_time_c) <= 1e-12   # round-off (tests/simulate/test_lsoda_c.py)
+        assert all(walls[label, p][0] > careful[label, p][0] > 0 for p in bench_sweep.CAREFUL_PATHS)
+
+
 def test_the_models_compiler_flags_give_the_bits_of_the_reference_flags(tmp_path):
     """Issue 41 item 3: the flags the model is built with (model.compiler.MODEL_FLAGS, -O3) were adopted because
     they give -O2's trajectory bit for bit; this builds the model's C source both ways and integrates a

@@ -124,7 +124,8 @@ def test_merged_upper_body_conserves_mass_and_mass_centre():
 # ------------------------------------------------------------------ one more degree of freedom
 
 def _build_shift(m):
-    """A mass on the saddle sliding sideways along the rear frame's C.y on a spring-damper (q12 [m])."""
+    """A mass on the saddle sliding sideways along the rear frame's C.y (q12 [m]) on SymPy's PrismaticJoint,
+    held by a LinearSpring and a LinearDamper along a LinearPathway."""
     import sympy.physics.mechanics as me
 
     kin, b = m.kin, m.par
@@ -138,16 +139,20 @@ def _build_shift(m):
     S = me.ReferenceFrame("S")
     so = me.Point("shift_mass")
     mass = m.body("shifting_mass", so, S, b["ms"], me.inertia(S, b["is11"], b["is22"], b["is33"]))
-    me.PrismaticJoint("shift", m.rigid_body("rear_frame"), mass, coordinates=q12, speeds=u12, parent_point=rest,
-                      joint_axis=C.y)
+    joint = me.PrismaticJoint("shift", m.rigid_body("rear_frame"), mass, coordinates=q12, speeds=u12,
+                              parent_point=rest, joint_axis=C.y)
     so.v1pt_theory(rest, N, C)   # the joint gives its velocity in the rear frame; Kane's method reads it in N
-    # The spring-damper between the mass and the frame, by hand: SymPy's LinearSpring and LinearDamper act
-    # along a pathway's length, |q12| here, whose direction is undefined at the rest point q12 = 0.
-    force = -(b["ks"] * q12 + b["cs"] * u12)
-    m.loads += [(so, force * C.y), (rest, -force * C.y)]
-    m.spring_energy.append(b["ks"] * q12**2 / 2)
-    m.damper_dissipation.append(b["cs"] * u12**2)
-    m.outputs["shift_force"] = force
+    m.system.add_joints(joint)
+    # The spring and the damper pull along a straight pathway from an anchor in the rear frame 1 m to the
+    # left of the rest point: its length 1 + q12 keeps its direction (C.y) for any shift under 1 m, where a
+    # pathway from the rest point itself, of length |q12|, would have none at q12 = 0. The derivation takes
+    # the spring's store and the damper's dissipation from them.
+    anchor = rest.locatenew("shift_anchor", -C.y)
+    anchor.v2pt_theory(do, N, C)
+    pathway = me.LinearPathway(anchor, so)
+    m.system.add_actuators(me.LinearSpring(b["ks"], pathway, equilibrium_length=1),
+                           me.LinearDamper(b["cs"], pathway))
+    m.outputs["shift_force"] = -(b["ks"] * q12 + b["cs"] * u12)
 
 
 def _shift_part():
@@ -200,7 +205,8 @@ def test_a_part_declared_here_is_built_run_and_energy_checked(shift):
     kinetic and potential energy, the spring's store and the damper's dissipation all enter); the trajectory's
     columns and the gain table come from the declaration; the default model is untouched.
 
-    Measured: balance residual 6.0e-10 J against 512 J of kinetic energy, the damper dissipating 0.35 J;
+    Measured (the spring and damper SymPy actuators along a pathway): balance residual 5.9e-10 J against
+    512 J of kinetic energy, the damper dissipating 0.35 J;
     steady shift -2.9e-6 m; the shift spans 33 mm. Bounds: 1e-6 J (rtol 1e-10 integration of the
     quadratures) and the mass moves by more than 1 mm.
     """
@@ -296,7 +302,7 @@ def test_a_parts_gains_values_and_rider_parameters_come_from_its_declaration(shi
     assert assembly.custom_gains({"kq12": 1.0}, cls(shift="on"))["kq12"] == 1.0
     body = assembly.rider_body(cls(shift="on", shift_damping=40.0).body_spec, {})
     assert {n: body[n] for n in ("ms", "ls3", "ks", "cs")} == {"ms": 5.0, "ls3": -0.6, "ks": 2000.0, "cs": 40.0}
-    assert parts.TRUNK.from_rider == slip.parameters.TRUNK_BODY[:10]
+    assert set(parts.TRUNK.from_rider) < set(slip.parameters.body_names()) - set(parts.TRUNK.gains)
     segments = dict.fromkeys(parts.TRUNK.from_rider, 0.25)
     leaning = assembly.rider_body(wk.Scenario(rider_body="leaning").body_spec, {"body": segments})
     assert all(leaning[n] == 0.25 for n in segments) and leaning["kh"] == 128.0
@@ -341,7 +347,7 @@ def test_a_part_declared_here_runs_through_scenario_assemble_and_run_from_its_fi
 
     Measured: a 1 s run from the default kick at 3 m/s completes; the mass's shift spans 68 mm (bound 0.1 mm:
     it really is in the model), its spring-damper force is the declared law to rounding (bound rel 1e-12),
-    the run's energy balance residual is 1.0e-9 J against 512 J of kinetic energy (bound 1e-6 J, as the
+    the run's energy balance residual is 1.4e-9 J against 512 J of kinetic energy (bound 1e-6 J, as the
     part's own energy test: the run's rtol 1e-8 integration of the quadratures).
     """
     from whipple_kick import cli
@@ -384,6 +390,10 @@ def _hand_written_trunk(m):
     kin, b = m.kin, m.par
     N, C = kin.frames["N"], kin.frames["C"]
     q11, u11 = m.coordinate("q11", "u11")
+    # No joint: the coordinate, its speed and dq11/dt = u11 by hand.
+    m.system.add_coordinates(q11)
+    m.system.add_speeds(u11)
+    m.system.add_kdes(q11.diff(me.dynamicsymbols._t) - u11)
     H = me.ReferenceFrame("H")
     H.orient_axis(C, C.y, b["hip_tilt"])
     G = me.ReferenceFrame("G")
@@ -398,7 +408,7 @@ def _hand_written_trunk(m):
     kin.frames.update(H=H, G=G)
     kin.points.update(ho=ho, go=go)
     hip_torque = -(b["kh"] * q11 + b["ch"] * u11)
-    m.loads += [(C, -hip_torque * H.x), (G, hip_torque * H.x)]
+    m.system.add_loads(me.Torque(C, -hip_torque * H.x), me.Torque(G, hip_torque * H.x))
     axis_share = H.x.dot(C.z)
     m.hands_frame, m.hands_angle, m.hands_rate = G, axis_share * q11, axis_share * u11
     m.spring_energy.append(b["kh"] * q11**2 / 2)
@@ -408,6 +418,8 @@ def _hand_written_trunk(m):
 
 def _hand_written_arms(m):
     """The arms' loads as written by hand before the TorqueActuator: the reference."""
+    import sympy.physics.mechanics as me
+
     from whipple_kick.model import symbols
 
     kin, b = m.kin, m.par
@@ -415,7 +427,7 @@ def _hand_written_arms(m):
     arm_angle = symbols.dyn("q7") - m.hands_angle
     arm_rate = symbols.dyn("u7") - m.hands_rate
     arm_torque = -(b["ka"] * arm_angle + b["ca"] * arm_rate)
-    m.loads += [(m.hands_frame, -arm_torque * C.z), (E, arm_torque * C.z)]
+    m.system.add_loads(me.Torque(m.hands_frame, -arm_torque * C.z), me.Torque(E, arm_torque * C.z))
     m.spring_energy.append(b["ka"] * arm_angle**2 / 2)
     m.damper_dissipation.append(b["ca"] * arm_rate**2)
     m.outputs["arm_steer_torque"] = arm_torque
@@ -468,3 +480,125 @@ def test_the_hip_on_sympys_pin_joint_and_torque_actuator_gives_the_hand_written_
     for a, b in zip(at_joint, at_hand, strict=True):
         assert np.all(np.isfinite(a))
         assert np.abs(a - b).max() <= 1e-12 * np.abs(b).max()
+
+
+# ------------------------------------------------------------------ the rider's segments and the drawing
+
+_LEGS = ("J1", "J2", "K1", "K2")
+_LIFT_M = 0.1
+
+
+def _legs_body(bench, seat, mass, com, inertia):
+    """The legs as a body of their own (a test part's): their mass, mass centre and inertia by name."""
+    return {"legs_mass": mass, "legs_x": float(com[0]), "legs_z": float(com[2]), "legs_ixx": float(inertia[0, 0]),
+            "legs_iyy": float(inertia[1, 1]), "legs_izz": float(inertia[2, 2]), "legs_ixz": float(inertia[0, 2])}
+
+
+def _legs_pose(body, states, rear_rotation, rear_origin):
+    """The legs' frame in a drawing: the rear frame's, lifted by _LIFT_M (the ground's z points down)."""
+    return rear_rotation, rear_origin - _LIFT_M * np.array([0.0, 0.0, 1.0])
+
+
+@pytest.fixture
+def legs(monkeypatch):
+    """A part, declared here only, that carries the rider's legs as a body of its own, drawn in a frame of its
+    own (no equations: it is never built here)."""
+    part = parts.Part(name="legs", description="the rider's legs as a body of their own (a test part)",
+                      source="this test", symbols=(), coordinates=(), speeds=(), parameters=(), gains={},
+                      columns={}, outputs={}, build=lambda m: None, selected_by=("legs", "on"), title="the legs",
+                      split=parts.Split(segments=_LEGS, body=_legs_body, moves_with="L"), pose=_legs_pose)
+    monkeypatch.setitem(parts.REGISTRY, part.name, part)
+    return part
+
+
+def test_a_part_declared_here_splits_the_rider_and_is_drawn_in_its_frame(legs):
+    """A part's whole footprint on the rider from its declaration, no other file touched: its segments (the
+    legs) are split off the seated rider as its own body, the rest stays in the rear frame, the scenario field
+    that selects it splits the run's bicycle for it, and the animation draws its segments in its frame, posed
+    as it declares; the other parts' splits still hold (the arms take the forearms from the trunk).
+
+    Bounds: lumping the legs' body back into the rear frame gives the rider seated whole to rel 1e-12 (the
+    same sums in another order); the drawn legs are the rigid rider's lifted by the declared 0.1 m, to 1e-12 m.
+    """
+    import copy
+
+    from whipple_kick.figures import animation
+    from whipple_kick.library import riders
+    from whipple_kick.simulate import scenario as scenario_module
+    from whipple_kick.simulate import simulation
+
+    bike = wk.bicycles.load("balanceassist_v1")
+    rider = riders.yeadon_rider("jason", mass_kg=80.0)
+    split = riders.split_rider(bike, rider, ("legs",))
+    body = split.body
+    assert split.held == () and split.body_mass == body["legs_mass"] and 15.0 < body["legs_mass"] < 40.0
+    inertia = np.array([[body["legs_ixx"], 0.0, body["legs_ixz"]], [0.0, body["legs_iyy"], 0.0],
+                        [body["legs_ixz"], 0.0, body["legs_izz"]]])
+    back = riders.lump_into_frame(split.combined.benchmark, "B", body["legs_mass"],
+                                  np.array([body["legs_x"], 0.0, body["legs_z"]]), inertia)
+    whole = riders.seat(bike, rider).benchmark
+    for key in ("mB", "xB", "zB", "IBxx", "IByy", "IBzz", "IBxz", "mH", "IHxx"):
+        assert back[key] == pytest.approx(whole[key], rel=1e-12, abs=1e-12), key
+    carried = riders.segment_carriers(("legs",))
+    assert {s for s, p in carried.items() if p is legs} == set(_LEGS)
+    assert all(p is None for s, p in carried.items() if s not in _LEGS)
+    # With the trunk and the arms: the arms (built after the trunk) take the forearms, the legs theirs.
+    carried = riders.segment_carriers(("trunk", "arms", "legs"))
+    assert {s: p.name for s, p in carried.items()} == {**dict.fromkeys(("P", "T", "C", "A1", "B1"), "trunk"),
+                                                       **dict.fromkeys(("A2", "B2"), "arms"),
+                                                       **dict.fromkeys(_LEGS, "legs")}
+    # The run's bicycle is split for it when its field selects it (the bicycle's view holds the field).
+    cls = scenario_module.with_parts(legs)
+    _, _, info = assembly.build_bicycle(cls(legs="on").bicycle_spec)
+    _, _, plain = assembly.build_bicycle(cls().bicycle_spec)
+    assert set(info["body"]) == set(body) and plain["body"] is None
+    assert info["total_mass_kg"] == pytest.approx(plain["total_mass_kg"], rel=1e-12)
+    # The drawing: the legs in the part's frame "L", posed by its declaration; the rest where it was.
+    result = simulation.run(wk.Scenario(duration=0.2))
+    drawn = copy.copy(result)
+    drawn.scenario, drawn.summary = cls(legs="on"), copy.deepcopy(result.summary)
+    drawn.summary["bicycle"]["body"] = info["body"]
+    times = result.trajectory["time"].to_numpy()[:1]
+    rigid = {item.name: item.points for item in animation.build_scene(result, times).items}
+    items = {item.name: item.points for item in animation.build_scene(drawn, times).items}
+    legs_drawn = [name for name in items if name.startswith("L ")]
+    assert set(legs_drawn) == {"L J1", "L K1", "L left shank", "L right shank", "L left foot", "L right foot"}
+    assert not any(n.startswith("L ") for n in rigid) and "C left shank" not in items
+    for name in legs_drawn:
+        np.testing.assert_allclose(items[name], rigid["C" + name[1:]] + [0.0, 0.0, -_LIFT_M], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(items["C head"], rigid["C head"], rtol=0, atol=0)
+
+
+def test_the_parts_build_into_a_sympy_system_the_derivation_reads_back():
+    """The trunk's build adds its body, its hip joint (which brings q11, u11 and dq11/dt = u11) and its
+    spring-damper actuator to SymPy's System, which starts with the bicycle's four bodies; the derivation
+    reads them back (the coordinates after the bicycle's, the upper body with its weight). A build whose
+    system holds coordinates the part does not declare is refused, naming both."""
+    import sympy.physics.mechanics as me
+
+    from whipple_kick.model import symbols
+    from whipple_kick.model.symbolic import derivation
+
+    kin = derivation.kinematics(tyre_model=True)
+    chosen = parts.named(("trunk",))
+    par = {n: symbols.sym(n) for n in symbols.SLIP_CONSTANTS + parts.TRUNK.parameters}
+    mech = parts.Mechanics(kin=kin, par=par, hands_frame=kin.frames["C"])
+    assert [b.name for b in mech.system.bodies] == ["rear_frame", "rear_wheel", "front_frame", "front_wheel"]
+    parts.TRUNK.build(mech)
+    q11, u11 = symbols.dyn("q11"), symbols.dyn("u11")
+    assert tuple(mech.system.q) == (q11,) and tuple(mech.system.u) == (u11,)
+    assert [type(j).__name__ for j in mech.system.joints] == ["PinJoint"]
+    assert [type(a).__name__ for a in mech.system.actuators] == ["TorqueActuator"] and len(mech.loads()) == 2
+    assert [b.name for b in mech.added_bodies()] == ["upper_body"]
+    derivation.take_parts(kin, mech, chosen)
+    assert kin.q[-1] == q11 and kin.u[-1] == u11 and kin.qd_to_u[q11.diff(me.dynamicsymbols._t)] == u11
+    point, weight = kin.gravity_loads[-1]
+    assert point is mech.rigid_body("upper_body").masscenter
+    assert weight == par["mt"] * par["g"] * kin.frames["N"].z
+    # A build that gives the system a coordinate its part does not declare is refused.
+    kin = derivation.kinematics(tyre_model=True)
+    mech = parts.Mechanics(kin=kin, par=par, hands_frame=kin.frames["C"])
+    parts.TRUNK.build(mech)
+    mech.system.add_coordinates(symbols.dyn("q9"))
+    with pytest.raises(ValueError, match=r"gave the system the coordinates \['q11', 'q9'\]; they declare \['q11'\]"):
+        derivation.take_parts(kin, mech, chosen)

@@ -83,7 +83,7 @@ def fingerprint(sc):
     model = assembly.model_of(sc.body_spec, sc.tyre_transient)
     if sc.controller == "lqr" and sc.lqr_model == "simulated":
         spec = sc.design_spec
-        felt, K = control.simulated_design_start(spec, design)
+        felt, K = control.simulated_design_start(spec, design, model.parts)
         A, b, C = control._linear_design_model(spec, moore, rear, front, body, felt, 1.0, control.SCALED_BODY_GAINS,
                                                model)
         gains = {"design": (A, b, C, K, sc.gain_scale, sc.lqr_design_speed)}

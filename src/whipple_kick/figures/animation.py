@@ -204,20 +204,34 @@ def _yeadon_segments(human, seat, to_bike):
     return segments
 
 
-def _segment_frames(bicycle, scenario):
-    """The frame that carries each Yeadon segment in the run's model: {segment label: "C", "E" or "G"}.
+def _model_parts(scenario):
+    """The run's model's parts (:func:`whipple_kick.model.parts.selected`), in build order."""
+    from whipple_kick.model import parts
 
-    As :func:`whipple_kick.library.riders.seat_with_body` splits the rider (``bicycle`` the summary's section:
-    its ``body`` is set when the rider was split): the legs in the rear frame C; the forearms and hands with
-    the bar E when the arms are on it, else with the upper body; the upper body in G, leaning on the hip,
-    with the trunk part, else in C. A rider not split is rigid in C.
+    return parts.named([p.name for p in parts.selected(scenario)])
+
+
+def _segment_frames(bicycle, scenario):
+    """The frame that carries each Yeadon segment in the run's model: {segment label: "C", "E", "G" ...}.
+
+    As :func:`whipple_kick.library.riders.split_rider` splits the rider for the model's parts (``bicycle`` the
+    summary's section: its ``body`` is set when the rider was split): a segment a part of the model carries
+    moves with the frame its split declares (``Split.moves_with``: the forearms and hands with the bar E when
+    the arms are on it, the upper body in G, leaning on the hip, with the trunk part); the rest, and the
+    segments of a part the model lacks that the rear frame holds, in the rear frame C. A rider not split is
+    rigid in C.
     """
     if not bicycle.get("body"):
         return {}
-    spec = scenario.bicycle_spec
-    upper = "G" if spec.leaning else "C"
-    frames = dict.fromkeys(riders.LEG_SEGMENTS, "C") | dict.fromkeys(riders.UPPER_BODY_SEGMENTS, upper)
-    return frames | dict.fromkeys(riders.FOREARM_SEGMENTS, "E" if spec.arms_on_bar else upper)
+    names = [p.name for p in _model_parts(scenario)]
+    owner = riders.segment_carriers(names)
+    return {label: part.split.moves_with if part is not None and part.name in names else "C"
+            for label, part in owner.items()}
+
+
+def _part_frames(scenario):
+    """The model's parts that draw their segments in a frame of their own, by that frame (``"G"``: the trunk)."""
+    return {p.split.moves_with: p for p in _model_parts(scenario) if p.pose is not None}
 
 
 def _inertia_ellipsoid(mass, inertia, vertices=16):
@@ -242,11 +256,12 @@ class Body:
 
     Attributes
     ----------
-    frame : {"C", "E", "G"}
-        Rear frame (with the rider), front frame, or the rider's upper body leaning on the hip (the trunk part).
+    frame : str
+        Rear frame ``"C"`` (with the rider), front frame ``"E"``, or a part's own frame (``"G"``: the rider's
+        upper body leaning on the hip, the trunk part's; :attr:`whipple_kick.model.parts.Part.pose`).
     lines : dict of str -> ndarray (m, 3)
-        Polylines [m] in body axes from the body's wheel centre (the upper body: the rear frame's axes at
-        zero lean).
+        Polylines [m] in body axes from the body's wheel centre (a part's own frame: the rear frame's axes at
+        the part's rest).
     solids : dict of str -> ndarray (m, 3)
         Point clouds [m] of convex bodies, drawn as the outline of their projection.
     """
@@ -270,18 +285,17 @@ def _bicycle_bodies(scenario, summary, params):
     to_e = functools.partial(geometry.benchmark_to_body, parameters=params, body="E")
     d1, d2, d3 = params["d1"], params["d2"], params["d3"]
     axis_foot_e = np.array([-d3, 0.0, 0.0])          # on the steer axis, from the front wheel centre
-    bodies = {frame: Body(frame, {}, {}) for frame in ("C", "E", "G")}
+    bodies = {frame: Body(frame, {}, {}) for frame in ("C", "E", *_part_frames(scenario))}
     rear_lines, front_lines = bodies["C"].lines, bodies["E"].lines
     if posture is not None:
         rider = riders.yeadon_rider(scenario.rider, mass_kg=bicycle["rider_mass_kg"])
         human = rider.human(dict(posture["configuration_rad"]))
         seat_pt, grip_left = np.array(posture["seat_m"]), np.array(posture["left_grip_m"])
-        convert = {"C": to_c, "E": to_e, "G": to_c}
         carriers = _segment_frames(bicycle, scenario)
         for label, named in _yeadon_segments(human, seat_pt, riders.YEADON_TO_BIKE).items():
             frame = carriers.get(label, "C")
-            for name, pts in named.items():
-                bodies[frame].solids[name] = convert[frame](pts)
+            for name, pts in named.items():   # a part's own frame in the rear frame's axes at its rest
+                bodies[frame].solids[name] = (to_e if frame == "E" else to_c)(pts)
         g = bicycleparameters.load_bicycle(scenario.bicycle, scenario.rider).geometry
         frame_shift = np.array([bicycle["rider_shift_m"], 0.0, 0.0])
         bb, seat = np.array(posture["bottom_bracket_m"]) - frame_shift, seat_pt - frame_shift
@@ -311,25 +325,13 @@ def _bicycle_bodies(scenario, summary, params):
     return [body for body in bodies.values() if body.lines or body.solids]
 
 
-def _upper_body_pose(result, times, rear_rotation, rear_origin):
-    """Rotation and origin of the leaning upper body G at ``times``: (n, 3, 3), (n, 3).
-
-    The trunk part's hinge (:data:`whipple_kick.model.parts.TRUNK`): G is the rear frame C turned by the
-    lean q11 (trajectory column ``upper_body_lean``) about the hip axis H.x, which is C.x turned about C.y by
-    ``hip_tilt``, through the hip point (``lh1``, 0, ``lh3``) in C from the rear wheel centre. A point p
-    given in C's axes at zero lean is then at ``origin + rotation @ p``.
-    """
-    body = result.summary["bicycle"]["body"]
-    tilt = body["hip_tilt"]
-    axis = np.array([math.cos(tilt), 0.0, -math.sin(tilt)])    # H.x in C (sympy's orient_axis about C.y)
-    hinge = np.array([body["lh1"], 0.0, body["lh3"]])
-    lean = np.interp(times, result.trajectory["time"].to_numpy(), result.trajectory["upper_body_lean"].to_numpy())
-    cross = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
-    turn = (np.eye(3) + np.sin(lean)[:, None, None] * cross
-            + (1.0 - np.cos(lean))[:, None, None] * (cross @ cross))          # Rodrigues: about H.x by q11
-    rotation = rear_rotation @ turn
-    origin = rear_origin + rear_rotation @ hinge - rotation @ hinge
-    return rotation, origin
+def _part_pose(result, times, part, rear_rotation, rear_origin):
+    """Rotation (n, 3, 3) and origin (n, 3) of ``part``'s own frame at ``times`` (its declared ``pose``), from
+    the run's body parameters and the part's states (its declared trajectory columns) at ``times``."""
+    traj = result.trajectory
+    t = traj["time"].to_numpy()
+    states = {state: np.interp(times, t, traj[column].to_numpy()) for state, (column, _) in part.columns.items()}
+    return part.pose(result.summary["bicycle"]["body"], states, rear_rotation, rear_origin)
 
 
 def _model_parameters(result, tyres):
@@ -504,9 +506,10 @@ def build_scene(result, times, tyres=None, moments=True):
 
     placed = {"C": (pose.frames["C"], pose.points["rear_wheel_centre"]),
               "E": (pose.frames["E"], pose.points["front_wheel_centre"])}
+    own = _part_frames(result.scenario)
     for body in _bicycle_bodies(result.scenario, result.summary, params):
-        if body.frame not in placed:   # "G": the leaning upper body
-            placed["G"] = _upper_body_pose(result, times, *placed["C"])
+        if body.frame not in placed:   # a part's own frame ("G": the leaning upper body), as it declares
+            placed[body.frame] = _part_pose(result, times, own[body.frame], *placed["C"])
         rot, origin = placed[body.frame]
         for name, pts in body.lines.items():
             world = origin[:, None, :] + np.einsum("nij,mj->nmi", rot, pts)

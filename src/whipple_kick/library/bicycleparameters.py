@@ -46,6 +46,7 @@ import yaml
 
 from whipple_kick.errors import DefaultValueWarning, InputError
 from whipple_kick.model import benchmark as _benchmark
+from whipple_kick.model import parts
 
 from . import bicycles, parameters, riders
 from .riders import MAX_RIDER_MASS_KG, MIN_RIDER_MASS_KG, NO_RIDER
@@ -510,14 +511,10 @@ def leaning_rider(obj):
                             parameterisation="moore", includes_rider=True,
                             source=f"bicycleparameters {type(obj).__name__} (Moore 2012)",
                             description="Moore's leaning-rider set: the bicycle with the rider's legs")
-    lam = bike.benchmark["lam"]
-    c_x, c_z = _benchmark._pitch_matrix(lam)
     hinge = np.array([0.0, params["d4"]])              # (x, z) from the rear wheel centre, benchmark axes
-    body = {"hip_tilt": -lam, "lh1": float(hinge @ c_x), "lh3": float(hinge @ c_z),
-            "mt": params["mg"], "lt1": params["l5"], "lt3": params["l6"], "it11": params["ig11"],
-            "it22": params["ig22"], "it33": params["ig33"], "it31": params["ig31"],
-            "kh": params["k9"], "ch": params["c9"]}
-    return bike, body
+    inertia = [[params["ig11"], 0.0, params["ig31"]], [0.0, params["ig22"], 0.0], [params["ig31"], 0.0, params["ig33"]]]
+    body = parts.trunk_body(bike.benchmark["lam"], hinge, (params["l5"], params["l6"]), params["mg"], inertia)
+    return bike, {**body, "kh": params["k9"], "ch": params["c9"]}
 
 
 def _body_in_benchmark(bike, body):

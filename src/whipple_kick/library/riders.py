@@ -794,13 +794,10 @@ def for_load_share(bike, share, fz_n=None, rider_mass_kg=None, rider="jason", he
     return LoadShareSolution(combined=combined, rider_mass_kg=mass, shift_m=shift)
 
 
-#: Yeadon segments of the upper body that leans on the saddle: pelvis, thorax, chest-head and
-#: the upper arms; the forearms and hands too unless they move with the bar. The legs stay in the rear frame.
-UPPER_BODY_SEGMENTS = ("P", "T", "C", "A1", "B1")
-#: Forearm-hand segments: with the arms on the bar they move with the front frame (their inertia about the
-#: steer axis is the arms' inertia moving with the bar), else with the upper body.
-FOREARM_SEGMENTS = ("A2", "B2")
-LEG_SEGMENTS = ("J1", "J2", "K1", "K2")
+#: The rider's eleven Yeadon segments: pelvis, thorax, chest-head, the arms (upper, forearm-hand) and the legs
+#: (thigh, shank-foot). Those no part of the model carries (:attr:`whipple_kick.model.parts.Split.segments`) stay
+#: in the rear frame.
+RIDER_SEGMENTS = ("P", "T", "C", "A1", "A2", "B1", "B2", "J1", "J2", "K1", "K2")
 
 
 def _segments(human, seat_pt, names):
@@ -813,61 +810,110 @@ def _segments(human, seat_pt, names):
     return float(mass), com, inertia
 
 
-def seat_with_body(bike, rider, arms_on_bar=True, shift_m=0.0):
-    """Seat a rider whose upper body leans on the saddle and whose forearms move with the bar.
+def carriers(part_names):
+    """The declared parts that split the rider for a model with parts ``part_names``, in build order.
 
-    The rider is seated as by :func:`place`. The legs are lumped into the
-    rear frame; with ``arms_on_bar`` the forearms and hands are lumped into
-    the front frame (they turn with the bar); the rest (pelvis, trunk,
-    head, upper arms, and the forearms without ``arms_on_bar``) is the upper
-    body G, hinged at the seat point (the top of the seat post, where
-    yeadon's origin sits) about a horizontal axis along the bicycle's
-    heading. This is Moore's (2012, ch. 4, "Leaning rider extension")
-    upper-body hinge near the saddle, with the segments taken from the
-    rider's own Yeadon model.
+    The model's parts that declare a :class:`~whipple_kick.model.parts.Split`, and every declared part the
+    model lacks that holds its body rigidly (``Split.rigid``) and names segments one of them carries: its
+    body is the rest of its segments, held as it declares (the upper body of the rigid rider whose arms take
+    the forearms to the bar). Empty: the rider is not split.
+    """
+    from whipple_kick.model import parts
+
+    chosen = [p for p in parts.named(part_names) if p.split is not None]
+    taken = {s for p in chosen for s in p.split.segments}
+    held = [n for n, p in parts.REGISTRY.items() if p.split is not None and p.split.rigid
+            and p not in chosen and taken & set(p.split.segments)]
+    return parts.named([p.name for p in chosen] + held) if chosen else ()
+
+
+def segment_carriers(part_names):
+    """The part that carries each of :data:`RIDER_SEGMENTS` in a model with ``part_names`` (None: the rear frame).
+
+    Parts in build order each take the segments they name, a later one from an earlier one.
+    """
+    owner = dict.fromkeys(RIDER_SEGMENTS)
+    for part in carriers(part_names):
+        owner.update(dict.fromkeys(part.split.segments, part))
+    return owner
+
+
+class SplitRider(NamedTuple):
+    """A rider split among the rear frame, the bicycle's frames and the parts' own bodies (:func:`split_rider`)."""
+
+    combined: object   # Bicycle: the rear frame with the segments no part carries, the lumped parts' in theirs
+    body: dict         # the own-body parts' parameters by name (a held part's too)
+    body_mass: float   # [kg] of the own bodies, which ``combined`` lacks
+    held: tuple        # (rigid, body) of each part the model lacks whose body the rear frame holds
+
+
+def split_rider(bike, rider, part_names, shift_m=0.0):
+    """Seat ``rider`` on ``bike`` split as the parts ``part_names`` of a model declare (:func:`carriers`).
+
+    The rider is seated as by :func:`place`. Each part's :class:`~whipple_kick.model.parts.Split` says which
+    Yeadon segments it carries and how: lumped into a frame of the bicycle (the forearms into the front
+    frame) or as a body of its own (the upper body, its parameters by its ``body``). The segments no part
+    carries are lumped into the rear frame. A part the model lacks whose split holds its body rigidly
+    (``rigid``) is split off all the same and listed in ``held``: apply each to the Moore parameters.
 
     Parameters
     ----------
     bike : Bicycle
         Bicycle-only set with seating geometry.
     rider : YeadonRider
-    arms_on_bar : bool
+    part_names : tuple of str
+        The model's parts.
     shift_m : float
-        Fore-aft shift of the whole seated rider [m], forward positive (:func:`shifted`): the hinge moves
-        with the seat point, the legs and the forearms (on the bar) with the rider.
+        Fore-aft shift of the whole seated rider [m], forward positive (:func:`shifted`): a hinge at the seat
+        point moves with it, the legs and the lumped segments with the rider.
+
+    Returns
+    -------
+    SplitRider
+    """
+    seated = shifted(place(bike, rider), shift_m)
+    human = rider.human(seated.configuration)
+    seat_pt = seated.seat
+    owner = segment_carriers(part_names)
+    rest, bench, total = [s for s in RIDER_SEGMENTS if owner[s] is None], bike.benchmark, 0.0
+    if rest:   # the segments no part carries, in the rear frame
+        rest = _segments(human, seat_pt, rest)
+        bench, total = lump_into_frame(bench, "B", *rest), rest[0]
+    body, body_mass, held, titles = {}, 0.0, [], []
+    for part in carriers(part_names):
+        names = [s for s in part.split.segments if owner[s] is part]
+        if not names:
+            continue
+        mass, com, inertia = _segments(human, seat_pt, names)
+        total += mass
+        titles.append(part.title or part.name)
+        if part.split.frame:
+            bench = lump_into_frame(bench, part.split.frame, mass, com, inertia)
+            continue
+        own = part.split.body(bike.benchmark, seat_pt, mass, com, inertia)
+        body.update(own)
+        body_mass += mass
+        if part.name not in part_names:
+            held.append((part.split.rigid, own))
+    if abs(total - seated.mass) > 1e-9 * seated.mass:
+        raise RuntimeError(f"the rider's segments sum to {total} kg, not {seated.mass} kg")
+    combined = _with_rider(bike, rider, seated, bench, ", body" + _shift_label(shift_m),
+                           f": split as the model's parts declare ({', '.join(titles)} carrying their segments), "
+                           "the rest in the rear frame.")
+    return SplitRider(combined, body, body_mass, tuple(held))
+
+
+def seat_with_body(bike, rider, arms_on_bar=True, shift_m=0.0):
+    """Seat a rider whose upper body leans on the saddle (the trunk part) and, with ``arms_on_bar``, whose
+    forearms move with the bar (the arms part): :func:`split_rider` for those parts.
 
     Returns
     -------
     combined : Bicycle
         The bicycle with the legs (and forearms) lumped in; its ``rider`` metadata as :func:`seat`'s.
     body : dict
-        The upper body's parameters by name (:data:`whipple_kick.model.slip.parameters.BODY_NAMES`: ``hip_tilt``,
-        ``lh1``, ``lh3``, ``mt``, ``lt1``, ``lt3``, ``it11``, ``it22``, ``it33``, ``it31``), in Moore's
-        rear frame C from the rear wheel centre (the trunk part's, :data:`whipple_kick.model.parts.TRUNK`).
+        The upper body's parameters by name (the trunk part's :data:`whipple_kick.model.parts.TRUNK`
+        ``from_rider``), in Moore's rear frame C from the rear wheel centre.
     """
-    seated = shifted(place(bike, rider), shift_m)
-    human = rider.human(seated.configuration)
-    seat_pt = seated.seat
-    legs = _segments(human, seat_pt, LEG_SEGMENTS)
-    m_t, com_t, i_t = _segments(human, seat_pt, UPPER_BODY_SEGMENTS + (() if arms_on_bar else FOREARM_SEGMENTS))
-    bench = lump_into_frame(bike.benchmark, "B", *legs)
-    total = legs[0] + m_t
-    if arms_on_bar:
-        forearms = _segments(human, seat_pt, FOREARM_SEGMENTS)
-        bench = lump_into_frame(bench, "H", *forearms)
-        total += forearms[0]
-    if abs(total - seated.mass) > 1e-9 * seated.mass:
-        raise RuntimeError(f"the rider's segments sum to {total} kg, not {seated.mass} kg")
-    lam = bike.benchmark["lam"]
-    # Moore's rear frame C (C.x, C.z in benchmark x, z), from the rear wheel centre (0, 0, -rR). Turning C
-    # about C.y by -lam gives H.x = X: a horizontal hinge.
-    c_x, c_z = _benchmark._pitch_matrix(lam)
-    hip = (seat_pt - np.array([0.0, 0.0, -bike.benchmark["rR"]]))[[0, 2]]
-    arm = com_t - seat_pt
-    body = {"hip_tilt": -lam, "lh1": float(hip @ c_x), "lh3": float(hip @ c_z),
-            "mt": m_t, "lt1": float(arm[0]), "lt3": float(arm[2]),
-            "it11": float(i_t[0, 0]), "it22": float(i_t[1, 1]), "it33": float(i_t[2, 2]), "it31": float(i_t[0, 2])}
-    where = "forearms and hands in the front frame, " if arms_on_bar else ""
-    combined = _with_rider(bike, rider, seated, bench, ", body" + _shift_label(shift_m),
-                           f": legs in the rear frame, {where}the rest a leaning upper body.")
-    return combined, body
+    split = split_rider(bike, rider, ("trunk", "arms") if arms_on_bar else ("trunk",), shift_m)
+    return split.combined, split.body

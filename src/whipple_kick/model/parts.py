@@ -5,12 +5,15 @@ is the bicycle with a rigid rider lumped into the rear frame and its
 reflex; each :class:`Part` adds
 to it what it declares: its symbols (with units and descriptions), its
 coordinates and speeds, its bodies, joint, springs, dampers and loads (its
-``build``), its parameters, the rider's feedback gains on its states, its
-trajectory columns and its outputs. A part is declared once, in its own
+``build``, which adds them to a SymPy ``System``: :class:`Mechanics`), its
+parameters, the rider's feedback gains on its states, its trajectory
+columns, its outputs, how it takes its body from the rider's segments
+(:class:`Split`) and how it is drawn. A part is declared once, in its own
 module, and the rest follows from the declaration: the derivation, the
 generated code and its cache key, the state, parameter and output layouts
-(:class:`whipple_kick.model.slip.layout.Layout`), the trajectory's columns
-and the gain table. A model without a part has none of its terms: the rigid
+(:class:`whipple_kick.model.slip.layout.Layout`), the trajectory's columns,
+the gain table, the rider's split (:func:`whipple_kick.library.riders.split_rider`)
+and the animation. A model without a part has none of its terms: the rigid
 rider is the model without the trunk part, not a locked one.
 
 This follows SymBRiM's split of a rider into models and connections that
@@ -28,63 +31,111 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 import hashlib
 import inspect
+import math
 
 import numpy as np
 
 from whipple_kick.errors import InputError
+from whipple_kick.model import benchmark
 from whipple_kick.model import symbols as S
 
 
 @dataclass
 class Mechanics:
-    """What the parts of one derivation add to the bicycle, as SymPy objects (the build side only).
+    """What the parts of one derivation add to the bicycle: a SymPy :class:`~sympy.physics.mechanics.System`.
 
-    A part's ``build`` receives this and appends to it. ``hands_frame`` is the
-    frame the rider's hands react the steer torque and the arms on (the rear
-    frame C unless a part carries the upper body), and ``hands_angle`` /
-    ``hands_rate`` its rotation [rad] and rate [rad/s] about the steer axis
-    C.z relative to the rear frame (the arms' spring stretches by the bar's
-    rotation relative to the hands).
+    A part's ``build`` receives this and adds to :attr:`system` what SymPy's
+    mechanics API holds: its bodies (``system.add_bodies``, or :meth:`body`),
+    joints (``system.add_joints``: a joint brings its coordinates, speeds and
+    kinematic differential equations), actuators (``system.add_actuators``:
+    a ``TorqueActuator``, a ``LinearSpring`` or ``LinearDamper`` along a
+    pathway) and other loads (``system.add_loads``). The system starts with
+    the bicycle's four bodies (a joint's parent, :meth:`rigid_body`); the
+    derivation reads the parts' bodies, coordinates, speeds, kinematic
+    equations and loads back from it, weighs every body the parts added, and
+    takes the store of each ``LinearSpring`` and the dissipation of each
+    ``LinearDamper`` into the energy balance. What SymPy's system does not
+    hold is here: the energy of a spring-damper written as a torque
+    (:attr:`spring_energy`, :attr:`damper_dissipation`), the part's declared
+    outputs, and the frame the hands hold.
+
+    ``hands_frame`` is the frame the rider's hands react the steer torque and
+    the arms on (the rear frame C unless a part carries the upper body), and
+    ``hands_angle`` / ``hands_rate`` its rotation [rad] and rate [rad/s] about
+    the steer axis C.z relative to the rear frame (the arms' spring stretches
+    by the bar's rotation relative to the hands).
     """
 
-    kin: object                 # derivation.Kinematics (frames, points, q, u, bodies, gravity loads)
+    kin: object                 # derivation.Kinematics (frames, points, q, u, the bicycle's bodies, its weights)
     par: dict                   # parameter symbols by name (the base model's and every part's)
-    coordinates: dict = field(default_factory=dict)   # name -> dynamicsymbol, the parts' coordinates
-    speeds: dict = field(default_factory=dict)        # name -> dynamicsymbol, the parts' speeds
-    loads: list = field(default_factory=list)         # (point or frame, vector) as KanesMethod takes them
-    spring_energy: list = field(default_factory=list)        # terms [J]
-    damper_dissipation: list = field(default_factory=list)   # terms [W], each >= 0
+    system: object = None       # sympy.physics.mechanics.System in the ground frame N about O (set when None)
+    spring_energy: list = field(default_factory=list)        # terms [J] of springs that are not LinearSprings
+    damper_dissipation: list = field(default_factory=list)   # terms [W], each >= 0, of dampers that are not
+    #                                                          LinearDampers
     outputs: dict = field(default_factory=dict)       # name -> expression (the part's declared outputs)
     hands_frame: object = None
     hands_angle: object = 0
     hands_rate: object = 0
 
-    def coordinate(self, q_name, u_name):
-        """A new coordinate and its speed (``u = dq/dt``), appended to the system's: (q, u) dynamicsymbols."""
-        import sympy.physics.mechanics as me
+    def __post_init__(self):
+        if self.system is None:
+            import sympy.physics.mechanics as me
 
-        q, u = S.dyn(q_name), S.dyn(u_name)
-        self.kin.q = (*self.kin.q, q)
-        self.kin.u = (*self.kin.u, u)
-        self.kin.qd_to_u[q.diff(me.dynamicsymbols._t)] = u
-        self.coordinates[q_name], self.speeds[u_name] = q, u
-        return q, u
+            self.system = me.System(self.kin.frames["N"], self.kin.points["O"])
+            self.system.add_bodies(*self.kin.bodies)
+        self._bicycle = tuple(self.kin.bodies)
+
+    def coordinate(self, q_name, u_name):
+        """A part's coordinate and its speed (``u = dq/dt``) by name: (q, u) dynamicsymbols, for its joint.
+
+        The joint brings them into :attr:`system` (``system.add_joints``); a coordinate no joint carries is
+        added with ``system.add_coordinates``, ``add_speeds`` and ``add_kdes`` (``dq/dt - u``).
+        """
+        return S.dyn(q_name), S.dyn(u_name)
 
     def body(self, name, point, frame, mass, inertia):
-        """Add a rigid body with its weight (``inertia`` a dyadic about ``point``, its mass centre); return it."""
+        """Add a rigid body (``inertia`` a dyadic about ``point``, its mass centre) to :attr:`system`; return it.
+
+        The derivation weighs it (every body a part adds).
+        """
         import sympy.physics.mechanics as me
 
         body = me.RigidBody(name, point, frame, mass, (inertia, point))
-        self.kin.bodies.append(body)
-        self.kin.gravity_loads.append((point, mass * self.par["g"] * self.kin.frames["N"].z))
+        self.system.add_bodies(body)
         return body
 
     def rigid_body(self, name):
-        """The system's rigid body called ``name`` (``"rear_frame"``, ``"front_frame"``, a part's), to join to."""
-        found = [b for b in self.kin.bodies if b.name == name]
+        """The system's body called ``name`` (``"rear_frame"``, ``"front_frame"``, a part's), to join to."""
+        found = [b for b in self.system.bodies if b.name == name]
         if not found:
-            raise KeyError(f"no body {name!r}; bodies: {', '.join(b.name for b in self.kin.bodies)}")
+            raise KeyError(f"no body {name!r}; bodies: {', '.join(b.name for b in self.system.bodies)}")
         return found[0]
+
+    def added_bodies(self):
+        """The bodies the parts added, in the order they were added (the bicycle's four excluded)."""
+        return [b for b in self.system.bodies if not any(b is own for own in self._bicycle)]
+
+    def loads(self):
+        """The parts' loads as Kane's method takes them: each actuator's (in the order added), then the rest."""
+        return [*(load for act in self.system.actuators for load in act.to_loads()), *self.system.loads]
+
+    def actuator_energy(self):
+        """(store [J], dissipation rate [W]) of the system's ``LinearSpring`` and ``LinearDamper`` actuators.
+
+        A linear spring of stiffness k and equilibrium length l0 along a pathway of length l stores
+        k (l - l0)^2 / 2; a linear damper of damping c dissipates c (dl/dt)^2 >= 0.
+        """
+        import sympy.physics.mechanics as me
+
+        store, dissipation = [], []
+        for act in self.system.actuators:
+            if isinstance(act, me.LinearSpring):
+                store.append(act.stiffness * (act.pathway.length - act.equilibrium_length) ** 2 / 2)
+            elif isinstance(act, me.LinearDamper):
+                dissipation.append(act.damping * act.pathway.extension_velocity ** 2)
+        # A pathway's extension velocity is d(length)/dt: in the speeds by dq/dt = u.
+        return ([e.xreplace(self.kin.qd_to_u) for e in store],
+                [e.xreplace(self.kin.qd_to_u) for e in dissipation])
 
 
 @dataclass(frozen=True)
@@ -120,6 +171,45 @@ class Field:
     default: float
     source: str
     refuse_low: str = ""
+
+
+@dataclass(frozen=True)
+class Split:
+    """How a part takes its body from the rider's Yeadon segments (:func:`whipple_kick.library.riders.split_rider`).
+
+    The rider's segments go to the rear frame unless a part of the model carries them: the parts in their
+    build order (:func:`named`) each take the segments they name, a later part from an earlier one (the arms,
+    built after the trunk, take the forearms the trunk names).
+
+    Attributes
+    ----------
+    segments : tuple of str
+        The Yeadon segments it carries (``"P"`` pelvis, ``"A2"`` a forearm and hand ...).
+    frame : str
+        The benchmark body its segments are lumped into (``"H"``: the front frame, they turn with the bar), or
+        ``""`` for a body of its own (then :attr:`body`).
+    body : callable, optional
+        ``body(bench, seat, mass, com, inertia)``: its parameters by name from its segments' mass [kg], mass
+        centre (3,) [m] and inertia (3, 3) [kg m^2] about it, in the benchmark frame, ``seat`` (3,) [m] the
+        rider's seat point and ``bench`` the bicycle's benchmark parameters.
+    rigid : callable, optional
+        ``rigid(moore, body)``: the Moore parameters with :attr:`body`'s parameters held by the rear frame, for
+        a model without the part whose rider is split for another part (the rigid rider with the arms on the
+        bar); without it the segments are lumped into the rear frame.
+    moves_with : str
+        The model's frame its segments move with, for drawings (``"G"`` the leaning upper body, ``"E"`` the
+        front frame; the rest of the rider moves with the rear frame ``"C"``).
+    """
+
+    segments: tuple
+    frame: str = ""
+    body: Callable = None
+    rigid: Callable = None
+    moves_with: str = "C"
+
+    def __post_init__(self):
+        if bool(self.frame) == (self.body is not None):
+            raise ValueError("a part's split lumps its segments into a frame or makes a body of its own, one of them")
 
 
 @dataclass(frozen=True)
@@ -169,6 +259,15 @@ class Part:
         Its parameters a run takes from the rider's segments (the upper body that
         :func:`whipple_kick.library.riders.seat_with_body` splits off, by the same names), where the bicycle's
         rider has them (``whipple_kick.simulate.assembly.rider_body``).
+    split : Split, optional
+        How it takes its body from the rider's segments (:func:`whipple_kick.library.riders.split_rider`).
+    pose : callable, optional
+        For a part whose segments move with a frame of its own (``split.moves_with``, the upper body's G):
+        ``pose(body, states, rear_rotation, rear_origin)`` gives that frame's rotation (n, 3, 3) and origin
+        (n, 3) in the ground frame at n drawn instants, from the run's body parameters by name, the part's
+        states by name (n,) and the rear frame's rotation and wheel-centre origin; a point p given in the
+        rear frame's axes at the part's rest (from the rear wheel centre) is drawn at ``origin + rotation @ p``
+        (:func:`whipple_kick.figures.animation.build_scene`).
     """
 
     name: str
@@ -189,6 +288,8 @@ class Part:
     after: tuple = ()
     values: dict = field(default_factory=dict)
     from_rider: tuple = ()
+    split: Split = None
+    pose: Callable = None
 
     def __post_init__(self):
         if self.name in self.needs + self.after:
@@ -283,9 +384,103 @@ def _selection(name):
     return f"{part.selected_by[0]} {part.selected_by[1]!r}" if part is not None and part.selected_by else ""
 
 
+def _hinge_rotation(hip_tilt):
+    """Rotation matrix whose columns are the hip frame H's axes in the rear frame C (H turned about C.y)."""
+    c, s = np.cos(hip_tilt), np.sin(hip_tilt)
+    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+
+
+def _parallel_axis(mass, offset):
+    """Inertia [kg m^2] a point mass at ``offset`` [m] adds about the origin."""
+    d = np.asarray(offset, dtype=float)
+    return mass * (d @ d * np.eye(3) - np.outer(d, d))
+
+
+def merge_into_rear_frame(moore, body):
+    """Moore parameters with the upper body of ``body`` (the trunk's placement and inertia) in the rear frame.
+
+    The upper body at zero lean is a rigid part of the rear frame: its mass,
+    mass centre and inertia are combined with the rear frame's (Moore's
+    ``mc l1 l2 ic11 ic22 ic33 ic31``, about the combined mass centre, in the
+    rear frame's axes), exactly as a locked hip would hold it. For the rigid
+    rider whose forearms turn with the bar (the rest of the rider is then
+    the rear frame plus this upper body).
+
+    Parameters
+    ----------
+    moore : mapping
+        Moore parameters of the bicycle whose rear frame lacks the upper body.
+    body : mapping
+        At least the trunk's placement and inertia (``hip_tilt lh1 lh3 mt lt1 lt3 it11 it22 it33 it31``).
+
+    Returns
+    -------
+    dict
+        ``moore`` with the rear frame's seven entries replaced.
+    """
+    out = dict(moore)
+    mc, mt = float(moore["mc"]), float(body["mt"])
+    R = _hinge_rotation(float(body["hip_tilt"]))   # G = H at zero lean
+    r_c = np.array([moore["l1"], 0.0, moore["l2"]], dtype=float)
+    r_g = np.array([body["lh1"], 0.0, body["lh3"]], dtype=float) + R @ np.array([body["lt1"], 0.0, body["lt3"]])
+    mass = mc + mt
+    r = (mc * r_c + mt * r_g) / mass
+    I_c = np.array([[moore["ic11"], 0.0, moore["ic31"]], [0.0, moore["ic22"], 0.0],
+                    [moore["ic31"], 0.0, moore["ic33"]]], dtype=float)
+    I_g = np.array([[body["it11"], 0.0, body["it31"]], [0.0, body["it22"], 0.0],
+                    [body["it31"], 0.0, body["it33"]]], dtype=float)
+    inertia = I_c + _parallel_axis(mc, r_c - r) + R @ I_g @ R.T + _parallel_axis(mt, r_g - r)
+    out.update(mc=mass, l1=float(r[0]), l2=float(r[2]), ic11=float(inertia[0, 0]), ic22=float(inertia[1, 1]),
+               ic33=float(inertia[2, 2]), ic31=float(inertia[0, 2]))
+    return out
+
+
 # ------------------------------------------------------------------ the trunk
 
 _TRUNK_BODY = ("hip_tilt", "lh1", "lh3", "mt", "lt1", "lt3", "it11", "it22", "it33", "it31")
+
+
+def trunk_body(lam, hinge, offset, mass, inertia):
+    """The trunk's placement and inertia (:data:`_TRUNK_BODY`) from an upper body hinged on a horizontal axis.
+
+    ``lam`` [rad] is the bicycle's steer axis tilt (Moore's rear frame C is the benchmark frame pitched by
+    it: turning C about C.y by ``-lam`` makes the hinge axis H.x horizontal), ``hinge`` (x, z) [m] the hinge
+    point from the rear wheel centre and ``offset`` (x, z) [m] the body's mass centre from the hinge, both in
+    benchmark axes, ``mass`` [kg] and ``inertia`` (3, 3) [kg m^2] about the mass centre in benchmark axes
+    (G is level with them at zero lean).
+    """
+    c_x, c_z = benchmark._pitch_matrix(lam)
+    hinge = np.asarray(hinge, dtype=float)
+    return {"hip_tilt": -lam, "lh1": float(hinge @ c_x), "lh3": float(hinge @ c_z),
+            "mt": mass, "lt1": float(offset[0]), "lt3": float(offset[1]),
+            "it11": float(inertia[0][0]), "it22": float(inertia[1][1]), "it33": float(inertia[2][2]),
+            "it31": float(inertia[0][2])}
+
+
+def _split_trunk(bench, seat, mass, com, inertia):
+    """The trunk from its Yeadon segments: hinged at the rider's seat point (the top of the seat post, where
+    yeadon's origin sits), Moore's (2012, ch. 4) upper-body hinge near the saddle."""
+    hinge = (seat - np.array([0.0, 0.0, -bench["rR"]]))[[0, 2]]
+    arm = com - seat
+    return trunk_body(bench["lam"], hinge, arm[[0, 2]], mass, inertia)
+
+
+def _trunk_pose(body, states, rear_rotation, rear_origin):
+    """The upper body G's rotation and origin at the drawn instants (:attr:`Part.pose`).
+
+    G is the rear frame C turned by the lean q11 about the hip axis H.x, which is C.x turned about C.y by
+    ``hip_tilt``, through the hip point (``lh1``, 0, ``lh3``) in C from the rear wheel centre.
+    """
+    tilt = body["hip_tilt"]
+    axis = np.array([math.cos(tilt), 0.0, -math.sin(tilt)])    # H.x in C (sympy's orient_axis about C.y)
+    hinge = np.array([body["lh1"], 0.0, body["lh3"]])
+    lean = np.asarray(states["q11"], dtype=float)
+    cross = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+    turn = (np.eye(3) + np.sin(lean)[:, None, None] * cross
+            + (1.0 - np.cos(lean))[:, None, None] * (cross @ cross))          # Rodrigues: about H.x by q11
+    rotation = rear_rotation @ turn
+    origin = rear_origin + rear_rotation @ hinge - rotation @ hinge
+    return rotation, origin
 
 
 def _build_trunk(m):
@@ -311,10 +506,11 @@ def _build_trunk(m):
                       parent_point=ho, child_point=-(b["lt1"] * G.x + b["lt3"] * G.z), parent_interframe=H,
                       joint_axis=H.x)
     go.v2pt_theory(ho, N, G)   # the joint gives go's velocity in the rear frame; Kane's method reads it in N
+    m.system.add_joints(hip)   # brings q11, u11 and dq11/dt = u11
     kin.frames.update(H=H, G=G)
     kin.points.update(ho=ho, go=go)
     hip_torque = -(b["kh"] * q11 + b["ch"] * u11)   # on G about H.x, reacted on the rear frame
-    m.loads += me.TorqueActuator.at_pin_joint(hip_torque, hip).to_loads()
+    m.system.add_actuators(me.TorqueActuator.at_pin_joint(hip_torque, hip))
     # The hands hold the bar from G: the bar turns relative to G about C.z by q7 - (H.x . C.z) q11
     # (H.x . C.z is constant), so the arms' spring is exact.
     axis_share = H.x.dot(C.z)
@@ -367,6 +563,12 @@ TRUNK = declare(Part(
     ),
     title="the leaning upper body",
     from_rider=_TRUNK_BODY,   # the rider's own upper body: its placement on the hip and its inertia
+    # Pelvis, thorax, chest-head, the upper arms and the forearms and hands (which a part the model has built
+    # after it takes: the arms on the bar); the legs stay in the rear frame. Without the trunk, a rider split
+    # for another part holds its upper body rigidly in the rear frame.
+    split=Split(segments=("P", "T", "C", "A1", "B1", "A2", "B2"), body=_split_trunk,
+                rigid=merge_into_rear_frame, moves_with="G"),
+    pose=_trunk_pose,   # drawn leaning on the hip
 ))
 
 
@@ -386,7 +588,7 @@ def _build_arms(m):
     arm_angle = S.dyn("q7") - m.hands_angle
     arm_rate = S.dyn("u7") - m.hands_rate
     arm_torque = -(b["ka"] * arm_angle + b["ca"] * arm_rate)   # on the bar E about C.z, reacted on the hands
-    m.loads += me.TorqueActuator(arm_torque, C.z, E, m.hands_frame).to_loads()
+    m.system.add_actuators(me.TorqueActuator(arm_torque, C.z, E, m.hands_frame))
     m.spring_energy.append(b["ka"] * arm_angle**2 / 2)
     m.damper_dissipation.append(b["ca"] * arm_rate**2)
     m.outputs["arm_steer_torque"] = arm_torque
@@ -420,6 +622,9 @@ ARMS = declare(Part(
     ),
     title="the arms on the bar",
     after=("trunk",),   # the hands hold the upper body when it leans: the trunk sets the hands' frame first
+    # The forearms and hands turn with the bar (their inertia about the steer axis is the arms' inertia
+    # moving with it): lumped into the benchmark front frame H.
+    split=Split(segments=("A2", "B2"), frame="H", moves_with="E"),
 ))
 
 
@@ -431,54 +636,3 @@ def selected(scenario):
 def fields():
     """Every declared part's scenario fields, in declaration order."""
     return tuple(f for p in REGISTRY.values() for f in p.fields)
-
-
-def _hinge_rotation(hip_tilt):
-    """Rotation matrix whose columns are the hip frame H's axes in the rear frame C (H turned about C.y)."""
-    c, s = np.cos(hip_tilt), np.sin(hip_tilt)
-    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
-
-
-def _parallel_axis(mass, offset):
-    """Inertia [kg m^2] a point mass at ``offset`` [m] adds about the origin."""
-    d = np.asarray(offset, dtype=float)
-    return mass * (d @ d * np.eye(3) - np.outer(d, d))
-
-
-def merge_into_rear_frame(moore, body):
-    """Moore parameters with the upper body of ``body`` (the trunk's placement and inertia) in the rear frame.
-
-    The upper body at zero lean is a rigid part of the rear frame: its mass,
-    mass centre and inertia are combined with the rear frame's (Moore's
-    ``mc l1 l2 ic11 ic22 ic33 ic31``, about the combined mass centre, in the
-    rear frame's axes), exactly as a locked hip would hold it. For the rigid
-    rider whose forearms turn with the bar (the rest of the rider is then
-    the rear frame plus this upper body).
-
-    Parameters
-    ----------
-    moore : mapping
-        Moore parameters of the bicycle whose rear frame lacks the upper body.
-    body : mapping
-        At least the trunk's placement and inertia (``hip_tilt lh1 lh3 mt lt1 lt3 it11 it22 it33 it31``).
-
-    Returns
-    -------
-    dict
-        ``moore`` with the rear frame's seven entries replaced.
-    """
-    out = dict(moore)
-    mc, mt = float(moore["mc"]), float(body["mt"])
-    R = _hinge_rotation(float(body["hip_tilt"]))   # G = H at zero lean
-    r_c = np.array([moore["l1"], 0.0, moore["l2"]], dtype=float)
-    r_g = np.array([body["lh1"], 0.0, body["lh3"]], dtype=float) + R @ np.array([body["lt1"], 0.0, body["lt3"]])
-    mass = mc + mt
-    r = (mc * r_c + mt * r_g) / mass
-    I_c = np.array([[moore["ic11"], 0.0, moore["ic31"]], [0.0, moore["ic22"], 0.0],
-                    [moore["ic31"], 0.0, moore["ic33"]]], dtype=float)
-    I_g = np.array([[body["it11"], 0.0, body["it31"]], [0.0, body["it22"], 0.0],
-                    [body["it31"], 0.0, body["it33"]]], dtype=float)
-    inertia = I_c + _parallel_axis(mc, r_c - r) + R @ I_g @ R.T + _parallel_axis(mt, r_g - r)
-    out.update(mc=mass, l1=float(r[0]), l2=float(r[2]), ic11=float(inertia[0, 0]), ic22=float(inertia[1, 1]),
-               ic33=float(inertia[2, 2]), ic31=float(inertia[0, 2]))
-    return out

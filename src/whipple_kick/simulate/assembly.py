@@ -246,7 +246,10 @@ def _file_stamp(name):
 @functools.lru_cache(maxsize=256)
 def _bicycle_setup(spec, _stamp):
     bike = bicycleparameters.load_bicycle(spec.bicycle, spec.rider)
-    if spec.split and bike.includes_rider:
+    # The model's parts that split the rider (riders.carriers: the leaning upper body, the arms on the bar).
+    model_parts = tuple(p.name for p in parts.selected(spec))
+    split = bool(riders.carriers(model_parts))
+    if split and bike.includes_rider:
         raise _lumped_rider_error(bike)
     _refuse_rider_file(bike, spec.rider)
     if bike.includes_rider:
@@ -271,16 +274,17 @@ def _bicycle_setup(spec, _stamp):
         shift = 0.0 if rider_mass is not None else None
     rear_n, front_n = riders.static_loads(combined)
     design = dict(combined.moore)
-    body = None
-    if spec.split:
-        # The same rider, split into legs (rear frame), forearms (front frame, when on the bar) and upper body.
+    body, body_mass, held = None, 0.0, ()
+    if split:
+        # The same rider, split as the model's parts declare: the legs in the rear frame, the forearms in
+        # the front frame (on the bar), the upper body on its hip.
         rider = riders.yeadon_rider(spec.rider, mass_kg=rider_mass)
-        combined, body = riders.seat_with_body(bike, rider, arms_on_bar=spec.arms_on_bar, shift_m=shift)
+        combined, body, body_mass, held = riders.split_rider(bike, rider, model_parts, shift_m=shift)
     moore = dict(combined.moore)
-    if body and not spec.leaning:
-        # The rigid rider with the arms on the bar: the upper body is part of the rear frame (the model
-        # without the trunk part), the forearms turn with the bar.
-        moore = parts.merge_into_rear_frame(moore, body)
+    for hold, own in held:
+        # A part the model lacks whose body the rear frame holds (the rigid rider's upper body with the
+        # arms on the bar; the forearms turn with the bar).
+        moore = hold(moore, own)
     if spec.low_inertia:
         bench = dict(combined.benchmark)
         for key in LOW_INERTIA_KEYS:
@@ -296,7 +300,7 @@ def _bicycle_setup(spec, _stamp):
             # drawing shows the rider the run had without seating it again; None for a preset.
             "rider_posture": None if bike.includes_rider else dict(combined.rider["posture"]),
             "total_mass_kg": sum(float(combined.benchmark[k]) for k in ("mR", "mB", "mH", "mF"))
-            + (body["mt"] if body else 0.0), "body": body}
+            + body_mass, "body": body}
     return moore, design, info
 
 
@@ -342,7 +346,7 @@ def _rear_load_range(bicycle, _stamp, rider_name):
 
 
 def rider_body(spec, info):
-    """The rider's body parameters by name (:data:`whipple_kick.model.slip.parameters.BODY_NAMES`).
+    """The rider's body parameters by name (:func:`whipple_kick.model.slip.parameters.body_names`).
 
     ``spec`` is ``scenario.body_spec``, ``info`` :func:`build_bicycle`'s.
     The reflex (:data:`~whipple_kick.model.slip.parameters.RIGID_BODY`) in every model; each declared part

@@ -25,7 +25,7 @@ from scipy.optimize import minimize
 
 from whipple_kick.errors import ConvergenceWarning, InputError, check_range
 from whipple_kick.library import thesis
-from whipple_kick.model import classic, slip
+from whipple_kick.model import classic, parts, slip
 
 from . import steady
 
@@ -412,7 +412,7 @@ def lqr_on_simulated_model(spec, moore, design, body, rear, front, model):
         The design's closed-loop eigenvalues.
     """
     speed = spec.speed
-    felt, K = simulated_design_start(spec, design)
+    felt, K = simulated_design_start(spec, design, model.parts)
     scaled = SCALED_BODY_GAINS
     models = {}
 
@@ -454,10 +454,15 @@ def lqr_on_simulated_model(spec, moore, design, body, rear, front, model):
 SCALED_BODY_GAINS = ("ka", "ca", "rq4", "rq7", "ru4", "ru7")
 
 
-def simulated_design_start(spec, design):
-    """The gains the design on the simulated model feeds back (``felt``) and its starting gains (Whipple design)."""
+def simulated_design_start(spec, design, part_names):
+    """The gains the design on the simulated model feeds back (``felt``) and its starting gains (Whipple design).
+
+    ``part_names`` are the simulated model's parts (``slip.Model.parts``): each part's declared gains
+    (:attr:`whipple_kick.model.parts.Part.gains`: the upper body's lean and lean rate) are fed back too,
+    from 0.
+    """
     speed = spec.speed
-    felt = (["kq4", "kq7", "ku4", "ku7"] + (["kq11", "ku11"] if spec.leaning else [])
+    felt = (["kq4", "kq7", "ku4", "ku7"] + [g for part in parts.named(part_names) for g in part.gains]
             + (["kq3"] if spec.heading else []))
     K = np.r_[whipple_lqr(design, speed)[0], np.zeros(len(felt) - 4)]
     if spec.heading:   # start from the Whipple model's heading design (its yaw gain holds the heading)

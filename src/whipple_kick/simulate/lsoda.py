@@ -8,11 +8,13 @@ through a jump map where the caller gives one (the plate stop's impulse).
 A fall (``|roll|`` beyond a limit) ends the run as an event, not an error.
 LSODA's stiff steps use the compiled model's Jacobian (forward differences
 in C over the dynamic states, one foreign call; the energy quadratures feed
-nothing back). On the fast path LSODA runs in C with
-the compiled model (:mod:`whipple_kick.simulate.lsoda_c`: one call per piece, the
-roll and steer limits checked in C); elsewhere it calls the compiled model
-through ``CompiledRHS.fast`` (:mod:`whipple_kick.model.rhs_call`: one foreign
-call per evaluation).
+nothing back). For the compiled model LSODA runs in C
+(:mod:`whipple_kick.simulate.lsoda_c`): the fast path one call per piece, the
+roll and steer limits checked in C, and the careful path (a fall, LSODA's
+trouble, the budget) one call per chunk, stepped, sampled and its fall found
+in C; elsewhere (another SciPy release, no C compiler, any other ``f(t, x)``)
+it calls the compiled model through ``CompiledRHS.fast``
+(:mod:`whipple_kick.model.rhs_call`: one foreign call per evaluation).
 
 No integration runs for ever: a :class:`Budget` bounds the right-hand-side
 evaluations per simulated second (those LSODA makes and those inside each
@@ -166,7 +168,10 @@ DEFAULT_BUDGET = Budget()
 
 
 def _careful_chunk(rhs, x, times, rtol, atol, fall, spent, budget, t_start, jac=None):
-    """Integrate one chunk with LSODA stepped from Python, the fall event and the budget.
+    """Integrate one chunk with LSODA stepped from Python, the fall event and the budget (the careful path).
+
+    For a compiled model where the driver builds, :func:`_careful_chunk_in_c` does the same in C; this is
+    the path for any other ``f(t, x)``, and the fallback.
 
     The same solver, step by step, as ``solve_ivp(method="LSODA", t_eval=times,
     events=fall)`` (samples from each step's dense output, the fall time by
@@ -230,16 +235,72 @@ def _careful_chunk(rhs, x, times, rtol, atol, fall, spent, budget, t_start, jac=
             recent.popleft()
         why = None
         if spent + used > budget.limit(t_new - t_start):
-            why = (f"{spent + used} right-hand-side evaluations for {t_new - t_start:.4g} s simulated, "
-                   f"more than the budget {budget.allowance} + {budget.per_second:g}/s")
+            why = "budget"
         elif recent[0][0] <= used - budget.stall_window and t_new - recent[0][1] < budget.stall_progress:
-            why = (f"{used - recent[0][0]} right-hand-side evaluations advanced it only "
-                   f"{t_new - recent[0][1]:.2g} s (at least {budget.stall_progress:g} s per "
-                   f"{budget.stall_window} evaluations)")
+            why = "stall"
         if why is not None:
             return (np.concatenate(out_t), np.concatenate(out_x), end, "failed",
-                    f"integration stalled at t = {t_new:.6g} s: {why}; last step {solver.step_size:.2g} s",
+                    _stall_message(why, budget, spent, used, t_new, t_start, recent[0], solver.step_size),
                     counts())
+
+
+def _stall_message(why, budget, spent, used, t_new, t_start, window, step_size):
+    """Why a careful chunk stopped at ``t_new`` [s]: ``why`` "budget" (``spent + used`` evaluations over the
+    budget) or "stall" (``used`` less ``window``'s evaluations advanced it less than the stall window allows
+    since ``window``'s time), with the last step's size [s]. The one wording of both careful paths."""
+    if why == "budget":
+        why = (f"{spent + used} right-hand-side evaluations for {t_new - t_start:.4g} s simulated, "
+               f"more than the budget {budget.allowance} + {budget.per_second:g}/s")
+    else:
+        why = (f"{used - window[0]} right-hand-side evaluations advanced it only "
+               f"{t_new - window[1]:.2g} s (at least {budget.stall_progress:g} s per "
+               f"{budget.stall_window} evaluations)")
+    return f"integration stalled at t = {t_new:.6g} s: {why}; last step {step_size:.2g} s"
+
+
+def _careful_chunk_in_c(chunks_in_c, rhs, x, times, rtol, atol, fall, spent, budget, t_start, jac):
+    """:func:`_careful_chunk` in C (:meth:`whipple_kick.simulate.lsoda_c.FastChunks.careful`), the same return.
+
+    The same arguments after ``chunks_in_c``, whose own tolerances, limits and model C uses (``rtol``,
+    ``atol`` and ``fall`` are those; they are not read here).
+
+    The same steps, evaluation counts, ending and messages; the samples, the fall time and the state at the
+    fall from the same interpolant evaluated in another order (Horner's rule, not ``np.dot``), so equal to
+    round-off (``tests/simulate/test_lsoda_c.py``). What scipy raises in the Python path (brentq on a NaN
+    margin or without a sign change; a non-``FloatingPointError`` from the model cannot happen in C) is
+    raised here with scipy's words. ``rhs`` and ``jac`` (the Python callables of the same model) only word
+    a model failure: re-evaluated where C saw it fail, they raise the Python path's error.
+    """
+    if not np.all(np.isfinite(x)):   # scipy's LSODA refuses such a start (the Python path raises this)
+        raise ValueError("All components of the initial state `y0` must be finite.")
+    out = chunks_in_c.careful(times, x, spent)
+    status, samples, end = out.status, out.samples, out.end
+    sample_t = times[:len(samples)]
+    if status in ("completed", "fell"):
+        return sample_t, samples, end, status, None, out.counts
+    if status == "root_nan":
+        raise ValueError(f"The function value at x={out.failed[0]} is NaN; solver cannot continue.")
+    if status == "root_signs":
+        raise ValueError("f(a) and f(b) must have different signs")
+    if status == "root_iterations":
+        raise RuntimeError("Failed to converge after 100 iterations.")
+    if status in ("budget", "stall"):
+        message = _stall_message(status, budget, spent, out.counts[2], out.step, t_start, out.window, out.step_size)
+    else:
+        if status == "model":
+            t_failed, x_failed, which = out.failed
+            trouble = f"the compiled model failed at t = {t_failed:.6g} s"   # unless its Python call says more
+            try:
+                (jac if which == "jacobian" else rhs)(t_failed, x_failed)
+            except FloatingPointError as exc:
+                trouble = str(exc)
+        else:   # istate < 0, as scipy's ode warns and its LSODA solver object words it
+            from scipy.integrate._ode import lsoda as ode_lsoda
+            warnings.warn(f"lsoda: {ode_lsoda.messages.get(out.istate, f'Unexpected istate={out.istate:d}')}",
+                          stacklevel=2)
+            trouble = "Unexpected istate in LSODA."
+        message = f"LSODA stopped at t = {out.step:.6g} s: {trouble}"
+    return sample_t, samples, end, "failed", message, out.counts
 
 
 def _evaluations(jac, nfev, njev):
@@ -322,8 +383,9 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
     model all the chunks of a piece in one C call (:mod:`whipple_kick.simulate.lsoda_c`,
     the same numbers), otherwise through ``odeint``. A chunk in which the roll limit is crossed (or in
     which LSODA reports trouble) is integrated again from its start with
-    the same LSODA stepped from Python (:class:`scipy.integrate.LSODA`,
-    as ``solve_ivp`` does) and a fall event, which gives the exact fall
+    the same LSODA stepped one step at a time (:class:`scipy.integrate.LSODA`,
+    as ``solve_ivp`` does; for a compiled model the same steps in C, the
+    samples and the fall time equal to round-off) and a fall event, which gives the exact fall
     time. Numerical
     trouble there (LSODA giving up, a non-finite derivative, or more
     evaluations than ``budget`` allows) ends the integration as a failure:
@@ -481,8 +543,9 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
                 x = y[-1]
                 continue
             # A failed fast attempt is redone here, so only this attempt counts against the budget.
-            sample_t, sample_x, (t_reached, x), status, why, (n, nj, used) = _careful_chunk(
-                plain, x, times, rtol, atol, fall, spent, budget, t_start, jac)
+            arguments = (plain, x, times, rtol, atol, fall, spent, budget, t_start, jac)
+            sample_t, sample_x, (t_reached, x), status, why, (n, nj, used) = (
+                _careful_chunk(*arguments) if chunks_in_c is None else _careful_chunk_in_c(chunks_in_c, *arguments))
             nfev, njev, spent = nfev + n, njev + nj, spent + used
             if status == "completed" and last is not None and sample_t.size and sample_t[-1] == times[-1]:
                 sample_t, sample_x = sample_t[:-1], sample_x[:-1]

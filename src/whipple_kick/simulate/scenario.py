@@ -872,8 +872,9 @@ def with_parts(*declared, base=None):
     For each part, the field that selects it (:attr:`~whipple_kick.model.parts.Part.selected_by`: "off" by
     default, or the part's value), unless ``base`` (default :class:`Scenario`) has it, then its fields
     (:func:`~whipple_kick.simulate.settings.part_setting`), all derived from its declaration: validated,
-    refused while the part is not selected, held by the body's view (so the run's model has the part) and
-    given command-line flags (``whipple_kick.cli._simulate_parser(cls)``). The parts must be declared
+    refused while the part is not selected, held by the body's view (so the run's model has the part; by
+    the bicycle's too when it carries some of the rider's segments) and given command-line flags
+    (``whipple_kick.cli._simulate_parser(cls)``). The parts must be declared
     (:func:`whipple_kick.model.parts.declare`) before the class is made and while it is used.
 
     Example
@@ -896,7 +897,10 @@ def with_parts(*declared, base=None):
             members.append((name, str, setting(
                 "off", f'"{value}": {title}, {part.description}; "off" (default): a model without it '
                 f"(the part {part.name!r}, :mod:`{part.build.__module__}`).", choices=("off", value),
-                label=name.replace("_", " "), views=("body",), commands=EVERY_COMMAND, section=_BODY,
+                label=name.replace("_", " "), commands=EVERY_COMMAND, section=_BODY,
+                # The body's view holds it (the run's model has the part); the bicycle's too when the part
+                # carries some of the rider's segments (the rider is split for it: riders.split_rider).
+                views=("body",) + (("bicycle",) if part.split is not None else ()),
                 help=f"{value}: {title}; off (default): without it")))
             have.add(name)
         members += [(f.name, float, part_setting(part.name, f.name)) for f in part.fields if f.name not in have]
@@ -972,21 +976,6 @@ class _BicycleView:
     """What :func:`~whipple_kick.simulate.assembly.build_bicycle` reads: the bicycle and the rider seated on it."""
 
     __slots__ = ()
-
-    @property
-    def split(self) -> bool:
-        """Whether the rider is split into legs, forearms and upper body (a leaning body or arms on the bar)."""
-        return self.rider_body != "rigid" or self.arms_on_bar
-
-    @property
-    def leaning(self) -> bool:
-        """Whether the upper body leans on the hip (otherwise it is merged into the rear frame)."""
-        return self.rider_body == "leaning"
-
-    @property
-    def arms_on_bar(self) -> bool:
-        """Whether the forearms and hands turn with the bar."""
-        return self.arms == "on"
 
 
 class _TyreView:

@@ -318,7 +318,8 @@ def sweep(grid=None, cases=None, *, base=None, folder=None, executor=None, worke
         ``table.csv``, one trajectory file per case) and an existing folder of
         the same sweep is resumed. Without it nothing is written.
     executor : concurrent.futures.Executor, optional
-        Where the cases run, e.g. ``dask.distributed.Client(...).get_executor()``;
+        Where the cases run, e.g. ``dask.distributed.Client(...).get_executor()``
+        (readied first by :func:`whipple_kick.studies.cluster.prepare_workers`);
         it is not shut down. Default: a local process pool of ``workers``,
         kept alive for later sweeps in this process.
     workers : int, optional
@@ -468,8 +469,8 @@ def _memory_kept_once():
     """:func:`_keep_freed_memory` once per process, from the first case it runs.
 
     The default pool's workers set it when they start (:func:`_worker_start`); a worker of another executor
-    (a Dask cluster's, which issue 41 measured at 1.27x the pool's time per case, about half of it from the
-    page faults this setting avoids) gets it from its first case. Results are unchanged.
+    (a Dask cluster's, whose nanny sets glibc's opposite, ``MALLOC_TRIM_THRESHOLD_=65536``) gets it from its
+    first case, or before it from :func:`whipple_kick.studies.cluster.prepare_workers`. Results are unchanged.
     """
     global _memory_kept
     if _memory_kept is None:

@@ -19,12 +19,6 @@ MZ_OFFSET_INDICES = magic_formula.MZ_OFFSET_INDICES
 #: The rider's reflex in the base model by parameter name, with the rigid rider's values: none. (The
 #: upper body and the arms are parts: a model without them has none of their parameters.)
 RIGID_BODY = {"rq4": 0.0, "rq7": 0.0, "ru4": 0.0, "ru7": 0.0, "reflex_delay": 0.0}
-#: The parameters of the trunk part (:data:`whipple_kick.model.parts.TRUNK`) that are not gains: the leaning
-#: upper body's placement and inertia and the hip's spring-damper.
-TRUNK_BODY = tuple(n for n in parts.TRUNK.parameters if n not in parts.TRUNK.gains)
-#: The arms part's parameters (:data:`whipple_kick.model.parts.ARMS`): their spring-damper.
-ARMS_BODY = parts.ARMS.parameters
-BODY_NAMES = tuple(RIGID_BODY) + TRUNK_BODY + ARMS_BODY
 
 
 def gain_states():
@@ -49,6 +43,13 @@ def _part_body():
     """Each declared part's parameters that are not gains, by part name (read when called: a part declared
     later counts too)."""
     return {p.name: tuple(n for n in p.parameters if n not in p.gains) for p in parts.REGISTRY.values()}
+
+
+def body_names():
+    """The rider's body parameters by name: the reflex (:data:`RIGID_BODY`), then each declared part's that
+    are not gains (the leaning upper body's placement, inertia and hip spring-damper, the arms'
+    spring-damper), read when called: a part declared later counts too."""
+    return tuple(RIGID_BODY) + tuple(n for names in _part_body().values() for n in names)
 
 
 def tyre_parameters(tyre, wheel, symmetric=False, lateral=True, reverse_camber=False):
@@ -164,8 +165,8 @@ def model_parameters(moore, rear_tyre, front_tyre, options=None, *, model=None, 
     body : mapping, optional
         The rider's body by parameter name: the reflex (:data:`RIGID_BODY`, missing ones 0; a nonzero
         ``reflex_delay`` needs the model's delay filter) and every parameter of each of the model's parts
-        that is not a gain (for the trunk :data:`TRUNK_BODY`: :func:`whipple_kick.library.riders.seat_with_body`
-        makes them; for the arms :data:`ARMS_BODY`), and no other part's.
+        that is not a gain (:func:`body_names`; the leaning upper body's placement and inertia from the
+        rider's segments, :func:`whipple_kick.library.riders.split_rider`), and no other part's.
     drive_torque : float
         Constant rear-wheel torque T6c [N m] about the rear frame's C.y axis
         (+ opposes forward rolling); the steady-state solver sets it.

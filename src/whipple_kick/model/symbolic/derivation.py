@@ -361,6 +361,35 @@ def _slip_speed(centre_vel, contact_vel, heading, contact_weight):
     return centre + contact_weight * (contact_vel.dot(heading) - centre)
 
 
+def take_parts(kin, mech, chosen):
+    """Read what the parts ``chosen`` built into ``mech.system`` (:class:`whipple_kick.model.parts.Mechanics`)
+    into ``kin``: their coordinates and speeds after the bicycle's, their bodies with their weights.
+
+    The system's coordinates and speeds must be the parts' declared ones in the parts' order, and its
+    kinematic differential equations ``dq/dt = u`` (the convention of every speed here); a build that adds
+    others is refused (ValueError naming them).
+    """
+    system = mech.system
+    t = me.dynamicsymbols._t
+    q, u = tuple(system.q), tuple(system.u)
+    for what, got, declared in (("coordinates", q, [n for p in chosen for n in p.coordinates]),
+                                ("speeds", u, [n for p in chosen for n in p.speeds])):
+        names = [s.func.__name__ for s in got]
+        if names != declared:
+            raise ValueError(f"the parts' builds gave the system the {what} {names}; they declare {declared}")
+    rates = sm.solve(list(system.kdes), [qi.diff(t) for qi in q], dict=True) if q else [{}]
+    if len(rates) != 1 or any(sm.simplify(rates[0].get(qi.diff(t), sm.nan) - ui) != 0
+                              for qi, ui in zip(q, u, strict=True)):
+        raise ValueError(f"the parts' kinematic differential equations {list(system.kdes)} are not "
+                         f"dq/dt = u for {[s.func.__name__ for s in q]}")
+    kin.q, kin.u = (*kin.q, *q), (*kin.u, *u)
+    kin.qd_to_u.update({qi.diff(t): ui for qi, ui in zip(q, u, strict=True)})
+    g, down = mech.par["g"], kin.frames["N"].z
+    for body in mech.added_bodies():   # every body a part adds has its weight
+        kin.bodies.append(body)
+        kin.gravity_loads.append((body.masscenter, body.mass * g * down))
+
+
 def slip_equations(part_names=()):
     """Derive the slip model: toroidal tyres, vertical compliance, lateral tyre loads as inputs.
 
@@ -404,9 +433,10 @@ def slip_equations(part_names=()):
     mech = parts.Mechanics(kin=kin, par=par, hands_frame=C)
     for part in chosen:
         part.build(mech)
+    take_parts(kin, mech, chosen)
     q, u = kin.q, kin.u
-    Q = {f"q{i + 1}": qi for i, qi in enumerate(q[:10])} | mech.coordinates
-    U = {f"u{i + 1}": ui for i, ui in enumerate(u[:10])} | mech.speeds
+    Q = {qi.func.__name__: qi for qi in q}
+    U = {ui.func.__name__: ui for ui in u}
     Fy_r, Fy_f, Mz_r, Mz_f = S.syms(["Fy_r", "Fy_f", "Mz_r", "Mz_f"])
     yp, vp, ap = kick_plate_motion(sm.Symbol("t", real=True))
     vp_s, ap_s = S.syms(["vp", "ap"])   # placeholders, replaced by the profile at code generation
@@ -446,7 +476,7 @@ def slip_equations(part_names=()):
         (C, -T6 * C.y),
         (mech.hands_frame, -T7 * C.z),
         (E, T7 * C.z),
-        *mech.loads,
+        *mech.loads(),
     ]
     mass_matrix, forcing = kane_full(kin, loads)
 
@@ -466,12 +496,14 @@ def slip_equations(part_names=()):
     # Spring energy counts only while the tyre is compressed; the damper
     # dissipates Fz dq/dt - kz max(q, 0) dq/dt >= 0 in every branch of
     # normal_force (docs/validation.md).
-    # The parts' springs (the hip's, the arms') store energy, their dampers dissipate it.
+    # The parts' springs (the hip's, the arms', the system's LinearSprings) store energy, their dampers
+    # dissipate it.
+    store, dissipation = mech.actuator_energy()
     spring = ((par["kzr"] * sm.Max(0, Q["q9"])**2 + par["kzf"] * sm.Max(0, Q["q10"])**2) / 2
-              + sum(mech.spring_energy))
+              + sum(mech.spring_energy) + sum(store))
     damper = (fz_r * U["u9"] - par["kzr"] * sm.Max(0, Q["q9"]) * U["u9"]
               + fz_f * U["u10"] - par["kzf"] * sm.Max(0, Q["q10"]) * U["u10"]
-              + sum(mech.damper_dissipation))
+              + sum(mech.damper_dissipation) + sum(dissipation))
     extra = {
         "yp": yp, "vp": vp, "ap": ap,
         # Inputs of the tyre block (model convention: slip > 0 slides to the

@@ -96,8 +96,8 @@ def mode_content(model, eigenvalue, vector, wheelbase):
     scaled = np.vstack(groups)
     power = np.abs(scaled) ** 2
     shares = [power[0], power[1], power[2] + power[3], power[4] + power[5], power[6] + power[8], power[7] + power[9]]
-    if len(groups) > 1:
-        shares += [power[10]]
+    if len(groups) > 1:   # the lean: every angle of the body's parts (the rows before the filter's four)
+        shares += [power[10:-len(slip.REFLEX_STATES)].sum(axis=0)]
     shares = np.array(shares).T
     total = shares.sum(axis=1, keepdims=True)
     shares = shares / np.where(total > 0, total, 1.0)
@@ -127,23 +127,32 @@ def groups_of(model):
     return GROUPS + (BODY_GROUPS if any(n in _body_states() for n in model.states) else ())
 
 
-def _body_content(model, lam, vec, idx):
-    """Angle-like amplitudes of the rider body's states: the lean q11, the reflex filter's states.
+def _lean_states():
+    """Every declared part's coordinates that are angles (their declared column unit rad; the trunk's lean q11),
+    read when called (a part declared after this module was imported counts too)."""
+    return tuple(n for part in parts.REGISTRY.values() for n in part.coordinates
+                 if part.columns.get(n, ("", ""))[1] == "rad")
 
-    The upper body's lean on the hip is an angle [rad] like the roll. The
+
+def _body_content(model, lam, vec, idx):
+    """Angle-like amplitudes of the rider body's states: its parts' angles (the lean q11), the reflex filter's.
+
+    The upper body's lean on the hip is an angle [rad] like the roll (each angle a part declares, at least
+    one row). The
     reflex filter's states are torques [N m] (controllable canonical form of
     :mod:`whipple_kick.model.reflex`): divided by the reflex's torque per radian
     of motion at this eigenvalue, ``|rq4| + |rq7| + |lambda| (|ru4| + |ru7|)``
     (at least 1 N m/rad), they compare with the angles that drive them.
-    Rows: lean, then the four filter states (zero where the model lacks them).
+    Rows: the parts' angles the model has (one row of zeros without any), then the four filter states (zero
+    where the model lacks them).
     """
     n = lam.size
-    lean = vec[idx["q11"]] if "q11" in idx else np.zeros(n)
+    lean = [vec[idx[q]] for q in _lean_states() if q in idx] or [np.zeros(n)]
     p = model.steady.params
     per_rad = np.maximum(abs(p.get("rq4", 0.0)) + abs(p.get("rq7", 0.0))
                          + np.abs(lam) * (abs(p.get("ru4", 0.0)) + abs(p.get("ru7", 0.0))), 1.0)
     reflex = [vec[idx[r]] / per_rad if r in idx else np.zeros(n) for r in slip.REFLEX_STATES]
-    return np.array([lean, *reflex])
+    return np.array([*lean, *reflex])
 
 
 def filter_share(lam, tau):
