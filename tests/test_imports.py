@@ -16,12 +16,12 @@ PACKAGE = pathlib.Path(whipple_kick.__file__).parent
 
 #: Packages a function may import (each keeps out of a warm run what the run does not use): SymPy (the
 #: model's build on a cache miss), python-control (the control-analysis API), matplotlib and Pillow (the
-#: figures), imageio-ffmpeg (mp4 animations, optional), Tornado and Selenium (the explorer, optional), SALib,
-#: scikit-learn and emcee (the uncertainty study and the calibration), SciPy's signal package (about 0.9 s
-#: of import; the measurements' spectra and filters), and the package's own modules that import SymPy
-#: at their top (the symbolic derivation and code generation).
-LAZY = ("sympy", "control", "matplotlib", "PIL", "imageio_ffmpeg", "tornado", "selenium", "SALib", "sklearn",
-        "emcee", "scipy.signal", "whipple_kick.model.symbolic")
+#: figures), imageio-ffmpeg (mp4 animations, optional), Tornado and Selenium (the explorer, optional), Dask
+#: (a sweep on a cluster, optional), SALib, scikit-learn and emcee (the uncertainty study and the
+#: calibration), SciPy's signal package (about 0.9 s of import; the measurements' spectra and filters), and
+#: the package's own modules that import SymPy at their top (the symbolic derivation and code generation).
+LAZY = ("sympy", "control", "matplotlib", "PIL", "imageio_ffmpeg", "tornado", "selenium", "dask", "distributed",
+        "SALib", "sklearn", "emcee", "scipy.signal", "whipple_kick.model.symbolic")
 #: The command-line module imports a command's own studies and figures when that command runs, so that a
 #: ``simulate`` does not load the sweeps, the calibration or the figures it does not draw.
 CLI_LAZY = ("whipple_kick.studies", "whipple_kick.figures", "whipple_kick.library.priors",

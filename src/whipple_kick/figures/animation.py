@@ -42,7 +42,7 @@ from scipy.ndimage import gaussian_filter1d
 
 from whipple_kick.errors import InputError, check_range
 from whipple_kick.library import bicycleparameters, riders
-from whipple_kick.model import geometry
+from whipple_kick.model import geometry, parts
 from whipple_kick.simulate import assembly
 
 from . import plotting
@@ -206,8 +206,6 @@ def _yeadon_segments(human, seat, to_bike):
 
 def _model_parts(scenario):
     """The run's model's parts (:func:`whipple_kick.model.parts.selected`), in build order."""
-    from whipple_kick.model import parts
-
     return parts.named([p.name for p in parts.selected(scenario)])
 
 

@@ -31,6 +31,7 @@ import warnings
 
 import numpy as np
 from scipy.integrate import LSODA, odeint
+from scipy.integrate._ode import lsoda as ode_lsoda
 from scipy.optimize import brentq
 
 from whipple_kick.model import slip
@@ -295,7 +296,6 @@ def _careful_chunk_in_c(chunks_in_c, rhs, x, times, rtol, atol, fall, spent, bud
             except FloatingPointError as exc:
                 trouble = str(exc)
         else:   # istate < 0, as scipy's ode warns and its LSODA solver object words it
-            from scipy.integrate._ode import lsoda as ode_lsoda
             warnings.warn(f"lsoda: {ode_lsoda.messages.get(out.istate, f'Unexpected istate={out.istate:d}')}",
                           stacklevel=2)
             trouble = "Unexpected istate in LSODA."
