@@ -22,6 +22,7 @@ into the current folder.
 import atexit
 import concurrent.futures as cf
 import ctypes
+import ctypes.util
 import dataclasses
 import datetime
 import itertools
