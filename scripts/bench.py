@@ -180,7 +180,7 @@ def bench_transient(repeats):
     base = _base_case()
     for form in forms:
         params = slip.Parameters(slip.Model(base.params.model.parts, base.params.model.delayed_reflex, form),
-                                 base.params.replace(tyre_transient=float(wk.transient.TRANSIENTS.index(form))))
+                                 base.params.replace(tyre_transient=float(wk.transient.transients().index(form))))
         ss = steady.steady_state(params, 3.0)
         x = ss.x.copy()
         x[slip.X["u4"]] = 0.1

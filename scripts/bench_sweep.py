@@ -536,6 +536,7 @@ def bench_tolerance(samples, fz, rtol, workers):
     """Print the uncertainty study at the default rtol and at ``rtol`` side by side (same rows, same seed)."""
     import numpy as np
 
+    from whipple_kick.simulate.criteria import CRITERIA
     from whipple_kick.simulate.scenario import Scenario
     from whipple_kick.studies import uncertainty
     rtols = (Scenario().rtol, rtol)
@@ -568,7 +569,7 @@ def bench_tolerance(samples, fz, rtol, workers):
               f"{row['q50_s_new']:.3f} s ({row['q05_s_new']:.3f}-{row['q95_s_new']:.3f})")
     pair = ["sample", "fz_n", "pressure_kpa"]
     both = ref.outcomes.merge(new.outcomes, on=pair, suffixes=("_ref", "_new"))
-    for key, criterion in uncertainty.CRITERIA.items():
+    for key, criterion in CRITERIA.items():
         a, b = (both[f"{criterion.column}{s}"].astype(float).to_numpy() for s in ("_ref", "_new"))
         finite = np.isfinite(a) & np.isfinite(b)
         moved = np.abs(a[finite] - b[finite])
@@ -597,7 +598,7 @@ def _flag_libraries(folder, names=None):
     import pathlib
     import subprocess
 
-    from whipple_kick.model import compiler
+    from whipple_kick.model import compiler, transient
     from whipple_kick.model.slip import compiled, layout
     base = layout.BASE
     source = compiled.library_path(base).with_suffix(".c")
@@ -611,7 +612,7 @@ def _flag_libraries(folder, names=None):
         original = compiled.library_path
         compiled.library_path = lambda L, target=target: pathlib.Path(target)
         try:
-            libraries[name] = compiled.library.__wrapped__(base)   # the same argument types as the model's
+            libraries[name] = compiled._library.__wrapped__(base, transient.fingerprint())   # the model's argument types
         finally:
             compiled.library_path = original
     return libraries

@@ -4,7 +4,7 @@ Usage:
     python scripts/experiments_study.py [--workers 2] [--forms contact_patch slip_lag force_lag]
 
 For each tyre transient form (default: every one of
-``whipple_kick.model.transient.TRANSIENTS``, the default form first) it runs
+``whipple_kick.model.transient.transients()``, the default form first) it runs
 ``whipple_kick.studies.validation.validate`` (nine cases x two kick directions, the
 experiments' set-up) and prints, as Markdown: the model against the measured
 metrics per case, the mean |error| per metric, the slow swing, and the best
@@ -36,7 +36,7 @@ def main():
     parser.add_argument("--forms", nargs="+", default=None)
     args = parser.parse_args()
     default = Scenario().tyre_transient
-    forms = args.forms or [default] + [f for f in wk.transient.TRANSIENTS if f != default]
+    forms = args.forms or [default] + [f for f in wk.transient.transients() if f != default]
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
     print(f"commit {commit or 'unknown'}, model {wk.slip.model_hash()}, default tyre transient {default}\n")
     exp = experiments.load()

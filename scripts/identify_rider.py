@@ -42,12 +42,12 @@ import time
 import numpy as np
 
 import whipple_kick as wk
-from whipple_kick.library import experiments
+from whipple_kick.library import experiments, thesis
 from whipple_kick.studies import validation
 
-FITTED_LOADS = (570.0, 635.0)
-HELD_OUT_LOADS = (701.0,)
-PRESSURES = (300.0, 400.0, 500.0)
+FITTED_LOADS = thesis.LOADS_N[:2]
+HELD_OUT_LOADS = thesis.LOADS_N[2:]
+PRESSURES = thesis.PRESSURES_KPA
 #: Run length [s]: the metrics use the first 1.2 s after the kick (the spectrum's 1 s record from 0.2 s).
 DURATION = 2.0
 

@@ -2,7 +2,7 @@
 
 On the nine thesis cases (T03 at 300/400/500 kPa x rear loads 570/635/701 N,
 default scenario) this script measures, for each ranking criterion of
-``wk.recommend.CRITERIA`` (the recovery time, i.e. yaw, roll and steer rates settled,
+``whipple_kick.simulate.criteria.CRITERIA`` (the recovery time, i.e. yaw, roll and steer rates settled,
 and the thesis' last-peak time):
 
 * the value per case at the default settings (rtol 1e-10), the margin between
@@ -26,6 +26,7 @@ import numpy as np
 
 import whipple_kick as wk
 from whipple_kick.simulate import simulation
+from whipple_kick.simulate.criteria import CRITERIA
 from whipple_kick.simulate.simulation import Scenario
 
 PRESSURES = (300.0, 400.0, 500.0)
@@ -111,7 +112,7 @@ def measure():
 
     spread = {}
     for criterion in VALUES:
-        print(f"## {criterion}: {wk.recommend.CRITERIA[criterion].text}\n")
+        print(f"## {criterion}: {CRITERIA[criterion].text}\n")
         print("| rear load | " + " | ".join(f"{p:g} kPa [s]" for p in PRESSURES) + " | best | margin [s] |")
         print("|---|" + "---|" * (len(PRESSURES) + 2))
         margins = {}

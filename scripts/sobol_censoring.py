@@ -36,6 +36,7 @@ import numpy as np
 import pandas as pd
 
 from whipple_kick.library import uncertain
+from whipple_kick.simulate.criteria import CRITERIA
 from whipple_kick.simulate.scenario import Scenario
 from whipple_kick.studies import uncertainty
 
@@ -69,7 +70,7 @@ def main(argv=None):
 
 def times(study, criterion):
     """``(rows x pressures)`` criterion values, ``inf`` where the run did not recover (fell, failed, not settled)."""
-    col = uncertainty.CRITERIA[criterion].column
+    col = CRITERIA[criterion].column
     o = study.outcomes
     v = pd.to_numeric(o[col], errors="coerce").to_numpy(dtype=float)
     ok = np.isfinite(v) & ~o["fell"].to_numpy(dtype=bool) & (o["status"] == "ok").to_numpy()
@@ -125,7 +126,7 @@ def _range(s):
 
 def report(short, long_, d_short, d_long):
     """Print the comparison of the two studies (same rows, two run lengths)."""
-    for criterion in uncertainty.CRITERIA:
+    for criterion in CRITERIA:
         ts, pressures = times(short, criterion)
         tl, _ = times(long_, criterion)
         rec_s, rec_l = np.isfinite(ts), np.isfinite(tl)
@@ -147,8 +148,8 @@ def report(short, long_, d_short, d_long):
     print("\nnew output (which recovers first), short run against long run:")
     compare(short.sobol, long_.sobol, "new")
     print("\nold output (T(b) - T(a), a run not recovered given the run's duration), for contrast:")
-    compare(pd.concat([old_indices(short, c, d_short) for c in uncertainty.CRITERIA]),
-            pd.concat([old_indices(long_, c, d_long) for c in uncertainty.CRITERIA]), "old")
+    compare(pd.concat([old_indices(short, c, d_short) for c in CRITERIA]),
+            pd.concat([old_indices(long_, c, d_long) for c in CRITERIA]), "old")
     for name, study in (("short", short), ("long", long_)):
         cautions = [" / ".join(uncertainty.sobol_caution(g)) for _, g in
                     study.sobol.groupby(["criterion", "pressure_a_kpa", "pressure_b_kpa"], sort=False)]

@@ -21,10 +21,11 @@ import time
 
 import whipple_kick as wk
 from whipple_kick.errors import InputError
+from whipple_kick.library import thesis
 from whipple_kick.simulate.simulation import Scenario, run
 
 HERE = pathlib.Path(__file__).resolve().parent
-PRESSURES = (300.0, 400.0, 500.0)
+PRESSURES = thesis.PRESSURES_KPA
 
 
 def _scenario(args, **changes):

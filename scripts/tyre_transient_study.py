@@ -69,13 +69,13 @@ def forms():
           "| max rear patch slip [deg] | plate work [J] | sliding dissipation [J] | rear carcass at 6 s [J] "
           "| zero-slip-force work [J] | moment work [J] | max balance residual [J] |")
     print("|" + "---|" * 15)
-    for name in transient.TRANSIENTS:
+    for name in transient.transients():
         print(_row(name + (" (default)" if name == transient.DEFAULT_TRANSIENT else ""),
                    run(dataclasses.replace(BASE, tyre_transient=name))))
     earlier = dataclasses.replace(BASE, tyre_transient="force_lag", plate_stop="resolve", kick_heading="settled")
     print(_row("force_lag, re-solve, settled heading (earlier model)", run(earlier)))
     print()
-    for name in transient.TRANSIENTS:
+    for name in transient.transients():
         r = run(dataclasses.replace(BASE, tyre_transient=name, controller="off"))
         print(f"controller off, {name}: fell {r.summary['fell']} ({r.summary['fall_reason']}) at "
               f"{r.summary['fall_time_s']}")
@@ -105,14 +105,14 @@ def _secant_floor(value):
         return hash_function(sources, extra=f"{extra} G_MIN={value!r}")
     transient.G_MIN = value
     cache.source_hash = keyed
-    slip_build._expressions.cache_clear()
-    slip.library.cache_clear()
+    slip_build._expressions_of.cache_clear()
+    slip.compiled._library.cache_clear()
     try:
         yield
     finally:
         transient.G_MIN, cache.source_hash = original, hash_function
-        slip_build._expressions.cache_clear()
-        slip.library.cache_clear()
+        slip_build._expressions_of.cache_clear()
+        slip.compiled._library.cache_clear()
 
 
 def plate_stop():
@@ -266,7 +266,7 @@ def six_runs():
           "| peak rear F_y [N] | 5 % recovery yaw / roll / steer rate [s] | created energy [J] |")
     print("|" + "---|" * 9)
     for label, changes in SIX_RUNS.items():
-        for name in (transient.DEFAULT_TRANSIENT, *(f for f in transient.TRANSIENTS if f != transient.DEFAULT_TRANSIENT)):
+        for name in (transient.DEFAULT_TRANSIENT, *(f for f in transient.transients() if f != transient.DEFAULT_TRANSIENT)):
             r = run(dataclasses.replace(BASE, tyre_transient=name, **changes))
             s, df = r.summary, r.trajectory
             rec = s["recovery"]["signals"]

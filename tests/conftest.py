@@ -1,4 +1,5 @@
 """Fixtures shared by several test files."""
+from collections.abc import Sequence
 import dataclasses
 import pathlib
 
@@ -97,9 +98,9 @@ def _choices(name):
     from whipple_kick.simulate import scenario as module
     for label in dir(module):
         value = getattr(module, label)
-        if label.isupper() and isinstance(value, tuple) and SCENARIO_DEFAULTS[name] in value and len(value) > 1 \
-                and all(isinstance(v, str) for v in value):
-            return value
+        if label.isupper() and isinstance(value, Sequence) and not isinstance(value, str) \
+                and SCENARIO_DEFAULTS[name] in value and len(value) > 1 and all(isinstance(v, str) for v in value):
+            return tuple(value)   # a tuple, or a listing read when asked (the declared tyre forms)
     if name == "kick_profile":
         return inputs.PROFILES
     if name == "kick_direction":

@@ -49,17 +49,20 @@ try:
     simulate_main(["--pressure", "400", "--fz", "635", "--quiet", "--out", sys.argv[1]])
 except SystemExit as exc:
     assert exc.code == 0, exc.code
-print(sorted(name for name in ("sympy", "control", "matplotlib.pyplot", "SALib") if name in sys.modules))
+print(sorted(name for name in ("sympy", "control", "matplotlib.pyplot", "SALib", "sklearn", "emcee", "scipy.signal",
+                               "tornado", "whipple_kick.studies.sweep_engine") if name in sys.modules))
 """
 
 
 def test_warm_simulate_imports_neither_sympy_nor_python_control(tmp_path):
     """The main job in a fresh process with the compiled model cached: no SymPy, no python-control, no pyplot,
-    no SALib.
+    no SALib, scikit-learn or emcee, no SciPy signal package, no Tornado, no sweep engine.
 
     SymPy belongs to the build (a cache miss), python-control to the
-    control-analysis API, SALib to the uncertainty study; the LQR design comes from SciPy's Riccati solver
-    and the figure is drawn without pyplot.
+    control-analysis API, SALib to the uncertainty study, scikit-learn and emcee to the calibration, SciPy's
+    signal package to the measurements' spectra, Tornado to the explorer, the sweep engine to the studies
+    (the command-line module imports a command's own studies when it runs); the LQR design comes from
+    SciPy's Riccati solver and the figure is drawn without pyplot.
     """
     wk.slip.library_path()                                     # the compiled model, built if needed
     out = tmp_path / "run"

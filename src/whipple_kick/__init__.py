@@ -14,6 +14,16 @@ The package is five wings, each importing only the ones below it:
 ``figures`` < ``studies`` (sweeps, recommendation, validation, stability)
 < ``cli``; ``errors`` and ``fileio`` sit beneath them all.
 
+Imports sit at the top of each module, and the modules' top-level imports
+form no circle. A function imports only what keeps a slow or optional
+package out of a run that does not use it: SymPy (the model's build on a
+cache miss, and the package's symbolic modules), python-control,
+matplotlib and Pillow, imageio-ffmpeg, Tornado, Selenium, Dask, SALib,
+scikit-learn, emcee, SciPy's signal package; and the command-line module
+imports a command's own studies and figures when that command runs.
+``tests/test_imports.py`` checks both rules; a warm ``simulate`` loads
+none of these packages (``tests/test_cli.py``).
+
 Names and submodules are imported lazily on first attribute access
 (``wk.Scenario``, ``wk.tyres``, ``wk.stability`` ...), so importing the
 package is cheap and nothing slow to import (the symbolic derivation) is

@@ -12,15 +12,39 @@ file is left behind.
 """
 import argparse
 import contextlib
+import datetime
 import math
+import os
+import pathlib
+import re
+import select
+import shutil
+import signal
 import sys
+import threading
+import time
+import warnings
 
 import numpy as np
+import pandas as pd
 
-from whipple_kick.simulate import criteria
+from whipple_kick.library import bicycleparameters, riders, thesis, tyres
+from whipple_kick.library.inputs import DIRECTIONS
+from whipple_kick.model import benchmark, classic
+from whipple_kick.simulate import assembly, criteria, provenance, results, settings, simulation
 from whipple_kick.simulate.criteria import CRITERIA
+from whipple_kick.simulate.scenario import (
+    DEFAULTS,
+    LQR_MODELS,
+    MAX_DURATION,
+    SETTINGS,
+    TYRE_TRANSIENTS,
+    UNITS,
+    Scenario,
+    UnusedFieldError,
+)
 
-from . import fileio
+from . import __version__, fileio
 from .errors import (
     BuildError,
     CacheError,
@@ -28,6 +52,7 @@ from .errors import (
     InputError,
     SimulationError,
     Terminated,
+    WhippleKickWarning,
     terminate_raises,
 )
 
@@ -50,9 +75,6 @@ def _warnings_as_lines(prog):
     are for users. The filters and the printer are the caller's again after
     the block: nothing is changed process-wide.
     """
-    import warnings
-
-    from .errors import WhippleKickWarning
     shown = set()
 
     def show(message, category, filename, lineno, file=None, line=None):
@@ -69,7 +91,6 @@ def _warnings_as_lines(prog):
 
 def _stdout_is_broken():
     """True when standard output is a pipe whose reader has gone (``poll`` reports an error on it)."""
-    import select
     try:
         poller = select.poll()
         poller.register(sys.stdout.fileno(), select.POLLOUT)
@@ -94,7 +115,6 @@ def _run(main, argv, prog="whipple_kick", kept="no results were kept"):
             return 2
         # The reader of the printed text closed it (``simulate | head``): what was to be written is written.
         # Standard output goes to /dev/null, so that Python's own flush at exit has nothing to complain about.
-        import os
         with contextlib.suppress(OSError, ValueError):
             os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return EXIT_BROKEN_PIPE
@@ -129,7 +149,6 @@ def _benchmark(argv):
     parser.add_argument("--speeds", type=float, nargs="+", default=list(range(11)),
                         metavar="M/S", help="forward speeds in m/s (default 0..10)")
     args = parser.parse_args(argv)
-    from whipple_kick.model import benchmark, classic
     moore = benchmark.to_moore(benchmark.meijaard2007_parameters())
     speeds = [float(v) for v in args.speeds]
     eigs = classic.eigenvalues(moore, speeds)
@@ -166,7 +185,6 @@ class _OneLineParser(argparse.ArgumentParser):
 
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
-        from . import __version__
         self.add_argument("--version", action="version", version=f"%(prog)s (whipple_kick {__version__})",
                           help="print the package version and exit")
 
@@ -233,9 +251,6 @@ def _scenario_flags(p, command, scenario_class=None, **context):
     more fields. Returns the sections (argument groups) by title, for the
     command's own options.
     """
-    from whipple_kick.simulate import settings
-    from whipple_kick.simulate.scenario import Scenario
-
     declared = [s for s in settings.settings(scenario_class or Scenario).values() if command in s.commands]
     used = {s.section for s in declared}
     sections = {title: p.add_argument_group(title, text) for title, text in SECTIONS.items() if title in used}
@@ -278,9 +293,6 @@ def _field_flag(group, s, **overrides):
 
 def _scenario_fields(args, command, scenario_class=None):
     """The Scenario fields whose flags (:func:`_scenario_flags`) were given, by name (pressures checked together)."""
-    from whipple_kick.simulate import settings
-    from whipple_kick.simulate.scenario import DEFAULTS, Scenario
-
     fields = {s.name: getattr(args, s.name) for s in settings.settings(scenario_class or Scenario).values()
               if command in s.commands and getattr(args, s.name, None) is not None}
     if not hasattr(args, "pressure_kpa"):
@@ -297,8 +309,6 @@ def _scenario_fields(args, command, scenario_class=None):
 
 def _simulate_parser(scenario_class=None):
     """``simulate``'s parser; its scenario flags are those of ``scenario_class`` (default: :class:`Scenario`)."""
-    from whipple_kick.library import riders, thesis, tyres
-    from whipple_kick.simulate.scenario import DEFAULTS
     p = _OneLineParser(
         prog="simulate", allow_abbrev=False,
         description="Kick-plate test on the nonlinear Carvallo-Whipple bicycle-rider model with "
@@ -365,14 +375,11 @@ _REPLACED_FIELDS = {"fz_n": ("rider_mass_kg",), "rider_mass_kg": ("fz_n",), "kic
 
 def _flag(field):
     """The flag that sets a Scenario field (its declaration's :attr:`~whipple_kick.simulate.settings.Setting.option`)."""
-    from whipple_kick.simulate import settings
-    from whipple_kick.simulate.scenario import Scenario
     return settings.settings(Scenario)[field].option
 
 
 def _flag_value(field, value):
     """``field = value`` as flags give it: ``--hip-stiffness 500 N m/rad``, ``--plate-stop resolve``, ``--lqr-heading``."""
-    from whipple_kick.simulate.scenario import UNITS
     if isinstance(value, bool):
         return _flag(field) if value else f"no {_flag(field)}"
     unit = UNITS.get(field)
@@ -384,10 +391,6 @@ def _flag_value(field, value):
 def _in_flags(words):
     """A mechanism's condition (:data:`whipple_kick.simulate.scenario.MECHANISM_FIELDS`) in flags: "rider_body
     'leaning'" -> "--rider-body leaning", "pressure_front_kpa" -> "--pressure-front"."""
-    import re
-
-    from whipple_kick.simulate.scenario import DEFAULTS
-
     def quoted(match):
         if match[1] not in DEFAULTS:
             return match[0]
@@ -404,8 +407,6 @@ def _preflight(scenario):
     The scenario's own refusal (:class:`~whipple_kick.simulate.scenario.UnusedFieldError`) names the Python
     field; a user of the command line gave a flag.
     """
-    from whipple_kick.simulate import assembly
-    from whipple_kick.simulate.scenario import DEFAULTS, UnusedFieldError
     try:
         return assembly.preflight(scenario)
     except UnusedFieldError as exc:
@@ -425,7 +426,6 @@ def _check_loads(bicycle, loads, rider=None):
     """
     if not loads:
         return   # nothing to check (the bicycle itself is checked with the scenario)
-    from whipple_kick.library import bicycleparameters, riders
     bike = bicycleparameters.load_bicycle(bicycle, rider)
     if bike.includes_rider:
         return   # refused later in one line (the preset already includes its rider)
@@ -437,7 +437,6 @@ def _check_loads(bicycle, loads, rider=None):
 def _scenario_from_args(args, scenario_class=None):
     """The scenario of the parsed flags; with ``--compat`` or ``--scenario``, the preset or file with the given
     flags' fields changed. ``scenario_class`` (default :class:`Scenario`) is the parser's (:func:`_simulate_parser`)."""
-    from whipple_kick.simulate.scenario import Scenario
     cls = scenario_class or Scenario
     fields = _scenario_fields(args, "simulate", cls)
     if args.kick_table is not None:
@@ -471,7 +470,6 @@ _STABILITY_FILES = ("eigenvalues.csv", "summary.json", "stability.png")
 
 def _discard(out, created, written):
     """Remove what an unfinished command left: the folder it created, else the files it wrote."""
-    import shutil
     if created:
         shutil.rmtree(out, ignore_errors=True)
         return
@@ -505,8 +503,6 @@ def _default_out(scenario, prefix="kick"):
 
 def _new_folder(name):
     """``<name>_<date-time>`` under the current directory, numbered if it exists (never an existing folder)."""
-    import datetime
-    import pathlib
     stamp = datetime.datetime.now().strftime("%Y%m%d-%H%M%S")
     base = pathlib.Path.cwd() / f"{name}_{stamp}"
     out, k = base, 1
@@ -544,8 +540,6 @@ def _output_folder(path, force, previous=()):
     SIGTERM, from the folder's creation on) removes the folder it created,
     else the files it wrote (the staging folder), unless ``keep`` was set.
     """
-    import pathlib
-    import shutil
     out = pathlib.Path(path)
     if out.exists() and not out.is_dir():
         raise InputError(f"output folder {str(out)!r} exists and is not a folder")
@@ -576,11 +570,6 @@ def _replace_from_staging(job, previous):
     Ctrl-C and SIGTERM are held back meanwhile (a few renames), so the
     folder never mixes two runs' files.
     """
-    import os
-    import shutil
-    import signal
-    import threading
-
     main = threading.current_thread() is threading.main_thread()
     held = {signal.SIGINT, signal.SIGTERM}
     if main:
@@ -618,8 +607,6 @@ def _claim(job, force, previous):
     except OSError as exc:
         raise InputError(f"output folder {str(out)!r} is not writable: {exc.strerror or exc}") from None
     # Holding the lock, any temporary of ours here is a killed writer's.
-    import os
-    import shutil
     for stale in fileio.stale_temporaries(out, previous):
         stale.unlink(missing_ok=True)
     for stale in out.glob(f"{STAGING_PREFIX}.*"):   # a killed writer's staging folder
@@ -638,7 +625,6 @@ def _claim(job, force, previous):
 
 
 def _print_summary(result, out, files):
-    from whipple_kick.simulate import results
     s = result.summary
     sc, bike, ctl, kick, st = s["scenario"], s["bicycle"], s["controller"], s["kick"], s["steady_state"]
     deg = 180.0 / np.pi
@@ -716,10 +702,7 @@ def _print_summary(result, out, files):
 def _simulate(argv):
     args = _simulate_parser().parse_args(argv)
     if args.quiet:   # summary.json lists the tyre files' data warnings (tyres.data_warnings)
-        import warnings
-
-        from whipple_kick.library.tyres import DataQualityWarning
-        warnings.filterwarnings("ignore", category=DataQualityWarning)   # within _run's warnings block only
+        warnings.filterwarnings("ignore", category=tyres.DataQualityWarning)   # within _run's warnings block only
     scenario = _preflight(_scenario_from_args(args))
     movie_options = _animation_options(args)
     with _output_folder(args.out or _default_out(scenario), args.force, _OUTPUT_FILES) as job:
@@ -744,7 +727,6 @@ def _simulate_into(args, scenario, movie_options, out, written):
     Returns (result, files, note): the run's result, the written files'
     descriptions and a note for the user or None.
     """
-    from whipple_kick.simulate import simulation
     result = simulation.run(scenario)
     files = result.save(out)
     written.extend(files)
@@ -781,8 +763,6 @@ def simulate_main(argv=None):
 # ------------------------------------------------------------ recommend-pressure
 
 def _recommend(argv):
-    from whipple_kick.library import thesis, tyres
-    from whipple_kick.simulate.scenario import DEFAULTS, MAX_DURATION
     from whipple_kick.studies import recommend
     p = _OneLineParser(
         prog="recommend-pressure",
@@ -807,9 +787,9 @@ def _recommend(argv):
                    help="also try a grid of interpolated pressures between the measured ones")
     p.add_argument("--step", type=_number("kPa"), default=10.0, metavar="KPA",
                    help="step of the --fine grid in kPa (default 10)")
-    p.add_argument("--criterion", choices=tuple(k.replace("_", "-") for k in recommend.CRITERIA), default="settling",
+    p.add_argument("--criterion", choices=tuple(k.replace("_", "-") for k in CRITERIA), default="settling",
                    help="; ".join(f"{k.replace('_', '-')}{' (default)' * (k == 'settling')}: "
-                                  + c.text.replace("%", "%%") for k, c in recommend.CRITERIA.items()))
+                                  + c.text.replace("%", "%%") for k, c in CRITERIA.items()))
     p.add_argument("--duration", type=_number("s"), metavar="S",
                    help=f"simulated time after the kick in s (default {DEFAULTS['duration']:g}, at most "
                         f"{MAX_DURATION:g})")
@@ -819,8 +799,6 @@ def _recommend(argv):
                    help="sweep folder keeping every run (re-running with it resumes)")
     p.add_argument("--extend", action="store_true",
                    help="with --out: add these runs to a folder that holds another sweep")
-    from whipple_kick.library.inputs import DIRECTIONS
-    from whipple_kick.simulate.scenario import TYRE_TRANSIENTS, Scenario
     p.add_argument("--kick-direction", choices=(*DIRECTIONS, "both"), default=DEFAULTS["kick_direction"],
                    help=f"direction the plate moves (default {DEFAULTS['kick_direction']}); both: run each direction and say whether "
                         "the best pressure depends on it (twice the runs)")
@@ -885,12 +863,8 @@ def _recommend(argv):
         for line in verdicts:
             print(f"  {line}")
     if args.out is not None:
-        import pathlib
-
-        import pandas as pd
-
         from whipple_kick.figures import plotting
-        metric = recommend.CRITERIA[recommend.criterion_key(args.criterion)].column
+        metric = CRITERIA[recommend.criterion_key(args.criterion)].column
         for (direction, form), by_load in recs.items():
             name = SWEEP_FIGURE if len(variants) == 1 else SWEEP_FIGURE.replace(".png", f"_{direction}_{form}.png")
             plotting.sweep_figure(pd.concat([rec.table.assign(fz_n=rec.fz_n) for rec in by_load], ignore_index=True),
@@ -911,7 +885,6 @@ UNCERTAINTY_FIGURES = criteria.Listing(lambda: ("p_best.png", *(f"recovery_{key}
 
 def _study_flags_given(args):
     """The flags of a plain recommendation given on a command line of a study that sets them itself."""
-    from whipple_kick.simulate.scenario import DEFAULTS, Scenario
     return [flag for flag, value in (("--fine", args.fine), ("--extend", args.extend),
                                      ("--duration", args.duration is not None),
                                      ("--kick-direction", args.kick_direction != DEFAULTS["kick_direction"]),
@@ -921,10 +894,7 @@ def _study_flags_given(args):
 
 def _recommend_uncertain(args):
     """``recommend-pressure --uncertain``: the uncertainty study (whipple_kick.studies.uncertainty)."""
-    import pathlib
-
     from whipple_kick.figures import uncertainty as figures
-    from whipple_kick.simulate.scenario import Scenario
     from whipple_kick.studies import recommend, uncertainty
     given = _study_flags_given(args)
     if given:
@@ -946,7 +916,7 @@ def _recommend_uncertain(args):
         study.write(out)
         figures.p_best_figure(study.p_best, out / UNCERTAINTY_FIGURES[0],
                               title=f"P(best), N = {samples} ({len(study.inputs)} rows), 95 % intervals")
-        for crit in uncertainty.CRITERIA:
+        for crit in CRITERIA:
             figures.distribution_figure(study.outcomes, crit, out / f"recovery_{crit}.png")
             figures.paired_figure(study.outcomes, crit, out / f"paired_{crit}.png")
             figures.sobol_figure(study.sobol, crit, None, out / f"sobol_{crit}.png")   # every pair at every load
@@ -958,9 +928,6 @@ def _recommend_uncertain(args):
 def _recommend_posterior(args):
     """``recommend-pressure --posterior DIR``: P(best) under a calibration's posterior
     (whipple_kick.studies.posterior_study), read from DIR or run there."""
-    import pathlib
-
-    from whipple_kick.library import thesis
     from whipple_kick.studies import posterior_study
     given = ["--uncertain"] * (args.uncertain is not None) + _study_flags_given(args) + ["--out"] * (args.out is not None)
     if given:
@@ -1022,8 +989,6 @@ _COMPARE_FILES = ("compare.png", "compare.csv")
 
 
 def _compare(argv):
-    import pathlib
-
     p = _OneLineParser(
         prog="compare", allow_abbrev=False,
         description="Overlay kick-plate runs (folders written by simulate or Result.save) in one figure, each "
@@ -1035,7 +1000,6 @@ def _compare(argv):
     _output_options(p.add_argument_group("output"), "compare.png")
     args = p.parse_args(argv)
     from whipple_kick.figures import plotting
-    from whipple_kick.simulate import results
     runs = [results.Result.load(folder) for folder in args.runs]
     labels = args.labels or [pathlib.Path(folder).resolve().name for folder in args.runs]
     if args.labels is None and len(set(labels)) < len(labels):
@@ -1050,7 +1014,6 @@ def _compare(argv):
             plotting.compare(runs, job.dir / "compare.png", labels=labels,
                              title=f"{len(runs)} runs compared: " + "; ".join(labels))
     if not args.quiet:
-        import pandas as pd
         with pd.option_context("display.max_colwidth", 40, "display.width", 200):
             print(table.to_string(na_rep="-"))
         print(f"  wrote {', '.join(n for n in _COMPARE_FILES if (out / n).exists())} in {out}")
@@ -1065,8 +1028,6 @@ def compare_main(argv=None):
 # ------------------------------------------------------------------ stability
 
 def _stability_parser():
-    from whipple_kick.library import riders, thesis, tyres
-    from whipple_kick.simulate.scenario import DEFAULTS
     from whipple_kick.studies import stability
     start, stop, step = stability.DEFAULT_SPEEDS
     p = _OneLineParser(
@@ -1098,10 +1059,6 @@ def _stability_parser():
 
 
 def _stability(argv):
-    import time
-
-    from whipple_kick.simulate import provenance
-    from whipple_kick.simulate.scenario import Scenario
     from whipple_kick.studies import stability
     args = _stability_parser().parse_args(argv)
     started = time.perf_counter()
@@ -1141,8 +1098,6 @@ _VALIDATE_FILES = ("validation.csv", "summary.json", "validation.png")
 
 
 def _validate_parser():
-    from whipple_kick.library import riders, thesis, tyres
-    from whipple_kick.simulate.scenario import MAX_DURATION, SETTINGS
     from whipple_kick.studies import validation
     p = _OneLineParser(
         prog="validate", allow_abbrev=False,
@@ -1189,8 +1144,6 @@ def _validate_parser():
 
 
 def _validate(argv):
-    import time
-
     from whipple_kick.studies import validation
     args = _validate_parser().parse_args(argv)
     started = time.perf_counter()
@@ -1239,8 +1192,6 @@ CALIBRATION_FIGURE = "predictive.png"
 
 def _held_out(args, result, base, inputs, cells, progress, options):
     """``calibrate --held-out``: the checks' table (its rows also appended to ``result.checks``)."""
-    import pandas as pd
-
     from whipple_kick.studies import calibration
 
     def factory(prior_list, cells, features, direction):
@@ -1257,9 +1208,6 @@ def _held_out(args, result, base, inputs, cells, progress, options):
 
 def _screen(args, inputs, cells, base, progress):
     """``calibrate --screen``: Morris screening of every prior the rider reads, into DIR/screening.csv."""
-    import pathlib
-
-    from whipple_kick import fileio
     from whipple_kick.library import priors
     from whipple_kick.studies import calibration
     spec = priors.load(args.spec)
@@ -1312,9 +1260,6 @@ def calibrate_main(argv=None):
     measured kick responses (see ``calibrate --help`` and :mod:`whipple_kick.studies.calibration`)."""
 
     def main(argv):
-        import pathlib
-        import time
-
         from whipple_kick.library import priors
         from whipple_kick.studies import calibration, validation
         p = _OneLineParser(
@@ -1332,7 +1277,6 @@ def calibrate_main(argv=None):
                             "kick_accel)")
         p.add_argument("--rider-body", choices=("rigid", "leaning"), default="rigid",
                        help="the rider model (a modelling choice: calibrate per option; default rigid)")
-        from whipple_kick.simulate.scenario import LQR_MODELS
         p.add_argument("--lqr-model", choices=LQR_MODELS, default=LQR_MODELS[0],
                        help="the model the rider's LQR gains are designed on (a modelling choice: calibrate per "
                             f"option, as the uncertainty file's rider options; default {LQR_MODELS[0]})")
@@ -1369,7 +1313,7 @@ def calibrate_main(argv=None):
         started = time.perf_counter()
         base = validation.base_scenario(duration=calibration.FEATURE_DURATION, rider_body=args.rider_body,
                                         kick_direction=args.direction, lqr_model=args.lqr_model)
-        cells = [(570.0, 300.0), (635.0, 400.0), (701.0, 500.0)] if args.quick else None
+        cells = list(zip(thesis.LOADS_N, thesis.PRESSURES_KPA, strict=True)) if args.quick else None   # the diagonal
         inputs = args.inputs or (["gain_scale", "carcass_stiffness_scale", "carcass_damping", "kick_accel"]
                                  + (["hip_stiffness"] if args.rider_body == "leaning" else []))
         progress = sys.stderr.isatty()

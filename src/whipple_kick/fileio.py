@@ -25,6 +25,7 @@ import pathlib
 import time
 
 import numpy as np
+import pandas as pd
 
 from .errors import InputError
 
@@ -230,8 +231,6 @@ def read_csv(path, what: str, *, name: str | None = None, **options):
         The file does not exist, is not a file, is not UTF-8 text, is empty
         or is not a delimited table.
     """
-    import pandas as pd
-
     p = pathlib.Path(path)
     label = f"{what} {str(path) if name is None else name!r}"
     if not p.is_file():

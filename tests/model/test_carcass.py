@@ -341,7 +341,7 @@ def test_blended_pressure_rhs_is_unchanged_at_every_sample():
     assert sorted(ref["state_names"][dropped]) == sorted(("q11", "u11", *slip.REFLEX_STATES))
     assert not np.any(ref["x"][:, dropped]) and not np.any(ref["dx"][:, dropped])
     output = [list(ref["output_names"]).index(n) for n in slip.OUTPUT_NAMES]
-    model = slip.Model(transient=wk.transient.TRANSIENTS[int(p_old["tyre_transient"])])
+    model = slip.Model(transient=wk.transient.transients()[int(p_old["tyre_transient"])])
     rhs = slip.CompiledRHS(slip.Parameters(model, {n: p_old[n] for n in slip.PARAMETER_NAMES}))
     assert rhs.p[slip.P["wr"]] == 0.5 and rhs.p[slip.P["wf"]] == 0.5   # the blend: 300 and 400 kPa, 1:1
     pairs = [rhs.outputs(t, x) for t, x in zip(ref["t"], ref["x"][:, state], strict=True)]

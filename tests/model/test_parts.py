@@ -319,6 +319,25 @@ def test_a_part_declared_here_has_its_columns_in_the_stability_study(shift):
     assert {"q12", "u12", "q11"} <= modes._body_states() and "q4" not in modes._body_states()
 
 
+def test_a_part_declared_here_is_in_the_gain_table_and_the_trajectory_columns(shift):
+    """The rider's gain table (the LQR design's, the gain check's) and the trajectory's columns and units are
+    read from the registry when used, so the part declared after the package was imported is in them, and
+    out of them again once it is removed."""
+    assert slip.gain_states()["kq12"] == "q12"
+    assert slip.gain_names()[:6] == ("kq3", "kq4", "kq7", "ku3", "ku4", "ku7") and "kq12" in slip.gain_names()
+    assert results.part_columns()["q12"] == ("mass_shift", "m")
+    assert results.unit_of("mass_shift_rate") == "m/s" and results.UNITS["shift_force"] == "N"
+    assert "mass_shift" in results.UNITS and "mass_shift" in set(results.UNITS)
+    with pytest.raises(wk.errors.InputError, match=r"unknown steer-torque gain\(s\) \['kq99'\]; known: .*'kq12'"):
+        assembly.custom_gains({"kq99": 1.0})
+    parts.REGISTRY.pop(shift.name)
+    try:
+        assert "kq12" not in slip.gain_states() and "q12" not in results.part_columns()
+        assert "mass_shift" not in results.UNITS
+    finally:
+        parts.REGISTRY[shift.name] = shift
+
+
 @pytest.mark.slow   # derives and compiles the shift model when no other test has (about 40 s), then runs it
 def test_a_part_declared_here_runs_through_scenario_assemble_and_run_from_its_field_and_flag(shift):
     """The acceptance of issue 42: the sliding-mass part, declared in this module alone, is selected and set

@@ -80,12 +80,12 @@ def test_failing_compiler_from_simulate_is_status_1_and_leaves_no_folder(tmp_pat
     def fail(*layout):
         raise BuildError("the C compiler /bin/false failed (exit status 1: no output)")
     monkeypatch.setattr(slip.compiled, "library_path", fail)
-    slip.library.cache_clear()
+    slip.compiled._library.cache_clear()
     try:
         out = tmp_path / "run"
         status, stdout, err = _simulate(["--duration", "0.6", "--no-plot", "--out", str(out)], capsys)
     finally:
-        slip.library.cache_clear()
+        slip.compiled._library.cache_clear()
     assert status == 1 and stdout == ""
     assert err.count("\n") == 1 and err.startswith("simulate: cannot build the compiled model: the C compiler")
     assert not out.exists()                      # the folder it made is removed
@@ -100,11 +100,11 @@ def test_missing_compiler_from_simulate_is_status_2_one_line(tmp_path, capsys, m
         raise CompilerNotFoundError("no C compiler found (looked for cc, gcc, clang on PATH): install a C compiler "
                                     "(e.g. gcc) or set CC to one")
     monkeypatch.setattr(slip.compiled, "library_path", missing)
-    slip.library.cache_clear()
+    slip.compiled._library.cache_clear()
     try:
         status, stdout, err = _simulate(["--duration", "0.6", "--no-plot", "--out", str(tmp_path / "run")], capsys)
     finally:
-        slip.library.cache_clear()
+        slip.compiled._library.cache_clear()
     assert status == 2 and stdout == "" and "Traceback" not in err
     assert err.count("\n") == 1 and err.startswith("simulate: cannot build the compiled model: no C compiler found")
     assert "install a C compiler" in err

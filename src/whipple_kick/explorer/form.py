@@ -21,6 +21,7 @@ Example
 """
 import argparse
 import dataclasses
+import re
 
 from whipple_kick import cli
 from whipple_kick.errors import InputError
@@ -97,7 +98,6 @@ def plain(doc):
     >>> plain("Tyre file (:func:`~whipple_kick.library.tyres.load`); ``None``: the rule.")
     'Tyre file (whipple_kick.library.tyres.load); None: the rule.'
     """
-    import re
     return re.sub(r":[a-z]+:`~?([^`]+)`", r"\1", doc).replace("``", "")
 
 

@@ -15,8 +15,12 @@ import pathlib
 import signal
 import threading
 
-from whipple_kick.simulate.results import Result
-from whipple_kick.studies import sweep_engine
+import pandas as pd
+
+from whipple_kick.figures import animation, plotting
+from whipple_kick.simulate import results
+from whipple_kick.simulate.results import Result, run_labels
+from whipple_kick.studies import stability, sweep_engine
 
 #: What :func:`~whipple_kick.studies.sweep_engine.run_case` returns of the trajectory: all of it, unthinned,
 #: in double precision (the run folder's trajectory.csv is the run's, as ``simulate`` writes it).
@@ -80,10 +84,6 @@ def run_into(scenario, folder):
         ``outcome`` ("completed", "fell", "failed"), ``words`` (sentences: :func:`words`), ``files`` (written),
         ``recovery_s`` (None where it has none), ``figure`` (whether response.png was drawn).
     """
-    import pandas as pd
-
-    from whipple_kick.figures import plotting
-
     folder = pathlib.Path(folder)
     record = sweep_engine.run_case(scenario, folder.name, WHOLE_TRAJECTORY)
     if record["summary"] is None:   # nothing ran (the model could not start): the record says why
@@ -111,8 +111,6 @@ def words(summary):
     ...        "metrics": {}, "recovery": {}, "controller": {}, "linear_stability": {}})[0]
     'The bicycle FELL 1.536 s after the kick start (|steer| reached 90 deg: the fork turned over).'
     """
-    from whipple_kick.simulate import results
-
     sc, out = summary["scenario"], []
     if summary["outcome"] == "failed":
         out.append(f"The run FAILED numerically: {summary['message']} (the download holds the run up to then).")
@@ -149,9 +147,6 @@ def overlay(folders, numbers, path):
     """Draw ``compare``'s figure of the run folders (at most four on the page) into ``path``, each run labelled
     by its number on the page and the fields in which the runs differ
     (:func:`whipple_kick.simulate.results.run_labels`, as ``compare``)."""
-    from whipple_kick.figures import plotting
-    from whipple_kick.simulate.results import run_labels
-
     runs = [Result.load(f) for f in folders]
     differ = run_labels(runs)
     same = differ == [f"run {k + 1}" for k in range(len(runs))]   # no field tells them apart
@@ -163,8 +158,6 @@ def overlay(folders, numbers, path):
 def stability_into(scenario, speeds, folder):
     """The ``stability`` command's analysis of ``scenario`` against ``speeds``, its files written into
     ``folder`` (eigenvalues.csv, summary.json, stability.png); returns the printed lines."""
-    from whipple_kick.studies import stability
-
     result = stability.analyse(scenario, speeds)
     stability.write(result, pathlib.Path(folder), plot=True)
     return [result.summary["title"], *stability.report_lines(result.summary)]
@@ -173,7 +166,5 @@ def stability_into(scenario, speeds, folder):
 def animate_into(folder, **options):
     """The animation of the run in ``folder`` (:data:`ANIMATION`; ``simulate --animate``'s defaults unless
     ``options`` of :func:`whipple_kick.figures.animation.animate` say otherwise)."""
-    from whipple_kick.figures import animation
-
     movie = animation.animate(Result.load(folder), pathlib.Path(folder) / ANIMATION, **options)
     return {"frames": movie.frames, "video_s": movie.video_duration_s, "wall_s": movie.wall_s}

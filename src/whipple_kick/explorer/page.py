@@ -9,6 +9,8 @@ the P(best). Element ids are the page's interface for the browser tests (tests/e
 """
 import html
 
+from whipple_kick import __version__
+
 #: Most runs overlaid in one figure (the issue's "up to four").
 MAX_OVERLAID = 4
 
@@ -208,8 +210,6 @@ def render(fields, study=None):
 
     ``study`` names the uncertainty study's folder the page reads P(best) from (None: none given).
     """
-    from whipple_kick import __version__
-
     e = html.escape
     study_text = (f"from the uncertainty study in {e(str(study))}" if study is not None else
                   "none: start the explorer with --study DIR (a folder holding p_best.csv)")

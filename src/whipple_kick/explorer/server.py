@@ -36,6 +36,8 @@ import zipfile
 
 from whipple_kick import cli
 from whipple_kick.errors import InputError
+from whipple_kick.simulate.scenario import SETTINGS
+from whipple_kick.studies import stability
 
 from . import form, jobs, page, study
 
@@ -197,7 +199,6 @@ def _app(explorer):
     class PBestHandler(Handler):
         async def get(self):
             async def work():
-                from whipple_kick.simulate.scenario import SETTINGS
                 if explorer.study is None:
                     self.reply({"note": "No study was given (whipple-kick-explorer --study DIR).", "text": False})
                     return
@@ -285,7 +286,6 @@ def _parser():
                         "--out DIR writes): the page shows its P(best) for the chosen load")
     p.add_argument("--workers", type=int, metavar="N",
                    help="worker processes of the pool runs go to (default: one per CPU core, as sweeps)")
-    from whipple_kick.studies import stability
     start, stop, step = stability.DEFAULT_SPEEDS
     p.add_argument("--speeds", default=f"{start:g}:{stop:g}:{step:g}", metavar="START:STOP:STEP",
                    help=f"speeds of the page's stability sweep in m/s, as stability --speeds: START:STOP:STEP (STOP "
@@ -307,7 +307,6 @@ def _serve(argv):
         study.check_folder(args.study)
     if args.workers is not None and args.workers < 1:
         raise InputError(f"--workers {args.workers} must be a whole number >= 1")
-    from whipple_kick.studies import stability
     speeds = stability.parse_speeds(args.speeds)
     if not 0 <= args.port <= 65535:
         raise InputError(f"--port {args.port} is outside the allowed range [0, 65535]")

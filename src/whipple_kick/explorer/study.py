@@ -16,6 +16,8 @@ Example
 import math
 import pathlib
 
+import pandas as pd
+
 from whipple_kick.errors import InputError
 from whipple_kick.simulate.criteria import CRITERIA
 
@@ -27,8 +29,6 @@ COLUMNS = ("fz_n", "criterion", "pressure_kpa", "p", "low", "high", "measured_be
 
 def check_folder(folder):
     """The study folder's p_best.csv path; :class:`InputError` (one line) where there is none or it lacks a column."""
-    import pandas as pd
-
     path = pathlib.Path(folder) / P_BEST_FILE
     if not path.is_file():
         raise InputError(f"study folder {str(folder)!r} has no {P_BEST_FILE} (recommend-pressure --uncertain "
@@ -52,8 +52,6 @@ def p_best(folder, fz_n):
         ``{criterion: [{"pressure", "p", "low", "high", "measured_best"}, ...]}``, the criteria in
         :data:`~whipple_kick.simulate.criteria.CRITERIA` order; ``pressure`` is "300 kPa" or "none recovers".
     """
-    import pandas as pd
-
     table = pd.read_csv(check_folder(folder))
     at = table[(table["fz_n"] - float(fz_n)).abs() < 1e-9]
     if at.empty:
@@ -69,6 +67,4 @@ def p_best(folder, fz_n):
 
 def loads(folder):
     """The rear loads [N] the study computed, ascending."""
-    import pandas as pd
-
     return sorted({float(v) for v in pd.read_csv(check_folder(folder))["fz_n"]})

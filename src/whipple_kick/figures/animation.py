@@ -38,9 +38,14 @@ import subprocess
 import time
 
 import numpy as np
+from scipy.ndimage import gaussian_filter1d
 
 from whipple_kick.errors import InputError, check_range
-from whipple_kick.model import geometry
+from whipple_kick.library import bicycleparameters, riders
+from whipple_kick.model import geometry, parts
+from whipple_kick.simulate import assembly
+
+from . import plotting
 
 #: Trajectory columns the animation reads, by what they hold: the ONE place
 #: to change when trajectory columns are renamed. q1..q10 are Moore's
@@ -201,8 +206,6 @@ def _yeadon_segments(human, seat, to_bike):
 
 def _model_parts(scenario):
     """The run's model's parts (:func:`whipple_kick.model.parts.selected`), in build order."""
-    from whipple_kick.model import parts
-
     return parts.named([p.name for p in parts.selected(scenario)])
 
 
@@ -216,8 +219,6 @@ def _segment_frames(bicycle, scenario):
     segments of a part the model lacks that the rear frame holds, in the rear frame C. A rider not split is
     rigid in C.
     """
-    from whipple_kick.library import riders
-
     if not bicycle.get("body"):
         return {}
     names = [p.name for p in _model_parts(scenario)]
@@ -276,8 +277,6 @@ def _bicycle_bodies(scenario, summary, params):
     fore-aft shift included, and the joint angles), not seated again here; the frame is the bicycle's own
     (the posture less the shift, which stands for a fit change: the saddle is drawn at the rider's seat).
     """
-    from whipple_kick.library import bicycleparameters, riders
-
     bicycle = summary["bicycle"]
     posture = bicycle.get("rider_posture")
     to_c = functools.partial(geometry.benchmark_to_body, parameters=params, body="C")
@@ -340,9 +339,6 @@ def _model_parameters(result, tyres):
     posture), so the bicycle's own set serves, without seating the rider again; a preset (rider lumped in)
     gives the rear frame's inertia the lumped drawing needs, low-inertia change included.
     """
-    from whipple_kick.library import bicycleparameters
-    from whipple_kick.simulate import assembly
-
     scenario = result.scenario
     if result.summary["bicycle"].get("rider_posture") is not None:
         moore = dict(bicycleparameters.load_bicycle(scenario.bicycle, scenario.rider).moore)
@@ -384,8 +380,6 @@ def _steady_path(first, arc_lengths):
 
 
 def _smooth(values, times, sigma_s):
-    from scipy.ndimage import gaussian_filter1d
-
     step = float(np.median(np.diff(times))) if times.size > 1 else 1.0
     return gaussian_filter1d(values, sigma_s / step, mode="nearest")
 
@@ -755,7 +749,6 @@ class _Frames:
         from matplotlib.figure import Figure
         from matplotlib.patches import Polygon
 
-        from . import plotting
 
         width, height = size
         self.fig = Figure(figsize=(width / dpi, height / dpi), dpi=dpi, facecolor="white")

@@ -16,8 +16,12 @@ import math
 import textwrap
 
 import numpy as np
+import pandas as pd
 
-from whipple_kick.library import thesis
+from whipple_kick.errors import InputError
+from whipple_kick.library import experiments, thesis
+from whipple_kick.simulate import analysis
+from whipple_kick.simulate.results import checked_labels
 
 #: (column, axis label) of the four panels, top to bottom.
 RESPONSE_PANELS = (
@@ -293,9 +297,6 @@ def compare(results, path=None, labels=None, title=None, time_range=None, dpi=15
     >>> [t.get_text() for t in fig.axes[0].get_legend().get_texts()][2]
     'pressure_kpa=400, controller=off, duration=3 (fell at 1.536 s)'
     """
-    from whipple_kick.errors import InputError
-    from whipple_kick.simulate.results import checked_labels
-
     results = list(results)
     if not results:
         raise InputError("nothing to compare: give at least one run")
@@ -317,9 +318,6 @@ SWEEP_KINDS = ("lines", "heatmap")
 
 def _sweep_cells(table, x, metric, y):
     """Per case: (x, y or None, metric value or NaN, fell, failed), duplicates of (x, y) refused."""
-    import pandas as pd
-
-    from whipple_kick.errors import InputError
     for name in (x, metric) + (() if y is None else (y,)):
         if name not in table.columns:
             raise InputError(f"column {name!r} is not in the sweep table ({len(table.columns)} columns, e.g. "
@@ -380,7 +378,6 @@ def sweep_figure(table, x, metric, y=None, kind="lines", path=None, title=None, 
     from matplotlib.figure import Figure
     import matplotlib.transforms as mtransforms
 
-    from whipple_kick.errors import InputError
     if kind not in SWEEP_KINDS:
         raise InputError(f"sweep figure kind {kind!r} is unknown; choose one of {', '.join(SWEEP_KINDS)}")
     if kind == "heatmap" and y is None:
@@ -487,9 +484,6 @@ def validation_figure(result, path=None, dpi=120):
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
-
-    from whipple_kick.library import experiments
-    from whipple_kick.simulate import analysis
 
     exp = experiments.load()
     band = (exp.processing["yaw_band_low"], exp.processing["yaw_band_high"])

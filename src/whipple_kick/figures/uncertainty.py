@@ -8,6 +8,7 @@ to ``path`` as PNG.
 import math
 
 import numpy as np
+import pandas as pd
 
 from whipple_kick.simulate.criteria import CRITERIA
 
@@ -39,7 +40,6 @@ def p_best_figure(p_best, path=None, title=None, dpi=120):
     The measured best pressure (thesis Table 8.9) is marked with a star above its bars' intervals; the legend
     sits below the panels, where it hides no bar and no star.
     """
-    import pandas as pd
     loads = list(dict.fromkeys(p_best["fz_n"]))
     fig, axes = _figure(len(loads), height=3.9)
     criteria = list(dict.fromkeys(p_best["criterion"]))

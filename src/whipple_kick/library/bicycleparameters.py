@@ -42,12 +42,14 @@ import re
 import warnings
 
 import numpy as np
+import yaml
 
 from whipple_kick.errors import DefaultValueWarning, InputError
 from whipple_kick.model import benchmark as _benchmark
 from whipple_kick.model import parts
 
-from . import bicycles, parameters
+from . import bicycles, parameters, riders
+from .riders import MAX_RIDER_MASS_KG, MIN_RIDER_MASS_KG, NO_RIDER
 
 #: The benchmark file of a bicycle (and of a rider on a bicycle) ends so.
 BENCHMARK_SUFFIX = "Benchmark.txt"
@@ -230,8 +232,6 @@ def load_bicycle(name, rider=None):
     >>> load_bicycle("balanceassist_v1").name
     'balanceassist_v1'
     """
-    from .riders import NO_RIDER
-
     text = str(name)
     # A shipped name wins over a folder of that name in the working directory (a run's output folder, say).
     if text not in bicycles.available() and not text.endswith(".toml") and is_bicycleparameters_path(text):
@@ -276,7 +276,6 @@ def _rider_benchmark(path):
     _missing(path, values, [n for n in RIDER_UNITS if n != "yB"])
     if values.get("yB", 0.0) != 0.0:
         raise InputError(f"{path}: yB = {values['yB']!r} m: the rider must sit in the bicycle's mid-plane (yB = 0)")
-    from .riders import MAX_RIDER_MASS_KG, MIN_RIDER_MASS_KG
     if not MIN_RIDER_MASS_KG <= values["mB"] <= MAX_RIDER_MASS_KG:   # a person's (riders.MIN_RIDER_MASS_KG says how)
         raise InputError(f"{path}: mB = {values['mB']!r} kg is outside a rider's allowed range "
                          f"[{MIN_RIDER_MASS_KG:g}, {MAX_RIDER_MASS_KG:g}] kg")
@@ -380,7 +379,6 @@ def load(path, rider=None, includes_rider=None):
         if not rider_path.is_file():
             raise InputError(f"{rider_path}: no such file: BicycleParameters has not seated rider {rider!r} "
                              f"on {name!r}")
-        from . import riders
         values = riders.lump_into_rear_frame(values, *_rider_benchmark(rider_path))
         # The rear frame is now bicycle + rider; the rider file gives no standard deviations.
         uncertainties = {k: v for k, v in uncertainties.items() if k not in RIDER_UNITS}
@@ -443,7 +441,6 @@ def from_bicycleparameters(obj, name=None):
         includes_rider = bool(getattr(obj, "includes_rider", False))
         if set(LEAN_NAMES) <= set(params):                 # MooreRiderLean2012: the upper body held rigid
             bike_only, body = leaning_rider(obj)
-            from . import riders
             params = riders.lump_into_rear_frame(bike_only.benchmark, *_body_in_benchmark(bike_only, body))
             includes_rider = True
         elif set(_benchmark.MOORE_NAMES) <= set(params) and not set(_benchmark.BENCHMARK_NAMES) <= set(params):
@@ -627,10 +624,8 @@ def yeadon_rider(path, bicycle=None, mass_kg=None):
     -------
     whipple_kick.library.riders.YeadonRider
     """
-    import yaml
     import yeadon
 
-    from . import riders
 
     path = pathlib.Path(path)
     if path.is_dir():

@@ -26,6 +26,7 @@ Example
 """
 from dataclasses import dataclass
 import math
+import pathlib
 
 from whipple_kick.errors import InputError
 
@@ -199,7 +200,6 @@ def load(name=DEFAULT_EXPERIMENT):
     InputError
         Unknown name, or a malformed file (one line naming the file and key).
     """
-    import pathlib
     files = parameters.toml_files(parameters.shipped("experiments"))
     if name in files:
         path = files[name]

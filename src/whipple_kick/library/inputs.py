@@ -17,6 +17,7 @@ import pathlib
 import re
 
 import numpy as np
+from scipy.interpolate import CubicSpline
 
 from whipple_kick import fileio
 from whipple_kick.errors import InputError, check_range
@@ -422,7 +423,6 @@ def cubic_segments(times, displacements):
     >>> [(a, b) for a, b, _ in cubic_segments([0.0, 0.1, 0.2], [0.0, 0.05, 0.15])]
     [(0.0, 0.1), (0.1, 0.2)]
     """
-    from scipy.interpolate import CubicSpline
     t = np.asarray(times, dtype=float)
     y = np.asarray(displacements, dtype=float)
     if t.ndim != 1 or t.shape != y.shape or t.size < 2:

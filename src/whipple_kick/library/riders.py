@@ -39,6 +39,7 @@ from scipy.optimize import fsolve
 
 from whipple_kick.errors import InputError, check_range
 from whipple_kick.model import benchmark as _benchmark
+from whipple_kick.model import parts
 
 from . import parameters
 from .bicycles import Bicycle
@@ -818,8 +819,6 @@ def carriers(part_names):
     body is the rest of its segments, held as it declares (the upper body of the rigid rider whose arms take
     the forearms to the bar). Empty: the rider is not split.
     """
-    from whipple_kick.model import parts
-
     chosen = [p for p in parts.named(part_names) if p.split is not None]
     taken = {s for p in chosen for s in p.split.segments}
     held = [n for n, p in parts.REGISTRY.items() if p.split is not None and p.split.rigid

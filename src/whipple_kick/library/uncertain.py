@@ -37,10 +37,11 @@ import math
 import pathlib
 
 import numpy as np
+from scipy import stats
 
 from whipple_kick.errors import InputError
 
-from . import parameters
+from . import bicycleparameters, parameters
 from .parameters import fail, number, table, text
 
 #: The ``format`` line of an uncertainty file.
@@ -118,7 +119,6 @@ class UncertainInput:
         if self.distribution == "uniform":
             return self.low + u * (self.high - self.low)
         if self.distribution == "normal":
-            from scipy import stats
             lo = -np.inf if self.low is None else (self.low - self.mean) / self.sd
             hi = np.inf if self.high is None else (self.high - self.mean) / self.sd
             return self.mean + self.sd * stats.truncnorm.ppf(u, lo, hi)
@@ -259,8 +259,6 @@ def bicycle_inputs(path, entry) -> tuple:
     standard deviation times ``sd_scale`` as sd, truncated to
     :data:`BICYCLE_TRUNCATION_SD` deviations.
     """
-    from . import bicycleparameters
-
     allowed = {"measured", "reason", "parameters", "sd_scale"}
     extra = sorted(set(entry) - allowed)
     if extra or "measured" not in entry or "reason" not in entry:

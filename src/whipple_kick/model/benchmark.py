@@ -24,6 +24,8 @@ import math
 
 import numpy as np
 
+from whipple_kick.errors import InputError
+
 #: Names of the benchmark parameters, in the order of Meijaard et al. Table 1.
 BENCHMARK_NAMES = (
     "w", "c", "lam", "g",
@@ -67,7 +69,6 @@ def meijaard2007_parameters():
 def _check_names(params, names, what):
     missing = [n for n in names if n not in params]
     if missing:
-        from whipple_kick.errors import InputError
         raise InputError(f"{what} parameters are missing: {', '.join(missing)}")
 
 

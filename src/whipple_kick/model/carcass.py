@@ -62,6 +62,11 @@ that the tests compare the C code with.
 """
 import math
 
+import numpy as np
+from scipy.optimize import brentq
+
+from whipple_kick.errors import InputError
+
 #: Largest patch slip [deg] of the rising branch. Beyond it the steady curve's
 #: extreme is taken at the cap: T03's 500 kPa fit (C = 1.024) has no peak
 #: below 90 deg, and a patch slip near 90 deg would slide at ``|v_x|`` tan(a'),
@@ -87,7 +92,6 @@ FZ_SHAPE_FLOOR = 1.0
 
 def check_sliding(name):
     """Index of the sliding law ``name``; ``InputError`` naming the choices otherwise."""
-    from whipple_kick.errors import InputError
     if name not in SLIDING_LAWS:
         raise InputError(f"carcass sliding law {name!r} is unknown; choose one of {', '.join(SLIDING_LAWS)}")
     return SLIDING_LAWS.index(name)
@@ -462,8 +466,6 @@ def reference_branch(curve_fy, camber, fz):
     narrower, to 1e-13 rad): a few vectorised calls, nothing of the C code's
     closed form or Newton iteration. An extreme at the cap stays there.
     """
-    import numpy as np
-
     cap = math.radians(PATCH_SLIP_CAP_DEG)
     load = max(fz, FZ_SHAPE_FLOOR)
     grid = np.linspace(-cap, cap, 16001)
@@ -516,9 +518,6 @@ def reference_block(curve_fy, curve_mz, vsy, vx, camber, fz, y, gl, cc, dc, sigm
         ``F M slip slip_moment rate gl_rate sat fmax fmin branch`` (``branch``:
         the rising branch's ends [rad]).
     """
-    import numpy as np
-    from scipy.optimize import brentq
-
     speed = abs(vx)
     kslip = math.atan2(vsy, speed)
     branches = {} if branches is None else branches

@@ -18,9 +18,14 @@ import functools
 import math
 
 import numpy as np
+from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
+from whipple_kick.errors import InputError
+
 from . import cache, kane
+from . import symbols as S
+from .benchmark import steer_axis_tilt
 from .symbols import CLASSIC_CONSTANTS
 
 COORDINATES = tuple(f"q{i}" for i in range(1, 9))
@@ -46,7 +51,6 @@ def _generate_source():
     dyn = list(eom.q) + list(eom.u)
     q = [codegen.plain_symbol(s) for s in eom.q]
     u = [codegen.plain_symbol(s) for s in eom.u]
-    from . import symbols as S
     p = list(S.syms(CLASSIC_CONSTANTS))
     r = list(eom.inputs)
     P = functools.partial(codegen.plain, dynamic=dyn)
@@ -83,7 +87,6 @@ def parameter_array(moore):
     """Moore parameters as the array the generated code expects, looked up by name."""
     missing = [n for n in CLASSIC_CONSTANTS if n not in moore]
     if missing:
-        from whipple_kick.errors import InputError
         raise InputError(f"Moore parameters are missing: {', '.join(missing)}")
     return np.array([float(moore[n]) for n in CLASSIC_CONSTANTS])
 
@@ -158,7 +161,6 @@ def upright_state(moore, speed, roll=0.0, steer=0.0):
     p = parameter_array(moore)
     q = np.zeros(8)
     q[Q["q4"]], q[Q["q7"]] = roll, steer
-    from .benchmark import steer_axis_tilt
     q[Q["q5"]] = steer_axis_tilt(moore)
     q = solve_pitch(q, p)
     return q, np.array([0.0, -speed / moore["rr"], 0.0])
@@ -184,7 +186,6 @@ def _reduced_rhs(x, u6, p, r):
 def _nominal_pitch(p_tuple):
     p = np.array(p_tuple)
     moore = dict(zip(CLASSIC_CONSTANTS, p, strict=True))
-    from .benchmark import steer_axis_tilt
     q = np.zeros(8)
     q[Q["q5"]] = steer_axis_tilt(moore)
     return solve_pitch(q, p)[Q["q5"]]
@@ -380,5 +381,4 @@ def simulate(moore, q0, u_ind0, t_end, steer_torque=None, rtol=1e-10, atol=1e-12
         return np.concatenate([u, udot[_PARTITION.ind]])
 
     x0 = np.concatenate([q0, u_ind0])
-    from scipy.integrate import solve_ivp  # 0.5-0.9 s to import; the linear analyses do not need it
     return solve_ivp(rhs, (0.0, t_end), x0, method="LSODA", rtol=rtol, atol=atol, t_eval=t_eval)

@@ -21,6 +21,9 @@ of a trajectory stays at integration accuracy (the plate stop's impulse adds its
 power is defined in :mod:`whipple_kick.model.transient`; docs/validation.md gives
 the argument and the measured sizes.
 """
+
+from . import symbols as S
+
 #: Quadrature states appended to the dynamic states, in this order.
 QUADRATURE_STATES = ("W_plate", "W_steer", "W_wheel", "W_zero_slip", "W_moment", "D_slide", "D_damper",
                      "E_carcass_r", "E_carcass_f", "D_carcass")
@@ -65,7 +68,6 @@ def common_rates(extra, u, t6):
     """
     import sympy as sm
 
-    from . import symbols as S
 
     fy_r, mz_r, mz_f, t7 = S.syms(["Fy_r", "Mz_r", "Mz_f", "T7"])
     vplate_r, wz_r, wz_f = S.syms(["vplate_r", "wz_r", "wz_f"])

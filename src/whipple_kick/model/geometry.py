@@ -20,6 +20,8 @@ import numpy as np
 from whipple_kick.errors import InputError
 
 from . import cache
+from . import symbols as S
+from .benchmark import steer_axis_tilt
 
 #: Coordinates the geometry depends on, in Moore's order (q9, q10: tyre compressions).
 COORDINATES = tuple(f"q{i}" for i in range(1, 11))
@@ -53,7 +55,6 @@ def _expressions():
 
     from whipple_kick.model.symbolic import codegen, derivation
 
-    from . import symbols as S
 
     kin = derivation.kinematics(tyre_model=True)
     N, E = kin.frames["N"], kin.frames["E"]
@@ -187,8 +188,6 @@ def nominal_coordinates(parameters):
     -------
     dict of str -> float
     """
-    from .benchmark import steer_axis_tilt
-
     q = dict.fromkeys(COORDINATES, 0.0)
     q["q5"] = steer_axis_tilt(parameters)
     return q

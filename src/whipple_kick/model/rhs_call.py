@@ -21,6 +21,7 @@ import functools
 import hashlib
 import importlib.machinery
 import importlib.util
+import pathlib
 import platform
 import sys
 import sysconfig
@@ -244,7 +245,6 @@ def module(compiler):
         With the type ``Rhs(function, params, n, on_status, limit_error=None,
         i1=0, lim1=inf, i2=0, lim2=inf)``, a callable ``f(t, x)``.
     """
-    import pathlib
     headers = pathlib.Path(sysconfig.get_paths()["include"], "Python.h")
     if not headers.exists():
         _fall_back(f"the Python headers are missing ({headers}; install the python3-dev package of this Python)")

@@ -181,7 +181,7 @@ def _entries():
         ("slip_speed_point", "forward speed the tyres' slip angle and relaxation use: 0 the wheel centre's "
                              "(default), 1 the geometric contact point's (the authors' published code)", "-", c),
         ("tyre_transient", "tyre transient form: its index among the declared forms "
-                           "(whipple_kick.model.transient.TRANSIENTS)", "-", c),
+                           "(whipple_kick.model.transient.transients())", "-", c),
         ("ccr", "rear carcass lateral stiffness C_Fa(F_z0)/sigma0 (carcass transient)", "N/m", c),
         ("ccf", "front carcass lateral stiffness C_Fa(F_z0)/sigma0 (carcass transient)", "N/m", c),
         ("dcr", "rear carcass lateral damping, parallel to its stiffness (carcass transient)", "N s/m", c),

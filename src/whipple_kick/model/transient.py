@@ -50,6 +50,11 @@ measured sizes.
 """
 from collections.abc import Callable
 from dataclasses import dataclass, field
+import functools
+import hashlib
+import inspect
+
+from whipple_kick.errors import InputError
 
 from . import symbols as S
 
@@ -61,7 +66,7 @@ class Form:
     Attributes
     ----------
     name : str
-        The ``tyre_transient`` value; the compiled model's parameter is its index in :data:`TRANSIENTS`.
+        The ``tyre_transient`` value; the compiled model's parameter is its index in :func:`transients`.
     description : str
         What it is, in a phrase (the scenario's help and documentation).
     states : tuple of str
@@ -96,33 +101,61 @@ FORMS: dict = {}
 
 
 def declare(form):
-    """Add ``form`` to :data:`FORMS` (its index is its place there) and return it."""
+    """Add ``form`` to :data:`FORMS` (its index is its place there) and return it.
+
+    A form may be declared anywhere (a test, a script): the scenario's choices, the trajectory's columns, the
+    layouts' state names and the generated code's cache key read :data:`FORMS` when they are used.
+    """
     if len(form.states) != 4 or len(form.scales) != 4:
         raise ValueError(f"transient form {form.name!r}: four states and four scales (rear, front, rear, front)")
     if form.wheel is None and any(f.wheel is None for f in FORMS.values() if f.name != form.name):
         # The generated C dispatches the SymPy forms by index and leaves the rest to the carcass' C block.
         raise ValueError(f"transient form {form.name!r} has no SymPy block: there is one form written in C (the "
                          "carcass), the rest need their wheel function")
+    for other in FORMS.values():
+        moved = [n for k, n in enumerate(form.states) if other.name != form.name and n in other.states
+                 and other.states.index(n) != k]
+        if moved:   # a state's name is an alias of one slot (whipple_kick.model.slip.layout.StateIndex)
+            raise ValueError(f"transient form {form.name!r}: states {moved} are in other slots in form {other.name!r}")
     FORMS[form.name] = form
     return form
 
 
 def transients():
-    """Names of the declared forms, in the compiled model's order (its ``tyre_transient`` index)."""
+    """Names of the declared forms, in the compiled model's order (its ``tyre_transient`` index), read when called:
+    a form declared after the package was imported (a test's, a script's) is among them."""
     return tuple(FORMS)
+
+
+def symbolic():
+    """Names of the declared forms whose tyre block is a SymPy expression (:func:`tyre_block`), in
+    :func:`transients` order; the carcass is written in C and Python."""
+    return tuple(name for name, form in FORMS.items() if form.wheel is not None)
+
+
+def slot(state):
+    """The slot (0-3: rear, front, rear, front) of the tyre state ``state`` of any declared form, or None."""
+    for form in FORMS.values():
+        if state in form.states:
+            return form.states.index(state)
+    return None
 
 
 def fingerprint():
     """The declared forms and their functions' source, hashed (part of the generated code's cache key).
 
     This module's own source is hashed with the others the model is generated from; this adds a form
-    declared elsewhere (its declaration and its own function's source, not of helpers it calls).
+    declared elsewhere (its declaration and its own function's source, not of helpers it calls). Read when
+    called: a form declared later changes it, so the model with that form is another cache entry.
     """
-    import hashlib
-    import inspect
+    return _fingerprint(tuple(FORMS.values()))
 
-    text = repr([(f.name, f.states, f.scales, f.steady_outputs, f.columns) for f in FORMS.values()])
-    text += "".join(inspect.getsource(f.wheel) for f in FORMS.values() if f.wheel is not None)
+
+@functools.cache
+def _fingerprint(forms):
+    """:func:`fingerprint` of the declared ``forms`` (once per set of declarations: a run asks for it often)."""
+    text = repr([(f.name, f.states, f.scales, f.steady_outputs, f.columns) for f in forms])
+    text += "".join(inspect.getsource(f.wheel) for f in forms if f.wheel is not None)
     return hashlib.sha256(text.encode()).hexdigest()[:12]
 
 
@@ -142,7 +175,6 @@ FZ_SHAPE_FLOOR = 1.0
 
 def check(name):
     """Index of the transient form ``name``; ``InputError`` naming the choices otherwise."""
-    from whipple_kick.errors import InputError
     if name not in FORMS:
         raise InputError(f"tyre transient {name!r} is unknown; choose one of {', '.join(FORMS)}")
     return transients().index(name)
@@ -154,7 +186,7 @@ def tyre_block(name, curves, sigma0):
     Parameters
     ----------
     name : str
-        One of :data:`TRANSIENTS`.
+        One of :func:`transients`.
     curves : mapping
         ``fy(wheel, slip, camber, fz)``, ``mz(wheel, slip, camber, fz)``
         (blended, scaled steady curves, zero when unloaded) and
@@ -176,7 +208,7 @@ def tyre_block(name, curves, sigma0):
     """
     import sympy as sm
 
-    states = [sm.Symbol(n, real=True) for n in STATES[name]]
+    states = [sm.Symbol(n, real=True) for n in FORMS[name].states]
     out, rates = {}, [None] * 4
     w0 = slide = 0
     for k, wheel in enumerate("rf"):
@@ -277,10 +309,5 @@ declare(Form("carcass", "a lateral carcass spring in series with a sliding conta
              columns=(*_PATCH_COLUMNS, ("carcass_deflection_rear", "state", "carcass_y_r", "m"),
                       ("carcass_deflection_front", "state", "carcass_y_f", "m"))))
 
-#: Transient forms, by name; the compiled model's ``tyre_transient`` parameter is the index.
-TRANSIENTS = transients()
+#: The form a scenario uses unless it names another.
 DEFAULT_TRANSIENT = "carcass"
-#: Tyre states in their fixed slots (rear, front, rear, front), per form.
-STATES = {name: form.states for name, form in FORMS.items()}
-#: Forms whose tyre block is a SymPy expression (:func:`tyre_block`); the carcass is written in C and Python.
-SYMBOLIC = tuple(name for name, form in FORMS.items() if form.wheel is not None)

@@ -31,9 +31,10 @@ import pathlib
 import numpy as np
 
 from whipple_kick.errors import InputError, check_range
-from whipple_kick.library import thesis
-from whipple_kick.model import parts, slip
+from whipple_kick.library import bicycleparameters, riders, thesis, tyres
+from whipple_kick.model import benchmark, parts, slip, symbols
 from whipple_kick.simulate import control, steady
+from whipple_kick.simulate.scenario import Scenario
 
 from .scenario import DEFAULTS, LOW_INERTIA_KEYS, SETTINGS, THESIS_DESIGN_SPEED
 
@@ -236,7 +237,6 @@ def build_bicycle(spec):
 
 def _file_stamp(name):
     """Modification time of a parameter file given by path (so an edited file is re-read)."""
-    from whipple_kick.library import bicycleparameters
     path = pathlib.Path(str(name))
     if path.suffix != ".toml" and bicycleparameters.is_bicycleparameters_path(name):
         return bicycleparameters.stamp(name)
@@ -245,9 +245,6 @@ def _file_stamp(name):
 
 @functools.lru_cache(maxsize=256)
 def _bicycle_setup(spec, _stamp):
-    from whipple_kick.library import bicycleparameters, riders
-    from whipple_kick.model import benchmark
-
     bike = bicycleparameters.load_bicycle(spec.bicycle, spec.rider)
     # The model's parts that split the rider (riders.carriers: the leaning upper body, the arms on the bar).
     model_parts = tuple(p.name for p in parts.selected(spec))
@@ -319,9 +316,6 @@ def _refuse_load_on_preset(bike, fz_n, rider_mass_kg, share):
 
 def _refuse_rider_file(bike, rider_name):
     """A preset with its rider lumped in seats no Yeadon rider: a rider file given with it would be ignored."""
-    from whipple_kick.library import riders
-    from whipple_kick.simulate.scenario import Scenario
-
     default = Scenario.__dataclass_fields__["rider"].default
     if bike.includes_rider and rider_name not in (default, riders.NO_RIDER):
         raise InputError(f"bicycle {bike.name!r} already includes its rider; rider {rider_name!r} would be ignored: "
@@ -348,7 +342,6 @@ def _lumped_rider_error(bike):
 def _rear_load_range(bicycle, _stamp, rider_name):
     # The rear loads a rider can give the bicycle (a probe rider seated, ~10 ms) do not depend on the load:
     # a sweep over loads finds them once per process.
-    from whipple_kick.library import bicycleparameters, riders
     return riders.rear_load_range(bicycleparameters.load_bicycle(bicycle), rider_name)
 
 
@@ -424,8 +417,6 @@ def thesis_load(spec):
     rider is labelled with (``balanceassist_635N``: 635 N), else :data:`DEFAULT_REAR_LOAD_N` for a
     bicycle whose rider is seated for the default load.
     """
-    from whipple_kick.library import bicycleparameters
-
     if spec.thesis_load_n is not None:
         return spec.thesis_load_n
     if spec.fz_n is not None:
@@ -445,8 +436,6 @@ def thesis_gains_warning(spec):
     ``spec`` is ``scenario.gains_spec``. The run's load: the one a preset with rider is labelled with, or
     ``fz_n``.
     """
-    from whipple_kick.library import bicycleparameters
-
     if spec.controller != "thesis":
         return None
     bike = bicycleparameters.load_bicycle(spec.bicycle, spec.rider)
@@ -461,8 +450,6 @@ def thesis_gains_warning(spec):
 
 def build_tyres(spec):
     """(rear, front) tyres and a list of notes about them, for ``spec`` (``scenario.tyre_spec``)."""
-    from whipple_kick.library import tyres
-
     notes = []
     rear_p, front_p = spec.pressures
     loaded = []
@@ -488,8 +475,6 @@ def preflight(scenario):
     lumped in cannot lean or hold the bar), the Table 8.4 row of
     ``controller="thesis"``. Raises :class:`InputError`; returns ``scenario``.
     """
-    from whipple_kick.library import bicycleparameters
-
     scenario.validate()
     build_tyres(scenario.tyre_spec)
     bike = bicycleparameters.load_bicycle(scenario.bicycle, scenario.rider)
@@ -559,8 +544,6 @@ def linear_stability(scenario, moore, gains, found, controller_type):
         ``model`` (which linearisation decided), ``poles_slip_model_1_s``,
         ``poles_no_slip_model_1_s`` (each as [real, imag] pairs), ``criterion``.
     """
-    from . import steady
-
     classic = control.classic_closed_loop_poles(moore, float(scenario.speed), gains)
     slip_poles = None
     if not gains.get("kq3", 0.0):
@@ -617,10 +600,7 @@ def custom_gains(gains, scenario=None):
     need ``scenario.rider_body="leaning"``: a rigid rider has no lean to feed back). With ``scenario``, its fields that the given gains
     replace (:data:`CONTROLLER_FIELDS`) must be at their defaults.
     """
-    from whipple_kick.model import symbols
-
-    # Every declared part's gains, read now: a part declared after the import counts too.
-    known = tuple(dict.fromkeys((*slip.GAIN_NAMES, *(g for part in parts.REGISTRY.values() for g in part.gains))))
+    known = slip.gain_names()   # every declared part's gains, read now: a part declared after the import too
     unknown = sorted(set(gains) - set(known))
     if unknown:
         raise InputError(f"unknown steer-torque gain(s) {unknown}; known: {list(known)}")

@@ -20,10 +20,14 @@ import math
 import warnings
 
 import numpy as np
+from scipy.linalg import solve_continuous_are, solve_continuous_lyapunov
+from scipy.optimize import minimize
 
 from whipple_kick.errors import ConvergenceWarning, InputError, check_range
 from whipple_kick.library import thesis
 from whipple_kick.model import classic, parts, slip
+
+from . import steady
 
 GAIN_ORDER = ("kq4", "kq7", "ku4", "ku7")
 #: Gains of :func:`heading_lqr_gains`, whose state adds the yaw angle q3.
@@ -72,8 +76,6 @@ def _solve_lqr(A, b, Qm, R):
     ``K = R^-1 b^T P`` with ``P`` the stabilising solution of the continuous
     algebraic Riccati equation ``A^T P + P A - P b R^-1 b^T P + Q = 0``.
     """
-    from scipy.linalg import solve_continuous_are
-
     Rm = np.atleast_2d(check_range("R", R, 0.0, None, "(weight)", low_open=True))
     P = solve_continuous_are(A, b, Qm, Rm)
     K = np.linalg.solve(Rm, b.T @ P)
@@ -252,9 +254,6 @@ def output_feedback_lqr(A, b, C, Q=None, R=1.0, K0=None, X0=None):
     InputError
         ``K0`` does not stabilise the model.
     """
-    from scipy.linalg import solve_continuous_lyapunov
-    from scipy.optimize import minimize
-
     A, b, C = (np.asarray(v, dtype=float) for v in (A, b, C))
     n, m = A.shape[0], C.shape[0]
     Qm = np.eye(m) if Q is None else np.asarray(Q, dtype=float)
@@ -324,8 +323,6 @@ def stabilising_gains(A, b, C, K0, margin=0.05):
     InputError
         No such gains were found.
     """
-    from scipy.optimize import minimize
-
     A, b, C = (np.asarray(v, dtype=float) for v in (A, b, C))
     K0 = np.asarray(K0, dtype=float).ravel()
 
@@ -387,7 +384,7 @@ def lqr_on_simulated_model(spec, moore, design, body, rear, front, model):
     symmetric tyres, linearised about upright straight running at the design
     speed at constant speed (:func:`whipple_kick.model.slip.heading_linearisation`);
     the law feeds back roll, steer and their rates, and the upper body's lean
-    and its rate when it leans (:data:`whipple_kick.model.slip.parameters.GAIN_STATES`),
+    and its rate when it leans (:func:`whipple_kick.model.slip.parameters.gain_states`),
     with gains LQR-optimal for that law (identity weights on those states,
     1 on the torque, as the Whipple design), found from the Whipple design's
     gains by :func:`whipple_kick.simulate.control.output_feedback_lqr`. Where the
@@ -410,7 +407,7 @@ def lqr_on_simulated_model(spec, moore, design, body, rear, front, model):
     Returns
     -------
     gains : dict
-        By name (:data:`whipple_kick.model.slip.parameters.GAIN_NAMES`), times ``gain_scale``.
+        By name (:func:`whipple_kick.model.slip.parameters.gain_names`), times ``gain_scale``.
     poles : ndarray
         The design's closed-loop eigenvalues.
     """
@@ -448,7 +445,7 @@ def lqr_on_simulated_model(spec, moore, design, body, rear, front, model):
         else:
             step /= 2.0
     K, poles = output_feedback_lqr(*design_model(1.0), K0=K)
-    gains = dict.fromkeys(slip.GAIN_NAMES, 0.0)
+    gains = dict.fromkeys(slip.gain_names(), 0.0)
     gains.update({name: float(spec.gain_scale * k) for name, k in zip(felt, K, strict=True)})
     return gains, poles
 
@@ -477,7 +474,6 @@ def simulated_design_start(spec, design, part_names):
 def _linear_design_model(spec, moore, rear, front, body, felt, share, scaled, model):
     """(A, b, C) of the design model with ``share`` of the ``scaled`` body gains (C picks the ``felt`` states)."""
     part = {k: (v * share if k in scaled else v) for k, v in body.items()}
-    from . import steady
 
     options = slip.ModelOptions(**dict(spec.model_options), symmetric_tyres=True)
     params = slip.model_parameters(moore, rear, front, options, model=model, body=part)
@@ -495,5 +491,5 @@ def _linear_design_model(spec, moore, rear, front, body, felt, share, scaled, mo
         names.append("q3")
     C = np.zeros((len(felt), len(names)))
     for row, gain in enumerate(felt):
-        C[row, names.index(slip.GAIN_STATES[gain])] = 1.0
+        C[row, names.index(slip.gain_states()[gain])] = 1.0
     return A, b, C

@@ -31,6 +31,8 @@ import warnings
 
 import numpy as np
 from scipy.integrate import LSODA, odeint
+from scipy.integrate._ode import lsoda as ode_lsoda
+from scipy.optimize import brentq
 
 from whipple_kick.model import slip
 from whipple_kick.model.transient import DEFAULT_TRANSIENT, FORMS
@@ -190,8 +192,6 @@ def _careful_chunk(rhs, x, times, rtol, atol, fall, spent, budget, t_start, jac=
         LSODA's evaluations, its Jacobians, and all evaluations (the
         Jacobians' included: :func:`_evaluations`), as the budget counts them.
     """
-    from scipy.optimize import brentq
-
     solver = LSODA(rhs, times[0], x, times[-1], rtol=rtol, atol=atol, jac=jac)
 
     def counts():
@@ -296,7 +296,6 @@ def _careful_chunk_in_c(chunks_in_c, rhs, x, times, rtol, atol, fall, spent, bud
             except FloatingPointError as exc:
                 trouble = str(exc)
         else:   # istate < 0, as scipy's ode warns and its LSODA solver object words it
-            from scipy.integrate._ode import lsoda as ode_lsoda
             warnings.warn(f"lsoda: {ode_lsoda.messages.get(out.istate, f'Unexpected istate={out.istate:d}')}",
                           stacklevel=2)
             trouble = "Unexpected istate in LSODA."

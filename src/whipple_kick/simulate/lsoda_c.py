@@ -42,6 +42,8 @@ import hashlib
 import pathlib
 
 import numpy as np
+import scipy
+from scipy.linalg import cython_lapack
 
 from whipple_kick.errors import BuildError, CompilerNotFoundError
 from whipple_kick.model import cache, compiler
@@ -65,7 +67,6 @@ def _capsule_pointer(capsule):
 @functools.cache
 def driver():
     """The compiled driver (ctypes library, built into the cache on a miss), or None where it cannot be used."""
-    import scipy
     if tuple(int(v) for v in scipy.__version__.split(".")[:2]) != SCIPY_RELEASE:
         return None
     try:
@@ -84,7 +85,6 @@ def driver():
         lib = ctypes.CDLL(str(cache.build_once(name, build)))
     except (BuildError, OSError):
         return None
-    from scipy.linalg import cython_lapack
     lib.wk_lsoda_set_lapack.argtypes = [ctypes.c_void_p] * 4
     lib.wk_lsoda_set_lapack(*(_capsule_pointer(cython_lapack.__pyx_capi__[f])
                               for f in ("dgetrf", "dgetrs", "dgbtrf", "dgbtrs")))

@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import math
 
 import numpy as np
+from scipy.optimize import least_squares
 
 from whipple_kick.errors import InputError, check_range
 
@@ -141,8 +142,6 @@ def fit(t, signal, t_first_peak, first_peak, window=WINDOW):
     InputError
         Fewer than 12 samples in the window, or a zero peak.
     """
-    from scipy.optimize import least_squares
-
     window = check_range("oscillation window", window, 0.0, None, "s", low_open=True)
     t = np.asarray(t, dtype=float)
     y = np.asarray(signal, dtype=float)

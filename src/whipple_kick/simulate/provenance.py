@@ -18,12 +18,16 @@ Example
 import datetime
 import functools
 import hashlib
+from importlib import metadata
 import pathlib
 import platform
 import socket
 import subprocess
 
 from whipple_kick import fileio
+from whipple_kick.library import bicycles, parameters, riders, tyres
+
+from .scenario import _is_path
 
 #: Distributions whose versions are recorded (the package and what its results depend on).
 DEPENDENCIES = ("whipple_kick", "numpy", "scipy", "pandas", "sympy", "control", "matplotlib", "yeadon")
@@ -44,8 +48,6 @@ def versions() -> dict:
     >>> versions()["python"] == platform.python_version()
     True
     """
-    from importlib import metadata
-
     out = {"python": platform.python_version(), "platform": platform.platform()}
     for name in DEPENDENCIES:
         try:
@@ -140,8 +142,6 @@ def _read_source(path) -> bytes:
 
 def result_sources() -> list:
     """The files :func:`code_hash` covers: the ``*.py`` of :data:`RESULT_CODE` and the shipped parameter files."""
-    from whipple_kick.library import parameters
-
     files = [p for folder in RESULT_CODE for p in (PACKAGE_DIR.parent / folder).rglob("*.py")]
     files += [p for kind in ("bicycles", "riders", "tyres", "experiments")
               for p in parameters.shipped(kind).rglob("*.toml")]
@@ -179,10 +179,6 @@ def input_files(scenario, custom_tyres=False) -> dict:
     for custom tyre objects) and the kick table. A file that does not exist is left out (the run itself
     reports it).
     """
-    from whipple_kick.library import bicycles, parameters, riders, tyres
-
-    from .scenario import _is_path
-
     candidates = {
         "bicycle": (pathlib.Path(scenario.bicycle) if _is_path("bicycle", scenario.bicycle)
                     else parameters.toml_files(bicycles.BICYCLE_DIR).get(scenario.bicycle)),

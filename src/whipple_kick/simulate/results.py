@@ -8,16 +8,25 @@ columns and units in :data:`UNITS`) and a JSON-ready summary
 the recovery and the Section 8.3 metrics of :mod:`whipple_kick.simulate.analysis`,
 numerics. Nothing in a result is NaN (:func:`clean`).
 """
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 import functools
 import json
 import math
+import pathlib
 
 import numpy as np
+import pandas as pd
 
+from whipple_kick import fileio
 from whipple_kick.errors import InputError, SimulationError
-from whipple_kick.model import energy, parts, slip, transient
+from whipple_kick.model import carcass, energy, parts, slip, symbols, transient
 from whipple_kick.simulate import criteria, lsoda, provenance
+
+from . import analysis
+from . import assembly as assembly_module
+from .integration import sample_times
+from .scenario import THESIS_DESIGN_SPEED, Scenario
 
 #: Significant digits of trajectory.csv's floats: a relative round-off of at most 5e-13, far below the
 #: integration's own error (rtol 1e-10 by default) and the float32 regression references (~6e-8), and
@@ -40,8 +49,6 @@ SPEED_COLUMNS = {
     "u8": ("front_wheel_rate", "rad/s"), "u9": ("compression_rate_rear", "m/s"),
     "u10": ("compression_rate_front", "m/s"),
 }
-#: The declared parts' states (:mod:`whipple_kick.model.parts`): state -> (column, unit), in a run that has them.
-PART_COLUMNS = {state: column for part in parts.REGISTRY.values() for state, column in part.columns.items()}
 #: The rear contact's velocity along the heading (yaw q3) [m/s]: forward and lateral (the drift).
 HEADING_COLUMNS = {"forward_speed": "m/s", "lateral_speed": "m/s"}
 #: The force and moment each tyre applies to the bicycle (in every transient form): output -> column.
@@ -71,26 +78,56 @@ CARCASS_STATE_COLUMNS = {name: col for col, source, name, _ in transient.FORMS["
                          if name.startswith("carcass_y")}
 #: Energy balance residual column [J] (:func:`whipple_kick.model.energy.balance_residual`).
 BALANCE_COLUMN = "energy_balance_residual"
-#: Unit of every trajectory column (from the symbol registry and :data:`whipple_kick.model.slip.OUTPUTS`).
-UNITS = {"time": "s", **dict(COORDINATE_COLUMNS.values()), **dict(SPEED_COLUMNS.values()), **HEADING_COLUMNS,
-         **dict.fromkeys(PATCH_STATE_COLUMNS.values(), "rad"),
-         **{col: unit for form in transient.FORMS.values() for col, _, _, unit in form.columns},
-         **{c: slip.OUTPUTS[o][0] for o, c in {**APPLIED_COLUMNS, **OUTPUT_COLUMNS}.items()},
-         **dict(PART_COLUMNS.values()),
-         **{o: unit for part in parts.REGISTRY.values() for o, (unit, _) in part.outputs.items()},
-         **dict(energy.COLUMNS.values()), BALANCE_COLUMN: "J"}
+#: Unit of each trajectory column of the bicycle (from :data:`whipple_kick.model.slip.OUTPUTS` and the energy
+#: columns); :data:`UNITS` adds the declared parts' and tyre forms' columns.
+_BICYCLE_UNITS = {"time": "s", **dict(COORDINATE_COLUMNS.values()), **dict(SPEED_COLUMNS.values()), **HEADING_COLUMNS,
+                  **dict.fromkeys(PATCH_STATE_COLUMNS.values(), "rad"),
+                  **{c: slip.OUTPUTS[o][0] for o, c in {**APPLIED_COLUMNS, **OUTPUT_COLUMNS}.items()},
+                  **dict(energy.COLUMNS.values()), BALANCE_COLUMN: "J"}
+
+
+def part_columns():
+    """The declared parts' states (:mod:`whipple_kick.model.parts`): state -> (column, unit), in a run that has
+    them; read when called, so a part declared after this module was imported counts too."""
+    return {state: column for part in parts.REGISTRY.values() for state, column in part.columns.items()}
+
+
+def _declared_units():
+    """Units of the declared parts' state columns and outputs and of the declared tyre forms' columns, now."""
+    return {**{col: unit for form in transient.FORMS.values() for col, _, _, unit in form.columns},
+            **dict(part_columns().values()),
+            **{o: unit for part in parts.REGISTRY.values() for o, (unit, _) in part.outputs.items()}}
+
+
+class _Units(Mapping):
+    """Unit of every trajectory column by name: the bicycle's, then the declared parts' and tyre forms' columns
+    read when asked (a part or form declared after this module was imported counts too)."""
+
+    def __getitem__(self, column):
+        if column in _BICYCLE_UNITS:
+            return _BICYCLE_UNITS[column]
+        return _declared_units()[column]
+
+    def __iter__(self):
+        return iter({**_BICYCLE_UNITS, **_declared_units()})
+
+    def __len__(self):
+        return len({**_BICYCLE_UNITS, **_declared_units()})
+
+    def __repr__(self):
+        return repr(dict(self))
+
+
+#: Unit of every trajectory column (a read-only mapping that follows the declarations).
+UNITS = _Units()
 
 
 def unit_of(column):
-    """The unit of trajectory column ``column``: :data:`UNITS`, or a declared part's state column or output
-    (read when called, so a part declared after this module was imported counts too)."""
-    if column in UNITS:
+    """The unit of trajectory column ``column`` (:data:`UNITS`); KeyError naming it if there is none."""
+    try:
         return UNITS[column]
-    for part in parts.REGISTRY.values():
-        units = {**dict(part.columns.values()), **{o: unit for o, (unit, _) in part.outputs.items()}}
-        if column in units:
-            return units[column]
-    raise KeyError(f"no trajectory column {column!r}")
+    except KeyError:
+        raise KeyError(f"no trajectory column {column!r}") from None
 
 
 #: Columns whose largest absolute values after the kick the summary lists (``max_abs_<column>_absolute_<unit>``).
@@ -169,10 +206,6 @@ class Result:
         >>> result.save("kick_run")
         ['trajectory.csv', 'summary.json', 'scenario.toml']
         """
-        import json
-        import pathlib
-
-        from whipple_kick import fileio
         out = pathlib.Path(folder)
         out.mkdir(parents=True, exist_ok=True)
         fileio.write_csv(with_units(self.trajectory), out / TRAJECTORY_FILE, significant_digits=TRAJECTORY_CSV_DIGITS)
@@ -203,10 +236,6 @@ class Result:
         >>> result.summary["recovered"], result.trajectory["yaw_rate"].iloc[-1]   # doctest: +SKIP
         (True, 0.0945...)
         """
-        import json
-        import pathlib
-
-        from .scenario import Scenario
         path = pathlib.Path(folder)
         if not path.is_dir():
             raise InputError(f"run folder {str(path)!r} {'is not a folder' if path.exists() else 'does not exist'}")
@@ -255,8 +284,6 @@ def trajectory_frame(solution, tyre_transient="carcass"):
     SimulationError
         A value is not finite (never NaN in a result).
     """
-    import pandas as pd
-
     traj = solution.states
     outs = solution.outputs()
     layout = frame_layout(tyre_transient, solution.model)
@@ -395,8 +422,6 @@ _BALANCE_INPUTS = frozenset((*energy.STORED, *energy.SUPPLIED, *energy.DISSIPATE
 def summary_columns(tyre_transient="carcass"):
     """The trajectory columns :func:`summarise` reads (the metrics, recovery, peaks, tyre ranges, energy, numerics,
     and those the declared criteria's functions read, :attr:`whipple_kick.simulate.criteria.Criterion.columns`)."""
-    from . import analysis
-
     # The patch slip (the tyre extrapolation's), where the form has it among its declared columns.
     declared = {col for col, _, _, _ in transient.FORMS[tyre_transient].columns}
     patch = [c for c in ("slip_patch_rear", "slip_patch_front") if c in declared]
@@ -459,8 +484,6 @@ def check_trajectory(frame, summary, scenario, path):
     an empty cell (a row cut in the middle) is refused, naming what is wrong.
     Times are compared to 1e-9 s: trajectory.csv keeps 13 significant digits.
     """
-    from .integration import sample_times
-
     where = f"{str(path)!r}"
     if "time" not in frame:
         raise InputError(f"{where} has no time column ('time [s]'): not a trajectory of simulate")
@@ -500,16 +523,12 @@ def read_trajectory(path):
 
     ``pandas.read_csv(path)`` reads the same file with the units in the names (``"roll [rad]"``).
     """
-    from whipple_kick import fileio
-
     frame = fileio.read_csv(path, "trajectory")
     return frame.rename(columns=lambda c: c.split(" [", 1)[0])
 
 
 def response_metrics(df, baseline, x0, scenario, traj):
     """Section 8.3 metrics (``metrics``, ``unavailable``) and the recovery of a (possibly partial) run."""
-    from . import analysis
-
     fall_roll = math.radians(scenario.fall_angle_deg)
     ended = None
     if traj.fell and traj.fall_time < 0.0:
@@ -543,8 +562,6 @@ def no_response_metrics(reason):
     The same keys as :func:`whipple_kick.simulate.analysis.kick_metrics` gives (no peaks, each
     peak metric None), so tables of runs keep their columns; ``unavailable`` names ``reason`` for each.
     """
-    from . import analysis
-
     keys = ["peak_times", "peak_values", "last_peak_time",
             *(f"{name}_{a}_{b}" for a, b in analysis.PEAK_PAIRS for name in ("log_decrement", "damping_ratio",
                                                                               "period")), "period"]
@@ -602,8 +619,6 @@ def _summary_metrics(metrics):
 
 def _recovery_section(recovery, baselines):
     """The recovery with each signal's first peak named "from steady", its steady value and its 5 % band."""
-    from . import analysis
-
     signals = {}
     for name, entry in recovery["signals"].items():
         peak = entry["first_peak_rad_s"]
@@ -782,7 +797,6 @@ def _carcass_section(scenario, assembly, start_outputs):
     if scenario.tyre_transient != "carcass":
         return None
     # The loads the stiffness was taken at: those of the state the run starts from (the kick start).
-    from whipple_kick.model import carcass
     _, out = start_outputs
     params = assembly.params
     return {
@@ -869,11 +883,6 @@ def extrapolation_line(summary):
 
 
 def _controller_section(scenario, assembly):
-    from whipple_kick.model import symbols
-
-    from . import assembly as assembly_module
-    from .scenario import THESIS_DESIGN_SPEED
-
     kind, gains = assembly.controller, assembly.gains
     poles = assembly.design_poles
     return {
@@ -1005,9 +1014,6 @@ def compare_table(results, labels=None):
     >>> compare_table(runs).loc["outcome"].tolist()
     ['completed', 'fell']
     """
-    import pandas as pd
-
-
     labels = checked_labels(results, labels)
     columns = {}
     for label, result in zip(labels, results, strict=True):

@@ -22,12 +22,18 @@ Example
 ((300.0, 300.0), 4.0)
 """
 from dataclasses import asdict, dataclass, fields, make_dataclass, replace
+import json
+import math
+import pathlib
 
+from whipple_kick import fileio
 from whipple_kick.errors import InputError, check_range
 from whipple_kick.library import inputs, thesis, tyres
+from whipple_kick.library.parameters import tomllib
 from whipple_kick.model import carcass, parts, transient
 from whipple_kick.model.slip import SLIP_SPEEDS
 
+from . import criteria
 from . import settings as _settings
 from .settings import CASE_COMMANDS, EVERY_COMMAND, SIMULATE, part_setting, setting
 
@@ -37,8 +43,9 @@ CONTROLLERS = ("lqr", "thesis", "off")
 LOW_INERTIA_KEYS = ("IBxx", "IByy", "IBzz", "IBxz", "zB")
 #: Table 8.4's gains were designed at this speed [m/s] (thesis Section 8.3).
 THESIS_DESIGN_SPEED = 3.0
-#: Tyre transient forms (:mod:`whipple_kick.model.transient`): the default and the others.
-TYRE_TRANSIENTS = transient.TRANSIENTS
+#: Tyre transient forms (:func:`whipple_kick.model.transient.transients`), read when listed: a form declared after
+#: the package was imported is a choice too.
+TYRE_TRANSIENTS = criteria.Listing(transient.transients)
 #: What happens to the speeds when the thesis' plate stops instantly (2 m/s to 0):
 #: ``impulse`` (the rear no-slip constraint's impulse, momentum-consistent),
 #: ``resolve`` (only the dependent speeds re-solved, as before the impulse existed)
@@ -778,10 +785,6 @@ class Scenario:
         ...     Scenario.from_file(path) == Scenario(pressure_kpa=300.0, design_speed=3.0)
         True
         """
-        import json
-        import pathlib
-
-        from whipple_kick import fileio
         lines = ["# whipple_kick scenario: one kick-plate run. Rerun it with `simulate --scenario FILE` (flags override",
                  "# its values) or wk.run(wk.Scenario.from_file(FILE)). Units: SI, pressures in kPa; \"none\": the",
                  "# field's rule for no value (see help(wk.Scenario)). Paths relative to this file's folder."]
@@ -814,10 +817,6 @@ class Scenario:
         >>> sc = Scenario.from_file("kick_run/scenario.toml")    # doctest: +SKIP
         >>> wk.run(sc.with_changes(pressure_kpa=300.0))          # doctest: +SKIP
         """
-        import math
-        import pathlib
-
-        from whipple_kick.library.parameters import tomllib
         file = pathlib.Path(path)
         label = f"scenario file {str(path)!r}"
         try:

@@ -53,10 +53,12 @@ from dataclasses import dataclass
 import math
 
 import numpy as np
+from scipy.optimize import root
 
-from whipple_kick.errors import InputError
+from whipple_kick.errors import InputError, SimulationError
 from whipple_kick.model import reflex, slip, transient
 from whipple_kick.model import symbols as S
+from whipple_kick.model.benchmark import from_moore, steer_axis_tilt
 
 #: Leans [deg] of the steady turns tried when the direct solve fails, smallest first.
 TURN_LEANS_DEG = (1.0, -1.0, 2.0, -2.0, 3.0, -3.0, 5.0, -5.0, 8.0, -8.0, 12.0, -12.0, 20.0, -20.0,
@@ -293,7 +295,6 @@ def turn_guess(params, speed, lean):
     acceleration); steer angle u3 w / (v cos(lam)) from the rolling
     kinematics (wheelbase w, steer-axis tilt lam of the bicycle).
     """
-    from whipple_kick.model.benchmark import from_moore
     bench = from_moore({name: params[name] for name in S.CLASSIC_CONSTANTS})
     yaw_rate = params["g"] * math.tan(lean) / speed
     return {"q4": lean, "u3": yaw_rate, "q7": yaw_rate * bench["w"] / (speed * math.cos(bench["lam"]))}
@@ -443,10 +444,6 @@ def steady_state(params, speed, tol=1e-13, guess=None):
     -------
     SteadyState
     """
-    from scipy.optimize import root
-
-    from whipple_kick.model.benchmark import steer_axis_tilt
-
     rhs = slip.CompiledRHS(params)
     rr = params["rr"]
     weight = params["g"] * (params["mc"] + params["md"] + params["me"] + params["mf"] + params.get("mt", 0.0))
@@ -584,10 +581,6 @@ def upright_state(params, speed, tol=1e-13, pitch_without_compression=False):
     >>> float(start.x[slip.X["q4"]]), float(start.params["T6c"])       # doctest: +SKIP
     (0.0, 0.0)
     """
-    from scipy.optimize import root
-
-    from whipple_kick.model.benchmark import steer_axis_tilt
-
     out_params = params.replace(T6c=0.0)
     rhs = slip.CompiledRHS(out_params)
     weight = params["g"] * (params["mc"] + params["md"] + params["me"] + params["mf"] + params.get("mt", 0.0))
@@ -698,8 +691,6 @@ def start_state(params, speed, *, start="steady", start_pitch="compressed", advi
     found : Found
     start : SteadyState
     """
-    from whipple_kick.errors import SimulationError
-
     if start == "steady":
         found = find_steady_state(params, speed, advice=advice)
         return found, found.steady

@@ -25,8 +25,10 @@ import json
 import pathlib
 
 import numpy as np
+import pandas as pd
 
 from whipple_kick.errors import InputError
+from whipple_kick.simulate import analysis
 
 #: This model's trajectory column for each signal of the stored run (their
 #: names: Moore's speeds u3 u4 u7, coordinates q4 q7 and the relaxed tyre forces).
@@ -109,8 +111,6 @@ def load_run(folder):
     InputError
         A file is missing.
     """
-    import pandas as pd
-
     folder = pathlib.Path(folder)
     for name in (SAMPLES_FILE, WHOLE_RUN_FILE, RUN_FILE):
         if not (folder / name).is_file():
@@ -167,8 +167,6 @@ def first_yaw_peak(frame, window=(0.0, 1.0)):
     window, baseline 0: both the stored run and the compatibility mode start
     from straight running.
     """
-    from whipple_kick.simulate import analysis
-
     t = frame["time"].to_numpy()
     keep = (t >= window[0] - 1e-12) & (t <= window[1] + 1e-12)
     peaks = analysis.yaw_rate_peaks(t[keep], frame["yaw_rate"].to_numpy()[keep], t_kick=window[0])

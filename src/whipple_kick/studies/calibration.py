@@ -83,13 +83,30 @@ Example
 >>> round(float(m["measured"].iloc[0]), 3), m["unit"].iloc[0]
 (5.263, 'Hz')
 """
+import contextlib
 import dataclasses
+import json
 import math
+import pathlib
+import tempfile
+import warnings
 
 import numpy as np
+import pandas as pd
+import scipy.linalg  # noqa: F401 -- loaded before calibrate()'s thread limit, so that its OpenBLAS is limited too
+from scipy.linalg import solve_triangular
+from scipy.stats import qmc
+from threadpoolctl import threadpool_limits
 
+from whipple_kick import fileio
 from whipple_kick.errors import InputError
 from whipple_kick.library import experiments, priors
+from whipple_kick.simulate import analysis, oscillation
+
+from . import validation
+from .sweep_engine import make_cases, sweep
+from .sweep_store import load_trajectory
+from .validation import DIRECTIONS
 
 #: Feature units (their definitions: the module docstring).
 FEATURE_UNITS = {"frequency_hz": "Hz", "log_decrement": "-", "last_peak_time_s": "s"}
@@ -165,8 +182,6 @@ def measured_features(spec=priors.DEFAULT, experiment=None, features=None, cells
         ``key, cell, fz_n, pressure_kpa, feature, unit, measured, sd_measurement,
         sd_discrepancy, how``, in :func:`feature_keys` order.
     """
-    import pandas as pd
-
     spec = spec if isinstance(spec, priors.CalibrationSpec) else priors.load(spec)
     exp = experiments.load(spec.experiment) if experiment is None else experiment
     features = _check_features(features)
@@ -229,8 +244,6 @@ def model_features(t, yaw_rate, steady=0.0, t_kick=0.0, processing=None):
         ``detrended_peaks`` (the rule on the signal less the fitted trend, over the fit's window:
         :class:`~whipple_kick.simulate.analysis.PeakSeries` on the input clock).
     """
-    from whipple_kick.simulate import analysis, oscillation
-
     proc = experiments.load().processing if processing is None else processing
     t_rec, y_rec = analysis.as_recorded(t, yaw_rate, t_kick, proc["imu_rate"], proc["lowpass_cutoff"])
     y = y_rec - steady
@@ -274,8 +287,6 @@ class ModelSimulator:
     """
 
     def __init__(self, fields, cells, features, base=None, workers=None, progress=False, folder=None):
-        from . import validation
-
         self.fields = list(fields)
         self.cells = [(float(a), float(b)) for a, b in cells]
         self.features = _check_features(features)
@@ -287,12 +298,6 @@ class ModelSimulator:
         self.runs = 0
 
     def __call__(self, X):
-        import contextlib
-        import tempfile
-
-        from .sweep_engine import make_cases, sweep
-        from .sweep_store import load_trajectory
-
         X = np.atleast_2d(np.asarray(X, dtype=float))
         cases = [{**dict(zip(self.fields, map(float, x), strict=True)), "fz_n": fz, "pressure_kpa": p}
                  for x in X for fz, p in self.cells]
@@ -402,7 +407,6 @@ class Emulators:
                       + WhiteKernel(1e-4, (1e-9, 1e-1)))
             gp = GaussianProcessRegressor(kernel, normalize_y=True, n_restarts_optimizer=self.restarts,
                                           random_state=self.seed)
-            import warnings
 
             from sklearn.exceptions import ConvergenceWarning
             with warnings.catch_warnings():
@@ -418,8 +422,6 @@ class Emulators:
         ``return_std``: the variance includes the nugget), without its input
         validation, which cost 0.2 ms a call, most of a sampler step.
         """
-        from scipy.linalg import solve_triangular
-
         U = np.atleast_2d(np.asarray(U, float))
         mean = np.full((len(U), len(self.models)), np.nan)
         var = np.full_like(mean, np.nan)
@@ -525,7 +527,6 @@ class _Matcher:
 
 
 def _lhs(n, d, rng):
-    from scipy.stats import qmc
     return qmc.LatinHypercube(d=d, seed=rng).random(n)
 
 
@@ -734,11 +735,6 @@ class Calibration:
 
     def write(self, folder):
         """``posterior.csv``, ``features.csv``, ``checks.csv`` and ``verdict.txt`` into ``folder``; the paths."""
-        import pathlib
-
-        import pandas as pd
-
-        from whipple_kick import fileio
         folder = pathlib.Path(folder)
         folder.mkdir(parents=True, exist_ok=True)
         post = self.posterior if self.posterior is not None else pd.DataFrame(columns=[p.name for p in self.priors])
@@ -751,7 +747,6 @@ class Calibration:
             fileio.write_atomic(path, frame.to_csv(index=False))
             paths.append(path)
         if self.settings is not None:
-            import json
             path = folder / SETTINGS_FILE
             fileio.write_atomic(path, json.dumps(self.settings, indent=1) + "\n")
             paths.append(path)
@@ -790,7 +785,6 @@ def screen(simulator, prior_list, sd, keys, trajectories=4, levels=4, seed=0):
         ``active`` (``mu_star_sd >= SCREEN_THRESHOLD``), ``rows`` (simulator rows), ``rows_without_value`` (rows where some
         feature had no value; their cells take the feature's mean over the design so the effects stay defined).
     """
-    import pandas as pd
     from SALib.analyze import morris as morris_analyze
     from SALib.sample import morris as morris_sample
 
@@ -886,9 +880,7 @@ def calibrate(simulator=None, spec=priors.DEFAULT, inputs=None, bounds=None, fea
     -------
     Calibration
     """
-    import scipy.linalg  # noqa: F401  (loaded before the limit, so that its OpenBLAS is limited too)
     import sklearn.gaussian_process  # noqa: F401
-    from threadpoolctl import threadpool_limits
 
     # One BLAS thread: the GP matrices are at most a few hundred rows; on a shared 2-core machine OpenBLAS'
     # threads made each Cholesky solve 2-3 ms instead of well under 1 ms (the sweep engine limits its runs alike).
@@ -900,8 +892,6 @@ def calibrate(simulator=None, spec=priors.DEFAULT, inputs=None, bounds=None, fea
 
 def _calibrate(simulator, spec, inputs, bounds, features, cells, discrepancy, measured, base, waves, first,
                per_wave, rank, walkers, steps, candidates, seed, workers, progress, check_runs, runs=None):
-    import pandas as pd
-
     spec = spec if isinstance(spec, priors.CalibrationSpec) else priors.load(spec)
     prior_list = choose_priors(spec, inputs, bounds)
     table = measured_features(spec, features=features, cells=cells, discrepancy=discrepancy)
@@ -987,8 +977,6 @@ def settings(prior_list, base, cells, features, spec):
     """What a posterior is conditional on, as plain data (``settings.json``): each posterior column's scenario
     field, the modelling choices of the runs (:data:`CHOICE_FIELDS`, never pooled: the posterior of one rider
     model or kick direction is not another's), the cells and features, the calibration file."""
-    from . import validation
-
     base = validation.base_scenario(duration=FEATURE_DURATION) if base is None else base
     return {"format": SETTINGS_FORMAT, "fields": {p.name: p.field for p in prior_list},
             "choices": {f: getattr(base, f) for f in CHOICE_FIELDS},
@@ -1025,8 +1013,6 @@ def _simulator_predictive(Y, z, var_obs, seed):
     A feature no run gives (every run fell or had no peak) keeps ``simulator_runs`` 0 and no interval (the
     feature is left out, not set to a number).
     """
-    import pandas as pd
-
     Y = np.atleast_2d(np.asarray(Y, float))
     rng = np.random.default_rng(seed + 4)
     out = {k: np.full(Y.shape[1], np.nan) for k in ("simulator_mean", "simulator_5", "simulator_95",
@@ -1152,10 +1138,6 @@ def held_out(mode, simulator_factory, spec=priors.DEFAULT, inputs=None, bounds=N
         ``runs`` (draws that gave the feature). A calibration that leaves nothing plausible predicts nothing:
         its rows say so in ``held_out`` with ``runs`` 0.
     """
-    import pandas as pd
-
-    from .validation import DIRECTIONS
-
     if mode not in HELD_OUT:
         raise InputError(f"held-out check {mode!r} unknown: choose {' or '.join(HELD_OUT)}")
     if direction not in DIRECTIONS:
@@ -1221,8 +1203,6 @@ def held_out(mode, simulator_factory, spec=priors.DEFAULT, inputs=None, bounds=N
 def held_out_checks(frame):
     """``checks.csv`` rows of :func:`held_out`'s table: one per predicted feature (its standardised error) and,
     per mode, the share within +-3."""
-    import pandas as pd
-
     rows = []
     for _, r in frame.iterrows():
         if not r["runs"]:

@@ -50,9 +50,11 @@ import math
 import pathlib
 
 import numpy as np
+import pandas as pd
 
+from whipple_kick import fileio
 from whipple_kick.errors import InputError, check_range
-from whipple_kick.library import thesis, uncertain
+from whipple_kick.library import experiments, thesis, uncertain
 from whipple_kick.simulate import criteria
 from whipple_kick.simulate.scenario import Scenario
 
@@ -105,7 +107,6 @@ class PosteriorStudy:
     def write(self, folder):
         """``p_best.csv``, ``posterior_rows.csv``, ``posterior_outcomes.csv``, ``answer.txt`` (and
         :data:`BESIDE_PRIOR`) into ``folder``; the paths."""
-        from whipple_kick import fileio
         folder = pathlib.Path(folder)
         tables = [("p_best", self.p_best), ("posterior_rows", self.rows), ("posterior_outcomes", self.outcomes)]
         if self.beside_prior is not None:
@@ -131,8 +132,6 @@ def read_calibration(folder):
         One line: no folder, no or an empty posterior (nothing plausible: no answer under it), no settings,
         a posterior column that the settings do not name.
     """
-    import pandas as pd
-
     folder = pathlib.Path(folder)
     if not folder.is_dir():
         raise InputError(f"--posterior {folder}: no such folder (give the --out folder of calibrate)")
@@ -166,8 +165,6 @@ def read_calibration(folder):
 def draw_rows(posterior, fields, samples, seed, spec, base):
     """``samples`` posterior rows (without replacement, seeded) with the uncertainty file's inputs that are not
     calibrated sampled per row: a DataFrame of scenario values per row (and ``posterior_index``)."""
-    import pandas as pd
-
     rng = np.random.default_rng(seed)
     if samples > len(posterior):
         raise InputError(f"--samples = {samples} is more than the posterior's {len(posterior)} rows")
@@ -223,9 +220,6 @@ def p_best_table(outcomes, loads, pressures, measured_best=None):
     -------
     (pandas.DataFrame of :data:`P_BEST_COLUMNS`, list of notes)
     """
-    import pandas as pd
-
-    from whipple_kick.library import experiments
     if measured_best is None:
         measured_best = {fz: b["best_pressure"] for fz, b in experiments.load().best.items()}
     out, notes = [], []
@@ -260,8 +254,6 @@ def beside_prior(p_best, folder):
     """``p_best`` with a prior study's (``recommend-pressure --uncertain --out DIR``: its ``p_best.csv``)
     ``p``, ``low``, ``high``, ``rows`` beside it, suffixed ``_prior`` (NaN where the prior study lacks the
     load or pressure)."""
-    import pandas as pd
-
     path = pathlib.Path(folder) / "p_best.csv"
     if not path.is_file():
         raise InputError(f"--prior-study {folder}: no p_best.csv in it (give the --out folder of "
@@ -304,8 +296,6 @@ def run(folder, samples=32, seed=0, loads=thesis.LOADS_N, pressures=thesis.PRESS
     -------
     PosteriorStudy
     """
-    import pandas as pd
-
     samples = int(check_range("--samples", samples, 2, 1e5, "posterior rows"))
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise InputError(f"seed = {seed!r} is outside the allowed range: a whole number >= 0")
@@ -382,8 +372,6 @@ def format_study(study):
 
 def from_folder(folder):
     """A finished study's p_best table and answer from a calibration folder (``p_best.csv``), or None."""
-    import pandas as pd
-
     path = pathlib.Path(folder) / "p_best.csv"
     if not path.is_file():
         return None

@@ -22,16 +22,15 @@ import math
 import numpy as np
 
 from whipple_kick.errors import InputError, check_range
+from whipple_kick.library import tyres
 from whipple_kick.simulate import criteria
+from whipple_kick.simulate.criteria import CRITERIA  # the one table: every declared criterion
 from whipple_kick.simulate.scenario import Scenario
 
 from .sweep_engine import check_some_ok, sweep
 
 # --------------------------------------------------------------- the pressure recommender
 
-#: Recommender criteria (:data:`whipple_kick.simulate.criteria.CRITERIA`): each names the table column ranked
-#: (``CRITERIA[key].column``, its first item), the criterion breaking its ties, its words and its spread.
-CRITERIA = criteria.CRITERIA
 #: Spread [s] of each criterion's value, below which a difference between pressures is not to be trusted
 #: (:attr:`whipple_kick.simulate.criteria.Criterion.spread_s`, where it is declared and measured). A margin
 #: between the best and the second-best pressure below the spread is "no clear optimum". The probability of
@@ -99,7 +98,6 @@ class Recommendation:
 
 def tyre_pressures(tyre="T03", coefficient_set="table7_9"):
     """Measured pressures [kPa] of a tyre's coefficient set."""
-    from whipple_kick.library import tyres
     files = tyres._tyre_files()
     if tyre not in files:
         raise InputError(f"tyre = {tyre!r} is unknown; choose one of {', '.join(files)}")

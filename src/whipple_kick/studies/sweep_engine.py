@@ -21,6 +21,8 @@ into the current folder.
 """
 import atexit
 import concurrent.futures as cf
+import ctypes
+import ctypes.util
 import dataclasses
 import datetime
 import itertools
@@ -33,8 +35,11 @@ import time
 import warnings
 
 import numpy as np
+from threadpoolctl import ThreadpoolController
+from tqdm.auto import tqdm
 
 from whipple_kick.errors import DefaultValueWarning, InputError, Terminated, UnstableRiderWarning, terminate_raises
+from whipple_kick.library import bicycleparameters
 from whipple_kick.model import slip
 from whipple_kick.simulate import simulation
 from whipple_kick.simulate.results import flatten_summary
@@ -260,7 +265,6 @@ def _warn_defaults(scenarios):
     """The defaults warning (DefaultValueWarning) of each BicycleParameters bicycle the cases name, here, once per
     bicycle (identical texts once): each case ignores it (:func:`run_case`), where it came once per case and
     worker (the uncertainty study's hundreds of sampled bicycles, all with the same ~600-character text)."""
-    from whipple_kick.library import bicycleparameters
     for name in dict.fromkeys(str(sc.bicycle) for sc in scenarios):
         if bicycleparameters.is_bicycleparameters_path(name):
             try:
@@ -280,7 +284,6 @@ def _blas_controller():
     ``sys.modules`` that has not changed means the same libraries.
     """
     global _blas
-    from threadpoolctl import ThreadpoolController
 
     controller, seen = _blas
     if seen != len(sys.modules):
@@ -497,8 +500,6 @@ def _keep_freed_memory():
     kept up to 1 GB, so the next case writes into pages already mapped. Results are unchanged (only
     where the bytes live changes). Elsewhere (no glibc) nothing is done. Returns whether it was set.
     """
-    import ctypes
-    import ctypes.util
     if not sys.platform.startswith("linux"):
         return False
     try:
@@ -536,14 +537,11 @@ def _preload():
     inherit the modules and the loaded compiled model instead of importing
     them each; with other start methods this costs the main process ~1 s.
     """
-    from whipple_kick.model import slip
     slip.library()
 
 
 def _collect(executor, todo, records, store, progress, total, spec, table_interval, lost):
     """Submit ``todo`` to ``executor`` and save each case as it finishes."""
-    from tqdm.auto import tqdm
-
     bar = tqdm(total=total, initial=total - len(todo), disable=not progress, desc="sweep",
                unit="case", dynamic_ncols=True)
     futures = {}

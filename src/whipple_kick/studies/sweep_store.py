@@ -20,12 +20,14 @@ example and one of its case ids.
 import dataclasses
 import datetime
 import hashlib
+import io
 import json
 import os
 import pathlib
 import time
 
 import numpy as np
+import pandas as pd
 
 from whipple_kick import fileio
 from whipple_kick.errors import InputError
@@ -119,7 +121,6 @@ def trajectory_path(folder, case_id):
 
 def load_trajectory(folder, case_id):
     """A saved case: (trajectory DataFrame, summary dict)."""
-    import pandas as pd
     with np.load(trajectory_path(folder, case_id)) as data:
         summary = json.loads(str(data["summary_json"]))
         columns = [str(c) for c in data["columns"]]
@@ -141,7 +142,6 @@ def pack_trajectory(trajectory, summary_json):
     summary_json : str
         The run's summary as JSON text.
     """
-    import io
     buffer = io.BytesIO()
     np.savez_compressed(buffer, columns=np.array(list(trajectory)), summary_json=np.array(summary_json), **trajectory)
     return buffer.getvalue()
@@ -157,7 +157,6 @@ def _save_trajectory(folder, record):
 
 def table(case_list, records):
     """DataFrame of the finished cases, in the order of the case list."""
-    import pandas as pd
     scenario_fields = [f.name for f in dataclasses.fields(Scenario)]
     rows, seen, result_cols, run_cols = [], set(), {}, {}
     for _, scenario, cid in case_list:

@@ -87,14 +87,26 @@ runs a small one; ``scripts/uncertainty_study.py`` the measured one).
 >>> print("\\n".join(study.verdict))                      # doctest: +SKIP
 """
 import dataclasses
+import difflib
+import hashlib
 import itertools
+import json
 import math
+import os
+import pathlib
+import shutil
+import warnings
 
 import numpy as np
+import pandas as pd
+from scipy import stats
 
+from whipple_kick import fileio
 from whipple_kick.errors import InputError, check_range
-from whipple_kick.library import thesis, uncertain
-from whipple_kick.simulate import criteria
+from whipple_kick.library import bicycleparameters, bicycles, experiments, priors, thesis, tyres, uncertain
+from whipple_kick.model import cache
+from whipple_kick.simulate import assembly
+from whipple_kick.simulate.criteria import CRITERIA  # the one table: every declared criterion
 from whipple_kick.simulate.scenario import DEFAULTS, MECHANISM_FIELDS, UNITS, Scenario
 
 from .recommend import _num, pressure_grid
@@ -105,9 +117,6 @@ from .sweep_store import table as stored_table
 #: Thesis Chapter 8's pressures [kPa] and rear loads [N] (:mod:`whipple_kick.library.thesis`).
 PRESSURES = thesis.PRESSURES_KPA
 LOADS = thesis.LOADS_N
-#: The recovery criteria (:data:`whipple_kick.simulate.criteria.CRITERIA`): ``CRITERIA[key].column`` is the
-#: table column of each.
-CRITERIA = criteria.CRITERIA
 #: Bootstrap resamples of the paired differences' intervals.
 BOOTSTRAP = 2000
 #: Confidence level of every interval.
@@ -172,9 +181,6 @@ class UncertaintyStudy:
 
     def write(self, folder):
         """Write every table as CSV into ``folder``; returns the paths."""
-        import pathlib
-
-        from whipple_kick import fileio
         folder = pathlib.Path(folder)
         folder.mkdir(parents=True, exist_ok=True)
         paths = []
@@ -259,7 +265,6 @@ def _reads(scenario, field):
 
 def _close(field):
     """" (did you mean ...?)" for a misspelt scenario field, or ""."""
-    import difflib
     close = difflib.get_close_matches(field, DEFAULTS, n=1)
     return f" (did you mean {close[0]!r}?)" if close else ""
 
@@ -267,7 +272,6 @@ def _close(field):
 def _check_changes(where, base, changes):
     """``base`` with ``changes`` passes the run's checks (the fields the changed mechanisms do not read left at
     ``base``'s, as a sample row leaves them); else InputError ``<where>: <the check's message>``."""
-    from whipple_kick.simulate import assembly
     scenario = base.with_changes(**changes)
     unread = {f: getattr(base, f) for f in scenario.unused_fields() if f in changes}
     try:
@@ -321,8 +325,6 @@ def sample(spec, samples, seed):
 
     ``N (D + 2)`` rows in SALib's order (per base point: A, AB1 ... ABD, B).
     """
-    import warnings
-
     from SALib.sample import sobol as sobol_sample
     samples = int(check_range("samples", samples, 2, 1e6, "(base samples N)"))
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
@@ -357,15 +359,6 @@ def sampled_bicycle(measured, values):
         The folder (in the per-user cache, named by a hash of the bicycle's content and the values, so a row
         that repeats another shares it), which a scenario's ``bicycle`` names.
     """
-    import hashlib
-    import json
-    import os
-    import pathlib
-    import shutil
-
-    from whipple_kick.library import bicycleparameters, bicycles
-    from whipple_kick.model import cache
-
     bike = bicycleparameters.load_bicycle(measured)
     changes = {k[len(uncertain.BICYCLE_PREFIX):]: float(v) for k, v in values.items()}
     benchmark, geometry = dict(bike.benchmark), dict(bike.geometry or {})
@@ -437,7 +430,6 @@ def _design(spec, samples, seed, loads, pressures, base):
     # Within the tyre's measured range (checked here: inside the sweep a bad pressure would fail every run at it).
     pressures, measured = pressure_grid(base.tyre, list(pressures), coefficient_set=base.coefficient_set)
     if len(pressures) < 2:
-        from whipple_kick.library import tyres
         others = [f"{name} ({_kpa(p)})" for name, p, _ in tyres.available() if len(p) > 1]
         raise InputError(f"the study compares pressures: it needs at least two, got {_kpa(pressures)}; tyre "
                          f"{base.tyre} ({base.coefficient_set}) was measured at {_kpa(measured)} only, and a "
@@ -526,9 +518,6 @@ def _kpa(pressures):
 
 def analyse(spec, samples, seed, unit, blocks, keys, ids, table, duration):
     """The study's tables from its sweep ``table`` (rows found by case id: a repeated case runs once)."""
-    import pandas as pd
-
-    from whipple_kick.library import experiments
     inputs = pd.DataFrame([{"sample": r, "block": blocks[r], **spec.labels(u)} for r, u in enumerate(unit)])
     by_id = table.set_index("case_id")
     wanted = ["status", "error", "fell", *(c.column for c in CRITERIA.values()), "run.wall_s", "run.cpu_s", "numerics.integration_wall_s"]
@@ -664,7 +653,6 @@ def p_best_interval(share):
     draws; their error is smaller than independent sampling's, so the interval
     is conservative.
     """
-    from scipy import stats
     share = np.asarray(share, dtype=float)
     n = share.shape[0]
     p = share.mean(axis=0) if n else np.full(share.shape[1], math.nan)
@@ -817,7 +805,6 @@ def measurement_error(calibration=None):
     the last-peak time itself does not have). Taken as the error of the cell's mean, not divided by the
     square root of the three trials: the thesis prints no spread.
     """
-    from whipple_kick.library import experiments, priors
     spec = priors.load() if calibration is None else calibration
     trial = spec.errors["last_peak_time_s"].sd
     rounding = experiments.PRINT_HALF_STEP / math.sqrt(3.0)
@@ -850,7 +837,6 @@ def predictive_check(t_best, t_other, measured_diff, sd):
         N"``. The Wilson interval holds its point estimate and widens as the rows get fewer: fewer rows never
         turn an inconsistent (or undecided) check into a consistent one.
     """
-    from scipy import stats
     t_best, t_other = np.asarray(t_best, dtype=float), np.asarray(t_other, dtype=float)
     if not len(t_best):
         return math.nan, math.nan, math.nan, "no rows"
@@ -894,10 +880,6 @@ def against_measurement(times_of, winners, loads, pressures, p_best, calibration
     gives the measured best at every load (the rows are shared by the loads) and the combined verdict of
     the resolved loads.
     """
-    import pandas as pd
-    from scipy import stats
-
-    from whipple_kick.library import experiments
     exp = experiments.load()
     z = float(stats.norm.ppf(0.5 + CONFIDENCE / 2.0))
     sd_cell, _ = measurement_error(calibration)

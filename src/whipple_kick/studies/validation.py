@@ -47,15 +47,26 @@ The choices (docs/experiments.md says why):
   the first second.
 """
 from dataclasses import dataclass
+import json
 import math
 import pathlib
+import tempfile
 
 import numpy as np
+import pandas as pd
 
+from whipple_kick import fileio
 from whipple_kick.errors import InputError
+from whipple_kick.figures.plotting import validation_figure
 from whipple_kick.library import experiments
-from whipple_kick.simulate import analysis, provenance
+from whipple_kick.model import transient
+from whipple_kick.simulate import analysis, provenance, results
+from whipple_kick.simulate.assembly import preflight
 from whipple_kick.simulate.scenario import Scenario
+
+from .recommend import dependence
+from .sweep_engine import sweep
+from .sweep_store import load_trajectory
 
 #: Kick directions run (the thesis does not give one).
 DIRECTIONS = ("right", "left")
@@ -235,13 +246,6 @@ def validate(base=None, experiment=None, directions=DIRECTIONS, workers=None, pr
         before any run: e.g. a bicycle preset that includes its rider, a
         tyre not measured at 300-500 kPa).
     """
-    import tempfile
-
-    import pandas as pd
-
-    from .sweep_engine import sweep
-    from .sweep_store import load_trajectory
-
     exp = experiments.load() if experiment is None else experiment
     base = base_scenario() if base is None else base
     directions = tuple(directions)
@@ -252,7 +256,6 @@ def validate(base=None, experiment=None, directions=DIRECTIONS, workers=None, pr
         raise InputError(f"time origin {time_origin!r} is unknown; choose one of {', '.join(TIME_ORIGINS)}")
     cases = [{"fz_n": c.fz_n, "pressure_kpa": c.pressure_kpa, "kick_direction": d}
              for c in exp.cases.values() for d in directions]
-    from whipple_kick.simulate.assembly import preflight
     for case in cases:   # a set-up no case can run (a preset with its rider, a tyre without these pressures) fails here
         preflight(base.with_changes(**case))
     with tempfile.TemporaryDirectory(prefix="whipple_kick_validate_") as folder:
@@ -335,8 +338,6 @@ def compare(table, experiment, directions=DIRECTIONS):
         ``verdicts`` ``{rule: text}`` (whether the best pressure depends on the direction);
         ``failed`` (runs that fell or failed).
     """
-    from .recommend import dependence
-
     exp = experiment
     measured = table[table["source"] == "measured"].set_index("case")
     model = table[(table["source"] == "model") & (table["status"] == "ok")]
@@ -387,10 +388,6 @@ def write(result, out, plot=True):
     list of str
         The files written (relative to ``out``).
     """
-    import json
-
-    from whipple_kick import fileio
-    from whipple_kick.simulate import results
     out = pathlib.Path(out)
     out.mkdir(parents=True, exist_ok=True)
     fileio.write_csv(result.table, out / "validation.csv", significant_digits=6)
@@ -406,7 +403,6 @@ def write(result, out, plot=True):
                         json.dumps(results.clean(result.summary), indent=2, allow_nan=False) + "\n")
     files.append("summary.json")
     if plot:
-        from whipple_kick.figures.plotting import validation_figure
         validation_figure(result, out / "validation.png")
         files.append("validation.png")
     return files
@@ -461,7 +457,7 @@ def compare_transients(base=None, forms=None, experiment=None, directions=DIRECT
     Parameters
     ----------
     forms : sequence of str, optional
-        Tyre transient forms (default every one of :data:`whipple_kick.model.transient.TRANSIENTS`).
+        Tyre transient forms (default every one of :func:`whipple_kick.model.transient.transients`).
     base, experiment, directions, workers, progress, time_origin
         As for :func:`validate`.
 
@@ -473,12 +469,8 @@ def compare_transients(base=None, forms=None, experiment=None, directions=DIRECT
         ``{rule: {direction: text}}``: the best pressure per load by form
         (:func:`whipple_kick.studies.recommend.dependence`).
     """
-    from whipple_kick.model import transient
-
-    from .recommend import dependence
-
     base = base_scenario() if base is None else base
-    forms = tuple(transient.TRANSIENTS if forms is None else forms)
+    forms = tuple(transient.transients() if forms is None else forms)
     results = {form: validate(base.with_changes(tyre_transient=form), experiment, directions, workers, progress,
                               time_origin) for form in forms}
     verdicts = {}

@@ -79,11 +79,11 @@ from .linear import (  # noqa: F401 -- the package's names, as before the split
 )
 from .parameters import (  # noqa: F401 -- the package's names, as before the split
     FY_OFFSET_INDICES,
-    GAIN_NAMES,
-    GAIN_STATES,
     MZ_OFFSET_INDICES,
     SLIP_SPEEDS,
     ModelOptions,
+    gain_names,
+    gain_states,
     model_parameters,
     tyre_parameters,
 )

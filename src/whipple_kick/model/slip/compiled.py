@@ -69,9 +69,15 @@ def model_hash(L=layouts.BASE):
     return os.path.splitext(os.path.basename(library(L)._name))[0]
 
 
-@functools.cache
 def library(L=layouts.BASE):
-    """The compiled slip model of the layout ``L`` (ctypes library of :func:`library_path`), loaded once per process."""
+    """The compiled slip model of the layout ``L`` (ctypes library of :func:`library_path`), loaded once per process
+    and set of declared tyre forms (a form declared later is in another library)."""
+    return _library(L, transient.fingerprint())
+
+
+@functools.cache
+def _library(L, forms):
+    """:func:`library` of ``L`` with the declared tyre forms whose fingerprint is ``forms``."""
     lib = ctypes.CDLL(str(library_path(L)))
     pointer = ctypes.c_void_p
     lib.wk_slip_rhs.restype = ctypes.c_int

@@ -17,9 +17,9 @@ SPEEDS = tuple(f"u{i}" for i in range(1, 11))
 DEPENDENT = ("u5", "u6", "u8")
 INDEPENDENT = tuple(n for n in SPEEDS if n not in DEPENDENT)
 #: Tyre-state slot names of the thesis' form (kept as aliases in :data:`X`).
-TYRE_STATES = transient.STATES["force_lag"]
+TYRE_STATES = transient.FORMS["force_lag"].states
 #: Tyre-state slot names of the default form.
-PATCH_STATES = transient.STATES["contact_patch"]
+PATCH_STATES = transient.FORMS["contact_patch"].states
 QUADRATURE_STATES = energy.QUADRATURE_STATES
 #: The reflex delay filter's states (:mod:`whipple_kick.model.reflex`): in a model whose reflex is delayed
 #: only (:attr:`Layout.REFLEX_STATES`); without a delay the reflex acts undelayed and has no states.
@@ -83,10 +83,27 @@ OUTPUT_NAMES = SPEEDS + tuple(OUTPUTS)
 #: a study's summary reads none of them (``scripts/bench_sweep.py cost --callgrind``).
 OPTIONAL_OUTPUTS = (("yp", "vp", "ap"), ("fy_ss_r", "fy_ss_f", "mz_ss_r", "mz_ss_f"), ("fy_limit_r", "fy_limit_f"))
 PARAMETER_NAMES = S.SLIP_CONSTANTS
-X = {n: i for i, n in enumerate(STATE_NAMES)}
-# Every declared form's state names are aliases of the slots (the thesis' force states, the carcass deflections).
-for _form in transient.FORMS.values():
-    X.update({n: X[m] for n, m in zip(_form.states, PATCH_STATES, strict=True)})
+
+
+class StateIndex(dict):
+    """Index of each state by name. Every declared tyre form's state names (the thesis' forces, the carcass'
+    deflections) are aliases of the four tyre slots, resolved when looked up: a form declared after this
+    module was imported (:func:`whipple_kick.model.transient.declare`) has its names here too."""
+
+    def __missing__(self, name):
+        slot = transient.slot(name)
+        if slot is None:
+            raise KeyError(name)
+        return self[PATCH_STATES[slot]]
+
+    def __contains__(self, name):
+        return dict.__contains__(self, name) or transient.slot(name) is not None
+
+    def get(self, name, default=None):
+        return self[name] if name in self else default
+
+
+X = StateIndex({n: i for i, n in enumerate(STATE_NAMES)})
 OUT = {n: i for i, n in enumerate(OUTPUT_NAMES)}
 P = {n: i for i, n in enumerate(PARAMETER_NAMES)}
 
@@ -100,7 +117,7 @@ _SOURCES = ("compiler", "symbols", "parts", "symbolic/derivation", "symbolic/cod
 def tyre_state_names(name=transient.DEFAULT_TRANSIENT):
     """Names of the four tyre-state slots under the transient form ``name``."""
     transient.check(name)
-    return transient.STATES[name]
+    return transient.FORMS[name].states
 
 
 #: The state each gain of the rider's voluntary law on the bicycle multiplies (``T7 = -sum(gain * state)``);
@@ -143,7 +160,7 @@ class Layout:
         self.PART_OUTPUTS = tuple(n for p in self.parts for n in p.outputs)
         self.OUTPUT_NAMES = OUTPUT_NAMES + speeds + self.PART_OUTPUTS
         self.PARAMETER_NAMES = PARAMETER_NAMES + tuple(n for p in self.parts for n in p.parameters)
-        self.X = dict(X)
+        self.X = StateIndex(X)
         self.X.update({n: len(STATE_NAMES) + i for i, n in enumerate(self.REFLEX_STATES + self.PART_STATES)})
         self.OUT = {n: i for i, n in enumerate(self.OUTPUT_NAMES)}
         self.P = {n: i for i, n in enumerate(self.PARAMETER_NAMES)}

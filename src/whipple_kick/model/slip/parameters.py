@@ -8,21 +8,35 @@ from whipple_kick.model import carcass, magic_formula, parts, transient
 from whipple_kick.model import symbols as S
 import whipple_kick.model.slip.layout as layouts  # the module by its full name, not through the package
 
+from .description import Model, Parameters
+
 # ------------------------------------------------------- parameters and steady state
 
 #: Magic-Formula coefficients that shift the curves at zero slip and camber
 #: (Sh and Sv terms not multiplied by camber). "Symmetric tyres" zero them.
 FY_OFFSET_INDICES = magic_formula.FY_OFFSET_INDICES
 MZ_OFFSET_INDICES = magic_formula.MZ_OFFSET_INDICES
-#: The state each gain of the rider's voluntary law multiplies (``T7 = -sum(gain * state)``), every
-#: declared part's gains included (a model without the part refuses its gains).
-GAIN_STATES = dict(layouts.GAIN_STATES)
-for _part in parts.REGISTRY.values():
-    GAIN_STATES.update(_part.gains)
-GAIN_NAMES = tuple(GAIN_STATES)
 #: The rider's reflex in the base model by parameter name, with the rigid rider's values: none. (The
 #: upper body and the arms are parts: a model without them has none of their parameters.)
 RIGID_BODY = {"rq4": 0.0, "rq7": 0.0, "ru4": 0.0, "ru7": 0.0, "reflex_delay": 0.0}
+
+
+def gain_states():
+    """The state each gain of the rider's voluntary law multiplies (``T7 = -sum(gain * state)``), every
+    declared part's gains included (a model without the part refuses its gains).
+
+    Read from :data:`whipple_kick.model.parts.REGISTRY` when called, so a part declared after the package
+    was imported (a test's, a script's) has its gains here.
+    """
+    table = dict(layouts.GAIN_STATES)
+    for part in parts.REGISTRY.values():
+        table.update(part.gains)
+    return table
+
+
+def gain_names():
+    """Names of the rider's gains (:func:`gain_states`' keys, the bicycle's first), read when called."""
+    return tuple(gain_states())
 
 
 def _part_body():
@@ -94,7 +108,7 @@ class ModelOptions:
     Attributes
     ----------
     tyre_transient : str
-        One of :data:`whipple_kick.model.transient.TRANSIENTS` (default ``carcass``).
+        One of :func:`whipple_kick.model.transient.transients` (default ``carcass``).
     symmetric_tyres : bool
         Zero the zero-slip offsets (:func:`tyre_parameters`).
     camber_sign : {"physical", "reversed"}
@@ -140,7 +154,7 @@ def model_parameters(moore, rear_tyre, front_tyre, options=None, *, model=None, 
         The model: its parts, the reflex's delay filter and its tyre form, which must be ``options``'; default
         the rigid rider without the delay filter.
     gains : mapping, optional
-        Steer-torque gains by name (:data:`GAIN_NAMES`); missing ones are 0.
+        Steer-torque gains by name (:func:`gain_names`); missing ones are 0.
         ``T7 = -(kq4 q4 + kq7 q7 + ku4 u4 + ku7 u7 + kq3 q3 + ku3 u3)``.
     kick : mapping, optional
         ``t0`` [s], ``duration`` [s], ``displacement`` [m, + to the right],
@@ -163,8 +177,6 @@ def model_parameters(moore, rear_tyre, front_tyre, options=None, *, model=None, 
     -------
     whipple_kick.model.slip.description.Parameters
     """
-    from .description import Model, Parameters
-
     options = ModelOptions() if options is None else options
     opt = {name: getattr(options, name, default.default)
            for name, default in ModelOptions.__dataclass_fields__.items()}
@@ -201,7 +213,7 @@ def model_parameters(moore, rear_tyre, front_tyre, options=None, *, model=None, 
     layout = model.layout
     gains = dict(gains or {})
     # A zero gain on a state the model does not have changes nothing; a nonzero one is refused.
-    unknown = {n for n in set(gains) - set(layout.GAIN_NAMES) if n not in GAIN_STATES or gains[n] != 0.0}
+    unknown = {n for n in set(gains) - set(layout.GAIN_NAMES) if n not in gain_states() or gains[n] != 0.0}
     if unknown:
         raise InputError(f"unknown controller gains {sorted(unknown)} for the {layout.key} model; known: "
                          f"{', '.join(layout.GAIN_NAMES)}")

@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 import sympy as sm
 import sympy.physics.mechanics as me
 
+from whipple_kick.model import parts
 from whipple_kick.model import symbols as S
 
 
@@ -425,8 +426,6 @@ def slip_equations(part_names=()):
         velocity along the ground normal is u9 and u10: at the rear by the
         geometry, checked symbolically, at the front by the constraint).
     """
-    from whipple_kick.model import parts
-
     kin = kinematics(tyre_model=True)
     N, A, C, D, E, F = (kin.frames[k] for k in "NACDEF")
     chosen = parts.named(part_names)

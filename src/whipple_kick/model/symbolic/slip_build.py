@@ -44,7 +44,7 @@ from whipple_kick.model.slip.layout import (
     P,
     X,
 )
-from whipple_kick.model.symbolic import codegen
+from whipple_kick.model.symbolic import codegen, derivation
 
 #: Status of the C functions when a reflex delay is set in a model without the delay filter.
 STATUS_NEEDS_DELAY = 3
@@ -198,9 +198,15 @@ def _c_limit_functions():
 
 # ---------------------------------------------------------------- expressions
 
-@functools.cache
 def _expressions(part_names=()):
-    """Everything both printers need, as plain-symbol SymPy expressions.
+    """Everything both printers need, as plain-symbol SymPy expressions (:func:`_expressions_of`), once per model
+    and set of declared tyre forms (a form declared later changes the blocks)."""
+    return _expressions_of(tuple(part_names), transient.fingerprint())
+
+
+@functools.cache
+def _expressions_of(part_names, forms):
+    """Everything both printers need, as plain-symbol SymPy expressions (``forms``: the forms' fingerprint).
 
     Returns
     -------
@@ -213,7 +219,6 @@ def _expressions(part_names=()):
         name, the block's copies excluded), ``mass`` (the mass matrix alone)
         and ``symbols``; of the model with the parts ``part_names``.
     """
-    from whipple_kick.model.symbolic import derivation
     L = layouts.for_parts(part_names)
     eom = derivation.slip_equations(part_names)
     dyn = list(eom.q) + list(eom.u)
@@ -234,7 +239,7 @@ def _expressions(part_names=()):
     kin = {name: plain(ex[name]) for name in _KINEMATICS}
     u = {f"u{i + 1}": codegen.plain_symbol(s) for i, s in enumerate(eom.u)}
     sigma0 = {"r": S.sym("sigr"), "f": S.sym("sigf")}
-    blocks = {style: {name: transient.tyre_block(name, curves(), sigma0) for name in transient.SYMBOLIC}
+    blocks = {style: {name: transient.tyre_block(name, curves(), sigma0) for name in transient.symbolic()}
               for style, curves in (("inline", _inline_curves), ("called", _called_curves))}
     common = {k: plain(v) for k, v in energy.common_rates(ex, u, S.sym("T6c")).items()}
     k_sym = {name: S.sym(name) for name in _KINEMATICS + _APPLIED}
@@ -268,7 +273,7 @@ def _expressions(part_names=()):
             "t": t,
             "q": [codegen.plain_symbol(s) for s in eom.q],
             "u": [codegen.plain_symbol(s) for s in eom.u],
-            "s": {name: [sm.Symbol(n, real=True) for n in transient.STATES[name]] for name in transient.TRANSIENTS},
+            "s": {name: [sm.Symbol(n, real=True) for n in transient.FORMS[name].states] for name in transient.transients()},
             "p": list(S.syms(L.PARAMETER_NAMES)),
             "kinematics": [k_sym[n] for n in _KINEMATICS],
             "applied": [k_sym[n] for n in _APPLIED],
@@ -460,7 +465,7 @@ def _c_prologue(ex, dynamics, L):
     for s in sy["q"]:
         lines.append(f"    const double {s.name} = x[{L.X[s.name]}];")
     declared = set()   # forms share slot names (slip_lag's are contact_patch's, the carcass' camber too)
-    for name in transient.TRANSIENTS:
+    for name in transient.transients():
         for slot, s in enumerate(sy["s"][name]):
             if s.name not in declared:
                 declared.add(s.name)
@@ -523,9 +528,9 @@ def _c_prologue(ex, dynamics, L):
     lines.append(f"    double {', '.join(_APPLIED)}, trate[{nt}], {', '.join(_BLOCK_EXTRAS)};")
     lines.append("    const int mode = (int)tyre_transient;")
     lines.append("    wk_carcass_state cr, cf;")
-    for code, name in enumerate(transient.SYMBOLIC):
+    for code, name in enumerate(transient.symbolic()):
         head = "if" if code == 0 else "else if"
-        lines += [f"    {head} (mode == {transient.TRANSIENTS.index(name)}) {{",
+        lines += [f"    {head} (mode == {transient.transients().index(name)}) {{",
                   _c_block(_block_list(ex["blocks"]["called"][name]), block_targets, "        "), "    }"]
     # The carcass tyre (whipple_kick.model.carcass): written in C, not a SymPy expression.
     lines += ["    else {",
@@ -742,7 +747,7 @@ def numpy_source(part_names=()):
                                doc="Mass matrix, forcing without tyre loads, its tyre-load derivative, "
                                    "constraint remainder, tyre-block inputs."),
     ]
-    for name in transient.SYMBOLIC:
+    for name in transient.symbolic():
         parts.append(codegen.numpy_function(
             f"tyre_{name}", [("t", t), ("k", sy["kinematics"]), ("s", sy["s"][name]), ("p", sy["p"])],
             [sm.Matrix(_block_list(ex["blocks"]["inline"][name]))], doc=f"Tyre block of {name}."))
@@ -760,11 +765,16 @@ def numpy_source(part_names=()):
     return "\n\n".join(parts)
 
 
-@functools.cache
 def numpy_module(part_names=()):
     """The generated NumPy oracle module of the model with ``part_names`` (cached like the C library)."""
+    return _numpy_module(tuple(part_names), transient.fingerprint())
+
+
+@functools.cache
+def _numpy_module(part_names, forms):
+    """:func:`numpy_module` with the declared tyre forms whose fingerprint is ``forms``."""
     L = layouts.for_parts(part_names)
-    key = cache.source_hash(_SOURCES, extra=f"numpy {L.fingerprint()} forms {transient.fingerprint()}")
+    key = cache.source_hash(_SOURCES, extra=f"numpy {L.fingerprint()} forms {forms}")
     path = cache.build_once(f"slip_numpy_{L.key}_{key}.py", lambda tmp: tmp.write_text(numpy_source(part_names)))
     return cache.load_module(path, f"whipple_kick_generated_slip_{L.key.replace('+', '_')}_{key}")
 

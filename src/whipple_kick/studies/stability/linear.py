@@ -5,8 +5,8 @@ import numpy as np
 
 from whipple_kick.errors import InputError, check_range
 from whipple_kick.model import parts, slip
-from whipple_kick.model.transient import DEFAULT_TRANSIENT
-from whipple_kick.simulate import assembly, control, results
+from whipple_kick.model.transient import DEFAULT_TRANSIENT, FORMS
+from whipple_kick.simulate import assembly, control, results, steady
 
 from ._constants import LOOPS
 
@@ -70,10 +70,12 @@ def state_labels(transient=DEFAULT_TRANSIENT, constant_speed=True, body=()):
     >>> state_labels()[:2]
     [('roll', 'rad'), ('steer', 'rad')]
     """
-    # The declared parts' states (the leaning upper body's lean and its rate) read now: a part declared after
-    # this module was imported counts too.
-    labels = {**{q: c for part in parts.REGISTRY.values() for q, c in part.columns.items()}, **_LABELS}
-    return [labels[n] for n in active_states(transient, body, constant_speed)]
+    # The declared parts' states (the leaning upper body's lean and its rate) and the form's state columns read
+    # now: a part or form declared after this module was imported counts too; a form's state it gives no column
+    # is named as it is, without a unit.
+    labels = {**{q: c for part in parts.REGISTRY.values() for q, c in part.columns.items()},
+              **{n: (col, unit) for col, source, n, unit in FORMS[transient].columns if source == "state"}, **_LABELS}
+    return [labels.get(n, (n, "")) for n in active_states(transient, body, constant_speed)]
 
 
 # ----------------------------------------------------------------- linear model
@@ -160,7 +162,7 @@ def _gains_vector(params, states):
     if params.get("kq3", 0.0):
         raise InputError("a yaw-angle gain kq3 breaks the heading invariance the linear model needs")
     K = np.zeros((1, len(states)))
-    for gain, state in slip.GAIN_STATES.items():   # q3 is not among the states (kq3 is refused above)
+    for gain, state in slip.gain_states().items():   # q3 is not among the states (kq3 is refused above)
         if state in states:
             K[0, states.index(state)] = params.get(gain, 0.0)
     return K
@@ -294,7 +296,6 @@ def _steady(params, speed, guess):
     continued motion that has left them is searched for afresh, and a speed
     with none is left out as having no near-upright steady motion.
     """
-    from whipple_kick.simulate import steady
     if guess is not None:
         try:
             continued = steady.steady_state(params, speed, guess=guess)

@@ -1,8 +1,10 @@
 """Modes: where an eigenvector carries its amplitude, the mode names, and tracking across speed."""
 
 import numpy as np
+from scipy.optimize import linear_sum_assignment
 
-from whipple_kick.model import parts, slip
+from whipple_kick.model import parts, reflex, slip
+from whipple_kick.model.benchmark import from_moore
 from whipple_kick.simulate import results
 
 from ._constants import (
@@ -17,7 +19,6 @@ from ._constants import (
 # ------------------------------------------------------------------ mode content
 
 def _wheelbase(moore):
-    from whipple_kick.model.benchmark import from_moore
     return float(from_moore(moore)["w"])
 
 
@@ -170,7 +171,6 @@ def filter_share(lam, tau):
     >>> round(float(filter_share(np.array([-0.5 + 3j]), 0.1)[0]), 3)
     0.0
     """
-    from whipple_kick.model import reflex
     num, den = reflex.pade_coefficients(reflex.NUMERATOR_DEGREE, reflex.ORDER)
     x = np.atleast_1d(np.asarray(lam, dtype=complex)) * tau
     H = np.abs(np.polyval(num[::-1], x) / np.polyval(den[::-1], x))
@@ -302,7 +302,6 @@ def track(eigenvalues, vectors):
     >>> [ids.tolist() for ids in track(lams, vecs)]
     [[0, 1], [1, 0]]
     """
-    from scipy.optimize import linear_sum_assignment
     ids, next_id, prev = [], 0, None
     for lam, vec in zip(eigenvalues, vectors, strict=True):
         if lam is None:

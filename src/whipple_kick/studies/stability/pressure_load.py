@@ -1,7 +1,9 @@
 """The pressure x load table of stability (the thesis' nine cases) and its figure."""
 import math
+import pathlib
 
 import numpy as np
+import pandas as pd
 
 from whipple_kick.library import thesis
 from whipple_kick.simulate.scenario import Scenario
@@ -109,7 +111,6 @@ def pressure_load_table(pressures=THESIS_PRESSURES_KPA, loads=THESIS_LOADS_N, *,
     >>> table = pressure_load_table(pressures=(400.0,), loads=(635.0,))   # doctest: +SKIP
     >>> table[["pressure_kpa", "weave_speed_m_s", "capsize_speed_m_s"]]   # doctest: +SKIP
     """
-    import pandas as pd
     base = Scenario(symmetric_tyres=True) if base is None else base
     speeds = parse_speeds("{}:{}:{}".format(*DEFAULT_SPEEDS)) if speeds is None else check_speeds(speeds)
     rows = []
@@ -141,8 +142,6 @@ def pressure_load_figure(table, path):
 
     >>> pressure_load_figure(pressure_load_table(), "stability_pressure_load.png")   # doctest: +SKIP
     """
-    import pathlib
-
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 

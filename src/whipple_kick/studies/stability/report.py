@@ -1,5 +1,7 @@
 """The figure, the printed lines and the files of a stability analysis."""
+import json
 import math
+import pathlib
 
 import numpy as np
 
@@ -108,8 +110,6 @@ def figure(result, path, title=None):
     >>> from whipple_kick.studies.stability import analyse
     >>> _ = figure(analyse(Scenario(symmetric_tyres=True), [3.0, 3.5, 4.0, 4.5, 5.0]), "stability.png")
     """
-    import pathlib
-
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
     from matplotlib.lines import Line2D
@@ -225,8 +225,6 @@ def write(result, out, plot=True):
     >>> write(analyse(Scenario(symmetric_tyres=True), [3.0, 4.0]), "out")
     ['eigenvalues.csv', 'summary.json', 'stability.png']
     """
-    import json
-    import pathlib
     out = pathlib.Path(out)
     fileio.write_csv(result.eigenvalues, out / "eigenvalues.csv")
     summary = results.clean(result.summary)

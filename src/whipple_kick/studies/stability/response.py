@@ -2,8 +2,10 @@
 import math
 
 import numpy as np
+from scipy.optimize import least_squares
 
 from whipple_kick.model import slip
+from whipple_kick.simulate import lsoda
 
 # ------------------------------------------------------------------ free response
 
@@ -80,7 +82,6 @@ def free_response(model, vector, amplitude=1e-4, duration=2.0, rate=500.0, rtol=
     >>> bool(abs(fit - lam[k]) < 1e-3 * abs(lam[k]))    # the nonlinear response decays at the eigenvalue
     True
     """
-    from whipple_kick.simulate import lsoda
     rhs = slip.CompiledRHS(model.steady.params)
     x0 = perturbed_state(model, vector, amplitude)
     traj = lsoda.integrate(rhs, x0, duration, rtol=rtol, output_rate=rate)
@@ -156,7 +157,6 @@ def fit_eigenvalue(t, signals, oscillatory=True):
     >>> round(lam.real, 6), round(lam.imag, 6)
     (-0.5, 4.0)
     """
-    from scipy.optimize import least_squares
     Y = np.asarray(signals, dtype=float)
     Y = Y / np.where(np.abs(Y).max(axis=0) > 0, np.abs(Y).max(axis=0), 1.0)
     half = len(t) // 2

@@ -3,6 +3,9 @@
 from typing import NamedTuple
 
 import numpy as np
+from scipy.optimize import brentq
+
+from whipple_kick.errors import InputError
 
 from ._constants import GROUPS, MODE_DESCRIPTIONS, MODES, WOBBLE_MIN_FREQUENCY_HZ
 from .modes import _segments, match_cost
@@ -23,7 +26,6 @@ def _root(fun, a, b):
     number without meaning. Nor where a speed tried has no near-upright
     steady motion (:class:`_NoLinearisation`).
     """
-    from scipy.optimize import brentq
     try:
         fa, fb = fun(a), fun(b)
         if fa == 0.0:
@@ -73,7 +75,6 @@ class _Sweep:
         Raises _NoLinearisation where there is no near-upright steady motion at ``v``: the refinement then
         gives no speed, with the reason, instead of one found on another branch.
         """
-        from whipple_kick.errors import InputError
         try:
             return self._eigen_at(v, k)
         except InputError as exc:    # NoSteadyMotion, or no rider design at that speed

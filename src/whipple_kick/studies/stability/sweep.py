@@ -3,10 +3,13 @@ from dataclasses import dataclass, field
 import math
 
 import numpy as np
+import pandas as pd
 
 from whipple_kick.errors import InputError, check_range
-from whipple_kick.model import slip
-from whipple_kick.simulate import assembly, steady
+from whipple_kick.model import classic, slip
+from whipple_kick.simulate import assembly, control, steady
+from whipple_kick.simulate.scenario import DEFAULTS
+from whipple_kick.simulate.steady import NoSteadyMotion
 
 from ._constants import BODY_GROUPS, GROUPS, LOOPS, MAX_SPEEDS, ZERO_TORQUE_N_M
 from .linear import NoRiderDesign, _base_params, _check_loop, _loop_params, _setup, _steady, linearise
@@ -24,8 +27,6 @@ NOT_ANALYSED = ("kick_displacement", "kick_duration", "kick_accel", "kick_profil
 
 def _refuse_unread(scenario):
     """InputError naming the first field of :data:`NOT_ANALYSED` set other than its default."""
-    from whipple_kick.simulate.scenario import DEFAULTS
-
     for name in NOT_ANALYSED:
         if getattr(scenario, name) != DEFAULTS[name]:
             raise InputError(f"{name} = {getattr(scenario, name)!r} is not read by the stability analysis (the "
@@ -230,8 +231,6 @@ def analyse(scenario, speeds, *, loops=None, tyres=None):
     >>> sorted(set(res.eigenvalues["mode"]))
     ['capsize', 'caster', 'lateral_rear', 'relaxation_front', 'relaxation_rear', 'vertical', 'weave', 'wobble']
     """
-    import pandas as pd
-
     _refuse_unread(scenario)
     speeds = check_speeds(speeds)
     loops = _check_loops(scenario, loops)
@@ -269,7 +268,6 @@ def _sweep_loop(ctx, speeds, models, steady_rows):
     taken from the other loop's where the steer torque is zero there);
     ``models`` and ``steady_rows`` receive each speed's model and steady motion.
     """
-    from whipple_kick.simulate.steady import NoSteadyMotion
     lams, vecs, shares, guess = [], [], [], None
     for k, v in enumerate(speeds):
         other = models.get(("open" if ctx.loop == "closed" else "closed", k))
@@ -335,7 +333,6 @@ def _named_rows(model_name, loop, speeds, lams, vecs, shares_all, raw=None, grou
 
 def _canonical(setup):
     """The classic model's canonical matrices M, C1, K0, K2 (and g) of the scenario's bicycle (rigid rider)."""
-    from whipple_kick.model import classic
     canonical = classic.canonical_matrices(setup.classic_moore)
     canonical["g"] = float(setup.classic_moore["g"])
     return canonical
@@ -362,7 +359,6 @@ def _classic_rows(setup, speeds, loops, raw=None, groups=GROUPS):
 
 def _classic_gains(setup, speed):
     """The rider's gains on the no-slip model: the scenario's controller on the rigid rider (Whipple design)."""
-    from whipple_kick.simulate import control
     gains, _ = assembly.controller_gains(setup.scenario.with_changes(speed=float(speed)).gains_spec, setup.design)
     return np.array([gains.get(n, 0.0) for n in control.GAIN_ORDER])
 
