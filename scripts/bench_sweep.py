@@ -371,7 +371,11 @@ def _cost_case(path, scenario, cid, spec, store):
         simulation.run(scenario)
         return time.perf_counter() - t0, 0.0
     # packed: the worker compresses the trajectory file (issue 41); code before it has no such keyword.
-    packed = {"packed": True} if "packed" in inspect.signature(sweep_engine.run_case).parameters else {}
+    parameters = inspect.signature(sweep_engine.run_case).parameters
+    packed = {"packed": True} if "packed" in parameters else {}
+    # As the sweep calls it: a case without trajectory returns no summary text (the parent keeps its flat results).
+    if "summary" in parameters:
+        packed["summary"] = path == "kept"
     record = sweep_engine.run_case(scenario, cid, spec if path == "kept" else None, **packed)
     t1 = time.perf_counter()
     assert record["status"] == "ok", record["error"]

@@ -152,3 +152,67 @@ def test_docstring_examples_leave_no_temporary_folder(tmp_path, monkeypatch):
     examples = [p.name for p in package.rglob("*.py")
                 if any(">>>" in line and "mkdtemp(" in line for line in p.read_text().splitlines())]
     assert examples == []
+
+
+class _Later:
+    """A stand-in for fileio's ``time`` module an hour ahead: every file counts as settled (cached by its stat)."""
+
+    @staticmethod
+    def time_ns():
+        import time
+        return time.time_ns() + 3600 * 10**9
+
+
+def _restamp_later(path, old):
+    """Let the file system's clock move past ``old``'s stamps (a coarse tick is at most ~10 ms), so that a write
+    that follows changes the ctime, as any write at least a tick later does."""
+    import time
+    while time.time_ns() <= max(old.st_mtime_ns, old.st_ctime_ns) + 20_000_000:
+        time.sleep(0.005)
+
+
+def test_settled_key_refuses_a_recent_change(tmp_path):
+    """A file changed within SETTLED_S has no key (a change within the same timestamp tick could keep its stat);
+    one changed earlier has its stat as key, and a missing file none."""
+    path = tmp_path / "a.toml"
+    path.write_text("x = 1\n")
+    assert fileio.settled_key(path) is None
+    assert fileio.settled_key(tmp_path / "missing.toml") is None
+
+
+def test_file_hash_cache_sees_an_edit_of_the_same_size(tmp_path, monkeypatch):
+    """The provenance hash of a parameter file is read once per process while the file is unchanged, and read
+    again after an edit between two runs, also one of the same size with the mtime set back (the ctime moves)."""
+    from whipple_kick.simulate import provenance
+    monkeypatch.setattr(fileio, "time", _Later)
+    path = tmp_path / "tyre.toml"
+    path.write_bytes(b"a = 1\n")
+    first = provenance.sha256(path)
+    assert provenance._HASHES[str(path)][1] == first   # cached
+    assert provenance.sha256(path) == first
+    old = os.stat(path)
+    _restamp_later(path, old)
+    path.write_bytes(b"a = 2\n")
+    os.utime(path, ns=(old.st_atime_ns, old.st_mtime_ns))   # the mtime back; the size the same
+    second = provenance.sha256(path)
+    assert second != first
+    assert second == provenance.hashlib.sha256(b"a = 2\n").hexdigest()
+
+
+def test_folder_listing_cache_sees_a_new_file(tmp_path, monkeypatch):
+    """The parameter files of a folder are listed once per process while it is unchanged; a file added, or
+    removed, between two runs is seen (the folder's stat moves)."""
+    from whipple_kick.library import parameters
+    monkeypatch.setattr(fileio, "time", _Later)
+    (tmp_path / "T01.toml").write_text("x = 1\n")
+    assert list(parameters.toml_files(tmp_path)) == ["T01"]
+    assert str(tmp_path) in parameters._LISTINGS   # cached
+    listing = parameters.toml_files(tmp_path)
+    listing["other"] = None   # a caller's copy: the cache is not changed through it
+    assert list(parameters.toml_files(tmp_path)) == ["T01"]
+    _restamp_later(tmp_path, os.stat(tmp_path))
+    (tmp_path / "T02.toml").write_text("x = 2\n")
+    assert list(parameters.toml_files(tmp_path)) == ["T01", "T02"]
+    _restamp_later(tmp_path, os.stat(tmp_path))
+    (tmp_path / "T01.toml").unlink()
+    assert list(parameters.toml_files(tmp_path)) == ["T02"]

@@ -22,11 +22,33 @@ import contextlib
 import fcntl
 import os
 import pathlib
+import time
 
 import numpy as np
 import pandas as pd
 
 from .errors import InputError
+
+#: A file or folder changed less than this long ago [s] has no :func:`settled_key`: a change within the file
+#: system's timestamp granularity (a clock tick, some milliseconds) could leave its stat as it was ("racy" stat).
+SETTLED_S = 2.0
+
+
+def settled_key(path) -> tuple | None:
+    """What a per-process cache of a file's (or folder's) contents may key on: its stat, or None.
+
+    ``(device, inode, size, mtime_ns, ctime_ns)``: any write changes the ctime, which no program can set back (the
+    mtime it can). None where the path cannot be stat'ed, or changed within :data:`SETTLED_S` of now (or in the
+    future): then a later change could keep the same stamps, so the caller reads afresh.
+    """
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    age_ns = time.time_ns() - max(st.st_mtime_ns, st.st_ctime_ns)
+    if not age_ns >= SETTLED_S * 1e9:   # recent, or stamped in the future
+        return None
+    return (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns)
 
 
 def temporary_name(path) -> pathlib.Path:

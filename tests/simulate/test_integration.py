@@ -1,4 +1,5 @@
 """Integration of one run: the settle, the kick's pieces, the plate stop, failures reported with what ran."""
+import dataclasses
 import json
 
 import numpy as np
@@ -191,7 +192,9 @@ def test_work_counters_are_the_sum_over_the_pieces(changes, monkeypatch):
 
     def counted(*args, **kwargs):
         traj = integrate(*args, **kwargs)
-        pieces.append(traj)
+        before = kwargs.get("before")   # a run joined in front (the settle): its counters are in traj's already
+        pieces.append(traj if before is None else dataclasses.replace(
+            traj, **{name: getattr(traj, name) - getattr(before, name) for name in ("nfev", "njev", "evaluations")}))
         return traj
     monkeypatch.setattr(lsoda, "integrate", counted)
     numerics = run(Scenario(duration=0.4, **changes)).summary["numerics"]
@@ -199,6 +202,24 @@ def test_work_counters_are_the_sum_over_the_pieces(changes, monkeypatch):
     assert pieces and all(p.evaluations >= p.nfev > 0 for p in pieces)
     for name in ("nfev", "njev", "evaluations"):
         assert numerics[name] == sum(getattr(p, name) for p in pieces), name
+
+
+def test_a_run_integrated_after_another_is_their_join():
+    """``lsoda.integrate(..., before=settle)`` (a run's settle and kick in one result, without the join's copy) gives
+    what ``lsoda.join([settle, integrate(...)])`` gives, every field bit for bit."""
+    from whipple_kick.library import inputs
+    from whipple_kick.simulate import assembly, lsoda
+    scenario = Scenario(duration=0.5)
+    kick = inputs.kick_of(scenario.validate())
+    rhs = wk.slip.CompiledRHS(assembly.assemble(scenario, kick).start.params)
+    x0 = assembly.assemble(scenario, kick).start.x
+    settle = lsoda.integrate(rhs, x0, 0.0, t_start=-0.2, samples=np.arange(-200, 0) / 1000.0)
+    run = dict(t_start=0.0, breakpoints=(0.1,), samples=np.arange(0, 501) / 1000.0)
+    joined = lsoda.join([settle, lsoda.integrate(rhs, settle.end_state, 0.5, **run)])
+    after = lsoda.integrate(rhs, settle.end_state, 0.5, **run, before=settle)
+    for field in dataclasses.fields(joined):
+        np.testing.assert_array_equal(getattr(after, field.name), getattr(joined, field.name), err_msg=field.name)
+    assert after.t.size == 701 and after.njev == joined.njev > 0
 
 
 def test_join_concatenates_samples_sums_counters_and_ends_as_the_last_piece():

@@ -196,3 +196,22 @@ def test_a_packed_case_is_its_trajectory_file_and_its_row_the_full_paths(tmp_pat
     assert table_only["trajectory"] is None
     assert {k: v for k, v in table_only["results"].items() if k not in volatile} == \
         {k: v for k, v in direct.items() if k not in volatile}
+
+
+def test_a_table_only_case_returns_no_summary_text_as_a_sweep_asks(tmp_path):
+    """A sweep keeps of a case without trajectory its flat results alone (sweep_store.slim), so it asks for no summary
+    text: the same results and log line; a case with a trajectory, or run_case by default, still has the text."""
+    scenario = Scenario(duration=1.0, settle=0.1)
+    volatile = set(wk.sweep_engine.VOLATILE_COLUMNS)
+    with_text = wk.sweep_engine.run_case(scenario, "c1")
+    without = wk.sweep_engine.run_case(scenario, "c1", summary=False)
+    assert without["summary"] is None and json.loads(with_text["summary"])["outcome"] == "completed"
+    assert {k: v for k, v in without["results"].items() if k not in volatile} == \
+        {k: v for k, v in with_text["results"].items() if k not in volatile}
+    assert wk.sweep_store.slim(without).keys() == wk.sweep_store.slim(with_text).keys()
+    spec = wk.sweep_engine._trajectory_spec(("time", "roll"), "float32", 200.0)
+    kept = wk.sweep_engine.run_case(scenario, "c1", spec, packed=True, summary=False)
+    stable = lambda text: {k: v for k, v in json.loads(text).items() if k not in ("numerics", "provenance")}
+    assert stable(kept["summary"]) == stable(with_text["summary"])   # the file holds it (wall time, date aside)
+    table = wk.sweep({"pressure_kpa": [400.0]}, base=scenario, workers=1, progress=False, folder=tmp_path / "s")
+    assert (table["status"] == "ok").all()

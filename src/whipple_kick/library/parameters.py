@@ -24,6 +24,7 @@ try:  # Python >= 3.11
 except ModuleNotFoundError:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
+from whipple_kick import fileio
 from whipple_kick.errors import InputError
 
 #: The package whose data are the shipped parameter files.
@@ -58,8 +59,24 @@ def shipped(kind: str) -> pathlib.Path:
 
 
 def toml_files(folder) -> dict:
-    """The ``*.toml`` files of a folder by name (file name without ``.toml``), sorted."""
-    return {p.stem: p for p in sorted(pathlib.Path(folder).glob("*.toml"))}
+    """The ``*.toml`` files of a folder by name (file name without ``.toml``), sorted.
+
+    Listed once per process while the folder stays as it was (its :func:`~whipple_kick.fileio.settled_key`:
+    adding, removing or renaming a file changes it): a sweep's every case looks its tyre, rider and bicycle
+    files up here.
+    """
+    key = fileio.settled_key(folder)
+    cached = _LISTINGS.get(str(folder))
+    if key is not None and cached is not None and cached[0] == key:
+        return dict(cached[1])
+    listing = {p.stem: p for p in sorted(pathlib.Path(folder).glob("*.toml"))}
+    if key is not None:
+        _LISTINGS[str(folder)] = (key, listing)
+    return dict(listing)
+
+
+#: :func:`toml_files`' listings: folder -> (its settled key, the listing).
+_LISTINGS = {}
 
 
 def load_toml(path) -> dict:

@@ -184,15 +184,18 @@ def _integrate(steady, scenario, kick):
     else:
         breakpoints = tuple(float(t) for t in table.times if -scenario.settle < t < scenario.duration)
 
-    def run_from(x, a, rows):
+    def run_from(x, a, rows, before=None):
+        # ``before``: the settle, joined to the result (by lsoda.integrate itself where one call makes the run).
         if kept and a < stop:
-            return _integrate_kept_speeds(rhs, steady.params, x, (a, kick_start), rows, stop, scenario, chunk,
-                                          jumps)
-        if table is None:
+            traj, rhs_out, owner = _integrate_kept_speeds(rhs, steady.params, x, (a, kick_start), rows, stop,
+                                                          scenario, chunk, jumps)
+        elif table is None:
             return lsoda.integrate(rhs, x, t_end, t_start=a, breakpoints=breakpoints, rtol=scenario.rtol,
-                                       **limits, chunk=chunk, samples=rows, jumps=jump_map), rhs, None
-        # The drive torque T6c found for the steady motion stays in every piece's parameters.
-        return _integrate_table(steady.params, x, table, scenario, chunk, t_start=a)
+                                   **limits, chunk=chunk, samples=rows, jumps=jump_map, before=before), rhs, None
+        else:
+            # The drive torque T6c found for the steady motion stays in every piece's parameters.
+            traj, rhs_out, owner = _integrate_table(steady.params, x, table, scenario, chunk, t_start=a)
+        return (traj if before is None else lsoda.join([before, traj])), rhs_out, owner
 
     if not (fixed and scenario.piecewise) or kick_start <= t_start:
         traj, rhs_out, owner = run_from(steady.x if kick_start <= t_start else x_start, t_start, samples)
@@ -206,8 +209,8 @@ def _integrate(steady, scenario, kick):
         # The steady motion did not last through the settle (it fell or the integration failed before
         # the kick): that is the run's outcome, and there is no kick to integrate.
         return replace(settle, x=settle_x), rhs, None, breakpoints, jumps
-    post, rhs_out, owner = run_from(steady.x, kick_start, samples[samples >= kick_start])
-    traj = lsoda.join([replace(settle, x=settle_x), post])
+    traj, rhs_out, owner = run_from(steady.x, kick_start, samples[samples >= kick_start],
+                                    before=replace(settle, x=settle_x))
     if owner is not None:
         # The settle's samples belong to the model of the plate at rest before the table.
         rhs_out = [rhs] + list(rhs_out)

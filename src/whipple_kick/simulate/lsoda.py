@@ -375,7 +375,7 @@ def _chunks_in_c(rhs, jac, rtol, atol, mxstep, limits, budget, t_start):
 
 def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None,
               output_rate=1000.0, fall_angle=np.deg2rad(45.0), chunk=None, samples=None,
-              budget=None, jumps=None, steer_limit=None):
+              budget=None, jumps=None, steer_limit=None, before=None):
     """Integrate ``rhs`` from ``x0`` piecewise between breakpoints with LSODA.
 
     Each smooth piece is integrated in chunks of about ``chunk`` seconds
@@ -431,6 +431,9 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
         ``{breakpoint: g(t, x) -> x}``: the state leaving the piece that
         ends at the breakpoint is mapped by ``g`` before the next piece
         starts (a sample at the breakpoint gets the mapped state).
+    before : StateHistory, optional
+        A run that ends before ``t_start`` and whose samples come first: the result is
+        ``join([before, this call's])``, without copying this call's samples again.
 
     Returns
     -------
@@ -483,19 +486,38 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
     mxstep = max(1, budget.stall_window // 4)
     chunks_in_c = _chunks_in_c(rhs, jac, rtol, atol, mxstep, (roll, fall_angle, steer, steer_limit), budget, t_start)
 
-    ts, xs = [], []
     nfev = njev = spent = 0   # LSODA's evaluations, Jacobians, all evaluations (the budget's count)
     last_t = -np.inf   # time of the last emitted sample (chunks share end points)
+    # The result's rows, written once each as they come (every sample, and a fall's time beyond them), instead
+    # of a list of pieces concatenated at the end; the C chunk loop writes its samples straight into them. Row 0
+    # of `x_rows` is spare: that loop writes a chunk's start state one row before the chunk's first sample.
+    head = 0 if before is None else before.t.size
+    t_out, x_rows = np.empty(head + samples.size + 2), np.empty((head + samples.size + 3, len(x0)))
+    x_out = x_rows[1:]
+    t_out[:head], x_out[:head] = (before.t, before.x) if head else (0.0, 0.0)
+    filled = head
 
-    def emit(times, states):
-        nonlocal last_t
-        # Sample membership by binary search (times are sorted and taken from `samples`, or piece edges).
-        at = np.minimum(np.searchsorted(samples, times), samples.size - 1)
-        keep = (samples[at] == times) & (times > last_t) if samples.size else np.zeros(times.size, bool)
-        if keep.any():
-            ts.append(times[keep])
-            xs.append(states[keep])
-            last_t = times[keep][-1]
+    def put(times, states):
+        nonlocal filled, last_t
+        t_out[filled:filled + times.size] = times
+        x_out[filled:filled + times.size] = states
+        filled += times.size
+        last_t = times[-1]
+
+    def emit(times, states, member=None):
+        # Sample membership (``member``, where the caller knows it) by binary search (times are sorted and
+        # taken from `samples`, or piece edges).
+        if member is None:
+            at = np.minimum(np.searchsorted(samples, times), samples.size - 1)
+            member = samples[at] == times if samples.size else np.zeros(times.size, bool)
+        keep = member & (times > last_t)
+        rows = np.flatnonzero(keep)
+        if rows.size == 0:
+            return
+        if rows[-1] - rows[0] + 1 == rows.size:   # one run of rows (nearly always: all but a chunk's first)
+            put(times[rows[0]:rows[-1] + 1], states[rows[0]:rows[-1] + 1])
+        else:
+            put(times[rows], states[rows])
 
     x = np.asarray(x0, dtype=float)
     fell, fall_time, message, failed, fall_reason = False, None, "completed", False, None
@@ -508,6 +530,10 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
         # Chunk boundaries: the piece's start, sample times about `chunk`
         # apart, and the piece's end (so the exact end state carries over).
         grid = np.concatenate([[a], inside, [b]])
+        # Which of the grid's times are samples: those inside are, taken from them; the piece's ends may not be.
+        on_grid = np.ones(grid.size, bool)
+        ends = np.minimum(np.searchsorted(samples, (a, b)), samples.size - 1)
+        on_grid[[0, -1]] = samples[ends] == (a, b) if samples.size else False
         if np.isinf(chunk):
             cuts = [0, len(grid) - 1]
         else:
@@ -518,12 +544,25 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
             if chunks_in_c is not None:
                 # The chunks of the piece in one C call, up to the first that the careful path must redo.
                 counts = np.array([nfev, njev, spent], dtype=np.int64)
-                ran, states, x = chunks_in_c(grid, cuts[k:], x, counts)
+                # Grid row g goes to x_rows' row filled + g - cuts[k]: the chunks' first sample to the result's
+                # next row; the start state to the row before, the last row emitted (kept: put back below).
+                start, spare = x, x_rows[filled].copy()
+                into = x_rows.ctypes.data + (filled - cuts[k]) * x_rows.strides[0]
+                ran, _, x = chunks_in_c(grid, cuts[k:], x, counts, into=into)
+                x_rows[filled] = spare
                 nfev, njev, spent = (int(v) for v in counts)
                 if ran:
                     j = cuts[k + ran]
-                    last = -1 if j == len(grid) - 1 else None   # the piece's end: after the jump map (below)
-                    emit(grid[cuts[k]:j + 1][:last], states[:last])
+                    stop = j if j == len(grid) - 1 else j + 1   # the piece's end: after the jump map (below)
+                    if stop > cuts[k] + 1 and on_grid[cuts[k] + 1:stop].all() and grid[cuts[k] + 1] > last_t:
+                        # Every row after the start is a sample (the grid's inner times are): in place already.
+                        t_out[filled:filled + stop - cuts[k] - 1] = grid[cuts[k] + 1:stop]
+                        filled += stop - cuts[k] - 1
+                        last_t = grid[stop - 1]
+                    else:
+                        states = x_rows[filled:filled + j - cuts[k] + 1].copy()
+                        states[0] = start
+                        emit(grid[cuts[k]:stop], states[:stop - cuts[k]], on_grid[cuts[k]:stop])
                     k += ran
                     if k == len(cuts) - 1:
                         break
@@ -539,7 +578,7 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
                     and _within_limits(fast[0], roll, fall_angle, steer, steer_limit):
                 y, (n, nj, used) = fast
                 nfev, njev, spent = nfev + n, njev + nj, spent + used
-                emit(times[:last], y[:last])
+                emit(times[:last], y[:last], on_grid[i0:i1 + 1][:last])
                 x = y[-1]
                 continue
             # A failed fast attempt is redone here, so only this attempt counts against the budget.
@@ -553,8 +592,7 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
             if status == "fell":
                 fell, fall_time = True, float(t_reached)
                 if fall_time > last_t:
-                    ts.append(np.array([fall_time]))
-                    xs.append(x[None, :])
+                    put(np.array([fall_time]), x[None, :])
                 if fall_angle - abs(x[roll]) <= steer_limit - abs(x[steer]):
                     fall_reason = "roll"
                     message = f"fell: |roll| reached {np.rad2deg(fall_angle):.0f} deg at t = {fall_time:.4f} s"
@@ -572,9 +610,10 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
         if b in jumps:
             x = np.asarray(jumps[b](b, x), dtype=float)
         emit(at_b, np.repeat(x[None, :], at_b.size, axis=0))
-    t = np.concatenate(ts) if ts else np.array([])
-    X = np.concatenate(xs) if xs else np.empty((0, len(x)))
+    t, X = t_out[:filled], x_out[:filled]
     if X.size and not np.all(np.isfinite(X)):
         raise FloatingPointError("non-finite state in the integration result")
+    if before is not None:   # as join() sums them
+        nfev, njev, spent = nfev + before.nfev, njev + before.njev, spent + before.evaluations
     return StateHistory(t, X, fell, fall_time, nfev, message, end_state=np.asarray(x, dtype=float), failed=failed,
                       njev=njev, evaluations=spent, fall_reason=fall_reason)

@@ -177,7 +177,7 @@ class FastChunks:
         # scipy's LSODA solver object raises its rtol to 100 eps (scipy.integrate._ivp.common.validate_tol).
         self.careful_rtol = float(np.maximum(rtol, 100 * np.finfo(float).eps))
 
-    def __call__(self, grid, cuts, x, counts):
+    def __call__(self, grid, cuts, x, counts, into=None):
         """Integrate the chunks ``grid[cuts[k]:cuts[k + 1] + 1]`` from ``x`` until one needs the careful path.
 
         Parameters
@@ -190,13 +190,17 @@ class FastChunks:
             State at ``grid[cuts[0]]``.
         counts : ndarray of int64, shape (3,)
             ``nfev, njev, evaluations`` so far; the chunks done are added to it.
+        into : int, optional
+            Address of grid row 0's row in a C-ordered float64 array of rows of ``x.size`` that the states are
+            written into (rows ``cuts[0]`` to ``cuts[done]``, which the caller makes room for); default an array
+            of this call's own.
 
         Returns
         -------
         done : int
             Chunks done.
-        states : ndarray
-            States at ``grid[cuts[0]:cuts[done] + 1]``.
+        states : ndarray or None
+            States at ``grid[cuts[0]:cuts[done] + 1]`` (None with ``into``).
         x : ndarray
             State at ``grid[cuts[done]]``.
         """
@@ -204,15 +208,16 @@ class FastChunks:
         c = np.ascontiguousarray(cuts, dtype=np.intc)
         x = np.array(x, dtype=float)
         n = x.size
-        out = np.empty((grid.size, n))
+        out = np.empty((grid.size, n)) if into is None else None
         roll, fall_angle, steer, steer_limit = self.limits
         done = self.lib.wk_lsoda_fast_chunks(
             self.rhs_address, self.jac_address, self.p.ctypes.data, self.scale.ctypes.data, n, grid.ctypes.data,
             c.ctypes.data, c.size, x.ctypes.data, self.rtol, self.atol.ctypes.data, self.mxstep, roll, fall_angle,
-            steer, steer_limit, self.jac_evaluations, *self.budget, counts.ctypes.data, out.ctypes.data)
+            steer, steer_limit, self.jac_evaluations, *self.budget, counts.ctypes.data,
+            out.ctypes.data if into is None else into)
         if done < 0:
             raise MemoryError("the C chunk loop ran out of memory")
-        return done, out[c[0]:c[done] + 1], x
+        return done, None if out is None else out[c[0]:c[done] + 1], x
 
     def careful(self, times, x, spent):
         """One chunk of the careful path in C: LSODA stepped one step at a time, the fall event, the budget.

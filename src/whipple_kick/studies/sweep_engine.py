@@ -193,7 +193,7 @@ def _sampled(columns, spec):
     return {n: columns[n][rows].astype(spec["dtype"]) for n in names}
 
 
-def run_case(scenario, case_id, trajectory=None, *, packed=False):
+def run_case(scenario, case_id, trajectory=None, *, packed=False, summary=True):
     """Run one case; never raises for a failing case (the worker function of :func:`sweep`).
 
     Parameters
@@ -209,13 +209,17 @@ def run_case(scenario, case_id, trajectory=None, *, packed=False):
         Return the trajectory as the bytes of its sweep-folder file
         (:func:`whipple_kick.studies.sweep_store.pack_trajectory`, compressed here in the worker) instead
         of a dict of arrays.
+    summary : bool
+        Put the summary's JSON text into the record. A sweep leaves it out of a case that keeps no trajectory:
+        what it keeps of such a case is the flat results (:func:`whipple_kick.studies.sweep_store.slim`),
+        and the text is only written into a trajectory's file.
 
     Returns
     -------
     dict
         ``case_id``, ``status`` ("ok" or "failed"), ``error`` (``"Type: message"``
         or None), ``results`` (flat, :func:`flatten_summary`), ``summary``
-        (JSON text), ``trajectory`` ({column: array}, its file's bytes, or None) and ``run``
+        (JSON text, or None without ``summary``), ``trajectory`` ({column: array}, its file's bytes, or None) and ``run``
         (start/end time stamps, wall time, worker host:pid). A numerical
         failure (a :class:`~whipple_kick.simulate.results.Result` whose ``success`` is
         False; error ``"SimulationError: <its message>"``, as before) keeps the
@@ -241,7 +245,7 @@ def run_case(scenario, case_id, trajectory=None, *, packed=False):
             warnings.simplefilter("ignore", DefaultValueWarning)
             # The lean path: the summary's columns and the kept ones, no trajectory table (the same table row).
             result = simulation.run(scenario, columns=() if trajectory is None else trajectory["columns"])
-        _keep(record, result, trajectory, packed)   # a numerical failure keeps what ran before it
+        _keep(record, result, trajectory, packed, summary)   # a numerical failure keeps what ran before it
         if not result.success:
             record.update(status="failed", error=f"SimulationError: {result.message}")
     except Exception as exc:
@@ -288,10 +292,12 @@ def _blas_controller():
     return controller
 
 
-def _keep(record, result, trajectory, packed=False):
-    """Put a run's flat results, summary and (thinned, or packed into its file) trajectory into its record."""
+def _keep(record, result, trajectory, packed=False, summary=True):
+    """Put a run's flat results, summary (``summary``, or a trajectory's file, needing it) and (thinned, or packed
+    into its file) trajectory into its record."""
     record["results"] = flatten_summary(result.summary)
-    record["summary"] = json.dumps(result.summary, allow_nan=False)
+    if summary or trajectory is not None:
+        record["summary"] = json.dumps(result.summary, allow_nan=False)
     if trajectory is not None:
         record["trajectory"] = _sampled(result.trajectory, trajectory)
         if packed:
@@ -541,7 +547,8 @@ def _collect(executor, todo, records, store, progress, total, spec, table_interv
     futures = {}
     try:
         for cid, scenario in todo:
-            futures[executor.submit(run_case, scenario, cid, spec, packed=True)] = cid
+            # A case without trajectory: the parent keeps its flat results alone (slim), no summary text.
+            futures[executor.submit(run_case, scenario, cid, spec, packed=True, summary=spec is not None)] = cid
         n_failed = 0
         for fut in cf.as_completed(futures):
             try:
