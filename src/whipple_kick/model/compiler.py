@@ -14,7 +14,7 @@ import subprocess
 from whipple_kick import fileio
 from whipple_kick.errors import BuildError, CompilerNotFoundError
 
-#: Flags of the slip model's library. -O3 (issue 41 item 3, ``scripts/bench_sweep.py flags``): 0.83x the
+#: Flags of the slip model's library. -O3 (measured by ``scripts/bench_sweep.py flags``): 0.83x the
 #: integration's instructions of -O2 and 0.94x its wall time, trajectories bit-identical (-std=c99, not gnu99,
 #: keeps GCC from contracting a*b+c into an FMA). -march=native (0.75x with AVX2, -O3 -march=x86-64-v3; 0.86x
 #: wall) is not used: the code would be CPU-specific (the CPU in the cache key, SIGILL on another CPU sharing

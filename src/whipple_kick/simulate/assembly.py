@@ -510,7 +510,7 @@ def _steady_advice(scenario, controller_type):
     symmetric = "or tyres without zero-slip offsets (--symmetric-tyres, symmetric_tyres=True)"
     if controller_type == "lqr" and scenario.lqr_model == "whipple" and (
             scenario.rider_body != "rigid" or scenario.arms == "on"):
-        # The rider designed on the Whipple model does not know the body or arms it rides with (issue 40:
+        # The rider designed on the Whipple model does not know the body or arms it rides with (measured:
         # with the forearms' mass on the bar the near-upright branch ends at 86 % of the offsets).
         return ("the rider is designed on the Whipple model without the rider's body or arms: design it on the "
                 f"model simulated (--lqr-model simulated, lqr_model='simulated'), {symmetric}")

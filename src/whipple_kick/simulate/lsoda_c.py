@@ -1,4 +1,4 @@
-"""LSODA driven from C with the compiled model: the fast path's chunk loop and the careful path (issue 41 item 1).
+"""LSODA driven from C with the compiled model: the fast path's chunk loop and the careful path.
 
 :func:`whipple_kick.simulate.lsoda.integrate` integrates each smooth piece in
 chunks of about half a second with ``odeint``'s LSODA, redoing a chunk in

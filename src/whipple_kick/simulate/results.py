@@ -316,8 +316,8 @@ def trajectory_columns(solution, tyre_transient="carcass", names=None):
     same refusal of a non-finite value in any of the table's columns; only
     the DataFrame is not built, and of the columns only ``names`` and those
     :func:`summarise` reads (:func:`summary_columns`) are kept. A sweep that
-    keeps no trajectory needs nothing else (issue 41: the table and its
-    pandas look-ups were ~6 ms of a ~140 ms case).
+    keeps no trajectory needs nothing else (the table and its pandas
+    look-ups were ~6 ms of a ~140 ms case when measured).
 
     Parameters
     ----------

@@ -1,4 +1,4 @@
-"""What the measurements say: history matching and a posterior of the model's uncertain inputs (issue 39).
+"""What the measurements say: history matching and a posterior of the model's uncertain inputs.
 
 Three steps, each a function of its own:
 
@@ -23,7 +23,7 @@ Three steps, each a function of its own:
      time (:attr:`~whipple_kick.simulate.oscillation.OscillationFit.envelope_time`),
      capped at the 1 s record. Measured from the oscillation, not the kick
      spike (peak #1 alone) and not the closed loop's slow swing at 0.9 s that
-     the raw 8 % rule ends on (issue 39: 31 % and 68 % of prior runs).
+     the raw 8 % rule ends on (31 % and 68 % of the prior study's runs).
 
 2. **History matching in waves** (:func:`history_match`): a Latin hypercube
    over the uniform priors (:mod:`whipple_kick.library.priors`), the

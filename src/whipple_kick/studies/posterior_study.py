@@ -1,4 +1,4 @@
-"""The answer under the calibration's posterior: which pressure recovers fastest, per rear load (issue 39 item 3).
+"""The answer under the calibration's posterior: which pressure recovers fastest, per rear load.
 
 The uncertainty study (:mod:`whipple_kick.studies.uncertainty`) asks it under
 the priors; this asks it under what the measurements leave

@@ -133,7 +133,7 @@ def pack_trajectory(trajectory, summary_json):
 
     A sweep's workers pack their own cases' files (:func:`whipple_kick.studies.sweep_engine.run_case`), so the
     compression, ~7 ms a case, is spread over the workers instead of capping the process that saves them
-    (issue 41: ~105 cases/s).
+    (the parent capped at ~105 cases/s when it compressed them).
 
     Parameters
     ----------

@@ -26,7 +26,7 @@ rear load on inputs sampled from an uncertainty file
 Why this Sobol output. The paired difference ``T(b) - T(a)`` is undefined
 where a run did not recover within the run (fell, not settled, failed):
 giving it the run's duration (6 s) made the indices depend on that number
-(and a row where neither recovered a difference of 0): issue 39 found, at
+(and a row where neither recovered a difference of 0): the earlier study found, at
 N = 48, 4-7 % of the rows carrying 20-43 % of the variance, total indices
 summing to 2.1 and 63 of 180 first-order indices negative. Which pressure recovers
 first is defined for every row without a number for the runs that did not
@@ -40,8 +40,8 @@ the runs that did not recover do so, which changes their rows (a tie becomes a
 win); ``scripts/sobol_censoring.py`` measures how much, at 6 against 8 s.
 
 Against the measurement. The thesis' last-peak times are means of three
-trials, without a printed spread (issue 39 reads differences of 0.04-0.07 s
-between the trials of a cell). The error of a cell is the calibration file's trial prior with the printing's
+trials, without a printed spread (the project was told of differences of 0.04-0.07 s
+between the trials of a cell, not re-checked: the calibration file's reason). The error of a cell is the calibration file's trial prior with the printing's
 rounding (:func:`measurement_error`). Where a measured difference to the
 measured best is within its 95 % error, the measured ranking at that load is
 **not resolved by the measurement** (the model can neither confirm nor
@@ -798,7 +798,7 @@ def measurement_error(calibration=None):
     """Standard deviation [s] of one measured last-peak time (a cell's mean of three trials), with its reason.
 
     The calibration file's trial prior (``errors.last_peak_time_s.trial_sd``, 0.04 s in the shipped one, an
-    unsourced prior: issue 39 reads differences of 0.04-0.07 s between a cell's trials;
+    unsourced prior: differences of 0.04-0.07 s between a cell's trials, as the project was told;
     :mod:`whipple_kick.library.priors`) and the printing's
     rounding (two decimals: ``0.005 / sqrt(3)``), as the calibration takes them
     (:func:`whipple_kick.studies.calibration.measured_features`, less the 8 % crossing's quantisation, which

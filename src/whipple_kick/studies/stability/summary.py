@@ -41,7 +41,8 @@ def _root(fun, a, b):
 
 
 class _NoLinearisation(Exception):
-    """A speed between two sweep samples has no near-upright steady motion to linearise about (issue 40)."""
+    """A speed between two sweep samples has no near-upright steady motion to linearise about
+    (:func:`whipple_kick.simulate.steady.find_steady_state` refuses a start that is not near-upright)."""
 
 
 class _Split(NamedTuple):
