@@ -490,6 +490,7 @@ def _linear_design_model(spec, moore, rear, front, body, felt, share, scaled, mo
         b = np.vstack([b, [[0.0]]])
         names.append("q3")
     C = np.zeros((len(felt), len(names)))
+    states = slip.gain_states()
     for row, gain in enumerate(felt):
-        C[row, names.index(slip.gain_states()[gain])] = 1.0
+        C[row, names.index(states[gain])] = 1.0
     return A, b, C

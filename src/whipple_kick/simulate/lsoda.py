@@ -74,8 +74,12 @@ def join(pieces):
     """
     pieces = list(pieces)
     return replace(pieces[-1], t=np.concatenate([p.t for p in pieces]), x=np.concatenate([p.x for p in pieces]),
-                   nfev=sum(p.nfev for p in pieces), njev=sum(p.njev for p in pieces),
-                   evaluations=sum(p.evaluations for p in pieces))
+                   **_summed_counters(pieces))
+
+
+def _summed_counters(pieces):
+    """The work counters of consecutive pieces, summed (:func:`join`, and :func:`integrate` after ``before``)."""
+    return {name: sum(getattr(p, name) for p in pieces) for name in ("nfev", "njev", "evaluations")}
 
 
 #: Fast-path chunk length [s]: each chunk is one odeint (LSODA restarted), and
@@ -613,7 +617,6 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
     t, X = t_out[:filled], x_out[:filled]
     if X.size and not np.all(np.isfinite(X)):
         raise FloatingPointError("non-finite state in the integration result")
-    if before is not None:   # as join() sums them
-        nfev, njev, spent = nfev + before.nfev, njev + before.njev, spent + before.evaluations
-    return StateHistory(t, X, fell, fall_time, nfev, message, end_state=np.asarray(x, dtype=float), failed=failed,
-                      njev=njev, evaluations=spent, fall_reason=fall_reason)
+    history = StateHistory(t, X, fell, fall_time, nfev, message, end_state=np.asarray(x, dtype=float), failed=failed,
+                           njev=njev, evaluations=spent, fall_reason=fall_reason)
+    return history if before is None else replace(history, **_summed_counters((before, history)))

@@ -213,7 +213,8 @@ def model_parameters(moore, rear_tyre, front_tyre, options=None, *, model=None, 
     layout = model.layout
     gains = dict(gains or {})
     # A zero gain on a state the model does not have changes nothing; a nonzero one is refused.
-    unknown = {n for n in set(gains) - set(layout.GAIN_NAMES) if n not in gain_states() or gains[n] != 0.0}
+    declared = gain_states()
+    unknown = {n for n in set(gains) - set(layout.GAIN_NAMES) if n not in declared or gains[n] != 0.0}
     if unknown:
         raise InputError(f"unknown controller gains {sorted(unknown)} for the {layout.key} model; known: "
                          f"{', '.join(layout.GAIN_NAMES)}")
