@@ -51,6 +51,19 @@ def settled_key(path) -> tuple | None:
     return (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns)
 
 
+def read_once(store, path, compute):
+    """``compute(path)``, kept in ``store`` (a dict: path -> (key, value)) while ``path``'s :func:`settled_key`
+    stays the same; computed afresh, and not kept, where there is no settled key."""
+    key = settled_key(path)
+    cached = store.get(str(path))
+    if key is not None and cached is not None and cached[0] == key:
+        return cached[1]
+    value = compute(path)
+    if key is not None:
+        store[str(path)] = (key, value)
+    return value
+
+
 def temporary_name(path) -> pathlib.Path:
     """A hidden temporary name next to ``path``, unique to this process: ``.<name>.<pid>.tmp``."""
     path = pathlib.Path(path)

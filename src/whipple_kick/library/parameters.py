@@ -65,14 +65,9 @@ def toml_files(folder) -> dict:
     adding, removing or renaming a file changes it): a sweep's every case looks its tyre, rider and bicycle
     files up here.
     """
-    key = fileio.settled_key(folder)
-    cached = _LISTINGS.get(str(folder))
-    if key is not None and cached is not None and cached[0] == key:
-        return dict(cached[1])
-    listing = {p.stem: p for p in sorted(pathlib.Path(folder).glob("*.toml"))}
-    if key is not None:
-        _LISTINGS[str(folder)] = (key, listing)
-    return dict(listing)
+    # A copy: a caller cannot change the kept listing.
+    return dict(fileio.read_once(_LISTINGS, folder,
+                                 lambda f: {p.stem: p for p in sorted(pathlib.Path(f).glob("*.toml"))}))
 
 
 #: :func:`toml_files`' listings: folder -> (its settled key, the listing).

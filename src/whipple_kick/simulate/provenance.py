@@ -113,16 +113,15 @@ def sha256(path) -> str:
     """
     # Read once per process while the file stays as it was (its settled stat: any write changes it): a
     # sweep's every case records the hashes of the same few parameter files.
-    key = fileio.settled_key(path)
-    cached = _HASHES.get(str(path))
-    if key is not None and cached is not None and cached[0] == key:
-        return cached[1]
+    return fileio.read_once(_HASHES, path, _file_digest)
+
+
+def _file_digest(path):
+    """SHA-256 hex digest of the file at ``path``, read in 1 MiB blocks."""
     digest = hashlib.sha256()
     with open(path, "rb") as fh:
         for block in iter(lambda: fh.read(1 << 20), b""):
             digest.update(block)
-    if key is not None:
-        _HASHES[str(path)] = (key, digest.hexdigest())
     return digest.hexdigest()
 
 

@@ -547,8 +547,9 @@ def _collect(executor, todo, records, store, progress, total, spec, table_interv
     futures = {}
     try:
         for cid, scenario in todo:
-            # A case without trajectory: the parent keeps its flat results alone (slim), no summary text.
-            futures[executor.submit(run_case, scenario, cid, spec, packed=True, summary=spec is not None)] = cid
+            # A case without trajectory: the parent keeps its flat results alone (slim), no summary text (a kept
+            # trajectory's file holds its summary all the same: _keep).
+            futures[executor.submit(run_case, scenario, cid, spec, packed=True, summary=False)] = cid
         n_failed = 0
         for fut in cf.as_completed(futures):
             try:

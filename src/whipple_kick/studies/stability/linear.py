@@ -4,7 +4,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from whipple_kick.errors import InputError, check_range
-from whipple_kick.model import parts, slip
+from whipple_kick.model import slip
 from whipple_kick.model.transient import DEFAULT_TRANSIENT, FORMS
 from whipple_kick.simulate import assembly, control, results, steady
 
@@ -73,7 +73,7 @@ def state_labels(transient=DEFAULT_TRANSIENT, constant_speed=True, body=()):
     # The declared parts' states (the leaning upper body's lean and its rate) and the form's state columns read
     # now: a part or form declared after this module was imported counts too; a form's state it gives no column
     # is named as it is, without a unit.
-    labels = {**{q: c for part in parts.REGISTRY.values() for q, c in part.columns.items()},
+    labels = {**results.part_columns(),
               **{n: (col, unit) for col, source, n, unit in FORMS[transient].columns if source == "state"}, **_LABELS}
     return [labels.get(n, (n, "")) for n in active_states(transient, body, constant_speed)]
 
