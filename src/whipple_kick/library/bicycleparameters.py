@@ -499,7 +499,7 @@ def leaning_rider(obj):
     bike : Bicycle
         The bicycle with the rider's legs (Moore's C, D, E, F).
     body : dict
-        :func:`whipple_kick.library.riders.seat_with_body`'s body (hinge horizontal, ``hip_tilt = -lam``; the
+        :func:`whipple_kick.library.riders.split_rider`'s body (hinge horizontal, ``hip_tilt = -lam``; the
         hinge point taken above the rear wheel centre, any point of the line will do), with ``kh = k9``,
         ``ch = c9``: pass it to ``slip.model_parameters(..., model=slip.Model(("trunk",)), body=body)``.
     """

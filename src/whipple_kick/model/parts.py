@@ -257,7 +257,7 @@ class Part:
         The trunk's come from the rider's segments instead (:attr:`from_rider`).
     from_rider : tuple of str
         Its parameters a run takes from the rider's segments (the upper body that
-        :func:`whipple_kick.library.riders.seat_with_body` splits off, by the same names), where the bicycle's
+        :func:`whipple_kick.library.riders.split_rider` splits off, by the same names), where the bicycle's
         rider has them (``whipple_kick.simulate.assembly.rider_body``).
     split : Split, optional
         How it takes its body from the rider's segments (:func:`whipple_kick.library.riders.split_rider`).
@@ -524,7 +524,7 @@ TRUNK = declare(Part(
     name="trunk",
     description="the rider's upper body (pelvis, trunk, head, upper arms) leaning on a hip spring-damper",
     source="Moore (2012), Human Control of a Bicycle, ch. 4 'Leaning rider extension'; segments from the "
-           "rider's own Yeadon model (whipple_kick.library.riders.seat_with_body)",
+           "rider's own Yeadon model (whipple_kick.library.riders.split_rider)",
     symbols=(
         ("q11", "rider's upper-body lean relative to the rear frame, about the hip axis H.x (positive = lean "
                 "right)", "rad", "coordinate"),
@@ -599,7 +599,7 @@ ARMS = declare(Part(
     description="the rider's arms holding the bar: a spring-damper about the steer axis between the bar and the "
                 "frame the hands hold (the forearms' mass turns with the bar)",
     source="Moore (2012), Human Control of a Bicycle, ch. 4 (the arms as a passive steer impedance); forearms "
-           "from the rider's own Yeadon model (whipple_kick.library.riders.seat_with_body)",
+           "from the rider's own Yeadon model (whipple_kick.library.riders.split_rider)",
     symbols=(
         ("ka", "arm stiffness about the steer axis: torque on the bar per radian of the bar's rotation relative "
                "to the frame the hands hold (the upper body, or the rear frame without one)", "N m/rad", "constant"),

@@ -21,6 +21,7 @@ import pandas as pd
 from whipple_kick import fileio
 from whipple_kick.errors import InputError, SimulationError
 from whipple_kick.model import carcass, energy, parts, slip, symbols, transient
+from whipple_kick.model.slip.call import optional_groups
 from whipple_kick.simulate import criteria, lsoda, provenance
 
 from . import analysis
@@ -350,7 +351,9 @@ def trajectory_columns(solution, tyre_transient="carcass", names=None):
     needed = {output_names[index] for name, source, index in layout
               if source == "output" and (name in wanted or name in _HEADING_SOURCES)}
     outs = solution.outputs(names=needed)
-    left_out = {name for group in slip.layout.OPTIONAL_OUTPUTS if not needed & set(group) for name in group}
+    evaluated = optional_groups(needed)   # the groups outputs_at evaluates for these names
+    left_out = {name for k, group in enumerate(slip.layout.OPTIONAL_OUTPUTS) if not evaluated >> k & 1
+                for name in group}
     # The finite check covers the table's columns, as trajectory_frame's does, not the outputs it leaves out
     # (the whole arrays first: no copy of the columns when all is finite, as it nearly always is); of the
     # optional groups, those evaluated.

@@ -434,7 +434,7 @@ class Scenario:
     rider_body: str = setting(
         "rigid",
         "The rider lumped rigidly into the rear frame (default), or an upper body (pelvis, trunk, head, upper "
-        "arms) leaning on the saddle on the hip spring-damper (:func:`whipple_kick.library.riders.seat_with_body`; "
+        "arms) leaning on the saddle on the hip spring-damper (:func:`whipple_kick.library.riders.split_rider`; "
         "the trunk part, :data:`whipple_kick.model.parts.TRUNK`).",
         choices=RIDER_BODIES, label="rider body", views=("bicycle", "body", "design"), commands=EVERY_COMMAND,
         section=_BODY,
@@ -1042,7 +1042,8 @@ class DesignSpec:
     speed : float
         Design speed [m/s].
     leaning : bool
-        The rider's upper body leans (its lean and lean rate are fed back).
+        The rider's upper body leans. Read by nothing now (what is fed back is the model's parts' declared
+        gains); it keeps designs for a rigid and a leaning rider apart in the design's cache key.
     heading : bool
         The heading is fed back too (yaw-angle gain ``kq3``).
     gain_scale : float
