@@ -342,8 +342,11 @@ static double wk_carcass_slip_%(w)s(wk_curve *c, double F, int curve_law, double
     return wk_curve_inverse(c, F, 0.0, lo, hi);
 }
 
+/* need: bit 1 the zero-slip force F0 (only the quadrature rates read it), bit 2 the aligning moment (its
+   solve at the lagged camber, the dearer half of the block); what is not needed is NAN. The right-hand side
+   needs both; an outputs call needs no F0, and the moment only where it asks for it. */
 static void wk_carcass_%(w)s(double vsy, double vx, double camber, double fz, double y, double gl,
-                             const double *p, wk_carcass_state *o)
+                             const double *p, int need, wk_carcass_state *o)
 {
     const double cc = p[%(cc)d], dc = p[%(dc)d], sig = p[%(sig)d];
     const int curve_law = p[%(law)d] > 0.5;
@@ -358,7 +361,7 @@ static void wk_carcass_%(w)s(double vsy, double vx, double camber, double fz, do
     wk_fyfac2_%(w)s_1(camber, gl, fzs, p, c.f1, cl.f1);
     if (c.two) wk_fyfac2_%(w)s_2(camber, gl, fzs, p, c.f2, cl.f2);
     o->gl_rate = speed * (camber - gl) / sig;
-    o->F0 = loaded * wk_curve_F(&c, 0.0);
+    o->F0 = need & 1 ? loaded * wk_curve_F(&c, 0.0) : NAN;
     o->sat = 0; o->cc = cc; o->dc = dc; o->y = y; o->vsy = vsy;
     if (!(cc > 0.0) || c.lam == 0.0) {     /* no lateral force: the carcass relaxes */
         o->F = 0.0; o->M = 0.0; o->slip = WK_KSLIP / WK_DEG; o->rate = -speed * y / sig;
@@ -392,6 +395,8 @@ static void wk_carcass_%(w)s(double vsy, double vx, double camber, double fz, do
         o->rate = speed * tan(a / WK_DEG) - vsy + (sat ? (lim - F) / p[%(visc)d] : 0.0);
     }
     o->sat = sat; o->F = F; o->slip = a / WK_DEG;
+    o->vslide = vsy + o->rate;
+    if (!(need & 2)) { o->slip_moment = NAN; o->M = NAN; return; }
     /* The moment at the lagged camber: the slip giving F there. */
     double aM = a;
     if (loaded > 0.0 && gl != camber) {
@@ -402,7 +407,6 @@ static void wk_carcass_%(w)s(double vsy, double vx, double camber, double fz, do
     }
     o->slip_moment = aM / WK_DEG;
     o->M = wk_mz_%(w)s(aM / WK_DEG, gl, fz, p);
-    o->vslide = vsy + o->rate;
 }
 
 /* The undamped carcass' patch slips [deg] giving the force F at the camber and at the lagged camber gl, as

@@ -314,9 +314,13 @@ def trajectory_columns(solution, tyre_transient="carcass", names=None):
     """Columns of :func:`trajectory_frame` as plain arrays, without the table: the lean path of a study.
 
     The same values bit for bit (the same sources, the same arithmetic), the
-    same refusal of a non-finite value in any of the table's columns; only
-    the DataFrame is not built, and of the columns only ``names`` and those
-    :func:`summarise` reads (:func:`summary_columns`) are kept. A sweep that
+    same refusal of a non-finite value in any of the table's columns it
+    evaluates; only the DataFrame is not built, and of the columns only
+    ``names`` and those :func:`summarise` reads (:func:`summary_columns`) are
+    kept. The optional output groups
+    (:data:`whipple_kick.model.slip.layout.OPTIONAL_OUTPUTS`: the plate's
+    motion, the steady curves, the friction limits, the aligning moments)
+    are evaluated, and checked, only where a kept column is in them. A sweep that
     keeps no trajectory needs nothing else (the table and its pandas
     look-ups were ~6 ms of a ~140 ms case when measured).
 
@@ -346,7 +350,7 @@ def trajectory_columns(solution, tyre_transient="carcass", names=None):
         raise InputError(f"trajectory column(s) {sorted(unknown)} do not exist; available: {', '.join(every)}")
     wanted = asked | (set(summary_columns(tyre_transient)) & set(every))
     # Only the optional output groups a wanted column is in are evaluated (the others are NaN, and not read):
-    # the summary reads none of them, and they are some 20% of the outputs' cost.
+    # the summary reads none of them (the aligning moments' group saves the carcass' second solve per wheel).
     output_names = solution.model.OUTPUT_NAMES
     needed = {output_names[index] for name, source, index in layout
               if source == "output" and (name in wanted or name in _HEADING_SOURCES)}

@@ -79,9 +79,12 @@ OUTPUT_NAMES = SPEEDS + tuple(OUTPUTS)
 #: Outputs evaluated beside the dynamics rather than by them, in groups an outputs call may leave out
 #: (:meth:`~whipple_kick.model.slip.call.CompiledRHS.outputs_at`'s ``names``): the plate's prescribed motion
 #: (a polynomial of time), the tyres' steady-state curves at the kinematic slip, the friction limits (a search
-#: on the curves). They are some 20% of the outputs' instructions per sample (callgrind, the thesis cases);
-#: a study's summary reads none of them (``scripts/bench_sweep.py cost --callgrind``).
-OPTIONAL_OUTPUTS = (("yp", "vp", "ap"), ("fy_ss_r", "fy_ss_f", "mz_ss_r", "mz_ss_f"), ("fy_limit_r", "fy_limit_f"))
+#: on the curves), the aligning moments (the carcass tyre's second patch-slip solve, at the lagged camber).
+#: A study's summary reads none of them. With all four left out a thesis case's outputs cost 41.8 M
+#: instructions, against 59.8 M with the moments kept (callgrind, the nine thesis cases, 6 501 samples each:
+#: ``scripts/bench_sweep.py cost --callgrind``).
+OPTIONAL_OUTPUTS = (("yp", "vp", "ap"), ("fy_ss_r", "fy_ss_f", "mz_ss_r", "mz_ss_f"), ("fy_limit_r", "fy_limit_f"),
+                    ("mz_r", "mz_f"))
 PARAMETER_NAMES = S.SLIP_CONSTANTS
 
 

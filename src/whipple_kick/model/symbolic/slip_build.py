@@ -443,7 +443,7 @@ _BLOCK_QUADRATURES = (("W_zero_slip", "W0"), ("D_slide", "D_slide"), ("E_carcass
                       ("E_carcass_f", "P_carcass_f"), ("D_carcass", "D_carcass"))
 
 
-def _c_prologue(ex, dynamics, L):
+def _c_prologue(ex, dynamics, L, carcass_need="3"):
     """C statements of one evaluation up to the tyre block: the locals every later part reads.
 
     Parameters, coordinates and tyre states as locals, the constraint matrix
@@ -452,7 +452,10 @@ def _c_prologue(ex, dynamics, L):
     active transient form's tyre block. Without ``dynamics`` the stage-2 block
     is the same CSE'd block pruned to the tyre-block inputs (:func:`_c_block`'s
     ``keep``): the outputs function computes them bit for bit as the
-    right-hand side does, without the mass matrix.
+    right-hand side does, without the mass matrix. ``carcass_need``: the C
+    expression of what the carcass block computes beyond the force and the
+    patch slip (bit 1 the zero-slip force, bit 2 the aligning moment;
+    :mod:`whipple_kick.model.carcass`), left NaN otherwise.
     """
     sy = ex["symbols"]
     n, m, k = len(L.SPEEDS), len(L.DEPENDENT), len(L.INDEPENDENT)
@@ -534,8 +537,8 @@ def _c_prologue(ex, dynamics, L):
                   _c_block(_block_list(ex["blocks"]["called"][name]), block_targets, "        "), "    }"]
     # The carcass tyre (whipple_kick.model.carcass): written in C, not a SymPy expression.
     lines += ["    else {",
-              "        wk_carcass_r(vsy_r, vx_r, camber_r, fz_r, carcass_y_r, camber_patch_r, p, &cr);",
-              "        wk_carcass_f(vsy_f, vx_f, camber_f, fz_f, carcass_y_f, camber_patch_f, p, &cf);",
+              f"        wk_carcass_r(vsy_r, vx_r, camber_r, fz_r, carcass_y_r, camber_patch_r, p, {carcass_need}, &cr);",
+              f"        wk_carcass_f(vsy_f, vx_f, camber_f, fz_f, carcass_y_f, camber_patch_f, p, {carcass_need}, &cf);",
               "        Fy_r = cr.F; Fy_f = cf.F; Mz_r = cr.M; Mz_f = cf.M;",
               "        trate[0] = cr.rate; trate[1] = cf.rate; trate[2] = cr.gl_rate; trate[3] = cf.gl_rate;",
               "        W0 = cr.F0 * cr.vslide + cf.F0 * cf.vslide;",
@@ -568,8 +571,9 @@ def _c_outputs_some(ex, L):
     same statements): every value is bit for bit the full block's. The outputs left out are not written.
     """
     optional = {name for group in layouts.OPTIONAL_OUTPUTS for name in group}
+    moment = 1 << next(k for k, group in enumerate(layouts.OPTIONAL_OUTPUTS) if "mz_r" in group)
     lines = ["static int wk_slip_sample_some(double t, const double *x, const double *p, int groups, double *out)",
-             "{", *_c_prologue(ex, dynamics=False, L=L),
+             "{", *_c_prologue(ex, dynamics=False, L=L, carcass_need=f"(groups & {moment} ? 2 : 0)"),
              *_c_outputs(ex, "    ", L, [o for o in L.OUTPUT_NAMES if o not in optional])]
     for k, group in enumerate(layouts.OPTIONAL_OUTPUTS):
         keep = [i - len(SPEEDS) for i, o in enumerate(L.OUTPUT_NAMES) if o in group]
@@ -664,7 +668,8 @@ def c_source(part_names=(), delayed_reflex=False):
     # The same outputs without the dynamics: the prologue without Kane's mass matrix, forcing and solve
     # (nothing in the outputs needs the accelerations), bit for bit the right-hand side's outputs.
     lines += ["static int wk_slip_sample(double t, const double *x, const double *p, double *out)", "{",
-              *_c_prologue(ex, dynamics=False, L=L), *_c_outputs(ex, "    ", L), "    return 0;", "}"]
+              *_c_prologue(ex, dynamics=False, L=L, carcass_need="2"), *_c_outputs(ex, "    ", L), "    return 0;",
+              "}"]
     lines += ["int wk_slip_outputs_only(int n, const double *t, const double *x, const double *p, double *out)", "{",
               "    for (int i = 0; i < n; i++) {",
               f"        int status = wk_slip_sample(t[i], x + (long)i * {ns}, p, out + (long)i * {len(L.OUTPUT_NAMES)});",
