@@ -401,8 +401,23 @@ class _Column:
 
 
 def _all_finite(values, columns):
-    """Whether ``values[:, columns]`` is finite everywhere (the whole array looked at first, without a copy)."""
-    return bool(np.isfinite(values).all()) or bool(np.isfinite(values[:, columns]).all())
+    """Whether ``values[:, columns]`` is finite everywhere.
+
+    Each run of consecutive columns is summed as a view, without a copy or a
+    mask: a sum is finite only where every term is (a NaN or an infinity
+    carries through to it), so only a run whose sum is not (a non-finite
+    term, or finite terms overflowing) is looked at value by value.
+    """
+    columns = sorted(columns)
+    start = 0
+    with np.errstate(over="ignore", invalid="ignore"):   # an overflowing sum, inf - inf: not the caller's to hear
+        for k in range(1, len(columns) + 1):
+            if k == len(columns) or columns[k] != columns[k - 1] + 1:
+                run = values[:, columns[start]:columns[k - 1] + 1]
+                if not np.isfinite(run.sum()) and not np.isfinite(run).all():
+                    return False
+                start = k
+    return True
 
 
 def _values(frame, column):
