@@ -196,15 +196,32 @@ def _sweep_time(workers, base, fresh=False, grid=None):
     return wall, table
 
 
-def _interleaved(repeats, base, grid=None):
+def _preheat(seconds):
+    """Keep both cores busy for about ``seconds`` (two pure-Python processes), unmeasured.
+
+    On this virtual machine a measurement that follows a busy spell of both cores runs faster than one that
+    follows idle or one-core work (measured: two workers' sweep 0.48 s right after the ceiling, 0.66 s
+    otherwise; the per-repeat efficiency then depended on the interleaving order, 0.69-1.31). Preheating
+    before every timed item puts them all in the same state.
+    """
+    from concurrent.futures import ProcessPoolExecutor
+    n = max(1, int(seconds / max(_burn(100_000), 1e-6) * 100_000))
+    with ProcessPoolExecutor(2) as pool:
+        list(pool.map(_burn, [n, n]))
+
+
+def _interleaved(repeats, base, grid=None, preheat=0.0):
     """One- and two-worker sweeps of ``grid`` and the pure-Python ceiling, interleaved: (times, tables,
-    ceilings, efficiencies), the efficiency per repeat being the speed-up over the ceiling beside it."""
+    ceilings, efficiencies), the efficiency per repeat being the speed-up over the ceiling beside it;
+    ``preheat`` [s]: both cores kept busy that long before each timed item (:func:`_preheat`)."""
     times, tables, ceilings, efficiency = {1: [], 2: []}, {1: [], 2: []}, [], []
     for w in (1, 2):   # warm pools of each size once (a later sweep of the same size reuses its pool)
         _sweep_time(w, base, grid=grid)
     for r in range(repeats):
         done = {}
         for what in _rotated(["1", "2", "ceiling"], r):
+            if preheat > 0:
+                _preheat(preheat)
             if what == "ceiling":
                 done["ceiling"] = parallel_ceiling(2)
             else:
@@ -225,9 +242,25 @@ def _print_scaling(label, times, ceilings, efficiency, cap_note):
     print(f"pure-Python ceiling beside them (two processes vs one): {', '.join(f'{c:.2f}' for c in ceilings)} "
           f"(median {statistics.median(ceilings):.2f}x)")
     quartiles = statistics.quantiles(efficiency, n=4) if len(efficiency) > 1 else efficiency * 3
+    low, high = _median_interval(efficiency)
     print(f"parallel efficiency, speed-up / ceiling per repeat: {', '.join(f'{e:.2f}' for e in efficiency)}; "
-          f"median {statistics.median(efficiency):.2f}, quartiles {quartiles[0]:.2f}-{quartiles[2]:.2f} "
-          f"(target >= 0.85); ratio of the medians {statistics.median(times[1]) / statistics.median(times[2]) / statistics.median(ceilings):.2f}")
+          f"median {statistics.median(efficiency):.2f} (90% bootstrap interval {low:.2f}-{high:.2f}), quartiles "
+          f"{quartiles[0]:.2f}-{quartiles[2]:.2f} (target >= 0.85, held when the interval's low end is); ratio of "
+          f"the medians {statistics.median(times[1]) / statistics.median(times[2]) / statistics.median(ceilings):.2f}")
+    if len(efficiency) >= 6:   # by interleaving order: an order effect (the machine's state) shows here
+        orders = ("1, 2, ceiling", "2, ceiling, 1", "ceiling, 1, 2")
+        print("efficiency median by order: " + "; ".join(
+            f"{orders[k]}: {statistics.median(efficiency[k::3]):.2f}" for k in range(3)))
+
+
+def _median_interval(values, level=0.90, resamples=10_000, seed=0):
+    """Percentile bootstrap interval of the median of ``values`` (its ``level`` central part of the resampled
+    medians): how far the median of this many noisy repeats can be trusted."""
+    import numpy as np
+    values = np.asarray(values, dtype=float)
+    rng = np.random.default_rng(seed)
+    medians = np.median(rng.choice(values, size=(resamples, values.size)), axis=1)
+    return tuple(np.quantile(medians, [(1 - level) / 2, (1 + level) / 2]))
 
 
 def bench_nine(repeats, duration):
@@ -259,7 +292,7 @@ def bench_nine(repeats, duration):
     return statistics.median(efficiency)
 
 
-def bench_parallel(repeats, duration):
+def bench_parallel(repeats, duration, preheat=0.0):
     """Print the parallel efficiency on the nine thesis cases in both kick directions (18 cases).
 
     Eighteen cases on two workers are nine rounds each, so the granularity that caps nine cases at
@@ -268,7 +301,9 @@ def bench_parallel(repeats, duration):
     from whipple_kick.simulate import simulation
     base = simulation.Scenario(duration=duration)
     grid = {**_thesis_grid(), "kick_direction": ["right", "left"]}
-    times, _, ceilings, efficiency = _interleaved(repeats, base, grid)
+    times, _, ceilings, efficiency = _interleaved(repeats, base, grid, preheat)
+    if preheat > 0:
+        print(f"(both cores preheated for {preheat:g} s before each timed item)")
     for w in (1, 2):
         print(f"18 cases (9 thesis cases x 2 kick directions), {w} worker(s): wall median "
               f"{statistics.median(times[w]):.3f} s (runs: {', '.join(f'{t:.3f}' for t in times[w])})")
@@ -899,6 +934,8 @@ def main(argv=None):
     p.add_argument("what", choices=("split", "nine", "parallel", "blend", "many", "cost", "tolerance", "flags",
                                     "fall", "all", "_count", "_count_flags", "_count_fall"))
     p.add_argument("--repeats", type=int, default=3)
+    p.add_argument("--preheat", type=float, default=0.0,
+                   help="parallel: keep both cores busy this long [s] before each timed item (default 0)")
     p.add_argument("--n", type=int, default=1000, help="cases of the large sweep")
     p.add_argument("--duration", type=float, default=6.0, help="simulated time after the kick [s]")
     p.add_argument("--workers", type=int, default=None, help="workers of the large sweep (default: cores)")
@@ -925,7 +962,7 @@ def main(argv=None):
     if args.what in ("nine", "all"):
         bench_nine(args.repeats, args.duration)
     if args.what in ("parallel", "all"):
-        bench_parallel(args.repeats, args.duration)
+        bench_parallel(args.repeats, args.duration, args.preheat)
     if args.what in ("blend", "all"):
         bench_blend(args.repeats, args.duration)
     if args.what in ("cost", "all"):
