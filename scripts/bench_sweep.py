@@ -182,56 +182,51 @@ def pool_startup(workers):
     return time.perf_counter() - t0
 
 
-def _sweep_time(workers, base, fresh=False, grid=None):
+def _sweep_time(workers, base, fresh=False, grid=None, executor=None):
     """(wall time [s], table) of the sweep over ``grid`` (default: the nine thesis cases) on ``workers``;
-    ``fresh``: on a new pool."""
+    ``fresh``: on a new pool; ``executor``: on that one instead of the default pool."""
     import whipple_kick as wk
     from whipple_kick.studies import sweep_engine
     if fresh:
         sweep_engine._discard_default_pool(end_workers=True)
     t0 = time.perf_counter()
-    table = wk.sweep(grid or _thesis_grid(), base=base, workers=workers, progress=False)
+    table = wk.sweep(grid or _thesis_grid(), base=base, workers=workers, progress=False, executor=executor)
     wall = time.perf_counter() - t0
     assert (table["status"] == "ok").all(), table["error"].dropna().tolist()
     return wall, table
 
 
-def _preheat(seconds):
-    """Keep both cores busy for about ``seconds`` (two pure-Python processes), unmeasured.
-
-    On this virtual machine a measurement that follows a busy spell of both cores runs faster than one that
-    follows idle or one-core work (measured: two workers' sweep 0.48 s right after the ceiling, 0.66 s
-    otherwise; the per-repeat efficiency then depended on the interleaving order, 0.69-1.31). Preheating
-    before every timed item puts them all in the same state.
-    """
-    from concurrent.futures import ProcessPoolExecutor
-    n = max(1, int(seconds / max(_burn(100_000), 1e-6) * 100_000))
-    with ProcessPoolExecutor(2) as pool:
-        list(pool.map(_burn, [n, n]))
-
-
-def _interleaved(repeats, base, grid=None, preheat=0.0):
+def _interleaved(repeats, base, grid=None):
     """One- and two-worker sweeps of ``grid`` and the pure-Python ceiling, interleaved: (times, tables,
-    ceilings, efficiencies), the efficiency per repeat being the speed-up over the ceiling beside it;
-    ``preheat`` [s]: both cores kept busy that long before each timed item (:func:`_preheat`)."""
+    ceilings, efficiencies), the efficiency per repeat being the speed-up over the ceiling beside it."""
+    from concurrent.futures import ProcessPoolExecutor
+
+    from whipple_kick.studies import sweep_engine
     times, tables, ceilings, efficiency = {1: [], 2: []}, {1: [], 2: []}, [], []
-    for w in (1, 2):   # warm pools of each size once (a later sweep of the same size reuses its pool)
-        _sweep_time(w, base, grid=grid)
-    for r in range(repeats):
-        done = {}
-        for what in _rotated(["1", "2", "ceiling"], r):
-            if preheat > 0:
-                _preheat(preheat)
-            if what == "ceiling":
-                done["ceiling"] = parallel_ceiling(2)
-            else:
-                w = int(what)
-                wall, table = _sweep_time(w, base, grid=grid)
-                done[w] = wall
-                times[w].append(wall)
-                tables[w].append(table)
-        ceilings.append(done["ceiling"])
-        efficiency.append((done[1] / done[2]) / done["ceiling"])
+    # A pool of each size, both kept for the whole measurement and warmed once, as the default pool is between
+    # sweeps of one size: the default pool is replaced whenever the worker count changes, so alternating 1 and 2
+    # workers on it timed a fresh pool's start in two thirds of the sweeps (and which ones, by the order).
+    sweep_engine._preload()   # what the default pool's workers inherit
+    pools = {w: ProcessPoolExecutor(max_workers=w, initializer=sweep_engine._worker_start) for w in (1, 2)}
+    try:
+        for w in (1, 2):
+            _sweep_time(w, base, grid=grid, executor=pools[w])
+        for r in range(repeats):
+            done = {}
+            for what in _rotated(["1", "2", "ceiling"], r):
+                if what == "ceiling":
+                    done["ceiling"] = parallel_ceiling(2)
+                else:
+                    w = int(what)
+                    wall, table = _sweep_time(w, base, grid=grid, executor=pools[w])
+                    done[w] = wall
+                    times[w].append(wall)
+                    tables[w].append(table)
+            ceilings.append(done["ceiling"])
+            efficiency.append((done[1] / done[2]) / done["ceiling"])
+    finally:
+        for pool in pools.values():
+            pool.shutdown()
     return times, tables, ceilings, efficiency
 
 
@@ -292,7 +287,7 @@ def bench_nine(repeats, duration):
     return statistics.median(efficiency)
 
 
-def bench_parallel(repeats, duration, preheat=0.0):
+def bench_parallel(repeats, duration):
     """Print the parallel efficiency on the nine thesis cases in both kick directions (18 cases).
 
     Eighteen cases on two workers are nine rounds each, so the granularity that caps nine cases at
@@ -301,9 +296,7 @@ def bench_parallel(repeats, duration, preheat=0.0):
     from whipple_kick.simulate import simulation
     base = simulation.Scenario(duration=duration)
     grid = {**_thesis_grid(), "kick_direction": ["right", "left"]}
-    times, _, ceilings, efficiency = _interleaved(repeats, base, grid, preheat)
-    if preheat > 0:
-        print(f"(both cores preheated for {preheat:g} s before each timed item)")
+    times, _, ceilings, efficiency = _interleaved(repeats, base, grid)
     for w in (1, 2):
         print(f"18 cases (9 thesis cases x 2 kick directions), {w} worker(s): wall median "
               f"{statistics.median(times[w]):.3f} s (runs: {', '.join(f'{t:.3f}' for t in times[w])})")
@@ -934,8 +927,6 @@ def main(argv=None):
     p.add_argument("what", choices=("split", "nine", "parallel", "blend", "many", "cost", "tolerance", "flags",
                                     "fall", "all", "_count", "_count_flags", "_count_fall"))
     p.add_argument("--repeats", type=int, default=3)
-    p.add_argument("--preheat", type=float, default=0.0,
-                   help="parallel: keep both cores busy this long [s] before each timed item (default 0)")
     p.add_argument("--n", type=int, default=1000, help="cases of the large sweep")
     p.add_argument("--duration", type=float, default=6.0, help="simulated time after the kick [s]")
     p.add_argument("--workers", type=int, default=None, help="workers of the large sweep (default: cores)")
@@ -962,7 +953,7 @@ def main(argv=None):
     if args.what in ("nine", "all"):
         bench_nine(args.repeats, args.duration)
     if args.what in ("parallel", "all"):
-        bench_parallel(args.repeats, args.duration, args.preheat)
+        bench_parallel(args.repeats, args.duration)
     if args.what in ("blend", "all"):
         bench_blend(args.repeats, args.duration)
     if args.what in ("cost", "all"):
