@@ -20,7 +20,7 @@ from whipple_kick.errors import BuildError, CompilerNotFoundError
 #: wall) is not used: the code would be CPU-specific (the CPU in the cache key, SIGILL on another CPU sharing
 #: the cache, a compiler that may refuse it) and valgrind cannot run its AVX-512, which the instruction counts
 #: rely on.
-MODEL_FLAGS = ("-O3", "-fPIC", "-shared", "-std=c99")
+MODEL_FLAGS = ("-O3", "-fno-math-errno", "-fPIC", "-shared", "-std=c99")
 #: Flags of the call extension (:mod:`whipple_kick.model.rhs_call`, which adds its include folders): a few
 #: lines of glue, left at -O2.
 EXTENSION_FLAGS = ("-O2", "-fPIC", "-shared", "-std=c99")
