@@ -358,8 +358,13 @@ static void wk_carcass_%(w)s(double vsy, double vx, double camber, double fz, do
     wk_curve c, cl;   /* the curve at the camber and at the lagged camber */
     c.w = cl.w = p[%(wgt)d]; c.lam = cl.lam = p[%(lam)d]; c.two = cl.two = c.w != 0.0;
     c.up[0] = c.up[1] = NAN;
-    wk_fyfac2_%(w)s_1(camber, gl, fzs, p, c.f1, cl.f1);
-    if (c.two) wk_fyfac2_%(w)s_2(camber, gl, fzs, p, c.f2, cl.f2);
+    if (need & 2) {   /* the factors at the lagged camber too, for the moment */
+        wk_fyfac2_%(w)s_1(camber, gl, fzs, p, c.f1, cl.f1);
+        if (c.two) wk_fyfac2_%(w)s_2(camber, gl, fzs, p, c.f2, cl.f2);
+    } else {
+        wk_fyfac1_%(w)s_1(camber, fzs, p, c.f1);
+        if (c.two) wk_fyfac1_%(w)s_2(camber, fzs, p, c.f2);
+    }
     o->gl_rate = speed * (camber - gl) / sig;
     o->F0 = need & 1 ? loaded * wk_curve_F(&c, 0.0) : NAN;
     o->sat = 0; o->cc = cc; o->dc = dc; o->y = y; o->vsy = vsy;

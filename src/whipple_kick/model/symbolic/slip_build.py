@@ -151,9 +151,13 @@ def _c_carcass_curves():
             lagged = sm.Symbol("gl", real=True)
             fac2 = magic_formula.lateral_force_model_factors(lagged, fz, sets[k - 1], friction_scale=mu)
             both = exprs + [fac2[n] for n in ("B", "C", "D", "E", "Sh", "Sv")]
+            targets = [f"fac[{i}]" for i in range(6)] + [f"fac2[{i}]" for i in range(6)]
             lines += [f"static void wk_fyfac2_{wheel}_{k}(double camber, double gl, double fz, const double *p, "
-                      "double *fac, double *fac2)", "{", *_parameter_locals(both),
-                      _c_block(both, [f"fac[{i}]" for i in range(6)] + [f"fac2[{i}]" for i in range(6)]), "}"]
+                      "double *fac, double *fac2)", "{", *_parameter_locals(both), _c_block(both, targets), "}"]
+            # The first camber's factors alone (a carcass block that needs no moment), as the pair's block prunes
+            # them: the same statements, so the same bits as wk_fyfac2's fac.
+            lines += [f"static void wk_fyfac1_{wheel}_{k}(double camber, double fz, const double *p, double *fac)",
+                      "{", *_parameter_locals(exprs), _c_block(both, targets, keep=range(6)), "}"]
             e = _set_curve("fy", wheel, k, slip, camber, fz)
             grad = [e, sm.diff(e, slip), sm.diff(e, camber), sm.diff(e, fz)]
             lines += [f"static void wk_fyg_{wheel}_{k}(double slip, double camber, double fz, const double *p, "
