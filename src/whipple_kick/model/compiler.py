@@ -19,7 +19,9 @@ from whipple_kick.errors import BuildError, CompilerNotFoundError
 #: keeps GCC from contracting a*b+c into an FMA). -march=native (0.75x with AVX2, -O3 -march=x86-64-v3; 0.86x
 #: wall) is not used: the code would be CPU-specific (the CPU in the cache key, SIGILL on another CPU sharing
 #: the cache, a compiler that may refuse it) and valgrind cannot run its AVX-512, which the instruction counts
-#: rely on.
+#: rely on. -fno-math-errno: the math functions need not set errno, so GCC may treat them as pure (keep a result,
+#: inline sqrt); values are unchanged (rows, trajectories and summaries of 14 scenarios bit-identical), and a
+#: thesis case's integration took 288.3 M instructions instead of 291.1 M, its outputs 41.2 M instead of 42.8 M.
 MODEL_FLAGS = ("-O3", "-fno-math-errno", "-fPIC", "-shared", "-std=c99")
 #: Flags of the call extension (:mod:`whipple_kick.model.rhs_call`, which adds its include folders): a few
 #: lines of glue, left at -O2.
