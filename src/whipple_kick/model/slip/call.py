@@ -192,7 +192,7 @@ class CompiledRHS:
         if X.shape != (t.size, ns):
             raise ValueError(f"states must have shape ({t.size}, {ns}), got {X.shape}")
         groups = optional_groups(names)
-        if via_rhs or groups == (1 << len(layouts.OPTIONAL_OUTPUTS)) - 1:
+        if via_rhs or groups == optional_groups():
             out = np.empty((t.size, len(self.layout.OUTPUT_NAMES)))
             fn = self.lib.wk_slip_outputs if via_rhs else self.lib.wk_slip_outputs_only
             status = fn(t.size, t.ctypes.data, X.ctypes.data, self._p_ptr, out.ctypes.data)
