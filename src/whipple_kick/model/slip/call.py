@@ -266,7 +266,7 @@ def optional_groups(names=None):
     """Bit mask of the :data:`~whipple_kick.model.slip.layout.OPTIONAL_OUTPUTS` groups that hold one of the outputs
     ``names`` (None: every group)."""
     if names is None:
-        return (1 << len(layouts.OPTIONAL_OUTPUTS)) - 1
+        return layouts.EVERY_OPTIONAL_GROUP
     names = set(names)
     return sum(1 << k for k, group in enumerate(layouts.OPTIONAL_OUTPUTS) if names & set(group))
 

@@ -85,6 +85,8 @@ OUTPUT_NAMES = SPEEDS + tuple(OUTPUTS)
 #: ``scripts/bench_sweep.py cost --callgrind``).
 OPTIONAL_OUTPUTS = (("yp", "vp", "ap"), ("fy_ss_r", "fy_ss_f", "mz_ss_r", "mz_ss_f"), ("fy_limit_r", "fy_limit_f"),
                     ("mz_r", "mz_f"))
+#: The bit mask asking for every group of :data:`OPTIONAL_OUTPUTS` (bit ``k``: group ``k``).
+EVERY_OPTIONAL_GROUP = (1 << len(OPTIONAL_OUTPUTS)) - 1
 PARAMETER_NAMES = S.SLIP_CONSTANTS
 
 

@@ -670,16 +670,14 @@ def c_source(part_names=(), delayed_reflex=False):
               f"        int status = wk_slip_rhs(t[i], x + (long)i * {ns}, p, dx, out + (long)i * {len(L.OUTPUT_NAMES)});",
               "        if (status) return status;", "    }", "    return 0;", "}"]
     # The same outputs without the dynamics: the prologue without Kane's mass matrix, forcing and solve
-    # (nothing in the outputs needs the accelerations), bit for bit the right-hand side's outputs.
-    lines += ["static int wk_slip_sample(double t, const double *x, const double *p, double *out)", "{",
-              *_c_prologue(ex, dynamics=False, L=L, carcass_need="2"), *_c_outputs(ex, "    ", L), "    return 0;",
-              "}"]
+    # (nothing in the outputs needs the accelerations), bit for bit the right-hand side's outputs; the optional
+    # groups only where a call asks for them (a study's summary reads none of them).
+    lines += _c_outputs_some(ex, L)
     lines += ["int wk_slip_outputs_only(int n, const double *t, const double *x, const double *p, double *out)", "{",
               "    for (int i = 0; i < n; i++) {",
-              f"        int status = wk_slip_sample(t[i], x + (long)i * {ns}, p, out + (long)i * {len(L.OUTPUT_NAMES)});",
+              f"        int status = wk_slip_sample_some(t[i], x + (long)i * {ns}, p, {layouts.EVERY_OPTIONAL_GROUP}, "
+              f"out + (long)i * {len(L.OUTPUT_NAMES)});",
               "        if (status) return status;", "    }", "    return 0;", "}"]
-    # The same without the optional groups a call does not ask for (a study's summary reads none of them).
-    lines += _c_outputs_some(ex, L)
     lines += ["int wk_slip_outputs_some(int n, const double *t, const double *x, const double *p, int groups, "
               "double *out)", "{",
               "    for (int i = 0; i < n; i++) {",
