@@ -1206,11 +1206,10 @@ def _held_out(args, result, base, inputs, cells, progress, options):
     return frame
 
 
-def _screen(args, inputs, cells, base, progress):
-    """``calibrate --screen``: Morris screening of every prior the rider reads, into DIR/screening.csv."""
-    from whipple_kick.library import priors
+def _screen(args, spec, inputs, cells, base, progress):
+    """``calibrate --screen``: Morris screening of every prior the rider reads (the loaded calibration file
+    ``spec``), into DIR/screening.csv."""
     from whipple_kick.studies import calibration
-    spec = priors.load(args.spec)
     candidates = [n for n in spec.priors if n != "hip_stiffness" or args.rider_body == "leaning"]
     frame = calibration.screen_inputs(spec, candidates, cells=cells, base=base, workers=args.workers,
                                       progress=progress, trajectories=4 if args.quick else 8, seed=args.seed,
@@ -1318,9 +1317,10 @@ def calibrate_main(argv=None):
                                  + (["hip_stiffness"] if args.rider_body == "leaning" else []))
         progress = sys.stderr.isatty()
         options = dict(waves=args.waves, steps=1000 if args.quick else 5000, seed=args.seed)
+        spec = priors.load(args.spec)   # once, for the screening and the calibration alike
         if args.screen:
-            _screen(args, inputs, cells, base, progress)
-        result = calibration.calibrate(spec=args.spec, inputs=inputs, cells=cells, base=base, workers=args.workers,
+            _screen(args, spec, inputs, cells, base, progress)
+        result = calibration.calibrate(spec=spec, inputs=inputs, cells=cells, base=base, workers=args.workers,
                                        progress=progress, check_runs=4 if args.quick else 8,
                                        runs=pathlib.Path(args.out) / calibration.RUNS, **options)
         if args.held_out:

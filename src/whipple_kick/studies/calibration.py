@@ -182,7 +182,7 @@ def measured_features(spec=priors.DEFAULT, experiment=None, features=None, cells
         ``key, cell, fz_n, pressure_kpa, feature, unit, measured, sd_measurement,
         sd_discrepancy, how``, in :func:`feature_keys` order.
     """
-    spec = spec if isinstance(spec, priors.CalibrationSpec) else priors.load(spec)
+    spec = _spec(spec)
     exp = experiments.load(spec.experiment) if experiment is None else experiment
     features = _check_features(features)
     cells = _check_cells(exp, cells)
@@ -816,22 +816,46 @@ def screen_inputs(spec=priors.DEFAULT, inputs=None, cells=None, features=None, b
                   progress=False, trajectories=4, seed=0, runs=None, simulator=None):
     """:func:`screen` on the kick model (or ``simulator``) for the file's priors ``inputs`` (default every
     prior the rigid rider reads: all but ``hip_stiffness``); the features' sd from the file."""
-    spec = spec if isinstance(spec, priors.CalibrationSpec) else priors.load(spec)
+    spec = _spec(spec)
     names = [n for n in spec.priors if n != "hip_stiffness"] if inputs is None else list(inputs)
-    prior_list = choose_priors(spec, names)
-    table = measured_features(spec, features=features, cells=cells)
-    feats = list(dict.fromkeys(table["feature"]))
-    cell_list = list(dict.fromkeys(zip(table["fz_n"], table["pressure_kpa"], strict=True)))
-    if simulator is None:
-        simulator = ModelSimulator([p.field for p in prior_list], cell_list, feats, base, workers, progress, runs)
+    prior_list, table, _, _, simulator = _problem(spec, names, None, features, cells, None, simulator, base, workers,
+                                                  progress, runs)
     sd = np.sqrt(table["sd_measurement"].to_numpy() ** 2 + table["sd_discrepancy"].to_numpy() ** 2)
     return screen(simulator, prior_list, sd, list(table["key"]), trajectories=trajectories, seed=seed)
+
+
+def _spec(spec):
+    """``spec`` as a :class:`~whipple_kick.library.priors.CalibrationSpec` (a path or name is loaded)."""
+    return spec if isinstance(spec, priors.CalibrationSpec) else priors.load(spec)
+
+
+def _problem(spec, inputs, bounds, features, cells, discrepancy, simulator, base, workers, progress, runs):
+    """What screening and calibrating share: the priors of ``inputs`` (:func:`choose_priors`), the measured
+    features' table (:func:`measured_features`), its cells and features in order, and the simulator over them
+    (default a :class:`ModelSimulator` on ``base``): ``(priors, table, cells, features, simulator)``."""
+    prior_list = choose_priors(spec, inputs, bounds)
+    table = measured_features(spec, features=features, cells=cells, discrepancy=discrepancy)
+    cells = list(dict.fromkeys(zip(table["fz_n"], table["pressure_kpa"], strict=True)))
+    features = list(dict.fromkeys(table["feature"]))
+    if simulator is None:
+        simulator = ModelSimulator([p.field for p in prior_list], cells, features, base, workers, progress, runs)
+    return prior_list, table, cells, features, simulator
+
+
+def _with_measured(table, measured):
+    """``table`` with its measured values replaced by ``measured`` (in its row order; None: as it is)."""
+    if measured is None:
+        return table
+    measured = np.asarray(measured, float)
+    if measured.shape != (len(table),):
+        raise InputError(f"measured values: {measured.size} given, {len(table)} features expected")
+    return table.assign(measured=measured)
 
 
 def choose_priors(spec, inputs=None, bounds=None):
     """The priors of ``inputs`` (names in the file; default all but ``hip_stiffness`` and ``speed``), with
     ``bounds = {name: (low, high)}`` overriding (checked; an override is marked unsourced)."""
-    spec = spec if isinstance(spec, priors.CalibrationSpec) else priors.load(spec)
+    spec = _spec(spec)
     names = [n for n in spec.priors if n not in ("hip_stiffness", "speed")] if inputs is None else list(inputs)
     unknown = [n for n in names if n not in spec.priors]
     if unknown or not names:
@@ -892,18 +916,10 @@ def calibrate(simulator=None, spec=priors.DEFAULT, inputs=None, bounds=None, fea
 
 def _calibrate(simulator, spec, inputs, bounds, features, cells, discrepancy, measured, base, waves, first,
                per_wave, rank, walkers, steps, candidates, seed, workers, progress, check_runs, runs=None):
-    spec = spec if isinstance(spec, priors.CalibrationSpec) else priors.load(spec)
-    prior_list = choose_priors(spec, inputs, bounds)
-    table = measured_features(spec, features=features, cells=cells, discrepancy=discrepancy)
-    features = list(dict.fromkeys(table["feature"]))
-    cells = list(dict.fromkeys(zip(table["fz_n"], table["pressure_kpa"], strict=True)))
-    if measured is not None:
-        measured = np.asarray(measured, float)
-        if measured.shape != (len(table),):
-            raise InputError(f"measured values: {measured.size} given, {len(table)} features expected")
-        table = table.assign(measured=measured)
-    if simulator is None:
-        simulator = ModelSimulator([p.field for p in prior_list], cells, features, base, workers, progress, runs)
+    spec = _spec(spec)
+    prior_list, table, cells, features, simulator = _problem(spec, inputs, bounds, features, cells, discrepancy,
+                                                             simulator, base, workers, progress, runs)
+    table = _with_measured(table, measured)
     z = table["measured"].to_numpy()
     var_obs = table["sd_measurement"].to_numpy() ** 2 + table["sd_discrepancy"].to_numpy() ** 2
     wave_list, matcher, U_all, Y_all, survivors = history_match(
@@ -1145,14 +1161,9 @@ def held_out(mode, simulator_factory, spec=priors.DEFAULT, inputs=None, bounds=N
     draws = int(draws)
     if draws < 2:
         raise InputError(f"held-out draws = {draws} must be a whole number >= 2 (a predictive spread needs two)")
-    spec = spec if isinstance(spec, priors.CalibrationSpec) else priors.load(spec)
+    spec = _spec(spec)
     prior_list = choose_priors(spec, inputs, bounds)
-    table = measured_features(spec, features=features, cells=cells, discrepancy=discrepancy)
-    if measured is not None:
-        measured = np.asarray(measured, float)
-        if measured.shape != (len(table),):
-            raise InputError(f"measured values: {measured.size} given, {len(table)} features expected")
-        table = table.assign(measured=measured)
+    table = _with_measured(measured_features(spec, features=features, cells=cells, discrepancy=discrepancy), measured)
     features = list(dict.fromkeys(table["feature"]))
     cells = list(dict.fromkeys(zip(table["fz_n"], table["pressure_kpa"], strict=True)))
     if mode == "load":
