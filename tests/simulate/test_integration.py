@@ -233,3 +233,16 @@ def test_join_concatenates_samples_sums_counters_and_ends_as_the_last_piece():
     assert c.t.tolist() == [0.0, 1.0, 2.0] and c.x.shape == (3, n) and c.x[2, 0] == 1.0
     assert (c.nfev, c.njev, c.evaluations) == (15, 3, 42)
     assert c.fell and c.fall_time == 2.0 and c.message == "fell" and c.fall_reason == "steer" and c.end_state[0] == 1.0
+
+
+def test_sample_times_are_one_read_only_array_per_grid():
+    """Every run of a sweep shares its grid's samples (computed once per process): read-only, the same values
+    whatever asked first, and not shared with another grid (nor a settle of -0.0 with one of 0.0)."""
+    t = integration.sample_times(Scenario(settle=0.5, duration=6.0))
+    assert t is integration.sample_times(Scenario(settle=0.5, duration=6.0)) and not t.flags.writeable
+    with pytest.raises(ValueError, match="read-only"):
+        t[0] = 0.0
+    assert t.size == 6501 and t[0] == -0.5 and t[-1] == 6.0 and t[500] == 0.0
+    assert integration.sample_times(Scenario(settle=0.5, duration=3.0)).size == 3501
+    assert integration.sample_times(Scenario(settle=0.0, duration=1.0)) is not \
+        integration.sample_times(Scenario(settle=-0.0, duration=1.0))

@@ -5,8 +5,10 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
+from whipple_kick.library import inputs
 from whipple_kick.model import slip
-from whipple_kick.simulate import lsoda
+from whipple_kick.simulate import assembly, lsoda
+from whipple_kick.simulate.scenario import Scenario
 
 N = len(slip.STATE_NAMES)
 ROLL, ROLL_RATE = slip.X["q4"], slip.X["u4"]
@@ -203,3 +205,56 @@ def test_a_chunk_starting_past_the_limit_falls_at_its_start():
     x0 = _start(roll=0.5)
     traj = lsoda.integrate(capsize, x0, 1.0, rtol=1e-10, output_rate=100.0, fall_angle=0.3)
     assert traj.fell and traj.fall_time == 0.0 and traj.t.tolist() == [0.0]
+
+
+def _piece_samples_by_masks(samples, a, b, eps):
+    """The per-piece sample sets as the tests on every sample give them (what lsoda._piece_samples must match)."""
+    return (samples[np.abs(samples - a) <= eps], samples[(np.abs(samples - b) <= eps) & (samples > a + eps)],
+            samples[(samples > a + eps) & (samples < b - eps)])
+
+
+@pytest.mark.parametrize("a, b", [(-0.5, 0.0), (0.0, 0.15), (0.15, 6.0), (0.1234, 0.5678), (-1.0, 7.0), (0.3, 0.3)])
+def test_piece_samples_are_those_the_tests_on_every_sample_give(a, b):
+    """Found by binary search on the candidates only, the same samples in the same order, also with samples just
+    inside, on and just outside ``eps`` of the piece's ends (where rounding decides) and with ``eps`` 0."""
+    eps = 1e-9 * 1e-3 + 1e-14 * 6.0
+    grid = np.arange(-500, 6001) / 1000.0
+    near = [t + d for t in (a, b) for d in (-4 * eps, -eps, -eps / 2, 0.0, eps / 2, eps, np.nextafter(eps, 1.0),
+                                           1.5 * eps, 4 * eps)]
+    samples = np.unique(np.concatenate([grid, near]))
+    for e in (eps, 0.0):
+        for got, want in zip(lsoda._piece_samples(samples, a, b, e), _piece_samples_by_masks(samples, a, b, e),
+                             strict=True):
+            np.testing.assert_array_equal(got, want)
+            assert got.tobytes() == want.tobytes()
+    empty = np.empty(0)
+    assert all(s.size == 0 for s in lsoda._piece_samples(empty, a, b, eps))
+
+
+def test_the_cached_tolerances_are_default_atol_and_read_only():
+    """Shared by every run of a process: the same values as a fresh default_atol, and nobody may change them."""
+    atol, scale = lsoda._tolerances(1e-10, "force_lag", N, lsoda._exact_key(1e-10))
+    np.testing.assert_array_equal(atol, lsoda.default_atol(1e-10, "force_lag"))
+    np.testing.assert_array_equal(scale, lsoda.default_atol(1e-10, "force_lag") / 1e-10)
+    assert not atol.flags.writeable and not scale.flags.writeable
+    assert lsoda._tolerances(1e-10, "force_lag", N, lsoda._exact_key(1e-10))[0] is atol
+    assert lsoda._exact_key(0.0) != lsoda._exact_key(-0.0) and lsoda._exact_key(1) != lsoda._exact_key(1.0)
+
+
+@pytest.mark.parametrize("compiled", [True, False], ids=["c_chunk_loop", "odeint"])
+def test_a_non_finite_state_in_the_result_is_an_error(compiled):
+    """The rows the C chunk loop checked are not checked again; every other row is: here the state a jump map
+    gives at the run's end (a sample), which no chunk produced."""
+    scenario = Scenario(duration=0.3)
+    model = assembly.assemble(scenario, inputs.kick_of(scenario.validate()))
+    rhs = slip.CompiledRHS(model.start.params)
+
+    def nan_map(t, x):
+        return np.full_like(x, np.nan)
+
+    def plain(t, x):   # the model without its C Jacobian: odeint's path
+        return rhs(t, x)
+    f = rhs if compiled else plain
+    lsoda.integrate(f, model.start.x, 0.2, output_rate=100.0)   # finite without the map
+    with pytest.raises(FloatingPointError, match="non-finite state in the integration result"):
+        lsoda.integrate(f, model.start.x, 0.2, output_rate=100.0, jumps={0.2: nan_map})

@@ -287,3 +287,27 @@ def test_a_non_finite_start_is_refused_by_both_careful_paths():
     for careful in paths:
         with pytest.raises(ValueError, match="must be finite"):
             careful(*arguments)
+
+
+@pytest.mark.parametrize("size", [0, 1, 7, 8, 9, 17, 1000])
+def test_the_c_finite_check_is_numpys(size):
+    """The C chunk loop's check of a chunk's states (a sum, then value by value where the sum is not finite) says
+    what ``np.all(np.isfinite(...))`` says: also for finite values whose sum overflows, and for a NaN or an
+    infinity anywhere (in the summed pairs or the rest)."""
+    lib = lsoda_c.driver()
+
+    def check(values):
+        values = np.ascontiguousarray(values, dtype=float)
+        return bool(lib.wk_lsoda_all_finite(values.ctypes.data, values.size))
+    rng = np.random.default_rng(size)
+    values = rng.normal(size=size)
+    assert check(values)
+    assert check(np.full(size, 1e308)) and check(np.tile([1e308, -1e308, np.finfo(float).max], size)[:size])
+    for position in {0, size // 2, size - 1} if size else ():
+        for bad in (np.nan, np.inf, -np.inf):
+            spoiled = values.copy()
+            spoiled[position] = bad
+            assert not check(spoiled) and not np.all(np.isfinite(spoiled))
+            spoiled = np.full(size, 1e308)
+            spoiled[position] = bad
+            assert not check(spoiled)

@@ -14,6 +14,7 @@ limit, :func:`end_limits`) ends it as an event. The result is one
 :class:`Solution`, handed to :mod:`whipple_kick.simulate.results`.
 """
 from dataclasses import dataclass, field, replace
+import functools
 import math
 import time
 
@@ -111,7 +112,8 @@ def sample_times(scenario):
     On the kick's clock (t = 0 at the nominal kick start), so the samples
     after the kick do not depend on ``settle``: k / rate for the integers k
     with -settle <= k / rate <= duration, and the run's ends if they fall
-    between multiples.
+    between multiples. Read-only: one array per process for each
+    (rate, settle, duration), which every run of a sweep shares.
 
     Example
     -------
@@ -119,12 +121,21 @@ def sample_times(scenario):
     >>> sample_times(Scenario(settle=0.002, duration=0.003, output_rate=1000.0)).tolist()
     [-0.002, -0.001, 0.0, 0.001, 0.002, 0.003]
     """
-    rate, t_start, t_end = scenario.output_rate, 0.0 - scenario.settle, scenario.duration   # no -0.0
+    rate, settle, duration = scenario.output_rate, scenario.settle, scenario.duration
+    return _sample_times(rate, settle, duration, lsoda._exact_key(rate, settle, duration))
+
+
+@functools.lru_cache(maxsize=16)
+def _sample_times(rate, settle, duration, _exactly):
+    """:func:`sample_times` of these fields (``_exactly``: :func:`whipple_kick.simulate.lsoda._exact_key`)."""
+    t_start, t_end = 0.0 - settle, duration   # no -0.0
     tiny = 1e-9   # of a sample spacing: a product like 0.5 * 1000 is an integer to round-off
     k = np.arange(math.ceil(t_start * rate - tiny), math.floor(t_end * rate + tiny) + 1)
     times = k / rate
     times = times[(times > t_start + tiny / rate) & (times < t_end - tiny / rate)]
-    return np.concatenate([[t_start], times, [t_end]])
+    times = np.concatenate([[t_start], times, [t_end]])
+    times.flags.writeable = False
+    return times
 
 
 def end_limits(scenario):
@@ -200,17 +211,17 @@ def _integrate(steady, scenario, kick):
     if not (fixed and scenario.piecewise) or kick_start <= t_start:
         traj, rhs_out, owner = run_from(steady.x if kick_start <= t_start else x_start, t_start, samples)
         return _from_kick_start(traj, kick_start), rhs_out, owner, breakpoints, jumps
+    # The samples before the kick and from it: the increasing samples split by binary search (views).
+    kick_row = int(np.searchsorted(samples, kick_start, "left"))
     settle = lsoda.integrate(rhs, x_start, kick_start, t_start=t_start, rtol=scenario.rtol, **limits,
-                                 chunk=chunk, samples=samples[samples < kick_start])
+                                 chunk=chunk, samples=samples[:kick_row])
     quad = [slip.X[n] for n in energy.CUMULATIVE]
-    settle_x = settle.x.copy()
-    settle_x[:, quad] -= settle.end_state[quad]   # cumulative from the kick start
+    settle.x[:, quad] -= settle.end_state[quad]   # cumulative from the kick start (in place: the states are this run's own)
     if settle.fell or settle.failed:
         # The steady motion did not last through the settle (it fell or the integration failed before
         # the kick): that is the run's outcome, and there is no kick to integrate.
-        return replace(settle, x=settle_x), rhs, None, breakpoints, jumps
-    traj, rhs_out, owner = run_from(steady.x, kick_start, samples[samples >= kick_start],
-                                    before=replace(settle, x=settle_x))
+        return settle, rhs, None, breakpoints, jumps
+    traj, rhs_out, owner = run_from(steady.x, kick_start, samples[kick_row:], before=settle)
     if owner is not None:
         # The settle's samples belong to the model of the plate at rest before the table.
         rhs_out = [rhs] + list(rhs_out)

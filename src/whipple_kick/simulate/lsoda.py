@@ -26,7 +26,9 @@ it produced so far, in bounded time.
 """
 import collections
 from dataclasses import dataclass, replace
+import functools
 import itertools
+import math
 import warnings
 
 import numpy as np
@@ -123,6 +125,24 @@ def default_atol(rtol, transient=DEFAULT_TRANSIENT, n_states=len(slip.STATE_NAME
     for name in slip.QUADRATURE_STATES:
         atol[slip.X[name]] = QUADRATURE_ATOL
     return atol
+
+
+@functools.lru_cache(maxsize=32)
+def _tolerances(rtol, transient, n_states, _exactly):
+    """:func:`default_atol` and the Jacobian's step scale ``atol / rtol``, read-only, once per process.
+
+    Every run of a sweep asks for the same ones (twice per run). ``_exactly`` tells keys apart that compare equal
+    but are not the same number (``0.0``, ``-0.0``; an int): :func:`_exact_key`.
+    """
+    atol = default_atol(rtol, transient, n_states)
+    scale = atol / rtol
+    atol.flags.writeable = scale.flags.writeable = False
+    return atol, scale
+
+
+def _exact_key(*values):
+    """What tells apart numbers that compare equal (``0.0 == -0.0``, ``1 == 1.0``) in a cache key."""
+    return tuple((type(v), math.copysign(1.0, v) if isinstance(v, float) else 0.0) for v in values)
 
 
 @dataclass(frozen=True)
@@ -377,6 +397,22 @@ def _chunks_in_c(rhs, jac, rtol, atol, mxstep, limits, budget, t_start):
     return lsoda_c.FastChunks(lib, rhs, jac, rtol, atol, mxstep, limits, budget, t_start)
 
 
+def _piece_samples(samples, a, b, eps):
+    """The samples within ``eps`` [s] of a piece's start ``a``, those of its end ``b`` (not ``a``'s), those inside.
+
+    The same samples as the tests ``|s - a| <= eps``, ``|s - b| <= eps and s > a + eps`` and
+    ``a + eps < s < b - eps`` on all of them, in a fraction of the time: ``samples`` increases, so each set is a
+    run of it (``s - a`` rounded does not decrease with ``s``) found by binary search, a view; the first two are
+    tested on the candidates within ``4 eps`` only, beyond which no sample passes the test.
+    """
+    w = 4 * eps
+    start_a, start_b, stop_inside = np.searchsorted(samples, (a - w, b - w, b - eps), "left").tolist()
+    stop_a, stop_b, start_inside = np.searchsorted(samples, (a + w, b + w, a + eps), "right").tolist()
+    near_a, near_b = samples[start_a:stop_a], samples[start_b:stop_b]
+    return (near_a[np.abs(near_a - a) <= eps], near_b[(np.abs(near_b - b) <= eps) & (near_b > a + eps)],
+            samples[start_inside:stop_inside])
+
+
 def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None,
               output_rate=1000.0, fall_angle=np.deg2rad(45.0), chunk=None, samples=None,
               budget=None, jumps=None, steer_limit=None, before=None):
@@ -458,8 +494,12 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
     """
     transient = getattr(rhs, "transient", DEFAULT_TRANSIENT)
     plain = getattr(rhs, "fast", rhs)   # the compiled model's one-foreign-call f(t, x)
-    atol = default_atol(rtol, transient, len(x0)) if atol is None else np.asarray(atol, dtype=float)
-    jac = rhs.jacobian_function(atol / rtol) if hasattr(rhs, "jacobian_function") else None
+    if atol is None:
+        atol, scale = _tolerances(rtol, transient, len(x0), _exact_key(rtol))
+    else:
+        atol = np.asarray(atol, dtype=float)
+        scale = atol / rtol
+    jac = rhs.jacobian_function(scale) if hasattr(rhs, "jacobian_function") else None
     jumps = dict(jumps or {})
     budget = DEFAULT_BUDGET if budget is None else budget
     chunk = DEFAULT_CHUNK if chunk is None else chunk
@@ -468,7 +508,8 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
         samples = np.linspace(t_start, t_end, n_samples)
     else:
         samples = np.asarray(samples, dtype=float)
-        samples = samples[(samples >= t_start) & (samples <= t_end)]
+        # Those in [t_start, t_end]: a run of the increasing samples, found by binary search (a view, no copy).
+        samples = samples[np.searchsorted(samples, t_start, "left"):np.searchsorted(samples, t_end, "right")]
     spacing = np.min(np.diff(samples)) if samples.size > 1 else (t_end - t_start)
     eps = 1e-9 * spacing + 1e-14 * max(abs(t_start), abs(t_end))
     edges = [t_start] + sorted(b for b in set(breakpoints) if t_start < b < t_end) + [t_end]
@@ -482,13 +523,14 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
         return min(fall_angle - abs(x[roll]), steer_limit - abs(x[steer]))
     fall.terminal = True
     fall.direction = -1
-    guarded = _guarded(rhs, roll, fall_angle, steer, steer_limit)   # once per integration, not per chunk
     # The fast path gives up (and the careful path takes over, with the budget) after more steps
     # between two samples than a quarter of the stall window's evaluations (a step costs 1 to ~25
     # evaluations, a stiff one with a new Jacobian the most), so a stall wastes about one window
     # here; a legitimate interval needs far fewer steps (docs/simulate.md).
     mxstep = max(1, budget.stall_window // 4)
     chunks_in_c = _chunks_in_c(rhs, jac, rtol, atol, mxstep, (roll, fall_angle, steer, steer_limit), budget, t_start)
+    # odeint's f (once per integration, not per chunk), where the chunks do not run in C.
+    guarded = _guarded(rhs, roll, fall_angle, steer, steer_limit) if chunks_in_c is None else None
 
     nfev = njev = spent = 0   # LSODA's evaluations, Jacobians, all evaluations (the budget's count)
     last_t = -np.inf   # time of the last emitted sample (chunks share end points)
@@ -500,11 +542,18 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
     x_out = x_rows[1:]
     t_out[:head], x_out[:head] = (before.t, before.x) if head else (0.0, 0.0)
     filled = head
+    # Rows whose finiteness is still to be checked, as [start, stop) runs: all but those the C chunk loop wrote in
+    # place (it checked them, as the odeint path checks each chunk's states).
+    unchecked = [[0, head]]
 
     def put(times, states):
         nonlocal filled, last_t
         t_out[filled:filled + times.size] = times
         x_out[filled:filled + times.size] = states
+        if unchecked[-1][1] == filled:
+            unchecked[-1][1] += times.size
+        else:
+            unchecked.append([filled, filled + times.size])
         filled += times.size
         last_t = times[-1]
 
@@ -526,10 +575,9 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
     x = np.asarray(x0, dtype=float)
     fell, fall_time, message, failed, fall_reason = False, None, "completed", False, None
     done = False
+    rows_address, row_bytes = (x_rows.ctypes.data, x_rows.strides[0]) if chunks_in_c is not None else (None, None)
     for a, b in itertools.pairwise(edges):
-        at_a = samples[np.abs(samples - a) <= eps]
-        at_b = samples[(np.abs(samples - b) <= eps) & (samples > a + eps)]
-        inside = samples[(samples > a + eps) & (samples < b - eps)]
+        at_a, at_b, inside = _piece_samples(samples, a, b, eps)
         emit(at_a, np.repeat(x[None, :], at_a.size, axis=0))
         # Chunk boundaries: the piece's start, sample times about `chunk`
         # apart, and the piece's end (so the exact end state carries over).
@@ -551,7 +599,7 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
                 # Grid row g goes to x_rows' row filled + g - cuts[k]: the chunks' first sample to the result's
                 # next row; the start state to the row before, the last row emitted (kept: put back below).
                 start, spare = x, x_rows[filled].copy()
-                into = x_rows.ctypes.data + (filled - cuts[k]) * x_rows.strides[0]
+                into = rows_address + (filled - cuts[k]) * row_bytes
                 ran, _, x = chunks_in_c(grid, cuts[k:], x, counts, into=into)
                 x_rows[filled] = spare
                 nfev, njev, spent = (int(v) for v in counts)
@@ -615,7 +663,7 @@ def integrate(rhs, x0, t_end, t_start=0.0, breakpoints=(), rtol=1e-10, atol=None
             x = np.asarray(jumps[b](b, x), dtype=float)
         emit(at_b, np.repeat(x[None, :], at_b.size, axis=0))
     t, X = t_out[:filled], x_out[:filled]
-    if X.size and not np.all(np.isfinite(X)):
+    if not all(np.isfinite(X[start:stop]).all() for start, stop in unchecked):
         raise FloatingPointError("non-finite state in the integration result")
     history = StateHistory(t, X, fell, fall_time, nfev, message, end_state=np.asarray(x, dtype=float), failed=failed,
                            njev=njev, evaluations=spent, fall_reason=fall_reason)

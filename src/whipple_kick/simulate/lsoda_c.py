@@ -93,12 +93,20 @@ def driver():
     lib.wk_lsoda_fast_chunks.argtypes = [pointer, pointer, pointer, pointer, c_int, pointer, pointer, c_int, pointer,
                                          c_double, pointer, c_int, c_int, c_double, c_int, c_double, c_int,
                                          c_double, c_double, c_double, pointer, pointer]
+    lib.wk_lsoda_all_finite.restype = c_int
+    lib.wk_lsoda_all_finite.argtypes = [pointer, ctypes.c_long]
     lib.wk_lsoda_careful_chunk.restype = c_int
     lib.wk_lsoda_careful_chunk.argtypes = [pointer, pointer, pointer, pointer, c_int, pointer, c_int, pointer,
                                            c_double, pointer, c_int, c_double, c_int, c_double, c_int, c_double,
                                            c_double, c_double, ctypes.c_longlong, ctypes.c_longlong, c_double,
                                            pointer, pointer, pointer, pointer, pointer]
     return lib
+
+
+@functools.cache
+def _model_functions(model_lib):
+    """Addresses of a compiled model library's ``wk_slip_rhs`` and ``wk_slip_jacobian`` (looked up once per library)."""
+    return tuple(ctypes.cast(f, ctypes.c_void_p).value for f in (model_lib.wk_slip_rhs, model_lib.wk_slip_jacobian))
 
 
 #: How a careful chunk ended: ``wk_lsoda_careful_chunk``'s codes (driver.c's CAREFUL_* enumeration).
@@ -144,6 +152,9 @@ class CarefulChunk:
     istate: int
 
 
+_CAREFUL_RTOL_FLOOR = 100 * float(np.finfo(float).eps)
+
+
 class FastChunks:
     """The C chunk loop bound to one compiled model, its Jacobian's scale and the run's limits and tolerances.
 
@@ -165,17 +176,18 @@ class FastChunks:
 
     def __init__(self, lib, rhs, jac, rtol, atol, mxstep, limits, budget, t_start):
         self.lib = lib
-        self.rhs_address = ctypes.cast(rhs.lib.wk_slip_rhs, ctypes.c_void_p).value
-        self.jac_address = ctypes.cast(rhs.lib.wk_slip_jacobian, ctypes.c_void_p).value
+        self.rhs_address, self.jac_address = _model_functions(rhs.lib)
         self.p = rhs.p   # kept alive: C reads it
         self.scale = np.ascontiguousarray(jac.scale, dtype=float)
         self.jac_evaluations = int(jac.evaluations)
         self.atol = np.ascontiguousarray(atol, dtype=float)
+        # The addresses of the arrays every call passes, once (each `ctypes.data` builds an object).
+        self._constant = (self.p.ctypes.data, self.scale.ctypes.data, self.atol.ctypes.data)
         self.rtol, self.mxstep, self.limits = float(rtol), int(mxstep), limits
         self.budget = (float(budget.allowance), float(budget.per_second), float(t_start))
         self.stall = (int(budget.stall_window), float(budget.stall_progress))
         # scipy's LSODA solver object raises its rtol to 100 eps (scipy.integrate._ivp.common.validate_tol).
-        self.careful_rtol = float(np.maximum(rtol, 100 * np.finfo(float).eps))
+        self.careful_rtol = max(float(rtol), _CAREFUL_RTOL_FLOOR)
 
     def __call__(self, grid, cuts, x, counts, into=None):
         """Integrate the chunks ``grid[cuts[k]:cuts[k + 1] + 1]`` from ``x`` until one needs the careful path.
@@ -192,8 +204,9 @@ class FastChunks:
             ``nfev, njev, evaluations`` so far; the chunks done are added to it.
         into : int, optional
             Address of grid row 0's row in a C-ordered float64 array of rows of ``x.size`` that the states are
-            written into (rows ``cuts[0]`` to ``cuts[done]``, which the caller makes room for); default an array
-            of this call's own.
+            written into (rows ``cuts[0]`` to ``cuts[done]``; the rows of the chunk that stopped the call, up to
+            ``cuts[done + 1]``, are written too, with no meaning: the caller makes room for rows ``cuts[0]`` to
+            ``cuts[-1]``); default an array of this call's own.
 
         Returns
         -------
@@ -210,11 +223,11 @@ class FastChunks:
         n = x.size
         out = np.empty((grid.size, n)) if into is None else None
         roll, fall_angle, steer, steer_limit = self.limits
+        p, scale, atol = self._constant
         done = self.lib.wk_lsoda_fast_chunks(
-            self.rhs_address, self.jac_address, self.p.ctypes.data, self.scale.ctypes.data, n, grid.ctypes.data,
-            c.ctypes.data, c.size, x.ctypes.data, self.rtol, self.atol.ctypes.data, self.mxstep, roll, fall_angle,
-            steer, steer_limit, self.jac_evaluations, *self.budget, counts.ctypes.data,
-            out.ctypes.data if into is None else into)
+            self.rhs_address, self.jac_address, p, scale, n, grid.ctypes.data, c.ctypes.data, c.size, x.ctypes.data,
+            self.rtol, atol, self.mxstep, roll, fall_angle, steer, steer_limit, self.jac_evaluations, *self.budget,
+            counts.ctypes.data, out.ctypes.data if into is None else into)
         if done < 0:
             raise MemoryError("the C chunk loop ran out of memory")
         return done, None if out is None else out[c[0]:c[done] + 1], x
@@ -244,9 +257,10 @@ class FastChunks:
         samples, end, failed_x = np.empty((m, n)), np.empty(n + 1), np.empty(n)
         counts, report = np.zeros(8, dtype=np.int64), np.zeros(4)
         roll, fall_angle, steer, steer_limit = self.limits
+        p, scale, atol = self._constant
         code = self.lib.wk_lsoda_careful_chunk(
-            self.rhs_address, self.jac_address, self.p.ctypes.data, self.scale.ctypes.data, n, times.ctypes.data, m,
-            x.ctypes.data, self.careful_rtol, self.atol.ctypes.data, roll, fall_angle, steer, steer_limit,
+            self.rhs_address, self.jac_address, p, scale, n, times.ctypes.data, m, x.ctypes.data, self.careful_rtol,
+            atol, roll, fall_angle, steer, steer_limit,
             self.jac_evaluations, *self.budget, int(spent), *self.stall, samples.ctypes.data, end.ctypes.data,
             failed_x.ctypes.data, counts.ctypes.data, report.ctypes.data)
         if code < 0:
