@@ -32,6 +32,30 @@ def test_clean_refuses_what_json_cannot_hold():
         results.clean({"a": [0.0, math.nan]})
 
 
+def test_clean_keeps_every_leaf_of_a_plain_dict_and_list():
+    """The plain dicts' and lists' leaves are kept as clean gives them (floats, strings, None, bools, ints); the
+    others still go through clean (a numpy scalar, a tuple, a non-string key, a non-finite float)."""
+    value = {"f": 1.5, "s": "x", "n": None, "b": False, "i": 3, 7: (np.float64(2.5), [0.5, np.int64(4)]),
+             "nested": {"list": [1.0, -0.0, True]}}
+    cleaned = results.clean(value)
+    assert cleaned == {"f": 1.5, "s": "x", "n": None, "b": False, "i": 3, "7": [2.5, [0.5, 4]],
+                       "nested": {"list": [1.0, -0.0, True]}}
+    assert [type(v) for v in cleaned["7"][1]] == [float, int] and math.copysign(1.0, cleaned["nested"]["list"][1]) < 0
+    for bad in ({"a": math.inf}, {"a": [1.0, -math.inf]}, [{"a": math.nan}]):
+        with pytest.raises(SimulationError, match="non-finite value"):
+            results.clean(bad)
+
+
+def test_the_samples_after_the_kick_are_a_slice_where_they_are_the_last_ones():
+    """A run's time increases: the samples at or after the kick are a slice (views, not copies); any other time
+    column keeps its mask, so the same samples are selected either way."""
+    for time in (np.array([-0.2, -0.1, 0.0, 0.1]), np.array([0.0, 0.1]), np.array([-0.2, -0.1]), np.array([]),
+                 np.array([0.1, -0.1, 0.2]), np.array([-0.1, 0.1, -0.2])):
+        rows = results._after_kick(time)
+        assert np.array_equal(time[rows], time[time >= 0.0])
+        assert isinstance(rows, slice) == bool(np.all(np.diff((time >= 0.0).astype(int)) >= 0))
+
+
 def test_base_run_outputs(base):
     df, s = base.trajectory, base.summary
     assert not s["fell"] and s["fall_time_s"] is None

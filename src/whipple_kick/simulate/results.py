@@ -123,6 +123,21 @@ class _Units(Mapping):
 UNITS = _Units()
 
 
+def _column_units(columns):
+    """``{column: unit_of(column)}`` for ``columns``, the declared units read once (not once per column)."""
+    declared = None
+    units = {}
+    for column in columns:
+        if column in _BICYCLE_UNITS:
+            units[column] = _BICYCLE_UNITS[column]
+            continue
+        declared = _declared_units() if declared is None else declared
+        if column not in declared:
+            unit_of(column)   # its KeyError
+        units[column] = declared[column]
+    return units
+
+
 def unit_of(column):
     """The unit of trajectory column ``column`` (:data:`UNITS`); KeyError naming it if there is none."""
     try:
@@ -425,6 +440,14 @@ def _values(frame, column):
     return np.asarray(frame[column])
 
 
+def _after_kick(time):
+    """Which samples are at or after the kick start (``time >= 0``): a slice where they are the last ones, as in
+    every run (the columns' views then, not masked copies: the same values in the same order), else the mask."""
+    after = time >= 0.0
+    first = time.size - int(np.count_nonzero(after))
+    return slice(first, None) if after[first:].all() else after
+
+
 def _source(entry, traj, outs):
     """The values of one ``(name, source, index)`` entry of :func:`frame_layout` (a state or an output)."""
     _, source, index = entry
@@ -661,8 +684,12 @@ def clean(value):
         return value
     if kind is str or value is None:
         return value
+    if kind is dict:
+        return _clean_dict(value)
     if isinstance(value, dict):
         return {str(k): clean(v) for k, v in value.items()}
+    if kind is list or kind is tuple:
+        return [v if type(v) is float and math.isfinite(v) else clean(v) for v in value]
     if isinstance(value, (list, tuple, np.ndarray)):
         return [clean(v) for v in value]
     if isinstance(value, (np.bool_, bool)):
@@ -677,6 +704,19 @@ def clean(value):
     if isinstance(value, complex):
         return [clean(value.real), clean(value.imag)]
     return value
+
+
+def _clean_dict(value):
+    """:func:`clean` of a dict: its string keys and its finite float, string, None, bool and int leaves as they
+    are (each its own copy, as clean gives it), without a call per leaf; the rest through clean."""
+    out = {}
+    for k, v in value.items():
+        kind = type(v)
+        if kind is str or v is None or kind is bool or kind is int or (kind is float and math.isfinite(v)):
+            out[k if type(k) is str else str(k)] = v
+        else:
+            out[k if type(k) is str else str(k)] = clean(v)
+    return out
 
 
 def _rear_wheel_torque(steady, start_outputs):
@@ -704,7 +744,10 @@ def _energy_summary(df, jumps, scenario):
     """Totals of the energy accounting after the kick, the balance residual and the velocity jumps."""
     after = _values(df, "time") >= 0.0
     totals = {f"{column}_j": float(_values(df, column)[-1]) for column, _ in energy.COLUMNS.values()}
-    stored = sum(_values(df, c) for c in energy.STORED)
+    # The stored energy at the last sample and at the first one after the kick start, each summed as the
+    # whole column's sum would (the same terms, the same order), without the column.
+    kick = int(after.argmax()) if after.size else 0
+    stored = [sum(_values(df, c)[k] for c in energy.STORED) for k in (-1, kick)]
     dissipation = _values(df, "sliding_dissipation") + _values(df, "damper_dissipation")
     residual = np.abs(_values(df, BALANCE_COLUMN))
     return {
@@ -714,7 +757,7 @@ def _energy_summary(df, jumps, scenario):
                        "and arm dampers; balance residual = "
                        "change of stored - (works - dissipations)"),
         **totals,
-        "stored_change_after_kick_j": float(stored[-1] - stored[after][0]) if after.any() else 0.0,
+        "stored_change_after_kick_j": float(stored[0] - stored[1]) if after.size and after[kick] else 0.0,
         "balance_residual_max_abs_j": float(residual.max()),
         "dissipation_largest_decrease_j": float(max(0.0, -np.diff(dissipation).min())) if after.size > 1 else 0.0,
         "plate_stop": scenario.plate_stop,
@@ -774,7 +817,7 @@ def summarise(scenario, kick, assembly, solution, frame, *, custom_tyres=False) 
         "metrics_unavailable": unavailable,
         "numerics": _numerics_section(scenario, solution, frame),
         "scenario": scenario.to_dict(),
-        "units": {column: unit_of(column) for column in column_names(scenario.tyre_transient, solution.model)},
+        "units": _column_units(column_names(scenario.tyre_transient, solution.model)),
         "provenance": provenance.record(provenance.input_files(scenario, custom_tyres)),
     }
     # The declared criteria the sections above do not report (criteria.summary_section): their values [s].
@@ -851,7 +894,7 @@ def extrapolation(frame, rear, front):
     dict
         ``rear`` and ``front``.
     """
-    rows = _values(frame, "time") >= 0.0
+    rows = _after_kick(_values(frame, "time"))
 
     def after(column):   # the column's values after the kick start (no copy of the whole table)
         return _values(frame, column)[rows]
@@ -866,8 +909,9 @@ def extrapolation(frame, rear, front):
     for wheel, tyre in (("rear", rear), ("front", front)):
         measured = getattr(tyre, "measured", None)
         patch_column = f"slip_patch_{wheel}" if f"slip_patch_{wheel}" in frame else f"slip_{wheel}"
-        patch = np.degrees(np.abs(after(patch_column)))
         kinematic = np.degrees(np.abs(after(f"slip_{wheel}")))
+        # Where the form has no patch slip, it is the kinematic slip: the same values, computed once.
+        patch = kinematic if patch_column == f"slip_{wheel}" else np.degrees(np.abs(after(patch_column)))
         load = after(f"fz_{wheel}")
         entry = {"max_abs_patch_slip_deg": float(patch.max(initial=0.0)),
                  "max_abs_kinematic_slip_deg": float(kinematic.max(initial=0.0)),
@@ -878,10 +922,11 @@ def extrapolation(frame, rear, front):
         if measured is None:
             entry["measured"] = None
         else:
+            kinematic_beyond = seconds(kinematic > measured["slip_deg"])
             entry.update({
                 "measured": {"slip_deg": measured["slip_deg"], "load_n": [measured["load_min"], measured["load_max"]]},
-                "patch_slip_beyond_s": seconds(patch > measured["slip_deg"]),
-                "kinematic_slip_beyond_s": seconds(kinematic > measured["slip_deg"]),
+                "patch_slip_beyond_s": kinematic_beyond if patch is kinematic else seconds(patch > measured["slip_deg"]),
+                "kinematic_slip_beyond_s": kinematic_beyond,
                 "load_outside_s": seconds((load < measured["load_min"]) | (load > measured["load_max"])),
                 "duration_s": float(t[-1] - t[0]) if t.size else 0.0,
             })
@@ -949,10 +994,13 @@ def _steady_section(scenario, assembly, baseline, start_outputs):
     }
 
 
+#: The summary's key of each peak column's largest absolute value (the bicycle's columns: their units are fixed).
+_PEAK_KEYS = {name: f"max_abs_{name}_absolute_{unit_suffix(_BICYCLE_UNITS[name])}" for name in PEAK_COLUMNS}
+
+
 def _peaks(frame):
-    after = _values(frame, "time") >= 0.0
-    return {f"max_abs_{name}_absolute_{unit_suffix(UNITS[name])}":
-            float(np.max(np.abs(_values(frame, name)[after]), initial=0.0)) for name in PEAK_COLUMNS}
+    after = _after_kick(_values(frame, "time"))
+    return {key: float(np.max(np.abs(_values(frame, name)[after]), initial=0.0)) for name, key in _PEAK_KEYS.items()}
 
 
 def _numerics_section(scenario, solution, frame):
