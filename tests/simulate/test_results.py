@@ -395,7 +395,7 @@ def test_the_lean_path_refuses_a_non_finite_value_where_the_table_does():
 
 @pytest.mark.parametrize("columns", [[0, 1, 2, 4, 7, 8], [3], [], [8, 0, 5, 6]])
 def test_the_finite_check_looks_at_exactly_its_columns(columns):
-    # Runs of consecutive columns are checked as views: a NaN anywhere in a listed column fails, elsewhere not.
+    # The columns are summed at once: a NaN or an infinity anywhere in a listed column fails, elsewhere not.
     values = np.ones((4, 9))
     assert results._all_finite(values, columns)
     for k in range(9):
@@ -408,3 +408,7 @@ def test_the_finite_check_looks_at_exactly_its_columns(columns):
     assert results._all_finite(huge, columns)
     huge[1, 8] = -np.inf
     assert results._all_finite(huge, columns) == (8 not in columns)
+    # Infinities of both signs in one column (their sum is NaN) fail it as a NaN does, where the column is listed.
+    both = np.ones((4, 9))
+    both[0, 3], both[2, 3], both[1, 5] = np.inf, -np.inf, np.nan
+    assert results._all_finite(both, columns) == (3 not in columns and 5 not in columns)

@@ -382,9 +382,8 @@ def trajectory_columns(solution, tyre_transient="carcass", names=None):
         raise SimulationError("non-finite values in the trajectory")
     source = {name: entry for name, *entry in layout}
     columns = {"time": traj.t + 0.0}
-    for name, kind, index in layout:
-        if kind != "derived" and name in wanted:
-            columns[name] = _source((name, kind, index), traj, outs) + 0.0   # + 0.0: no -0.0, as in the table
+    for kind, values in (("state", traj.x), ("output", outs)):
+        columns.update(_copied(values, [(name, index) for name, k, index in layout if k == kind and name in wanted]))
     if wanted & set(HEADING_COLUMNS):
         yaw, vx, vy = (_source((c, *source[c]), traj, outs) for c in _HEADING_SOURCES)
         columns.update({name: value + 0.0 for name, value in heading_speeds(yaw, vx, vy).items()})
@@ -416,23 +415,34 @@ class _Column:
 
 
 def _all_finite(values, columns):
-    """Whether ``values[:, columns]`` is finite everywhere.
+    """Whether ``values[:, columns]`` is finite everywhere (``values``: a 2-D array of samples by column).
 
-    Each run of consecutive columns is summed as a view, without a copy or a
-    mask: a sum is finite only where every term is (a NaN or an infinity
-    carries through to it), so only a run whose sum is not (a non-finite
-    term, or finite terms overflowing) is looked at value by value.
+    Every column is summed at once, as the product of a row of ones with
+    ``values`` (one matrix-vector product over the whole array, without a
+    copy, a mask or a pass per run of columns: the row sums of strided views
+    cost ~3 M instructions a case): a sum is finite only where every term is
+    (a product with 1 is the term itself; a NaN or an infinity carries
+    through), so only a column whose sum is not (a non-finite term, or
+    finite terms overflowing) is looked at value by value. The columns not
+    asked about (the outputs left out, NaN) are not looked at.
     """
-    columns = sorted(columns)
-    start = 0
     with np.errstate(over="ignore", invalid="ignore"):   # an overflowing sum, inf - inf: not the caller's to hear
-        for k in range(1, len(columns) + 1):
-            if k == len(columns) or columns[k] != columns[k - 1] + 1:
-                run = values[:, columns[start]:columns[k - 1] + 1]
-                if not np.isfinite(run.sum()) and not np.isfinite(run).all():
-                    return False
-                start = k
-    return True
+        sums = np.ones(values.shape[0]) @ values
+    return all(np.isfinite(values[:, k]).all() for k in columns if not math.isfinite(sums[k]))
+
+
+def _copied(values, entries):
+    """``{name: values[:, index] + 0.0}`` for the ``(name, index)`` entries (+ 0.0: no -0.0, as in the table).
+
+    The columns are copied in one gather, each a contiguous row of the copy,
+    and + 0.0 is added in place: the same values as a copy of each column
+    plus 0.0, at half the cost.
+    """
+    if not entries:
+        return {}
+    block = values.T[[index for _, index in entries]]
+    block += 0.0
+    return {name: row for (name, _), row in zip(entries, block, strict=True)}
 
 
 def _values(frame, column):
