@@ -56,6 +56,16 @@ def test_the_samples_after_the_kick_are_a_slice_where_they_are_the_last_ones():
         assert isinstance(rows, slice) == bool(np.all(np.diff((time >= 0.0).astype(int)) >= 0))
 
 
+def test_the_peaks_are_kick_metrics_largest_values(base):
+    """The summary's peaks take kick_metrics' largest absolute values after the kick where it has them: the same
+    numbers as the section finds by itself."""
+    from whipple_kick.simulate import analysis
+    metrics = analysis.kick_metrics(base.trajectory, include_spectra=False)
+    known = {n: metrics[f"max_abs_{n}"] for n in results.PEAK_COLUMNS if metrics.get(f"max_abs_{n}") is not None}
+    assert len(known) == len(results.PEAK_COLUMNS) - 1   # all but the steer torque
+    assert results._peaks(base.trajectory, known) == results._peaks(base.trajectory, {}) == base.summary["peaks"]
+
+
 def test_base_run_outputs(base):
     df, s = base.trajectory, base.summary
     assert not s["fell"] and s["fall_time_s"] is None

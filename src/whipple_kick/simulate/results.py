@@ -801,6 +801,9 @@ def summarise(scenario, kick, assembly, solution, frame, *, custom_tyres=False) 
     # Derivatives and outputs at the start state, read by the steady and carcass sections.
     start_outputs = slip.CompiledRHS(assembly.start.params).outputs(0.0, assembly.start.x)
     metrics, recovery = response_metrics(frame, baseline, assembly.reference.x, scenario, traj)
+    # kick_metrics' largest absolute values after the kick (DUPLICATE_METRICS) are the peaks section's: the same
+    # samples, the same maximum; it has them where it had a response to analyse.
+    largest = {name: metrics[f"max_abs_{name}"] for name in PEAK_COLUMNS if metrics.get(f"max_abs_{name}") is not None}
     recovery = _recovery_section(recovery, rate_baselines(assembly.reference.x))
     metrics, unavailable = _summary_metrics(metrics)
     summary = {
@@ -820,7 +823,7 @@ def summarise(scenario, kick, assembly, solution, frame, *, custom_tyres=False) 
         "linear_stability": assembly.stability,
         "kick": kick.summary(scenario.kick_direction),
         "steady_state": _steady_section(scenario, assembly, baseline, start_outputs),
-        "peaks": _peaks(frame),
+        "peaks": _peaks(frame, largest),
         "energy": _energy_summary(frame, solution.jumps, scenario),
         "recovery": recovery,
         "metrics": metrics,
@@ -1008,9 +1011,12 @@ def _steady_section(scenario, assembly, baseline, start_outputs):
 _PEAK_KEYS = {name: f"max_abs_{name}_absolute_{unit_suffix(_BICYCLE_UNITS[name])}" for name in PEAK_COLUMNS}
 
 
-def _peaks(frame):
-    after = _after_kick(_values(frame, "time"))
-    return {key: float(np.max(np.abs(_values(frame, name)[after]), initial=0.0)) for name, key in _PEAK_KEYS.items()}
+def _peaks(frame, known):
+    """The largest absolute value of each of :data:`PEAK_COLUMNS` after the kick (0 without a sample there), those
+    of ``known`` ({column: value}, found already) as they are."""
+    after = _after_kick(_values(frame, "time")) if len(known) < len(_PEAK_KEYS) else None
+    return {key: known[name] if name in known else float(np.max(np.abs(_values(frame, name)[after]), initial=0.0))
+            for name, key in _PEAK_KEYS.items()}
 
 
 def _numerics_section(scenario, solution, frame):
