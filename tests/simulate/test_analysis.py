@@ -462,3 +462,29 @@ def test_several_signals_of_one_record_are_checked_as_each_alone():
     late[3] = late[2]
     with pytest.raises(InputError, match="time must be strictly increasing"):
         an.kick_metrics({"time": late, "yaw_rate": x})
+
+
+def _forward_filled_lobes(x, band):
+    """The half-waves by the definition: the sign (+1 above the band, -1 below, 0 in it) forward-filled over the
+    samples in the band, split where it changes; the samples before the band is first left are in none."""
+    raw = np.where(x > band, 1, np.where(x < -band, -1, 0))
+    last = np.where(raw != 0, np.arange(x.size), 0)
+    state = raw[np.maximum.accumulate(last)]
+    edges = np.flatnonzero(np.diff(state)) + 1
+    starts, stops = np.concatenate(([0], edges)), np.concatenate((edges, [x.size]))
+    return [(int(a), int(b), int(state[a])) for a, b in zip(starts, stops, strict=True) if state[a] != 0]
+
+
+def test_half_waves_are_the_forward_filled_sign():
+    rng = np.random.default_rng(3)
+    for trial in range(2000):
+        n = int(rng.integers(1, 50))
+        x = rng.normal(size=n) * rng.choice([0.1, 1.0, 10.0])
+        if trial % 3 == 0:
+            x[:rng.integers(0, n)] = 0.0   # a start inside the band
+        band = float(abs(rng.normal())) * rng.choice([0.0, 0.5, 1.0])
+        if trial % 7 == 0:
+            x[rng.integers(0, n)] = band   # on the band's edge: inside it
+        lobes = an._lobes(x, band)
+        assert [(int(a), int(b), s) for a, b, s in lobes] == _forward_filled_lobes(x, band), (x, band)
+        assert all(type(s) is int for _, _, s in lobes)

@@ -219,16 +219,17 @@ def _lobes(x, band):
     half-waves. Returns a list of (start, stop, sign) slices; samples before
     the signal first leaves the band belong to no lobe.
     """
-    # The sign as int8 (1 above the band, -1 below it, 0 in it: the band is never negative, so not both).
-    raw = (x > band).view(np.int8) - (x < -band).view(np.int8)
-    last = np.arange(x.size)
-    last *= raw != 0   # each sample's index, 0 inside the band
-    np.maximum.accumulate(last, out=last)
-    state = raw[last]  # forward-filled sign; 0 until the band is first left
-    edges = np.flatnonzero(np.diff(state)) + 1
-    starts = np.concatenate(([0], edges))
-    stops = np.concatenate((edges, [x.size]))
-    return [(a, b, int(state[a])) for a, b in zip(starts, stops, strict=True) if state[a] != 0]
+    # A half-wave starts at each sample outside the band whose side differs from the previous such sample's
+    # (the first such sample starts the first one), and ends where the next starts: the sign forward-filled
+    # over the samples in the band, without filling it.
+    above, below = x > band, x < -band
+    outside = np.flatnonzero(above | below)
+    if not outside.size:
+        return []
+    side = above[outside]   # True above the band, False below it
+    starts = outside[np.concatenate(([0], np.flatnonzero(side[1:] != side[:-1]) + 1))]
+    stops = np.concatenate((starts[1:], [x.size]))
+    return [(a, b, 1 if up else -1) for a, b, up in zip(starts, stops, above[starts], strict=True)]
 
 
 def _refine(t, x, i, points):
@@ -355,7 +356,7 @@ def _peaks_of(t, x, t_kick, threshold, hysteresis, baseline, refine_points):
     # neither is a turning point.
     cand, open_end = [], False
     for a, b, sign in _lobes(xw, hysteresis * scale):
-        i = a + int(np.argmax(sign * xw[a:b]))
+        i = a + int(xw[a:b].argmax() if sign > 0 else xw[a:b].argmin())   # the first of equal extremes, as before
         if i == 0:
             continue
         if i == xw.size - 1:
