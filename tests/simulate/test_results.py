@@ -286,6 +286,29 @@ def test_extrapolation_gives_the_true_load_extremes(base):
     assert base.summary["tyres"]["extrapolation"]["rear"]["min_load_n"] == pytest.approx(525.3, abs=2.5)
 
 
+@pytest.mark.parametrize("slip_deg, load_min, load_max", [(2.0, 400.0, 700.0), (50.0, 100.0, 2000.0),
+                                                         (5.5, 560.0, 2000.0), (50.0, 100.0, 640.0)])
+def test_extrapolation_times_are_the_samples_beyond_the_measured_ranges(slip_deg, load_min, load_max):
+    """Each time outside a measured range sums the sample intervals of the samples outside it (0.0 where none is),
+    whether the largest value reaches past the range or not."""
+    import types
+    t = np.linspace(-0.5, 1.0, 151)
+    wave = np.sin(7.0 * t)
+    frame = {"time": t, "slip_rear": np.radians(6.0) * wave, "slip_front": np.radians(3.0) * wave,
+             "slip_patch_rear": np.radians(5.0) * wave, "fz_rear": 600.0 + 50.0 * wave, "fz_front": 400.0 - 30.0 * wave}
+    tyre = types.SimpleNamespace(measured={"slip_deg": slip_deg, "load_min": load_min, "load_max": load_max})
+    out = results.extrapolation(frame, tyre, tyre)
+    after = t >= 0.0
+    dt = np.diff(t[after], append=t[-1])
+    for wheel, patch in (("rear", "slip_patch_rear"), ("front", "slip_front")):
+        kinematic = np.degrees(np.abs(frame[f"slip_{wheel}"][after]))
+        load = frame[f"fz_{wheel}"][after]
+        e = out[wheel]
+        assert e["kinematic_slip_beyond_s"] == float(np.sum(dt[kinematic > slip_deg]))
+        assert e["patch_slip_beyond_s"] == float(np.sum(dt[np.degrees(np.abs(frame[patch][after])) > slip_deg]))
+        assert e["load_outside_s"] == float(np.sum(dt[(load < load_min) | (load > load_max)]))
+
+
 def _saved_run(folder, rows=600):
     """A short run saved in ``folder`` (0.1 s settle + 0.5 s at 1000 Hz: 601 rows)."""
     result = run(Scenario(duration=0.5, settle=0.1))

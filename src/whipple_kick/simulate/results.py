@@ -918,6 +918,10 @@ def extrapolation(frame, rear, front):
     def seconds(mask):
         return float(np.sum(dt[mask]))
 
+    def beyond(values, largest, limit):
+        # seconds(values > limit): none is beyond where their largest is not (then the sum of none, 0.0)
+        return seconds(values > limit) if largest > limit else 0.0
+
     out = {}
     for wheel, tyre in (("rear", rear), ("front", front)):
         measured = getattr(tyre, "measured", None)
@@ -935,12 +939,15 @@ def extrapolation(frame, rear, front):
         if measured is None:
             entry["measured"] = None
         else:
-            kinematic_beyond = seconds(kinematic > measured["slip_deg"])
+            slip_limit, low, high = measured["slip_deg"], measured["load_min"], measured["load_max"]
+            kinematic_beyond = beyond(kinematic, entry["max_abs_kinematic_slip_deg"], slip_limit)
+            inside = load.size and low <= entry["min_load_n"] and entry["max_load_n"] <= high   # no sample outside
             entry.update({
-                "measured": {"slip_deg": measured["slip_deg"], "load_n": [measured["load_min"], measured["load_max"]]},
-                "patch_slip_beyond_s": kinematic_beyond if patch is kinematic else seconds(patch > measured["slip_deg"]),
+                "measured": {"slip_deg": slip_limit, "load_n": [low, high]},
+                "patch_slip_beyond_s": (kinematic_beyond if patch is kinematic
+                                        else beyond(patch, entry["max_abs_patch_slip_deg"], slip_limit)),
                 "kinematic_slip_beyond_s": kinematic_beyond,
-                "load_outside_s": seconds((load < measured["load_min"]) | (load > measured["load_max"])),
+                "load_outside_s": 0.0 if inside else seconds((load < low) | (load > high)),
                 "duration_s": float(t[-1] - t[0]) if t.size else 0.0,
             })
         out[wheel] = entry
