@@ -419,7 +419,7 @@ def _all_finite(values, columns):
 
     Every column is summed at once, as the product of a row of ones with
     ``values`` (one matrix-vector product over the whole array, without a
-    copy, a mask or a pass per run of columns: the row sums of strided views
+    copy, a mask or a pass per run of columns: the sums of strided 2-D views
     cost ~3 M instructions a case): a sum is finite only where every term is
     (a product with 1 is the term itself; a NaN or an infinity carries
     through), so only a column whose sum is not (a non-finite term, or
