@@ -427,3 +427,64 @@ def test_recovery_is_the_latest_of_yaw_roll_and_steer_settling():
     assert all(v["time_s"] is None and v["first_peak_rad_s"] > 0 for v in fell["signals"].values())
     with pytest.raises(InputError, match="'steer_rate'"):
         an.recovery({"time": t, "yaw_rate": yaw, "roll_rate": roll})
+
+
+def test_the_peak_parabola_is_polyfit_bit_for_bit():
+    """The refinement's own least-squares parabola gives numpy.polyfit's coefficients exactly (same matrix, same
+    solve), on 3 and on more samples, and warns as polyfit does where the samples cannot fix a parabola."""
+    rng = np.random.default_rng(7)
+    for n in (3, 3, 3, 5, 7, 21):
+        x = np.sort(rng.normal(size=n)) * 10.0 ** rng.integers(-4, 2)
+        x -= x[n // 2]   # centred, as the refinement fits them (an exact 0.0 in the middle)
+        y = rng.normal(size=n) * 10.0 ** rng.integers(-3, 3)
+        assert an._parabola(x, y).tobytes() == np.polyfit(x, y, 2).tobytes()
+    same = np.array([-1.0, -1.0, 1.0])   # two distinct samples: rank 2
+    rank_warning = getattr(np, "exceptions", np).RankWarning
+    with pytest.warns(rank_warning, match="Polyfit may be poorly conditioned"):
+        fitted = an._parabola(same, np.array([1.0, 2.0, 3.0]))
+    with pytest.warns(rank_warning):
+        assert fitted.tobytes() == np.polyfit(same, np.array([1.0, 2.0, 3.0]), 2).tobytes()
+
+
+def test_several_signals_of_one_record_are_checked_as_each_alone():
+    """kick_metrics and recovery check the shared time once, and each signal as _as_series would."""
+    t = np.arange(0.0, 2.0, 1e-3)
+    x = damped(t)
+    bad = x.copy()
+    bad[[5, 9]] = np.nan
+    with pytest.raises(InputError, match="roll rate has 2 NaN/inf values"):
+        an.recovery({"time": t, "yaw_rate": x, "roll_rate": bad, "steer_rate": x})
+    with pytest.raises(InputError, match=r"time and steer rate must be 1-D arrays of equal length"):
+        an.recovery({"time": t, "yaw_rate": x, "roll_rate": x, "steer_rate": x[:-1]})
+    with pytest.raises(InputError, match="roll has 2 NaN/inf values"):
+        an.kick_metrics({"time": t, "yaw_rate": x, "roll": bad})
+    late = t.copy()
+    late[3] = late[2]
+    with pytest.raises(InputError, match="time must be strictly increasing"):
+        an.kick_metrics({"time": late, "yaw_rate": x})
+
+
+def _forward_filled_lobes(x, band):
+    """The half-waves by the definition: the sign (+1 above the band, -1 below, 0 in it) forward-filled over the
+    samples in the band, split where it changes; the samples before the band is first left are in none."""
+    raw = np.where(x > band, 1, np.where(x < -band, -1, 0))
+    last = np.where(raw != 0, np.arange(x.size), 0)
+    state = raw[np.maximum.accumulate(last)]
+    edges = np.flatnonzero(np.diff(state)) + 1
+    starts, stops = np.concatenate(([0], edges)), np.concatenate((edges, [x.size]))
+    return [(int(a), int(b), int(state[a])) for a, b in zip(starts, stops, strict=True) if state[a] != 0]
+
+
+def test_half_waves_are_the_forward_filled_sign():
+    rng = np.random.default_rng(3)
+    for trial in range(2000):
+        n = int(rng.integers(1, 50))
+        x = rng.normal(size=n) * rng.choice([0.1, 1.0, 10.0])
+        if trial % 3 == 0:
+            x[:rng.integers(0, n)] = 0.0   # a start inside the band
+        band = float(abs(rng.normal())) * rng.choice([0.0, 0.5, 1.0])
+        if trial % 7 == 0:
+            x[rng.integers(0, n)] = band   # on the band's edge: inside it
+        lobes = an._lobes(x, band)
+        assert [(int(a), int(b), s) for a, b, s in lobes] == _forward_filled_lobes(x, band), (x, band)
+        assert all(type(s) is int for _, _, s in lobes)

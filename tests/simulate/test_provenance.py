@@ -40,6 +40,25 @@ def test_kick_table_is_recorded_by_absolute_path_and_hash(tmp_path, monkeypatch)
     assert "tyre" not in provenance.input_files(wk.Scenario(), custom_tyres=True)
 
 
+def test_a_resolved_path_is_kept_while_the_file_it_names_is_the_same(tmp_path, monkeypatch):
+    """Kept per process (a sweep's every case records the same files), yet a link pointed at another file, or a
+    relative name in another folder, resolves afresh: the file it names has another stat."""
+    from whipple_kick import fileio
+    monkeypatch.setattr(fileio, "SETTLED_S", -1.0)   # every file counts as settled: the kept answer is used
+    for folder in ("a", "b"):
+        (tmp_path / folder).mkdir()
+        (tmp_path / folder / "plate.csv").write_text(f"time,y\n0,0\n0.15,0.15 # {folder}\n")
+    link = tmp_path / "link.csv"
+    link.symlink_to(tmp_path / "a" / "plate.csv")
+    assert provenance.resolved(link) == provenance.resolved(link) == str(tmp_path / "a" / "plate.csv")
+    link.unlink()
+    link.symlink_to(tmp_path / "b" / "plate.csv")
+    assert provenance.resolved(link) == str(tmp_path / "b" / "plate.csv")
+    for folder in ("a", "b"):
+        monkeypatch.chdir(tmp_path / folder)
+        assert provenance.resolved(pathlib.Path("plate.csv")) == str(tmp_path / folder / "plate.csv")
+
+
 def test_no_git_commit_outside_a_checkout(tmp_path):
     assert provenance.git_state(tmp_path) is None
 

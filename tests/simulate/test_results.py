@@ -32,6 +32,40 @@ def test_clean_refuses_what_json_cannot_hold():
         results.clean({"a": [0.0, math.nan]})
 
 
+def test_clean_keeps_every_leaf_of_a_plain_dict_and_list():
+    """The plain dicts' and lists' leaves are kept as clean gives them (floats, strings, None, bools, ints); the
+    others still go through clean (a numpy scalar, a tuple, a non-string key, a non-finite float)."""
+    value = {"f": 1.5, "s": "x", "n": None, "b": False, "i": 3, 7: (np.float64(2.5), [0.5, np.int64(4)]),
+             "nested": {"list": [1.0, -0.0, True]}}
+    cleaned = results.clean(value)
+    assert cleaned == {"f": 1.5, "s": "x", "n": None, "b": False, "i": 3, "7": [2.5, [0.5, 4]],
+                       "nested": {"list": [1.0, -0.0, True]}}
+    assert [type(v) for v in cleaned["7"][1]] == [float, int] and math.copysign(1.0, cleaned["nested"]["list"][1]) < 0
+    for bad in ({"a": math.inf}, {"a": [1.0, -math.inf]}, [{"a": math.nan}]):
+        with pytest.raises(SimulationError, match="non-finite value"):
+            results.clean(bad)
+
+
+def test_the_samples_after_the_kick_are_a_slice_where_they_are_the_last_ones():
+    """A run's time increases: the samples at or after the kick are a slice (views, not copies); any other time
+    column keeps its mask, so the same samples are selected either way."""
+    for time in (np.array([-0.2, -0.1, 0.0, 0.1]), np.array([0.0, 0.1]), np.array([-0.2, -0.1]), np.array([]),
+                 np.array([0.1, -0.1, 0.2]), np.array([-0.1, 0.1, -0.2])):
+        rows = results._after_kick(time)
+        assert np.array_equal(time[rows], time[time >= 0.0])
+        assert isinstance(rows, slice) == bool(np.all(np.diff((time >= 0.0).astype(int)) >= 0))
+
+
+def test_the_peaks_are_kick_metrics_largest_values(base):
+    """The summary's peaks take kick_metrics' largest absolute values after the kick where it has them: the same
+    numbers as the section finds by itself."""
+    from whipple_kick.simulate import analysis
+    metrics = analysis.kick_metrics(base.trajectory, include_spectra=False)
+    known = {n: metrics[f"max_abs_{n}"] for n in results.PEAK_COLUMNS if metrics.get(f"max_abs_{n}") is not None}
+    assert len(known) == len(results.PEAK_COLUMNS) - 1   # all but the steer torque
+    assert results._peaks(base.trajectory, known) == results._peaks(base.trajectory, {}) == base.summary["peaks"]
+
+
 def test_base_run_outputs(base):
     df, s = base.trajectory, base.summary
     assert not s["fell"] and s["fall_time_s"] is None
@@ -252,6 +286,29 @@ def test_extrapolation_gives_the_true_load_extremes(base):
     assert base.summary["tyres"]["extrapolation"]["rear"]["min_load_n"] == pytest.approx(525.3, abs=2.5)
 
 
+@pytest.mark.parametrize("slip_deg, load_min, load_max", [(2.0, 400.0, 700.0), (50.0, 100.0, 2000.0),
+                                                         (5.5, 560.0, 2000.0), (50.0, 100.0, 640.0)])
+def test_extrapolation_times_are_the_samples_beyond_the_measured_ranges(slip_deg, load_min, load_max):
+    """Each time outside a measured range sums the sample intervals of the samples outside it (0.0 where none is),
+    whether the largest value reaches past the range or not."""
+    import types
+    t = np.linspace(-0.5, 1.0, 151)
+    wave = np.sin(7.0 * t)
+    frame = {"time": t, "slip_rear": np.radians(6.0) * wave, "slip_front": np.radians(3.0) * wave,
+             "slip_patch_rear": np.radians(5.0) * wave, "fz_rear": 600.0 + 50.0 * wave, "fz_front": 400.0 - 30.0 * wave}
+    tyre = types.SimpleNamespace(measured={"slip_deg": slip_deg, "load_min": load_min, "load_max": load_max})
+    out = results.extrapolation(frame, tyre, tyre)
+    after = t >= 0.0
+    dt = np.diff(t[after], append=t[-1])
+    for wheel, patch in (("rear", "slip_patch_rear"), ("front", "slip_front")):
+        kinematic = np.degrees(np.abs(frame[f"slip_{wheel}"][after]))
+        load = frame[f"fz_{wheel}"][after]
+        e = out[wheel]
+        assert e["kinematic_slip_beyond_s"] == float(np.sum(dt[kinematic > slip_deg]))
+        assert e["patch_slip_beyond_s"] == float(np.sum(dt[np.degrees(np.abs(frame[patch][after])) > slip_deg]))
+        assert e["load_outside_s"] == float(np.sum(dt[(load < load_min) | (load > load_max)]))
+
+
 def _saved_run(folder, rows=600):
     """A short run saved in ``folder`` (0.1 s settle + 0.5 s at 1000 Hz: 601 rows)."""
     result = run(Scenario(duration=0.5, settle=0.1))
@@ -371,7 +428,7 @@ def test_the_lean_path_refuses_a_non_finite_value_where_the_table_does():
 
 @pytest.mark.parametrize("columns", [[0, 1, 2, 4, 7, 8], [3], [], [8, 0, 5, 6]])
 def test_the_finite_check_looks_at_exactly_its_columns(columns):
-    # Runs of consecutive columns are checked as views: a NaN anywhere in a listed column fails, elsewhere not.
+    # The columns are summed at once: a NaN or an infinity anywhere in a listed column fails, elsewhere not.
     values = np.ones((4, 9))
     assert results._all_finite(values, columns)
     for k in range(9):
@@ -384,3 +441,7 @@ def test_the_finite_check_looks_at_exactly_its_columns(columns):
     assert results._all_finite(huge, columns)
     huge[1, 8] = -np.inf
     assert results._all_finite(huge, columns) == (8 not in columns)
+    # Infinities of both signs in one column (their sum is NaN) fail it as a NaN does, where the column is listed.
+    both = np.ones((4, 9))
+    both[0, 3], both[2, 3], both[1, 5] = np.inf, -np.inf, np.nan
+    assert results._all_finite(both, columns) == (3 not in columns and 5 not in columns)

@@ -30,6 +30,17 @@ def test_defaults_are_the_thesis_settings_and_validate_returns_the_scenario():
     json.dumps(sc.to_dict(), allow_nan=False)
 
 
+def test_to_dict_is_asdict():
+    """to_dict gives asdict's dict (fields in order, the values themselves), and asdict's deep copy of a field
+    that is not a plain value (never one of a checked scenario, but the dataclass allows it)."""
+    import dataclasses
+    sc = Scenario(pressure_kpa=300.0, tyre_transient="contact_patch")
+    assert list(sc.to_dict().items()) == list(dataclasses.asdict(sc).items())
+    odd = dataclasses.replace(sc, kick_table=["rows"])   # not a scenario to run: only what to_dict makes of it
+    out = odd.to_dict()
+    assert out == dataclasses.asdict(odd) and out["kick_table"] is not odd.kick_table
+
+
 def test_with_changes_copies_and_leaves_the_original():
     sc = Scenario()
     other = sc.with_changes(pressure_kpa=300.0, fz_n=701.0)

@@ -35,6 +35,7 @@ A metric that cannot be computed is never NaN: low-level functions raise
 from dataclasses import dataclass
 import math
 import pathlib
+import warnings
 
 import numpy as np
 import pandas as pd
@@ -140,17 +141,37 @@ def _as_series(t, signal, name="signal"):
     t = np.asarray(t, dtype=float)
     x = np.asarray(signal, dtype=float)
     if t.ndim != 1 or x.shape != t.shape:
-        raise InputError(
-            f"time and {name} must be 1-D arrays of equal length, got shapes {t.shape} and {x.shape}")
+        _unequal(t, x, name)
     if t.size < 3:
         raise InputError(f"{name} needs at least 3 samples, got {t.size}")
-    for label, arr in (("time", t), (name, x)):
-        bad = np.count_nonzero(~np.isfinite(arr))
-        if bad:
-            raise InputError(f"{label} has {bad} NaN/inf values; drop or interpolate them first")
-    if np.any(np.diff(t) <= 0):
+    _check_finite(t, "time")
+    if x is not t:   # a time checked against itself is checked once
+        _check_finite(x, name)
+    # t[1:] <= t[:-1] is diff(t) <= 0 for finite times, without the differences' array.
+    if np.any(t[1:] <= t[:-1]):
         raise InputError("time must be strictly increasing (s); found a repeated or decreasing sample")
     return t, x
+
+
+def _as_signal(t, signal, name):
+    """``_as_series(t, signal, name)[1]`` for a time ``t`` that :func:`_as_series` accepted: only the signal's
+    checks are left (several signals of one record share its time)."""
+    x = np.asarray(signal, dtype=float)
+    if x.shape != t.shape:
+        _unequal(t, x, name)
+    _check_finite(x, name)
+    return x
+
+
+def _unequal(t, x, name):
+    raise InputError(f"time and {name} must be 1-D arrays of equal length, got shapes {t.shape} and {x.shape}")
+
+
+def _check_finite(values, label):
+    """InputError counting the NaN/inf of ``values`` if there are any."""
+    if not np.isfinite(values).all():
+        bad = np.count_nonzero(~np.isfinite(values))
+        raise InputError(f"{label} has {bad} NaN/inf values; drop or interpolate them first")
 
 
 def _is_uniform(t):
@@ -198,14 +219,17 @@ def _lobes(x, band):
     half-waves. Returns a list of (start, stop, sign) slices; samples before
     the signal first leaves the band belong to no lobe.
     """
-    raw = np.where(x > band, 1, np.where(x < -band, -1, 0))
-    last = np.where(raw != 0, np.arange(x.size), 0)
-    np.maximum.accumulate(last, out=last)
-    state = raw[last]  # forward-filled sign; 0 until the band is first left
-    edges = np.flatnonzero(np.diff(state)) + 1
-    starts = np.concatenate(([0], edges))
-    stops = np.concatenate((edges, [x.size]))
-    return [(a, b, int(state[a])) for a, b in zip(starts, stops, strict=True) if state[a] != 0]
+    # A half-wave starts at each sample outside the band whose side differs from the previous such sample's
+    # (the first such sample starts the first one), and ends where the next starts: the sign forward-filled
+    # over the samples in the band, without filling it.
+    above, below = x > band, x < -band
+    outside = np.flatnonzero(above | below)
+    if not outside.size:
+        return []
+    side = above[outside]   # True above the band, False below it
+    starts = outside[np.concatenate(([0], np.flatnonzero(side[1:] != side[:-1]) + 1))]
+    stops = np.concatenate((starts[1:], [x.size]))
+    return [(a, b, 1 if up else -1) for a, b, up in zip(starts, stops, above[starts], strict=True)]
 
 
 def _refine(t, x, i, points):
@@ -224,13 +248,41 @@ def _refine(t, x, i, points):
         if lo < 0 or hi > x.size:
             continue
         tc = t[lo:hi] - t[i]  # centred for conditioning
-        a, b, c = np.polyfit(tc, x[lo:hi], 2)
+        a, b, c = _parabola(tc, x[lo:hi])
         if a * np.sign(x[i]) >= 0:
             continue
         tv = -b / (2 * a)
         if tc[0] <= tv <= tc[-1]:
             return t[i] + tv, c - b * b / (4 * a)
     return t[i], x[i]
+
+
+def _parabola(x, y):
+    """``numpy.polyfit(x, y, 2)`` of 1-D float arrays of at least 3 samples, bit for bit, without its overhead.
+
+    The same scaled Vandermonde matrix, the same least-squares call
+    (:func:`numpy.linalg.lstsq`, with polyfit's ``rcond``) and the same
+    unscaling, hence the same coefficients; the same warning when the
+    matrix is rank-deficient. A sweep case refines ~14 peaks, and polyfit's
+    argument handling cost about as much as its solve.
+    """
+    x = x + 0.0   # as polyfit: no -0.0
+    lhs = np.empty((x.size, 3))
+    lhs[:, 0] = x * x   # np.vander(x, 3): x**2 as multiply.accumulate makes it, x, 1
+    lhs[:, 1] = x
+    lhs[:, 2] = 1.0
+    scale = np.sqrt((lhs * lhs).sum(axis=0))
+    lhs /= scale
+    c, _, rank, _ = np.linalg.lstsq(lhs, y + 0.0, x.size * _EPS)
+    if rank != 3:
+        warnings.warn("Polyfit may be poorly conditioned", _RANK_WARNING, stacklevel=2)
+    return c / scale
+
+
+#: Machine epsilon of float64 (polyfit's ``rcond`` is the number of samples times it).
+_EPS = float(np.finfo(float).eps)
+#: polyfit's warning class (numpy.exceptions from NumPy 1.25 on).
+_RANK_WARNING = getattr(np, "exceptions", np).RankWarning
 
 
 def yaw_rate_peaks(t, signal, t_kick=0.0, threshold=0.08, *, hysteresis=None,
@@ -266,6 +318,11 @@ def yaw_rate_peaks(t, signal, t_kick=0.0, threshold=0.08, *, hysteresis=None,
     PeakSeries
     """
     t, x = _as_series(t, signal, "yaw rate")
+    return _peaks_of(t, x, t_kick, threshold, hysteresis, baseline, refine_points)
+
+
+def _peaks_of(t, x, t_kick, threshold, hysteresis, baseline, refine_points):
+    """:func:`yaw_rate_peaks` of the float arrays ``t``, ``x`` that :func:`_as_series` accepted."""
     threshold = check_range("threshold", threshold, 0.0, 1.0, "(fraction of largest peak)",
                             low_open=True, high_open=True)
     hysteresis = threshold / 2 if hysteresis is None else check_range(
@@ -299,7 +356,7 @@ def yaw_rate_peaks(t, signal, t_kick=0.0, threshold=0.08, *, hysteresis=None,
     # neither is a turning point.
     cand, open_end = [], False
     for a, b, sign in _lobes(xw, hysteresis * scale):
-        i = a + int(np.argmax(sign * xw[a:b]))
+        i = a + int(xw[a:b].argmax() if sign > 0 else xw[a:b].argmin())   # the first of equal extremes, as before
         if i == 0:
             continue
         if i == xw.size - 1:
@@ -459,18 +516,25 @@ def settling_time(t, signal, t_kick=0.0, baseline=0.0, *, fraction=SETTLING_FRAC
     2.877
     """
     t, x = _as_series(t, signal, label)
+    return _settling(t, x, t_kick, baseline, fraction, first_peak_fraction, label)
+
+
+def _settling(t, x, t_kick, baseline, fraction, first_peak_fraction, label):
+    """:func:`settling_time` of the float arrays ``t``, ``x`` that :func:`_as_series` accepted."""
     fraction = check_range("settling band fraction", fraction, 0.0, 1.0, "(of the first peak)", low_open=True)
     if t[-1] <= t_kick:
         return Settling(None, None, f"the record ends before the kick (t = {t[-1]:.3f} s)")
-    peaks = yaw_rate_peaks(t, x, t_kick, threshold=first_peak_fraction, baseline=baseline)
+    peaks = _peaks_of(t, x, t_kick, first_peak_fraction, None, baseline, 3)
     if len(peaks) == 0:
         return Settling(None, None, f"no {label} peak after the kick")
     peak = float(abs(peaks.values[0]))
-    outside = np.flatnonzero((t >= t_kick) & (np.abs(x - baseline) > fraction * peak))
-    if outside.size and outside[-1] == t.size - 1:
+    # The samples from the kick on are a run (time increases): the search looks at them only.
+    first = int(np.searchsorted(t, t_kick))
+    outside = np.flatnonzero(np.abs(x[first:] - baseline) > fraction * peak)
+    if outside.size and outside[-1] == t.size - 1 - first:
         return Settling(None, peak, f"{label} still outside {fraction:.0%} of its first peak at the end "
                                     f"of the record ({t[-1] - t_kick:.3f} s after the kick)")
-    j = outside[-1] + 1 if outside.size else int(np.searchsorted(t, t_kick))
+    j = first + outside[-1] + 1 if outside.size else first
     return Settling(float(t[j] - t_kick), peak, None)
 
 
@@ -512,13 +576,18 @@ def recovery(data, t_kick=0.0, baselines=None, *, ended=None):
     (2.877, True)
     """
     baselines = dict(baselines or {})
-    signals = {}
+    signals, t = {}, None
     for name, unit in RECOVERY_SIGNALS.items():
         if name not in data:
             raise InputError(f"column {name!r} ({unit}) is missing; recovery needs "
                              f"{', '.join(RECOVERY_SIGNALS)}")
-        s = settling_time(np.asarray(data["time"], dtype=float), np.asarray(data[name], dtype=float),
-                          t_kick, float(baselines.get(name, 0.0)), label=name.replace("_", " "))
+        label = name.replace("_", " ")
+        if t is None:   # the record's time, checked once with its first signal
+            t, x = _as_series(data["time"], data[name], label)
+        else:
+            x = _as_signal(t, data[name], label)
+        s = _settling(t, x, t_kick, float(baselines.get(name, 0.0)), SETTLING_FRACTION, FIRST_PEAK_FRACTION,
+                      label)
         time, reason = (None, ended) if ended is not None else (s.time, s.reason)
         signals[name] = {f"first_peak_{unit.replace('/', '_')}": s.first_peak, "time_s": time, "reason": reason}
     unsettled = [name for name, v in signals.items() if v["time_s"] is None]
@@ -712,8 +781,10 @@ def _columns(data):
             except (TypeError, ValueError):
                 raise InputError(f"column {name!r} ({COLUMNS[name]}) must be numeric") from None
     t = cols["time"]
+    _as_series(t, t, "time")   # the time once; then each signal against it
     for name, arr in cols.items():
-        _as_series(t, arr, name)
+        if arr is not t:
+            _as_signal(t, arr, name)
     return cols
 
 
@@ -757,8 +828,7 @@ def kick_metrics(data, t_kick=0.0, threshold=0.08, *, baseline=0.0, lowpass_hz=N
     t = cols.pop("time")
     if lowpass_hz is not None:
         cols = {name: lowpass(t, x, lowpass_hz) for name, x in cols.items()}
-    peaks = yaw_rate_peaks(t, cols["yaw_rate"], t_kick, threshold, hysteresis=hysteresis,
-                           baseline=baseline, refine_points=refine_points)
+    peaks = _peaks_of(t, cols["yaw_rate"], t_kick, threshold, hysteresis, baseline, refine_points)
     out = {"n_peaks": len(peaks),
            "peak_times": (peaks.times - peaks.t_kick).tolist(),
            "peak_values": peaks.values.tolist(),
@@ -783,19 +853,20 @@ def kick_metrics(data, t_kick=0.0, threshold=0.08, *, baseline=0.0, lowpass_hz=N
     if out["period"] is None:
         missing["period"] = missing["period_1_3"]
 
-    after = t >= t_kick
+    # The samples from the kick on: a run, as time increases (a view, not a masked copy).
+    first = int(np.searchsorted(t, t_kick))
     for name in COLUMNS:
         if name == "time":
             continue
         key = f"max_abs_{name}"
         if name in cols:
-            out[key] = float(np.max(np.abs(cols[name][after])))
+            out[key] = float(np.max(np.abs(cols[name][first:])))
         else:
             out[key], missing[key] = None, f"no {name!r} column"
 
     if "roll" in cols:
         fall_roll = check_range("fall_roll", fall_roll, 0.0, math.pi / 2, "rad", low_open=True)
-        over = np.flatnonzero(after & (np.abs(cols["roll"]) > fall_roll))
+        over = first + np.flatnonzero(np.abs(cols["roll"][first:]) > fall_roll)
         out["fell"] = bool(over.size)
         if over.size:
             j = over[0]
@@ -811,7 +882,7 @@ def kick_metrics(data, t_kick=0.0, threshold=0.08, *, baseline=0.0, lowpass_hz=N
 
     if include_spectra:
         duration = check_range("spectrum_duration", spectrum_duration, 0.0, None, "s", low_open=True)
-        window = after & (t <= t_kick + duration)
+        window = (t >= t_kick) & (t <= t_kick + duration)
         out["spectra"] = {name: amplitude_spectrum(t[window], cols[name][window], f_max)
                           for name in ("yaw_rate", "roll_rate") if name in cols}
     out["unavailable"] = missing

@@ -185,8 +185,21 @@ def input_files(scenario, custom_tyres=False) -> dict:
         "tyre": None if custom_tyres else parameters.toml_files(tyres.TYRE_DIR).get(scenario.tyre),
         "kick_table": None if scenario.kick_table is None else pathlib.Path(scenario.kick_table),
     }
-    return {role: {"path": str(path.resolve()), "sha256": sha256(path)}
+    return {role: {"path": resolved(path), "sha256": sha256(path)}
             for role, path in candidates.items() if path is not None and path.is_file()}
+
+
+def resolved(path) -> str:
+    """The absolute path of ``path`` with its symbolic links resolved (:meth:`pathlib.Path.resolve`), as a string.
+
+    Resolved once per process while the file it names stays as it was (its settled stat: a link pointed at
+    another file names another inode): a sweep's every case records the same few parameter files.
+    """
+    return fileio.read_once(_RESOLVED, path, lambda p: str(pathlib.Path(p).resolve()))
+
+
+#: :func:`resolved`'s paths: path -> (the file's settled key, the resolved path).
+_RESOLVED = {}
 
 
 def record(files=None) -> dict:

@@ -123,6 +123,21 @@ class _Units(Mapping):
 UNITS = _Units()
 
 
+def _column_units(columns):
+    """``{column: unit_of(column)}`` for ``columns``, the declared units read once (not once per column)."""
+    declared = None
+    units = {}
+    for column in columns:
+        if column in _BICYCLE_UNITS:
+            units[column] = _BICYCLE_UNITS[column]
+            continue
+        declared = _declared_units() if declared is None else declared
+        if column not in declared:
+            unit_of(column)   # its KeyError
+        units[column] = declared[column]
+    return units
+
+
 def unit_of(column):
     """The unit of trajectory column ``column`` (:data:`UNITS`); KeyError naming it if there is none."""
     try:
@@ -367,9 +382,8 @@ def trajectory_columns(solution, tyre_transient="carcass", names=None):
         raise SimulationError("non-finite values in the trajectory")
     source = {name: entry for name, *entry in layout}
     columns = {"time": traj.t + 0.0}
-    for name, kind, index in layout:
-        if kind != "derived" and name in wanted:
-            columns[name] = _source((name, kind, index), traj, outs) + 0.0   # + 0.0: no -0.0, as in the table
+    for kind, values in (("state", traj.x), ("output", outs)):
+        columns.update(_copied(values, [(name, index) for name, k, index in layout if k == kind and name in wanted]))
     if wanted & set(HEADING_COLUMNS):
         yaw, vx, vy = (_source((c, *source[c]), traj, outs) for c in _HEADING_SOURCES)
         columns.update({name: value + 0.0 for name, value in heading_speeds(yaw, vx, vy).items()})
@@ -401,28 +415,47 @@ class _Column:
 
 
 def _all_finite(values, columns):
-    """Whether ``values[:, columns]`` is finite everywhere.
+    """Whether ``values[:, columns]`` is finite everywhere (``values``: a 2-D array of samples by column).
 
-    Each run of consecutive columns is summed as a view, without a copy or a
-    mask: a sum is finite only where every term is (a NaN or an infinity
-    carries through to it), so only a run whose sum is not (a non-finite
-    term, or finite terms overflowing) is looked at value by value.
+    Every column is summed at once, as the product of a row of ones with
+    ``values`` (one matrix-vector product over the whole array, without a
+    copy, a mask or a pass per run of columns: the sums of strided 2-D views
+    cost ~3 M instructions a case): a sum is finite only where every term is
+    (a product with 1 is the term itself; a NaN or an infinity carries
+    through), so only a column whose sum is not (a non-finite term, or
+    finite terms overflowing) is looked at value by value. The columns not
+    asked about (the outputs left out, NaN) are not looked at.
     """
-    columns = sorted(columns)
-    start = 0
     with np.errstate(over="ignore", invalid="ignore"):   # an overflowing sum, inf - inf: not the caller's to hear
-        for k in range(1, len(columns) + 1):
-            if k == len(columns) or columns[k] != columns[k - 1] + 1:
-                run = values[:, columns[start]:columns[k - 1] + 1]
-                if not np.isfinite(run.sum()) and not np.isfinite(run).all():
-                    return False
-                start = k
-    return True
+        sums = np.ones(values.shape[0]) @ values
+    return all(np.isfinite(values[:, k]).all() for k in columns if not math.isfinite(sums[k]))
+
+
+def _copied(values, entries):
+    """``{name: values[:, index] + 0.0}`` for the ``(name, index)`` entries (+ 0.0: no -0.0, as in the table).
+
+    The columns are copied in one gather, each a contiguous row of the copy,
+    and + 0.0 is added in place: the same values as a copy of each column
+    plus 0.0, at half the cost.
+    """
+    if not entries:
+        return {}
+    block = values.T[[index for _, index in entries]]
+    block += 0.0
+    return {name: row for (name, _), row in zip(entries, block, strict=True)}
 
 
 def _values(frame, column):
     """One column of a trajectory table or of :func:`trajectory_columns`' mapping as an array (no copy)."""
     return np.asarray(frame[column])
+
+
+def _after_kick(time):
+    """Which samples are at or after the kick start (``time >= 0``): a slice where they are the last ones, as in
+    every run (the columns' views then, not masked copies: the same values in the same order), else the mask."""
+    after = time >= 0.0
+    first = time.size - int(np.count_nonzero(after))
+    return slice(first, None) if after[first:].all() else after
 
 
 def _source(entry, traj, outs):
@@ -661,8 +694,12 @@ def clean(value):
         return value
     if kind is str or value is None:
         return value
+    if kind is dict:
+        return _clean_dict(value)
     if isinstance(value, dict):
         return {str(k): clean(v) for k, v in value.items()}
+    if kind is list or kind is tuple:
+        return [v if type(v) is float and math.isfinite(v) else clean(v) for v in value]
     if isinstance(value, (list, tuple, np.ndarray)):
         return [clean(v) for v in value]
     if isinstance(value, (np.bool_, bool)):
@@ -677,6 +714,19 @@ def clean(value):
     if isinstance(value, complex):
         return [clean(value.real), clean(value.imag)]
     return value
+
+
+def _clean_dict(value):
+    """:func:`clean` of a dict: its string keys and its finite float, string, None, bool and int leaves as they
+    are (each its own copy, as clean gives it), without a call per leaf; the rest through clean."""
+    out = {}
+    for k, v in value.items():
+        kind = type(v)
+        if kind is str or v is None or kind is bool or kind is int or (kind is float and math.isfinite(v)):
+            out[k if type(k) is str else str(k)] = v
+        else:
+            out[k if type(k) is str else str(k)] = clean(v)
+    return out
 
 
 def _rear_wheel_torque(steady, start_outputs):
@@ -704,7 +754,10 @@ def _energy_summary(df, jumps, scenario):
     """Totals of the energy accounting after the kick, the balance residual and the velocity jumps."""
     after = _values(df, "time") >= 0.0
     totals = {f"{column}_j": float(_values(df, column)[-1]) for column, _ in energy.COLUMNS.values()}
-    stored = sum(_values(df, c) for c in energy.STORED)
+    # The stored energy at the last sample and at the first one after the kick start, each summed as the
+    # whole column's sum would (the same terms, the same order), without the column.
+    kick = int(after.argmax()) if after.size else 0
+    stored = [sum(_values(df, c)[k] for c in energy.STORED) for k in (-1, kick)]
     dissipation = _values(df, "sliding_dissipation") + _values(df, "damper_dissipation")
     residual = np.abs(_values(df, BALANCE_COLUMN))
     return {
@@ -714,7 +767,7 @@ def _energy_summary(df, jumps, scenario):
                        "and arm dampers; balance residual = "
                        "change of stored - (works - dissipations)"),
         **totals,
-        "stored_change_after_kick_j": float(stored[-1] - stored[after][0]) if after.any() else 0.0,
+        "stored_change_after_kick_j": float(stored[0] - stored[1]) if after.size and after[kick] else 0.0,
         "balance_residual_max_abs_j": float(residual.max()),
         "dissipation_largest_decrease_j": float(max(0.0, -np.diff(dissipation).min())) if after.size > 1 else 0.0,
         "plate_stop": scenario.plate_stop,
@@ -748,6 +801,9 @@ def summarise(scenario, kick, assembly, solution, frame, *, custom_tyres=False) 
     # Derivatives and outputs at the start state, read by the steady and carcass sections.
     start_outputs = slip.CompiledRHS(assembly.start.params).outputs(0.0, assembly.start.x)
     metrics, recovery = response_metrics(frame, baseline, assembly.reference.x, scenario, traj)
+    # kick_metrics' largest absolute values after the kick (DUPLICATE_METRICS) are the peaks section's: the same
+    # samples, the same maximum; it has them where it had a response to analyse.
+    largest = {name: metrics[f"max_abs_{name}"] for name in PEAK_COLUMNS if metrics.get(f"max_abs_{name}") is not None}
     recovery = _recovery_section(recovery, rate_baselines(assembly.reference.x))
     metrics, unavailable = _summary_metrics(metrics)
     summary = {
@@ -767,14 +823,14 @@ def summarise(scenario, kick, assembly, solution, frame, *, custom_tyres=False) 
         "linear_stability": assembly.stability,
         "kick": kick.summary(scenario.kick_direction),
         "steady_state": _steady_section(scenario, assembly, baseline, start_outputs),
-        "peaks": _peaks(frame),
+        "peaks": _peaks(frame, largest),
         "energy": _energy_summary(frame, solution.jumps, scenario),
         "recovery": recovery,
         "metrics": metrics,
         "metrics_unavailable": unavailable,
         "numerics": _numerics_section(scenario, solution, frame),
         "scenario": scenario.to_dict(),
-        "units": {column: unit_of(column) for column in column_names(scenario.tyre_transient, solution.model)},
+        "units": _column_units(column_names(scenario.tyre_transient, solution.model)),
         "provenance": provenance.record(provenance.input_files(scenario, custom_tyres)),
     }
     # The declared criteria the sections above do not report (criteria.summary_section): their values [s].
@@ -851,7 +907,7 @@ def extrapolation(frame, rear, front):
     dict
         ``rear`` and ``front``.
     """
-    rows = _values(frame, "time") >= 0.0
+    rows = _after_kick(_values(frame, "time"))
 
     def after(column):   # the column's values after the kick start (no copy of the whole table)
         return _values(frame, column)[rows]
@@ -862,12 +918,17 @@ def extrapolation(frame, rear, front):
     def seconds(mask):
         return float(np.sum(dt[mask]))
 
+    def beyond(values, largest, limit):
+        # seconds(values > limit): none is beyond where their largest is not (then the sum of none, 0.0)
+        return seconds(values > limit) if largest > limit else 0.0
+
     out = {}
     for wheel, tyre in (("rear", rear), ("front", front)):
         measured = getattr(tyre, "measured", None)
         patch_column = f"slip_patch_{wheel}" if f"slip_patch_{wheel}" in frame else f"slip_{wheel}"
-        patch = np.degrees(np.abs(after(patch_column)))
         kinematic = np.degrees(np.abs(after(f"slip_{wheel}")))
+        # Where the form has no patch slip, it is the kinematic slip: the same values, computed once.
+        patch = kinematic if patch_column == f"slip_{wheel}" else np.degrees(np.abs(after(patch_column)))
         load = after(f"fz_{wheel}")
         entry = {"max_abs_patch_slip_deg": float(patch.max(initial=0.0)),
                  "max_abs_kinematic_slip_deg": float(kinematic.max(initial=0.0)),
@@ -878,11 +939,15 @@ def extrapolation(frame, rear, front):
         if measured is None:
             entry["measured"] = None
         else:
+            slip_limit, low, high = measured["slip_deg"], measured["load_min"], measured["load_max"]
+            kinematic_beyond = beyond(kinematic, entry["max_abs_kinematic_slip_deg"], slip_limit)
+            inside = load.size and low <= entry["min_load_n"] and entry["max_load_n"] <= high   # no sample outside
             entry.update({
-                "measured": {"slip_deg": measured["slip_deg"], "load_n": [measured["load_min"], measured["load_max"]]},
-                "patch_slip_beyond_s": seconds(patch > measured["slip_deg"]),
-                "kinematic_slip_beyond_s": seconds(kinematic > measured["slip_deg"]),
-                "load_outside_s": seconds((load < measured["load_min"]) | (load > measured["load_max"])),
+                "measured": {"slip_deg": slip_limit, "load_n": [low, high]},
+                "patch_slip_beyond_s": (kinematic_beyond if patch is kinematic
+                                        else beyond(patch, entry["max_abs_patch_slip_deg"], slip_limit)),
+                "kinematic_slip_beyond_s": kinematic_beyond,
+                "load_outside_s": 0.0 if inside else seconds((load < low) | (load > high)),
                 "duration_s": float(t[-1] - t[0]) if t.size else 0.0,
             })
         out[wheel] = entry
@@ -949,10 +1014,16 @@ def _steady_section(scenario, assembly, baseline, start_outputs):
     }
 
 
-def _peaks(frame):
-    after = _values(frame, "time") >= 0.0
-    return {f"max_abs_{name}_absolute_{unit_suffix(UNITS[name])}":
-            float(np.max(np.abs(_values(frame, name)[after]), initial=0.0)) for name in PEAK_COLUMNS}
+#: The summary's key of each peak column's largest absolute value (the bicycle's columns: their units are fixed).
+_PEAK_KEYS = {name: f"max_abs_{name}_absolute_{unit_suffix(_BICYCLE_UNITS[name])}" for name in PEAK_COLUMNS}
+
+
+def _peaks(frame, known):
+    """The largest absolute value of each of :data:`PEAK_COLUMNS` after the kick (0 without a sample there), those
+    of ``known`` ({column: value}, found already) as they are."""
+    after = _after_kick(_values(frame, "time")) if len(known) < len(_PEAK_KEYS) else None
+    return {key: known[name] if name in known else float(np.max(np.abs(_values(frame, name)[after]), initial=0.0))
+            for name, key in _PEAK_KEYS.items()}
 
 
 def _numerics_section(scenario, solution, frame):

@@ -22,6 +22,7 @@ Example
 ((300.0, 300.0), 4.0)
 """
 from dataclasses import asdict, dataclass, fields, make_dataclass, replace
+import functools
 import json
 import math
 import pathlib
@@ -147,6 +148,16 @@ def mechanism_fields(cls):
 
 _BICYCLE_AND_RIDER, _TYRES, _BODY, _RIDING = "bicycle and rider", "tyres", "rider's body", "riding and control"
 _KICK, _RUN = "kick", "run and output"
+
+
+#: Types whose values :func:`dataclasses.asdict` copies as themselves (immutable scalars).
+_ATOMS = frozenset((str, float, int, bool, type(None)))
+
+
+@functools.cache
+def _field_names(cls):
+    """The names of dataclass ``cls``' fields, in order (what :func:`dataclasses.asdict` walks)."""
+    return tuple(f.name for f in fields(cls))
 
 
 @_settings.documented
@@ -766,6 +777,10 @@ class Scenario:
 
     def to_dict(self) -> dict:
         """Fields as a plain dict (JSON-ready)."""
+        values = {name: getattr(self, name) for name in _field_names(type(self))}
+        # Fields of strings, numbers, booleans and None (as always): asdict's deep copies would be the values.
+        if set(map(type, values.values())) <= _ATOMS:
+            return values
         return asdict(self)
 
     def to_file(self, path, *, note=None) -> None:
