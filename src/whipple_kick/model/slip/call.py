@@ -36,14 +36,16 @@ def parameter_vector(params, L=None):
         If a name is missing or unknown.
     """
     L = _model_of(params).layout if L is None else L
-    missing = [n for n in L.PARAMETER_NAMES if n not in params]
-    if missing:
-        raise InputError(f"slip-model parameters are missing: {', '.join(missing[:8])}"
-                         + (" ..." if len(missing) > 8 else ""))
-    unknown = [n for n in params if n not in L.P]
-    if unknown:
-        raise InputError(f"unknown slip-model parameters: {', '.join(sorted(unknown)[:8])}")
-    return np.array([float(params[n]) for n in L.PARAMETER_NAMES])
+    if params.keys() != L.P.keys():   # the names one by one only when they differ (a set comparison in C)
+        missing = [n for n in L.PARAMETER_NAMES if n not in params]
+        if missing:
+            raise InputError(f"slip-model parameters are missing: {', '.join(missing[:8])}"
+                             + (" ..." if len(missing) > 8 else ""))
+        unknown = [n for n in params if n not in L.P]
+        if unknown:
+            raise InputError(f"unknown slip-model parameters: {', '.join(sorted(unknown)[:8])}")
+    # float() of each value, as a loop over the names would, without a Python frame per name.
+    return np.array(list(map(float, map(params.__getitem__, L.PARAMETER_NAMES))))
 
 
 class CompiledRHS:
@@ -64,10 +66,14 @@ class CompiledRHS:
 
     def __init__(self, params):
         model = _model_of(params)
+        self._bind(model, parameter_vector(params, model.layout))
+
+    def _bind(self, model, p):
+        """Set up the model ``model`` with the parameter vector ``p`` (checked against the model)."""
         self.model = model
         self.layout = model.layout
         self.lib = compiled.library(self.layout)
-        self.p = np.ascontiguousarray(parameter_vector(params, self.layout))
+        self.p = np.ascontiguousarray(p)
         # The values agree with the model they come with (the C reads the form's index and the delay).
         form, delay = self.p[self.layout.P["tyre_transient"]], self.p[self.layout.P["reflex_delay"]]
         if form != transient.check(model.transient):
@@ -84,6 +90,21 @@ class CompiledRHS:
         self._out = np.empty(len(self.layout.OUTPUT_NAMES))
         self._out_ptr = self._out.ctypes.data
         self.fast = self.guarded()   # f(t, x): one foreign call (what the integrators call)
+
+    def replaced(self, **changes):
+        """The same model with the parameters ``changes`` (by name) changed: a new object with its own vector.
+
+        As ``CompiledRHS(params.replace(**changes))`` gives, without looking every parameter up by name again
+        (the linearisation's steer-torque column needs the model with ``ku7`` raised by 1).
+        """
+        p = self.p.copy()
+        for name, value in changes.items():
+            if name not in self.layout.P:
+                raise InputError(f"unknown slip-model parameters: {name}")
+            p[self.layout.P[name]] = float(value)
+        new = CompiledRHS.__new__(CompiledRHS)
+        new._bind(self.model, p)
+        return new
 
     @property
     def transient(self):
@@ -253,13 +274,20 @@ class CompiledRHS:
 
     def outputs(self, t, x):
         """Derivatives and named outputs (the layout's ``OUTPUT_NAMES``) at one state."""
-        # Into a buffer of its own (no ctypes view of a new array per call: the steady search and the
-        # linearisation make some 100 of these calls per run).
+        dx, out = self.outputs_view(t, x)
+        return dx.copy(), out.copy()
+
+    def outputs_view(self, t, x):
+        """:meth:`outputs` in this object's own buffers (no copies): read them before its next call.
+
+        The steady search and the linearisation make some 100 of these calls per run, each reading a few
+        values; no ctypes view of a new array per call either.
+        """
         self._x[:] = x
         status = self.lib.wk_slip_rhs(t, self._x_ptr, self._p_ptr, self._dx_ptr, self._out_ptr)
         if status:
             _raise_status(status, t)
-        return self._dx.copy(), self._out.copy()
+        return self._dx, self._out
 
 
 def optional_groups(names=None):
