@@ -462,24 +462,24 @@ def steady_state(params, speed, tol=1e-13, guess=None):
     slots = np.array([L.X[name] for name in names[:-1]], dtype=np.intp)
     p, drive = rhs.p, slip.P["T6c"]
     tyre_states = _SteadyTyres(rhs)
-    speeds = np.array([slip.X[n] for n in ("u1", "u2", "u3")], dtype=np.intp)
+    speeds = [slip.X[n] for n in ("u1", "u2", "u3")]
     rates = np.array([slip.X[n] for n in ("u1", "u2", "u3", "u4", "u7", "u9", "u10")]
                      + [L.X[n] for part in L.parts for n in part.speeds], dtype=np.intp)
     holonomic = slip.OUT["holonomic"]
 
     def state(z):
         xs = x.copy()
-        xs[slots] = z[:-1]
+        xs.put(slots, z)   # z's first len(slots) values: the state's unknowns (T6c, the last, is a parameter)
         p[drive] = z[-1]
         return tyre_states(xs)
 
     def residual(zs):
         xs = state(zs * scale)
         dx, out = rhs.outputs_view(0.0, xs)
-        u1, u2, u3 = xs[speeds].tolist()
+        u1, u2, u3 = xs.item(speeds[0]), xs.item(speeds[1]), xs.item(speeds[2])
         du1, du2, du3, du4, du7, du9, du10, *du_parts = dx[rates].tolist()
         return np.array([out.item(holonomic) * 1e2, (du1 + u3 * u2) * rr, du2 - u3 * u1, du3, du4, du7,
-                         du9 * 1e-2, du10 * 1e-2, *du_parts])
+                         du9 * 1e-2, du10 * 1e-2, *du_parts], dtype=float)
 
     sol = root(residual, z0 / scale, method="hybr", options={"xtol": tol})
     z = sol.x * scale
@@ -544,8 +544,12 @@ class _SteadyTyres:
             return x
         p = rhs.p
         rhs.lib.wk_slip_cornering_stiffness(out.item(self.loads[0]), out.item(self.loads[1]), *self.pointers)
-        # carcass_stiffness's arithmetic (on arrays: a zero sigma0 gives inf, as there).
-        c_r, c_f = (self.cornering / p[self.sigma] * p[self.stiffness_scale]).tolist()
+        sigma_r, sigma_f = p.item(self.sigma[0]), p.item(self.sigma[1])
+        if sigma_r and sigma_f:   # carcass_stiffness's arithmetic, on Python floats
+            scale = p.item(self.stiffness_scale)
+            c_r, c_f = self.cornering.item(0) / sigma_r * scale, self.cornering.item(1) / sigma_f * scale
+        else:   # on arrays, as there: a zero sigma0 gives inf (a Python float division would raise)
+            c_r, c_f = (self.cornering / p[self.sigma] * p[self.stiffness_scale]).tolist()
         p[self.ccr], p[self.ccf] = c_r, c_f
         for c, (force, camber, deflection, camber_patch, energy) in zip((c_r, c_f), self.wheels, strict=True):
             y = out.item(force) / c if c > 0.0 else 0.0
