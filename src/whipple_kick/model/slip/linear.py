@@ -73,7 +73,7 @@ def heading_state(x):
     """The :data:`LINEAR_STATES` values of a full state ``x`` (velocities along the heading)."""
     c, s = np.cos(x[X["q3"]]), np.sin(x[X["q3"]])
     u1, u2 = x[X["u1"]], x[X["u2"]]
-    z = np.array([x[X[n]] if n in X else 0.0 for n in LINEAR_STATES])
+    z = np.asarray(x, dtype=float)[_HEADING_SLOTS]   # v_fwd, v_lat (u1, u2 there) are set below
     z[LINEAR_STATES.index("v_fwd")] = c * u1 + s * u2
     z[LINEAR_STATES.index("v_lat")] = -s * u1 + c * u2
     return z
