@@ -244,6 +244,35 @@ def test_bad_parameters_are_reported(rider_bike, t03):
         slip.CompiledRHS(par)
     with pytest.raises(wk.errors.InputError, match="unknown controller gains"):
         slip.model_parameters(rider_bike, t03, t03, gains={"kq5": 1.0})
+    # As many names as the model's, one of them not its own: refused as missing (the gather's shortcut needs
+    # every name found).
+    par["kzx"] = 1.0
+    with pytest.raises(wk.errors.InputError, match="missing: kzr"):
+        slip.CompiledRHS(par)
+    par = slip.model_parameters(rider_bike, t03, t03)
+    par["kzx"] = 1.0
+    with pytest.raises(wk.errors.InputError, match="unknown slip-model parameters: kzx"):
+        slip.CompiledRHS(par)
+    with pytest.raises(wk.errors.InputError, match="unknown slip-model parameters: kzx"):
+        slip.CompiledRHS(slip.model_parameters(rider_bike, t03, t03)).replaced(kzx=1.0)
+
+
+def test_a_replaced_model_is_the_model_of_the_replaced_parameters(rider_bike, gains, t03):
+    """CompiledRHS.replaced changes the named values of the vector only: the same vector, right-hand side and
+    outputs as the model built from ``params.replace``, bit for bit; the original is unchanged; and
+    outputs_view reads what outputs copies."""
+    par = slip.model_parameters(rider_bike, t03, t03, gains=gains)
+    ss = steady.steady_state(par, 3.0)
+    rhs = slip.CompiledRHS(ss.params)
+    before = rhs.p.copy()
+    bumped = rhs.replaced(ku7=ss.params["ku7"] + 1.0, T6c=0.5)
+    built = slip.CompiledRHS(ss.params.replace(ku7=ss.params["ku7"] + 1.0, T6c=0.5))
+    assert np.array_equal(bumped.p, built.p) and np.array_equal(rhs.p, before)
+    assert np.array_equal(bumped(0.0, ss.x), built(0.0, ss.x))
+    assert not np.array_equal(bumped(0.0, ss.x), rhs(0.0, ss.x))
+    for a, b in zip(bumped.outputs(0.0, ss.x), built.outputs_view(0.0, ss.x), strict=True):
+        assert np.array_equal(a, b)
+    assert np.array_equal(slip.parameter_vector(ss.params), slip.parameter_vector(dict(ss.params), rhs.layout))
 
 
 # ------------------------------------------------------- the tyre transient forms

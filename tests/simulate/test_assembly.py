@@ -263,6 +263,23 @@ def test_a_bicycle_is_seated_once_for_scenarios_that_differ_outside_its_view():
     assert again == first and again[0] is not first[0]   # equal, and the caller's own copy
 
 
+@pytest.mark.parametrize("fields", [{}, {"rider_body": "leaning", "arms": "on"}])
+def test_the_bicycle_copies_are_deep_copies(fields):
+    """build_bicycle's cheap copy equals copy.deepcopy of the cached set-up, and shares nothing mutable with it:
+    a caller changing its copy (a nested posture list included) leaves the next caller's as it was."""
+    import copy
+
+    spec = Scenario(**fields).validate().bicycle_spec
+    cached = assembly._bicycle_setup(spec, assembly._file_stamp(spec.bicycle))
+    mine = assembly.build_bicycle(spec)
+    assert mine == copy.deepcopy(cached)
+    mine[0]["rr"] = -1.0
+    mine[2]["rider_posture"]["configuration_rad"][0][1] = 99.0
+    if mine[2]["body"]:
+        mine[2]["body"].clear()
+    assert assembly.build_bicycle(spec) == copy.deepcopy(cached) != mine
+
+
 def test_an_edited_bicycle_file_is_designed_on_afresh(tmp_path):
     """The design on the simulated model is cached per process on its views and the bicycle file's stamp: an
     edited file gives a new design (the same file unedited is a cache hit)."""

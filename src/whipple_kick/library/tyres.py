@@ -158,7 +158,7 @@ def read_tyre_file(path):
     InputError
         One line naming the file, the key and the problem.
     """
-    path = pathlib.Path(path)
+    path = path if isinstance(path, pathlib.Path) else pathlib.Path(path)   # a listing's paths are Paths already
     return _read_tyre_file(path, parameters.file_bytes(path))
 
 

@@ -315,7 +315,7 @@ def lateral_poles(params, x):
         # (the finite differences of linear_state_space perturb the bicycle's states only).
         closed = slip.heading_linearisation(rhs, x)[0]
     else:
-        A, B, K = slip.linear_state_space(params, x)
+        A, B, K = slip.linear_state_space(params, x, rhs=rhs)
         closed = A - B @ K
     keep = [i for i, name in enumerate(slip.LINEAR_STATES + body) if name != "v_fwd"]
     poles = np.linalg.eigvals(closed[np.ix_(keep, keep)])
@@ -458,26 +458,28 @@ def steady_state(params, speed, tol=1e-13, guess=None):
     if guess is not None:
         z0 = np.array([float(guess.get(name, value)) for name, value in zip(names, z0, strict=True)])
     scale = np.array([1.0, 1.0, 1.0, 1e-3, 1e-3, 1.0, 1.0] + [1.0] * len(part_coordinates) + [1.0])
-    part_speeds = [L.X[n] for p in L.parts for n in p.speeds]
+    # Indices looked up once: the residual runs some 40 times a solve.
+    slots = np.array([L.X[name] for name in names[:-1]], dtype=np.intp)
+    p, drive = rhs.p, slip.P["T6c"]
+    tyre_states = _SteadyTyres(rhs)
+    speeds = [slip.X[n] for n in ("u1", "u2", "u3")]
+    rates = np.array([slip.X[n] for n in ("u1", "u2", "u3", "u4", "u7", "u9", "u10")]
+                     + [L.X[n] for part in L.parts for n in part.speeds], dtype=np.intp)
+    holonomic = slip.OUT["holonomic"]
 
     def state(z):
         xs = x.copy()
-        for name, value in zip(names[:-1], z[:-1], strict=True):
-            xs[L.X[name]] = value
-        rhs.p[slip.P["T6c"]] = z[-1]
-        return _steady_tyre_states(rhs, xs)
+        xs.put(slots, z)   # z's first len(slots) values: the state's unknowns (T6c, the last, is a parameter)
+        p[drive] = z[-1]
+        return tyre_states(xs)
 
     def residual(zs):
-        z = zs * scale
-        xs = state(z)
-        dx, out = rhs.outputs(0.0, xs)
-        u1, u2, u3 = xs[slip.X["u1"]], xs[slip.X["u2"]], xs[slip.X["u3"]]
-        return np.array([
-            out[slip.OUT["holonomic"]] * 1e2,
-            (dx[slip.X["u1"]] + u3 * u2) * rr, dx[slip.X["u2"]] - u3 * u1, dx[slip.X["u3"]],
-            dx[slip.X["u4"]], dx[slip.X["u7"]], dx[slip.X["u9"]] * 1e-2, dx[slip.X["u10"]] * 1e-2,
-            *dx[part_speeds],
-        ])
+        xs = state(zs * scale)
+        dx, out = rhs.outputs_view(0.0, xs)
+        u1, u2, u3 = xs.item(speeds[0]), xs.item(speeds[1]), xs.item(speeds[2])
+        du1, du2, du3, du4, du7, du9, du10, *du_parts = dx[rates].tolist()
+        return np.array([out.item(holonomic) * 1e2, (du1 + u3 * u2) * rr, du2 - u3 * u1, du3, du4, du7,
+                         du9 * 1e-2, du10 * 1e-2, *du_parts], dtype=float)
 
     sol = root(residual, z0 / scale, method="hybr", options={"xtol": tol})
     z = sol.x * scale
@@ -485,7 +487,7 @@ def steady_state(params, speed, tol=1e-13, guess=None):
     if not np.all(np.isfinite(z)) or res > 1e-8:
         raise FloatingPointError(f"steady state not found at {speed} m/s: {sol.message} (residual {res:.3g})")
     xs = state(z)
-    out = rhs.outputs(0.0, xs)[1]
+    out = rhs.outputs_view(0.0, xs)[1]
     out_params = params.copy()
     out_params["T6c"] = float(z[-1])
     out_params["ccr"], out_params["ccf"] = float(rhs.p[slip.P["ccr"]]), float(rhs.p[slip.P["ccf"]])
@@ -504,28 +506,57 @@ def _steady_tyre_states(rhs, x):
     loads (:func:`carcass_stiffness`), and its stored-energy quadratures to
     ``c y^2 / 2`` (what the carcass holds at the start).
     """
-    form = rhs.transient
-    x = np.array(x, dtype=float)
-    _, out = rhs.outputs(0.0, x)
-    # The reflex filter (a delayed reflex's model) in equilibrium with its (steady) input: its output is that input.
-    if rhs.layout.REFLEX_STATES:
-        x[[rhs.layout.X[n] for n in rhs.layout.REFLEX_STATES]] = reflex.steady_state(
-            out[slip.OUT["reflex_input"]], rhs.p[slip.P["reflex_delay"]])
-    outputs = transient.FORMS[form].steady_outputs
-    if outputs is None:   # the form sets its own: the carcass (the only one), its stiffness from the loads
-        stiffness = (carcass_stiffness(rhs, out[slip.OUT["fz_r"]], out[slip.OUT["fz_f"]])
-                     * rhs.p[slip.P["carcass_stiffness_scale"]])
-        rhs.p[slip.P["ccr"]], rhs.p[slip.P["ccf"]] = stiffness
-        for k, wheel in enumerate("rf"):
-            c = stiffness[k]
-            y = out[slip.OUT[f"fy_ss_{wheel}"]] / c if c > 0.0 else 0.0
-            x[slip.X[f"carcass_y_{wheel}"]] = y
-            x[slip.X[f"camber_patch_{wheel}"]] = out[slip.OUT[f"camber_{wheel}"]]
-            x[slip.X[f"E_carcass_{wheel}"]] = 0.5 * c * y * y
+    return _SteadyTyres(rhs)(np.array(x, dtype=float))
+
+
+class _SteadyTyres:
+    """:func:`_steady_tyre_states` of one compiled model, its indices looked up once (a steady solve sets the
+    tyre states some 40 times), in place on a state array of its own."""
+
+    def __init__(self, rhs):
+        self.rhs = rhs
+        L = rhs.layout
+        self.reflex = [L.X[n] for n in L.REFLEX_STATES]
+        outputs = transient.FORMS[rhs.transient].steady_outputs
+        self.carcass = outputs is None   # the form sets its own: the carcass (the only one), its stiffness from the loads
+        if self.carcass:
+            P, X, OUT = slip.P, slip.X, slip.OUT
+            self.loads = [OUT["fz_r"], OUT["fz_f"]]
+            self.wheels = [(OUT[f"fy_ss_{w}"], OUT[f"camber_{w}"], X[f"carcass_y_{w}"], X[f"camber_patch_{w}"],
+                            X[f"E_carcass_{w}"]) for w in "rf"]
+            self.sigma = np.array([P["sigr"], P["sigf"]], dtype=np.intp)
+            self.stiffness_scale, self.ccr, self.ccf = P["carcass_stiffness_scale"], P["ccr"], P["ccf"]
+            self.cornering = np.empty(2)   # the compiled cornering stiffnesses' output
+            self.pointers = rhs.p.ctypes.data, self.cornering.ctypes.data
+        else:
+            self.slots = np.array([slip.X[slot] for slot in slip.PATCH_STATES], dtype=np.intp)
+            self.values = np.array([slip.OUT[name] for name in outputs], dtype=np.intp)
+
+    def __call__(self, x):
+        """``x`` (a float array the caller owns) with its tyre slots set, as :func:`_steady_tyre_states`."""
+        rhs = self.rhs
+        _, out = rhs.outputs_view(0.0, x)
+        # The reflex filter (a delayed reflex's model) in equilibrium with its (steady) input: its output is that input.
+        if self.reflex:
+            x[self.reflex] = reflex.steady_state(out[slip.OUT["reflex_input"]], rhs.p[slip.P["reflex_delay"]])
+        if not self.carcass:
+            x[self.slots] = out[self.values]
+            return x
+        p = rhs.p
+        rhs.lib.wk_slip_cornering_stiffness(out.item(self.loads[0]), out.item(self.loads[1]), *self.pointers)
+        sigma_r, sigma_f = p.item(self.sigma[0]), p.item(self.sigma[1])
+        if sigma_r and sigma_f:   # carcass_stiffness's arithmetic, on Python floats
+            scale = p.item(self.stiffness_scale)
+            c_r, c_f = self.cornering.item(0) / sigma_r * scale, self.cornering.item(1) / sigma_f * scale
+        else:   # on arrays, as there: a zero sigma0 gives inf (a Python float division would raise)
+            c_r, c_f = (self.cornering / p[self.sigma] * p[self.stiffness_scale]).tolist()
+        p[self.ccr], p[self.ccf] = c_r, c_f
+        for c, (force, camber, deflection, camber_patch, energy) in zip((c_r, c_f), self.wheels, strict=True):
+            y = out.item(force) / c if c > 0.0 else 0.0
+            x[deflection] = y
+            x[camber_patch] = out.item(camber)
+            x[energy] = 0.5 * c * y * y
         return x
-    for slot, out_name in zip(slip.PATCH_STATES, outputs, strict=True):
-        x[slip.X[slot]] = out[slip.OUT[out_name]]
-    return x
 
 
 def carcass_stiffness(rhs, fz_rear, fz_front):

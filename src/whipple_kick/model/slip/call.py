@@ -1,5 +1,6 @@
 """Calling the compiled model: parameters by name, :class:`CompiledRHS` (right-hand side, outputs, Jacobian)."""
 import ctypes
+import functools
 import math
 
 import numpy as np
@@ -8,6 +9,8 @@ from whipple_kick.errors import InputError
 from whipple_kick.model import transient
 import whipple_kick.model.slip.compiled as compiled  # noqa: PLR0402 -- the module, not the package that imports this one; tests patch its names
 import whipple_kick.model.slip.layout as layouts  # the module by its full name, not through the package
+
+from .description import Parameters
 
 
 def _model_of(params):
@@ -36,14 +39,22 @@ def parameter_vector(params, L=None):
         If a name is missing or unknown.
     """
     L = _model_of(params).layout if L is None else L
-    missing = [n for n in L.PARAMETER_NAMES if n not in params]
+    names = L.PARAMETER_NAMES
+    if type(params) in (dict, Parameters) and len(params) == len(names):
+        # As many names as the model's, each found: the same names (the checks below would pass). float() of
+        # each value, as the loop below, without a Python frame per name.
+        try:
+            return np.array(list(map(float, map(params.__getitem__, names))))
+        except KeyError:
+            pass
+    missing = [n for n in names if n not in params]
     if missing:
         raise InputError(f"slip-model parameters are missing: {', '.join(missing[:8])}"
                          + (" ..." if len(missing) > 8 else ""))
     unknown = [n for n in params if n not in L.P]
     if unknown:
         raise InputError(f"unknown slip-model parameters: {', '.join(sorted(unknown)[:8])}")
-    return np.array([float(params[n]) for n in L.PARAMETER_NAMES])
+    return np.array([float(params[n]) for n in names])
 
 
 class CompiledRHS:
@@ -64,10 +75,14 @@ class CompiledRHS:
 
     def __init__(self, params):
         model = _model_of(params)
+        self._bind(model, parameter_vector(params, model.layout))
+
+    def _bind(self, model, p):
+        """Set up the model ``model`` with the parameter vector ``p`` (checked against the model)."""
         self.model = model
         self.layout = model.layout
         self.lib = compiled.library(self.layout)
-        self.p = np.ascontiguousarray(parameter_vector(params, self.layout))
+        self.p = np.ascontiguousarray(p)
         # The values agree with the model they come with (the C reads the form's index and the delay).
         form, delay = self.p[self.layout.P["tyre_transient"]], self.p[self.layout.P["reflex_delay"]]
         if form != transient.check(model.transient):
@@ -77,13 +92,30 @@ class CompiledRHS:
             raise InputError(f"reflex_delay = {delay:g} s does not fit the {model.layout.key} model (a delay needs "
                              "the delay filter, the filter a delay > 0 s)")
         self._p_ptr = self.p.ctypes.data
-        self._dx = np.empty(len(self.layout.STATE_NAMES))
-        self._dx_ptr = self._dx.ctypes.data
-        self._x = np.empty(len(self.layout.STATE_NAMES))
-        self._x_ptr = self._x.ctypes.data
-        self._out = np.empty(len(self.layout.OUTPUT_NAMES))
-        self._out_ptr = self._out.ctypes.data
+        # The derivative, state and output buffers of outputs(): one block, one pointer looked up (a linearisation
+        # builds two of these objects, the steady solve one).
+        n = len(self.layout.STATE_NAMES)
+        block = np.empty(2 * n + len(self.layout.OUTPUT_NAMES))
+        self._dx, self._x, self._out = block[:n], block[n:2 * n], block[2 * n:]
+        self._dx_ptr = block.ctypes.data
+        self._x_ptr = self._dx_ptr + self._dx.nbytes
+        self._out_ptr = self._x_ptr + self._x.nbytes
         self.fast = self.guarded()   # f(t, x): one foreign call (what the integrators call)
+
+    def replaced(self, **changes):
+        """The same model with the parameters ``changes`` (by name) changed: a new object with its own vector.
+
+        As ``CompiledRHS(params.replace(**changes))`` gives, without looking every parameter up by name again
+        (the linearisation's steer-torque column needs the model with ``ku7`` raised by 1).
+        """
+        p = self.p.copy()
+        for name, value in changes.items():
+            if name not in self.layout.P:
+                raise InputError(f"unknown slip-model parameters: {name}")
+            p[self.layout.P[name]] = float(value)
+        new = CompiledRHS.__new__(CompiledRHS)
+        new._bind(self.model, p)
+        return new
 
     @property
     def transient(self):
@@ -104,7 +136,7 @@ class CompiledRHS:
         """
         native = compiled._native_call()
         if native is not None:
-            address = ctypes.cast(self.lib.wk_slip_rhs, ctypes.c_void_p).value
+            address = _rhs_address(self.lib)
             return native.Rhs(address, self.p, len(self.layout.STATE_NAMES), _raise_status, exception, index, limit, index2,
                               limit2)
         fn, p_ptr, dx_ptr, dx = self.lib.wk_slip_rhs, self._p_ptr, self._dx_ptr, self._dx
@@ -253,13 +285,26 @@ class CompiledRHS:
 
     def outputs(self, t, x):
         """Derivatives and named outputs (the layout's ``OUTPUT_NAMES``) at one state."""
-        # Into a buffer of its own (no ctypes view of a new array per call: the steady search and the
-        # linearisation make some 100 of these calls per run).
+        dx, out = self.outputs_view(t, x)
+        return dx.copy(), out.copy()
+
+    def outputs_view(self, t, x):
+        """:meth:`outputs` in this object's own buffers (no copies): read them before its next call.
+
+        The steady search and the linearisation make some 100 of these calls per run, each reading a few
+        values; no ctypes view of a new array per call either.
+        """
         self._x[:] = x
         status = self.lib.wk_slip_rhs(t, self._x_ptr, self._p_ptr, self._dx_ptr, self._out_ptr)
         if status:
             _raise_status(status, t)
-        return self._dx.copy(), self._out.copy()
+        return self._dx, self._out
+
+
+@functools.cache
+def _rhs_address(lib):
+    """Address of the compiled right-hand side of ``lib`` (one lookup per library)."""
+    return ctypes.cast(lib.wk_slip_rhs, ctypes.c_void_p).value
 
 
 def optional_groups(names=None):

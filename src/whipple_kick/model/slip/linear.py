@@ -56,13 +56,14 @@ def solve_pitch(rhs, x, tol=1e-14, max_iter=30):
     """Return ``x`` with q5 re-solved so the front contact is on the ground (Newton)."""
     x = np.array(x, dtype=float)
     h_step = 1e-7
+    pitch, holonomic = X["q5"], OUT["holonomic"]
     for _ in range(max_iter):
-        h = rhs.outputs(0.0, x)[1][OUT["holonomic"]]
+        h = rhs.outputs_view(0.0, x)[1][holonomic]
         xp = x.copy()
-        xp[X["q5"]] += h_step
-        slope = (rhs.outputs(0.0, xp)[1][OUT["holonomic"]] - h) / h_step
+        xp[pitch] += h_step
+        slope = (rhs.outputs_view(0.0, xp)[1][holonomic] - h) / h_step
         step = h / slope
-        x[X["q5"]] -= step
+        x[pitch] -= step
         if abs(step) < tol:
             return x
     raise FloatingPointError(f"pitch did not converge (last step {abs(step):.3g} rad)")
@@ -72,7 +73,7 @@ def heading_state(x):
     """The :data:`LINEAR_STATES` values of a full state ``x`` (velocities along the heading)."""
     c, s = np.cos(x[X["q3"]]), np.sin(x[X["q3"]])
     u1, u2 = x[X["u1"]], x[X["u2"]]
-    z = np.array([x[X[n]] if n in X else 0.0 for n in LINEAR_STATES])
+    z = np.asarray(x, dtype=float)[_HEADING_SLOTS]   # v_fwd, v_lat (u1, u2 there) are set below
     z[LINEAR_STATES.index("v_fwd")] = c * u1 + s * u2
     z[LINEAR_STATES.index("v_lat")] = -s * u1 + c * u2
     return z
@@ -82,20 +83,16 @@ def _heading_derivative(rhs, x_ref, z, t, resolve_pitch):
     """d/dt of the heading-frame state ``z`` (yaw set to 0; pitch re-solved if a coordinate moved)."""
     x = np.array(x_ref, dtype=float)
     x[X["q3"]] = 0.0
-    for name, value in zip(LINEAR_STATES, z, strict=True):
-        if name == "v_fwd":
-            x[X["u1"]] = value
-        elif name == "v_lat":
-            x[X["u2"]] = value
-        else:
-            x[X[name]] = value
+    x[_HEADING_SLOTS] = z   # v_fwd, v_lat into u1, u2 (yaw 0), the others into their own slots
     if resolve_pitch:
         x = solve_pitch(rhs, x)
     dx = rhs(t, x)
-    u1, u2, u3 = x[X["u1"]], x[X["u2"]], x[X["u3"]]
+    u1, u2, u3 = x[_U1], x[_U2], x[_U3]
+    rates = dx[_HEADING_SLOTS]
     # Rotating-frame rates at q3 = 0: d(v_fwd)/dt = u1' + u3 u2, d(v_lat)/dt = u2' - u3 u1.
-    rates = {"v_fwd": dx[X["u1"]] + u3 * u2, "v_lat": dx[X["u2"]] - u3 * u1}
-    return np.array([rates[n] if n in rates else dx[X[n]] for n in LINEAR_STATES])
+    rates[_I_FWD] = dx[_U1] + u3 * u2
+    rates[_I_LAT] = dx[_U2] - u3 * u1
+    return rates
 
 
 def linearize(rhs, x, step=1e-7, t=0.0, columns=None):
@@ -177,6 +174,7 @@ _HEADING_SLOTS = np.array([X[{"v_fwd": "u1", "v_lat": "u2"}.get(n, n)] for n in 
 #: Heading-frame coordinates the front contact height depends on (pitch q5 follows them).
 _PITCH_DRIVERS = [(LINEAR_STATES.index(n), SPEEDS.index("u" + n[1:])) for n in ("q4", "q7", "q9", "q10")]
 _I_FWD, _I_LAT, _I_U3 = (LINEAR_STATES.index(n) for n in ("v_fwd", "v_lat", "u3"))
+_U1, _U2, _U3 = X["u1"], X["u2"], X["u3"]
 
 
 def heading_linearisation(rhs, x, t=0.0):
@@ -260,7 +258,7 @@ def heading_linearisation(rhs, x, t=0.0):
     return A, B
 
 
-def linear_state_space(params, x, step=1e-7):
+def linear_state_space(params, x, step=1e-7, rhs=None):
     """Open-loop ``A`` and steer-torque input ``B`` of the slip model about ``x``.
 
     ``x`` is a steady state of the closed loop with the gains in ``params``
@@ -276,14 +274,17 @@ def linear_state_space(params, x, step=1e-7):
         Per unit steer torque T7 [N m].
     K : ndarray (1, 15)
         The gains of ``params`` on :data:`LINEAR_STATES` (so ``A - B K`` is the closed loop).
+
+    ``rhs`` is ``CompiledRHS(params)`` where the caller has it already (it is only read).
     """
     if params.get("kq3", 0.0):
         raise InputError("linear_state_space: a yaw-angle gain kq3 breaks the heading invariance")
-    A_cl = linearize(CompiledRHS(params), x, step)
-    bumped = params.replace(ku7=params["ku7"] + 1.0)
+    rhs = CompiledRHS(params) if rhs is None else rhs
+    A_cl = linearize(rhs, x, step)
+    bumped = rhs.replaced(ku7=params["ku7"] + 1.0)
     j = LINEAR_STATES.index("u7")
     # Only the steer-rate column moves with ku7: the bumped model's other 14 columns are not computed.
-    B = (A_cl[:, j] - linearize(CompiledRHS(bumped), x, step, columns=[j])[:, 0]).reshape(-1, 1)
+    B = (A_cl[:, j] - linearize(bumped, x, step, columns=[j])[:, 0]).reshape(-1, 1)
     K = np.zeros((1, len(LINEAR_STATES)))
     for gain, state in layouts.GAIN_STATES.items():
         if state in LINEAR_STATES:   # the bicycle's states (q3 is not one: kq3 is refused above)
