@@ -615,6 +615,7 @@ def bench_tolerance(samples, fz, rtol, workers):
 FLAG_SETS = (
     ("O2", ("-O2", "-fPIC", "-shared", "-std=c99"), True),
     ("O3", ("-O3", "-fPIC", "-shared", "-std=c99"), True),
+    ("O3-nomatherrno", ("-O3", "-fno-math-errno", "-fPIC", "-shared", "-std=c99"), True),
     ("O2-v3", ("-O2", "-march=x86-64-v3", "-fPIC", "-shared", "-std=c99"), True),
     ("O3-v3", ("-O3", "-march=x86-64-v3", "-fPIC", "-shared", "-std=c99"), True),
     ("O3-native", ("-O3", "-march=native", "-fPIC", "-shared", "-std=c99"), False),

@@ -160,7 +160,7 @@ def test_the_fall_bench_runs_every_falling_case_on_both_careful_paths():
 
 
 def test_the_models_compiler_flags_give_the_bits_of_the_reference_flags(tmp_path):
-    """Issue 41 item 3: the flags the model is built with (model.compiler.MODEL_FLAGS, -O3) were adopted because
+    """Issue 41 item 3: the flags the model is built with (model.compiler.MODEL_FLAGS, -O3 -fno-math-errno) were adopted because
     they give -O2's trajectory bit for bit; this builds the model's C source both ways and integrates a
     short kick with each (exact equality: a flag that let the compiler reassociate or contract would fail)."""
     import bench_sweep
